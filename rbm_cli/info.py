@@ -1,0 +1,64 @@
+"""Derived properties a user checks first (`rbm info`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.linalg import eig
+
+from .config_types import Config
+from .simulate import model_from_config
+
+
+def describe(config: Config) -> dict:
+    """Masses, capacities, stiffnesses and frequencies of a configured column.
+
+    The rocking p is that of the rigid stack, p^2 = N_1 zbar_1 / (1^T M 1)
+    (for n = 1: m g (H/2) / (I_G + m H^2 / 4)). Elastic frequencies are those
+    of the elastic branches of the laws in the chosen formulation.
+    """
+    model = model_from_config(config)
+    col = model.column
+    n = col.n
+    ones = np.ones(n)
+    p = math.sqrt(col.normal_forces[0] * col.lever_arms[0] / (ones @ model.mass @ ones))
+    freqs: list[float] = []
+    if not model.rigid:
+        slopes = np.array([law.slopes[0] for law in model.laws])
+        stiff = model.diff.T @ (slopes[:, None] * model.arg_map) - model.gravity
+        w2 = np.real(eig(stiff, model.mass, right=False))
+        freqs = sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
+    uplift = None
+    if n == 1 and model.laws[0].rigid:
+        uplift = float(model.laws[0].intercepts[0] / abs(model.ground_load[0]) / 9.81)
+    interfaces = []
+    for i in range(n):
+        interfaces.append(
+            {
+                "interface": i + 1,
+                "width_m": float(col.widths[i]),
+                "drum_height_m": float(col.heights[i]),
+                "drum_mass_kg": float(col.masses[i]),
+                "drum_inertia_kgm2": float(col.inertias[i]),
+                "normal_force_N": float(col.normal_forces[i]),
+                "moment_capacity_Nm": float(col.moment_capacity[i]),
+                "rotation_capacity_rad": float(col.rotation_capacity[i]),
+                "stiffness_Nm_per_rad": float(col.stiffness[i]),
+                "elastic_limit_rad": float(model.laws[i].elastic_limit),
+            }
+        )
+    return {
+        "name": config.name,
+        "n_drums": n,
+        "total_mass_kg": col.total_mass,
+        "height_m": col.height,
+        "static_multiplier_g": col.static_multiplier,
+        "uplift_acceleration_g": uplift,
+        "rocking_p_rad_s": p,
+        "rocking_frequency_hz": p / (2 * math.pi),
+        "elastic_frequencies_hz": freqs,
+        "formulation": model.formulation,
+        "restitution": model.restitution,
+        "interfaces": interfaces,
+    }

@@ -1,0 +1,414 @@
+"""Event-driven integration of the Rigid Beam Model.
+
+Inside one set of active law pieces the equations are smooth (linear), so the
+integrator runs an explicit Runge-Kutta pair (scipy's DOP853/RK45 stepper,
+driven step by step here) and stops exactly at every event, found by root
+finding on the step's dense output:
+
+- a law argument reaching the end of its current piece (a kink of the law):
+  the pieces change and the integrator restarts there;
+- a zero crossing of a law argument after an excursion beyond its elastic
+  branch (every crossing for a rigid law): an impact, the argument's rate is
+  multiplied by the restitution e and the integrator restarts;
+- a collapse quantity reaching c times its limit: the run stops.
+
+A single scalar event function, the smallest normalised distance to any of
+these surfaces, is evaluated once per step (vectorised over interfaces).
+
+For a rigid monolithic column the column stays at rest, with no integration,
+until the ground demand exceeds the uplift level (found exactly from the
+excitation); a rigid block that loses its velocity at an impact returns to
+rest (rest detection: post-impact rate below REST_RATE * p * theta_u).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import DOP853, RK23, RK45
+from scipy.optimize import brentq
+
+from .config_types import SolverConfig
+from .excitation import GroundMotion
+from .model import Model
+
+_METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23}
+
+#: Relative offset of event surfaces, so that a restart exactly on a surface
+#: is not taken for a new crossing [fraction of theta_u].
+EVENT_EPS = 1e-12
+#: A rigid block whose post-impact rate is below REST_RATE * p * theta_u is
+#: put to rest (ends Zeno impact sequences in finite work).
+REST_RATE = 1e-9
+#: Stand-in for an infinite bound in the event distances.
+BIG = 1e30
+#: Free motion is checked for the early stop every so many steps.
+CHECK_EVERY = 200
+
+
+@dataclass
+class Outcome:
+    """Raw outcome of an integration (simulate() turns it into a RunResult)."""
+
+    status: str = "survived"
+    message: str = ""
+    t_end: float = 0.0
+    t_collapse: float = math.nan
+    collapse_interface: int | None = None
+    max_ratio: np.ndarray | None = None
+    max_top: float = 0.0
+    friction: np.ndarray | None = None
+    n_uplifts: int = 0
+    n_impacts: int = 0
+    n_steps: int = 0
+    n_rhs: int = 0
+    n_events: int = 0
+    samples: list = field(default_factory=list)  # (t, theta, rate) when recording
+
+
+class _Pieces:
+    """Which piece of its law each interface is on: side s = +-1 and index k."""
+
+    def __init__(self, model: Model):
+        self.model = model
+        n = model.n
+        self.side = np.ones(n, dtype=int)
+        self.k = np.zeros(n, dtype=int)
+        self.pending = np.zeros(n, dtype=bool)  # excursion beyond elastic branch
+        self.rigid = np.array([law.rigid for law in model.laws])
+        self.tu = model.column.rotation_capacity
+        self._cache: dict = {}
+
+    def locate(self, x: np.ndarray, rate: np.ndarray) -> None:
+        for i, law in enumerate(self.model.laws):
+            s = 1 if x[i] > 0 else -1 if x[i] < 0 else (1 if rate[i] >= 0 else -1)
+            self.side[i] = s
+            self.k[i] = int(np.searchsorted(law.edges, abs(x[i]), side="right"))
+            self.pending[i] = self.k[i] > 0 and not law.rigid
+
+    def zero_active(self, i: int) -> bool:
+        return bool(self.rigid[i] or self.pending[i])
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        n = self.model.n
+        lo, hi = np.empty(n), np.empty(n)
+        for i, law in enumerate(self.model.laws):
+            e = law.edges
+            k, s = self.k[i], self.side[i]
+            start = 0.0 if k == 0 else e[k - 1]
+            end = e[k] if k < len(e) else np.inf
+            if k == 0 and not self.zero_active(i):
+                start = -end
+            if s > 0:
+                lo[i], hi[i] = start, end
+            else:
+                lo[i], hi[i] = -end, -start
+        return lo, hi
+
+    def system(self):
+        key = (tuple(self.side), tuple(self.k))
+        sys_ = self._cache.get(key)
+        if sys_ is None:
+            laws = self.model.laws
+            a = np.array([s * law.intercepts[k] for s, k, law in zip(self.side, self.k, laws)])
+            b = np.array([law.slopes[k] for k, law in zip(self.k, laws)])
+            sys_ = self.model.linear_system(a, b)
+            self._cache[key] = sys_
+        return sys_
+
+
+def _hermite_peaks(z0, z1, d0, d1, dt):
+    """Largest |z| inside [0, dt] of the cubic Hermite interpolant, per row,
+    for rows whose derivative changes sign (else the end values bound it)."""
+    out = np.maximum(np.abs(z0), np.abs(z1))
+    rows = np.nonzero(d0 * d1 < 0)[0]
+    for r in rows:
+        # z(s) = h00 z0 + h10 dt d0 + h01 z1 + h11 dt d1, s in [0, 1]
+        p0, m0, p1, m1 = z0[r], dt * d0[r], z1[r], dt * d1[r]
+        # derivative coefficients of the cubic a s^3 + b s^2 + c s + d
+        a = 2 * p0 + m0 - 2 * p1 + m1
+        b = -3 * p0 - 2 * m0 + 3 * p1 - m1
+        c = m0
+        roots = np.roots([3 * a, 2 * b, c]) if abs(a) + abs(b) > 0 else []
+        for s in np.real(roots[np.isreal(roots)]) if len(roots) else []:
+            if 0.0 < s < 1.0:
+                val = ((a * s + b) * s + c) * s + p0
+                out[r] = max(out[r], abs(val))
+    return out
+
+
+def _hermite_dip(d0, d1, r0, r1, dt):
+    """Time (from the step start) of the lowest interior minimum of the cubic
+    Hermite interpolants of the distances d (values d0, d1, rates r0, r1),
+    if one dips below zero; else None. Only rows turning inside the step."""
+    rows = np.nonzero((r0 < 0.0) & (r1 > 0.0))[0]
+    best, t_best = 0.0, None
+    for r in rows:
+        p0, m0, p1, m1 = d0[r], dt * r0[r], d1[r], dt * r1[r]
+        # quick reject: the distance cannot reach zero within the step
+        if min(p0, p1) > 0.5 * (abs(m0) + abs(m1)):
+            continue
+        a = 2 * p0 + m0 - 2 * p1 + m1
+        b = -3 * p0 - 2 * m0 + 3 * p1 - m1
+        roots = np.roots([3 * a, 2 * b, m0]) if abs(a) + abs(b) > 0 else []
+        for s in np.real(roots[np.isreal(roots)]) if len(roots) else []:
+            if 0.0 < s < 1.0:
+                val = ((a * s + b) * s + m0) * s + p0
+                if val < best:
+                    best, t_best = val, s * dt
+    return t_best
+
+
+def integrate(
+    model: Model,
+    motion: GroundMotion,
+    theta0: np.ndarray,
+    rate0: np.ndarray,
+    solver: SolverConfig,
+    record: bool = False,
+    output_dt: float = 0.002,
+    early_stop: bool = True,
+) -> Outcome:
+    """Integrate one run of the model under a ground motion.
+
+    Parameters
+    ----------
+    model : Model  Assembled equations
+    motion : GroundMotion  a_g(t) [m/s^2] and the simulated time
+    theta0, rate0 : (n,) Initial absolute rotations [rad] and rates [rad/s]
+    solver : SolverConfig  Method, tolerances and budgets
+    record : bool  Keep samples every output_dt [s] for a time history
+    early_stop : bool  Stop a free motion (after a half-sine pulse) whose
+        energy is below the lowest collapse barrier (`relative` only)
+    """
+    n = model.n
+    col = model.column
+    out = Outcome()
+    out.max_ratio = np.zeros(n)
+    out.friction = np.zeros(n)
+    pieces = _Pieces(model)
+    tu = col.rotation_capacity
+    c_ratio = model.collapse_ratio
+    cmap = model.collapse_map / model.collapse_limit[:, None]
+    top = col.heights.copy()
+    track = np.vstack([cmap, top[None, :]])
+    g_rows = np.vstack([model.arg_map / tu[:, None], -model.arg_map / tu[:, None], -cmap, cmap])
+    c_vec = np.full(n, c_ratio)
+    argmap = model.arg_map
+    arg_inv = np.linalg.inv(argmap)
+    e_rest = model.restitution
+    stepper = _METHODS[solver.method]
+    atol = solver.atol * np.concatenate([np.full(n, tu.min()), np.full(n, tu.min() * 10.0)])
+
+    # rocking frequency of the rigid stack, to scale the rest threshold
+    ones = np.ones(n)
+    p_stack = math.sqrt(col.normal_forces[0] * col.lever_arms[0] / (ones @ model.mass @ ones))
+    rest_rate = REST_RATE * p_stack * tu.min()
+    rigid_mono = n == 1 and model.laws[0].rigid
+    uplift_level = None
+    if rigid_mono:
+        f0 = model.laws[0].intercepts[0]  # f(0+) = xi M_u
+        uplift_level = f0 / abs(model.ground_load[0])
+    barrier = None
+    if model.formulation == "relative":
+        barrier = min(
+            float(law.potential(c_ratio * tu[i])) for i, law in enumerate(model.laws)
+        )
+
+    t = 0.0
+    y = np.concatenate([np.asarray(theta0, float), np.asarray(rate0, float)])
+    at_rest = rigid_mono and not np.any(y)
+    pieces.locate(argmap @ y[:n], argmap @ y[n:])
+    next_out = 0.0
+
+    def emit_until(t_stop, dense=None, rest=False):
+        nonlocal next_out
+        while next_out <= t_stop + 1e-12:
+            if rest:
+                out.samples.append((next_out, np.zeros(n), np.zeros(n)))
+            else:
+                yy = dense(next_out)
+                out.samples.append((next_out, yy[:n].copy(), yy[n:].copy()))
+            next_out += output_dt
+
+    for seg_start, seg_end in motion.segments():
+        if t >= seg_end:
+            continue
+        free_seg = motion.amplitude == 0.0 or (
+            motion.kind == "half-sine" and seg_start >= motion.pulse_end
+        )
+        if free_seg:
+
+            def ag(tt):
+                return 0.0
+        else:
+            amp, om, ph = motion.amplitude, motion.omega, motion.phase
+
+            def ag(tt, amp=amp, om=om, ph=ph):
+                return amp * math.sin(om * tt + ph)
+
+        can_stop = early_stop and free_seg and motion.kind == "half-sine"
+
+        while t < seg_end:
+            if at_rest:
+                if free_seg:
+                    if record:
+                        emit_until(motion.t_end, rest=True)
+                    t = motion.t_end
+                    out.t_end = t
+                    return out
+                t_up = motion.next_exceedance(t, uplift_level)
+                if t_up is None or t_up >= seg_end:
+                    if record:
+                        emit_until(seg_end, rest=True)
+                    t = seg_end
+                    break
+                if record:
+                    emit_until(t_up - 1e-15, rest=True)
+                t = t_up
+                y = np.zeros(2 * n)
+                a_now = motion.accel(t)
+                pieces.side[0] = -1 if a_now > 0 else 1
+                pieces.k[0] = 0
+                at_rest = False
+                out.n_uplifts += 1
+
+            if can_stop and barrier is not None:
+                energy = float(model.energy(y[:n], y[n:])[0])
+                if energy < barrier * (1.0 - 1e-9):
+                    out.message = "free motion below the collapse barrier: stopped early"
+                    if record:  # pragma: no cover - record runs disable early stop
+                        pass
+                    out.t_end = t
+                    return out
+
+            A, cvec, evec = pieces.system()
+
+            def fun(tt, yy, A=A, cvec=cvec, evec=evec):
+                out.n_rhs += 1
+                return np.concatenate([yy[n:], A @ yy[:n] + cvec + evec * ag(tt)])
+
+            lo, hi = pieces.bounds()
+            # event distances, linear in theta: d = G theta + h0 (>= 0 inside)
+            h0 = np.concatenate(
+                [np.minimum(-lo / tu, BIG), np.minimum(hi / tu, BIG), c_vec, c_vec]
+            ) + EVENT_EPS
+
+            def gfun(yy, h0=h0):
+                return float(np.min(g_rows @ yy[:n] + h0))
+
+            integ = stepper(fun, t, y, seg_end, rtol=solver.rtol, atol=atol)
+            z_old = track @ y[:n]
+            dz_old = track @ y[n:]
+            d_old = g_rows @ y[:n] + h0
+            dd_old = g_rows @ y[n:]
+            event = False
+            while integ.status == "running":
+                msg = integ.step()
+                if integ.status == "failed":
+                    out.status, out.message, out.t_end = "failed", f"integrator: {msg}", t
+                    return out
+                out.n_steps += 1
+                if out.n_steps > solver.max_steps:
+                    out.status = "failed"
+                    out.message = f"step budget exceeded ({solver.max_steps} steps) at t={t:.6g} s"
+                    out.t_end = t
+                    return out
+                t_old = integ.t_old
+                t_new, y_new = integ.t, integ.y
+                d_new = g_rows @ y_new[:n] + h0
+                dd_new = g_rows @ y_new[n:]
+                t_hit = None
+                dense = None
+                if d_new.min() < 0.0:
+                    t_hit = t_new
+                else:
+                    # a surface touched and left inside the step: the cubic Hermite
+                    # of each distance has an interior minimum below zero
+                    t_min = _hermite_dip(d_old, d_new, dd_old, dd_new, t_new - t_old)
+                    if t_min is not None:
+                        dense = integ.dense_output()
+                        if gfun(dense(t_old + t_min)) < 0.0:
+                            t_hit = t_old + t_min
+                if t_hit is not None:
+                    if dense is None:
+                        dense = integ.dense_output()
+                    if gfun(dense(t_old)) <= 0.0:
+                        t_e = t_old
+                    else:
+                        t_e = brentq(lambda s: gfun(dense(s)), t_old, t_hit, xtol=1e-14)
+                    y_new = dense(t_e)
+                    t_new = t_e
+                    if record:
+                        emit_until(t_e, dense)
+                    event = True
+                elif record:
+                    emit_until(t_new, integ.dense_output())
+                # peaks and friction demand over [t_old, t_new]
+                z_new = track @ y_new[:n]
+                dz_new = track @ y_new[n:]
+                peaks = _hermite_peaks(z_old, z_new, dz_old, dz_new, t_new - t_old)
+                out.max_ratio = np.maximum(out.max_ratio, peaks[:n])
+                out.max_top = max(out.max_top, peaks[n])
+                acc = A @ y_new[:n] + cvec + evec * ag(t_new)
+                fr = model.shear_ratios(acc[None, :], np.array([ag(t_new)]))[0]
+                out.friction = np.maximum(out.friction, fr)
+                z_old, dz_old = z_new, dz_new
+                d_old, dd_old = d_new, dd_new
+                t, y = t_new, y_new
+                if event:
+                    break
+                if can_stop and barrier is not None and out.n_steps % CHECK_EVERY == 0:
+                    if float(model.energy(y[:n], y[n:])[0]) < barrier * (1.0 - 1e-9):
+                        break
+            if not event:
+                if integ.status == "finished":
+                    t = seg_end
+                continue
+
+            # ---- handle the event at (t, y)
+            out.n_events += 1
+            if out.n_events > solver.max_events:
+                out.status = "failed"
+                out.message = f"event budget exceeded ({solver.max_events} events) at t={t:.6g} s"
+                out.t_end = t
+                return out
+            row = int(np.argmin(g_rows @ y[:n] + h0))
+            which, i = divmod(row, n)
+            if which >= 2:
+                out.status = "collapsed"
+                out.t_collapse = t
+                out.collapse_interface = i + 1
+                out.max_ratio[i] = max(out.max_ratio[i], c_ratio)
+                out.message = f"interface {i + 1} reached its collapse limit"
+                out.t_end = t
+                return out
+            going_up = which == 1
+            s, k = pieces.side[i], pieces.k[i]
+            outward = going_up == (s > 0)
+            if k == 0 and not pieces.zero_active(i):
+                # leaving the elastic branch through +-elastic limit
+                pieces.side[i] = 1 if going_up else -1
+                pieces.k[i] = 1
+                pieces.pending[i] = True
+                out.n_uplifts += 1
+            elif outward:
+                pieces.k[i] = k + 1
+            elif k > 0:
+                pieces.k[i] = k - 1
+            else:
+                # zero crossing: an impact
+                out.n_impacts += 1
+                pieces.side[i] = -s
+                pieces.pending[i] = False
+                if e_rest < 1.0:
+                    xdot = argmap @ y[n:]
+                    y = y.copy()
+                    y[n:] += arg_inv[:, i] * (e_rest - 1.0) * xdot[i]
+                if rigid_mono and abs(y[n]) < rest_rate:
+                    y = np.zeros(2 * n)
+                    at_rest = True
+    out.t_end = t
+    return out

@@ -1,0 +1,179 @@
+"""The Rigid Beam Model equations (paper eqs. 1-5), assembled once per column.
+
+Generalised coordinates are the absolute drum rotations theta_i; the nodal
+displacements relative to the ground are u_{k+1} = sum_{j<=k} h_j theta_j. In
+these coordinates the paper's system (5) reads
+
+    M theta'' = D^T m(x) + K_g theta - r a_g(t)
+
+with M = L^T diag(m) L + diag(I_G) the (constant, symmetric) mass matrix,
+L the map from theta to the drums' centre displacements (weight at mid-height:
+L_ij = h_j for j < i, h_i / 2 for j = i), r = L^T m the ground load vector,
+D the difference matrix (D^T M gives M_i - M_{i+1}: interface moments acting
+on the drums above and below), m(x) = -f(x) the interface moments, x the
+argument the law reads (phi = D theta, or theta for `absolute`), and K_g the
+gravity term of the `geometric` formulation. Eliminating the shears T of
+eq. (1) gives the same system; for n = 1 it is
+(I_G + m h^2 / 4) theta'' = -f(theta) - m (h / 2) a_g.
+
+Inside one set of active law pieces the right-hand side is linear:
+theta'' = A theta + c + e a_g(t).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .column import Column
+from .law import Law, make_law
+
+
+@dataclass(frozen=True)
+class Model:
+    """Assembled equations of one column (SI units).
+
+    mass : (n, n) Mass matrix M [kg m^2]
+    mass_inv : (n, n) M^-1
+    ground_load : (n,) r = L^T m [kg m]
+    centre_map : (n, n) L, theta -> drum-centre displacements [m]
+    node_map : (n+1, n) theta -> node displacements relative to the ground [m]
+    arg_map : (n, n) theta -> law arguments x (D, or I for `absolute`)
+    diff : (n, n) D
+    gravity : (n, n) K_g [N m/rad] (zero unless `geometric`)
+    laws : tuple of Law, one per interface
+    collapse_map : (n, n) theta -> collapse quantities (law arguments, or
+        overturning moments of the stacks above each joint for `geometric`)
+    collapse_limit : (n,) their limits (theta_u [rad] or M_u [N m])
+    collapse_ratio : float  c, collapse when |quantity| >= c * limit
+    restitution : float  e, angular-velocity ratio at an impact
+    formulation : str
+    """
+
+    column: Column
+    mass: np.ndarray
+    mass_inv: np.ndarray
+    ground_load: np.ndarray
+    centre_map: np.ndarray
+    node_map: np.ndarray
+    arg_map: np.ndarray
+    diff: np.ndarray
+    gravity: np.ndarray
+    laws: tuple[Law, ...]
+    collapse_map: np.ndarray
+    collapse_limit: np.ndarray
+    collapse_ratio: float
+    restitution: float
+    formulation: str
+
+    @property
+    def n(self) -> int:
+        return self.mass.shape[0]
+
+    @property
+    def rigid(self) -> bool:
+        return any(law.rigid for law in self.laws)
+
+    def arguments(self, theta: np.ndarray) -> np.ndarray:
+        """Law arguments x (..., n) of rotations theta (..., n) [rad]."""
+        return theta @ self.arg_map.T
+
+    def collapse_ratios(self, theta: np.ndarray) -> np.ndarray:
+        """|collapse quantity| / limit (..., n); collapse at collapse_ratio."""
+        return np.abs(theta @ self.collapse_map.T) / self.collapse_limit
+
+    def energy(self, theta: np.ndarray, rate: np.ndarray) -> np.ndarray:
+        """Energy relative to the ground [J]: kinetic + the laws' potential
+        (+ gravity's for `geometric`). Conserved in free motion with e = 1
+        for `relative` and `geometric`."""
+        theta, rate = np.atleast_2d(theta), np.atleast_2d(rate)
+        kin = 0.5 * np.einsum("ki,ij,kj->k", rate, self.mass, rate)
+        x = self.arguments(theta)
+        pot = sum(law.potential(x[:, i]) for i, law in enumerate(self.laws))
+        grav = -0.5 * np.einsum("ki,ij,kj->k", theta, self.gravity, theta)
+        return kin + pot + grav
+
+    def linear_system(self, intercepts: np.ndarray, slopes: np.ndarray):
+        """(A, c, e) of theta'' = A theta + c + e a_g for active pieces
+        f_i(x) = intercepts_i + slopes_i x."""
+        minv = self.mass_inv
+        stiff = self.diff.T @ (slopes[:, None] * self.arg_map) - self.gravity
+        return -minv @ stiff, -minv @ (self.diff.T @ intercepts), -minv @ self.ground_load
+
+    def shear_ratios(self, accel: np.ndarray, ground_accel: np.ndarray) -> np.ndarray:
+        """|T_i / N_i| (k, n) from drum angular accelerations (k, n) and a_g (k,).
+
+        T_i = -sum_{j>=i} m_j (absolute horizontal acceleration of drum j's centre).
+        """
+        col = self.column
+        abs_acc = accel @ self.centre_map.T + np.asarray(ground_accel)[:, None]
+        forces = abs_acc * col.masses
+        shear = np.cumsum(forces[:, ::-1], axis=1)[:, ::-1]
+        return np.abs(shear) / col.normal_forces
+
+
+def build_model(
+    column: Column,
+    xi: float = 1.0,
+    restitution: float = 1.0,
+    formulation: str = "relative",
+    collapse_ratio: float = 1.0,
+) -> Model:
+    """Assemble the equations of a column.
+
+    Parameters
+    ----------
+    column : Column  Derived properties (rbm_cli.column.build_column)
+    xi : float  Smoothing parameter of the law, 0 < xi <= 1
+    restitution : float  e in (0, 1]
+    formulation : str  'relative', 'absolute' or 'geometric' (SPEC section 1)
+    collapse_ratio : float  c in (0, 1]
+    """
+    n = column.n
+    h = column.heights
+    lower = np.tril(np.ones((n, n)), -1) * h[None, :]
+    centre = lower + np.diag(h / 2.0)
+    mass = centre.T @ (column.masses[:, None] * centre) + np.diag(column.inertias)
+    node = np.vstack([np.zeros(n), np.tril(np.ones((n, n))) * h[None, :]])
+    diff = np.eye(n) - np.eye(n, k=-1)
+    arg_map = np.eye(n) if formulation == "absolute" else diff.copy()
+
+    mu, tu = column.moment_capacity, column.rotation_capacity
+    if formulation == "geometric":
+        n_above = np.concatenate([column.normal_forces[1:], [0.0]])
+        gravity = np.diag((column.normal_forces + n_above) * h / 2.0)
+        extra = mu / tu
+        # overturning moment of the drums above joint i about the joint:
+        # sum_{j>=i} P_j (x_j - u_i), x_j the centre, u_i the joint's node
+        over = np.zeros((n, n))
+        for i in range(n):
+            for j in range(i, n):
+                over[i] += column.weights[j] * (centre[j] - node[i])
+        collapse_map, collapse_limit = over, mu.copy()
+    else:
+        gravity = np.zeros((n, n))
+        extra = np.zeros(n)
+        collapse_map, collapse_limit = arg_map.copy(), tu.copy()
+
+    laws = tuple(
+        make_law(mu[i], tu[i], column.stiffness[i], xi, extra_slope=float(extra[i]))
+        for i in range(n)
+    )
+    return Model(
+        column=column,
+        mass=mass,
+        mass_inv=np.linalg.inv(mass),
+        ground_load=centre.T @ column.masses,
+        centre_map=centre,
+        node_map=node,
+        arg_map=arg_map,
+        diff=diff,
+        gravity=gravity,
+        laws=laws,
+        collapse_map=collapse_map,
+        collapse_limit=collapse_limit,
+        collapse_ratio=float(collapse_ratio),
+        restitution=float(restitution),
+        formulation=formulation,
+    )

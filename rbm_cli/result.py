@@ -1,0 +1,106 @@
+"""What a run returns: why it stopped, the summary figures, and optionally its history."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+STATUSES = ("collapsed", "survived", "failed")
+
+#: Columns of domain.csv, in order (SPEC section 5).
+CSV_FIELDS = (
+    "amplitude_g",
+    "frequency_hz",
+    "status",
+    "collapsed",
+    "t_collapse_s",
+    "collapse_interface",
+    "max_rotation_ratio",
+    "max_top_displacement_m",
+    "n_uplifts",
+    "n_impacts",
+    "n_steps",
+    "n_rhs",
+    "message",
+)
+
+
+@dataclass(frozen=True)
+class History:
+    """Sampled time history of a run (SI units).
+
+    t : (k,) Time [s]
+    ground_acceleration : (k,) a_g(t) [m/s^2]
+    ground_displacement : (k,) u_g(t) [m] (harmonic: the steady form -a_g/omega^2;
+        half-sine: integrated from rest)
+    node_displacements : (k, n+1) Horizontal displacement of nodes 1..n+1
+        relative to the ground [m] (node 1 is the base: always 0)
+    rotations : (k, n) Absolute drum rotations theta_i [rad]
+    rates : (k, n) Their rates theta_i' [rad/s]
+    """
+
+    t: np.ndarray
+    ground_acceleration: np.ndarray
+    ground_displacement: np.ndarray
+    node_displacements: np.ndarray
+    rotations: np.ndarray
+    rates: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Outcome of one run.
+
+    status : str  'collapsed', 'survived' or 'failed'
+    t_collapse_s : float  Time of collapse [s] (nan if none)
+    collapse_interface : int or None  1-based interface that reached its limit
+    max_rotation_ratio : float  max over interfaces and time of the collapse
+        quantity over its limit
+    max_top_displacement_m : float  max |u_{n+1} - u_1| [m]
+    n_uplifts : int  Rest-to-motion transitions (rigid law) or excursions
+        beyond an interface's elastic branch (finite K_M)
+    n_impacts : int  Zero crossings of a law argument after an excursion
+        beyond its elastic branch (every crossing for a rigid law)
+    n_steps, n_rhs : int  Accepted integrator steps, right-hand-side evaluations
+    friction_demand : tuple of float  max over time of |T_i / N_i| per interface
+    wall_time_s : float  Wall time of the run [s]
+    """
+
+    status: str
+    amplitude_g: float
+    frequency_hz: float
+    t_collapse_s: float
+    collapse_interface: int | None
+    max_rotation_ratio: float
+    max_top_displacement_m: float
+    n_uplifts: int
+    n_impacts: int
+    n_steps: int
+    n_rhs: int
+    message: str
+    friction_demand: tuple[float, ...]
+    wall_time_s: float
+    history: History | None = None
+
+    @property
+    def collapsed(self) -> bool:
+        return self.status == "collapsed"
+
+    @property
+    def max_friction_demand(self) -> float:
+        return max(self.friction_demand) if self.friction_demand else 0.0
+
+    def summary(self) -> dict:
+        """The domain.csv fields plus friction demand and wall time (JSON-ready)."""
+        d = asdict(self)
+        d.pop("history")
+        out = {k: d[k] for k in CSV_FIELDS if k in d}
+        out["collapsed"] = int(self.collapsed)
+        out["friction_demand"] = list(self.friction_demand)
+        out["max_friction_demand"] = self.max_friction_demand
+        out["wall_time_s"] = self.wall_time_s
+        for k, v in out.items():
+            if isinstance(v, float) and not np.isfinite(v):
+                out[k] = None
+        return out

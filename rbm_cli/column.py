@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .config_types import G, ColumnConfig, InterfaceConfig
+from .config_types import ColumnConfig, G, InterfaceConfig
 
 
 @dataclass(frozen=True)
@@ -103,12 +103,18 @@ def build_column(column: ColumnConfig, interface: InterfaceConfig) -> Column:
     mean_w = 0.5 * (w_a + w_b)
 
     if column.section == "circular":
-        volumes = np.pi / 4.0 * np.array(
-            [_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h)]
+        volumes = (
+            np.pi
+            / 4.0
+            * np.array(
+                [_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h, strict=True)]
+            )
         )
         depths = widths.copy()
     elif column.depth is None:  # square drums
-        volumes = np.array([_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h)])
+        volumes = np.array(
+            [_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h, strict=True)]
+        )
         depths = widths.copy()
     else:
         volumes = column.depth * h * mean_w

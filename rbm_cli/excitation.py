@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .config_types import G, ExcitationConfig
+from .config_types import ExcitationConfig, G
 
 
 @dataclass(frozen=True)

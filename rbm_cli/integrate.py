@@ -31,6 +31,7 @@ from scipy.integrate import DOP853, RK23, RK45
 from scipy.optimize import brentq
 
 from .config_types import SolverConfig
+from .events import Pieces, hermite_dip, hermite_peaks
 from .excitation import GroundMotion
 from .model import Model
 
@@ -68,99 +69,6 @@ class Outcome:
     samples: list = field(default_factory=list)  # (t, theta, rate) when recording
 
 
-class _Pieces:
-    """Which piece of its law each interface is on: side s = +-1 and index k."""
-
-    def __init__(self, model: Model):
-        self.model = model
-        n = model.n
-        self.side = np.ones(n, dtype=int)
-        self.k = np.zeros(n, dtype=int)
-        self.pending = np.zeros(n, dtype=bool)  # excursion beyond elastic branch
-        self.rigid = np.array([law.rigid for law in model.laws])
-        self.tu = model.column.rotation_capacity
-        self._cache: dict = {}
-
-    def locate(self, x: np.ndarray, rate: np.ndarray) -> None:
-        for i, law in enumerate(self.model.laws):
-            s = 1 if x[i] > 0 else -1 if x[i] < 0 else (1 if rate[i] >= 0 else -1)
-            self.side[i] = s
-            self.k[i] = int(np.searchsorted(law.edges, abs(x[i]), side="right"))
-            self.pending[i] = self.k[i] > 0 and not law.rigid
-
-    def zero_active(self, i: int) -> bool:
-        return bool(self.rigid[i] or self.pending[i])
-
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        n = self.model.n
-        lo, hi = np.empty(n), np.empty(n)
-        for i, law in enumerate(self.model.laws):
-            e = law.edges
-            k, s = self.k[i], self.side[i]
-            start = 0.0 if k == 0 else e[k - 1]
-            end = e[k] if k < len(e) else np.inf
-            if k == 0 and not self.zero_active(i):
-                start = -end
-            if s > 0:
-                lo[i], hi[i] = start, end
-            else:
-                lo[i], hi[i] = -end, -start
-        return lo, hi
-
-    def system(self):
-        key = (tuple(self.side), tuple(self.k))
-        sys_ = self._cache.get(key)
-        if sys_ is None:
-            laws = self.model.laws
-            a = np.array([s * law.intercepts[k] for s, k, law in zip(self.side, self.k, laws)])
-            b = np.array([law.slopes[k] for k, law in zip(self.k, laws)])
-            sys_ = self.model.linear_system(a, b)
-            self._cache[key] = sys_
-        return sys_
-
-
-def _hermite_peaks(z0, z1, d0, d1, dt):
-    """Largest |z| inside [0, dt] of the cubic Hermite interpolant, per row,
-    for rows whose derivative changes sign (else the end values bound it)."""
-    out = np.maximum(np.abs(z0), np.abs(z1))
-    rows = np.nonzero(d0 * d1 < 0)[0]
-    for r in rows:
-        # z(s) = h00 z0 + h10 dt d0 + h01 z1 + h11 dt d1, s in [0, 1]
-        p0, m0, p1, m1 = z0[r], dt * d0[r], z1[r], dt * d1[r]
-        # derivative coefficients of the cubic a s^3 + b s^2 + c s + d
-        a = 2 * p0 + m0 - 2 * p1 + m1
-        b = -3 * p0 - 2 * m0 + 3 * p1 - m1
-        c = m0
-        roots = np.roots([3 * a, 2 * b, c]) if abs(a) + abs(b) > 0 else []
-        for s in np.real(roots[np.isreal(roots)]) if len(roots) else []:
-            if 0.0 < s < 1.0:
-                val = ((a * s + b) * s + c) * s + p0
-                out[r] = max(out[r], abs(val))
-    return out
-
-
-def _hermite_dip(d0, d1, r0, r1, dt):
-    """Time (from the step start) of the lowest interior minimum of the cubic
-    Hermite interpolants of the distances d (values d0, d1, rates r0, r1),
-    if one dips below zero; else None. Only rows turning inside the step."""
-    rows = np.nonzero((r0 < 0.0) & (r1 > 0.0))[0]
-    best, t_best = 0.0, None
-    for r in rows:
-        p0, m0, p1, m1 = d0[r], dt * r0[r], d1[r], dt * r1[r]
-        # quick reject: the distance cannot reach zero within the step
-        if min(p0, p1) > 0.5 * (abs(m0) + abs(m1)):
-            continue
-        a = 2 * p0 + m0 - 2 * p1 + m1
-        b = -3 * p0 - 2 * m0 + 3 * p1 - m1
-        roots = np.roots([3 * a, 2 * b, m0]) if abs(a) + abs(b) > 0 else []
-        for s in np.real(roots[np.isreal(roots)]) if len(roots) else []:
-            if 0.0 < s < 1.0:
-                val = ((a * s + b) * s + m0) * s + p0
-                if val < best:
-                    best, t_best = val, s * dt
-    return t_best
-
-
 def integrate(
     model: Model,
     motion: GroundMotion,
@@ -188,7 +96,7 @@ def integrate(
     out = Outcome()
     out.max_ratio = np.zeros(n)
     out.friction = np.zeros(n)
-    pieces = _Pieces(model)
+    pieces = Pieces(model)
     tu = col.rotation_capacity
     c_ratio = model.collapse_ratio
     cmap = model.collapse_map / model.collapse_limit[:, None]
@@ -283,9 +191,10 @@ def integrate(
 
             lo, hi = pieces.bounds()
             # event distances, linear in theta: d = G theta + h0 (>= 0 inside)
-            h0 = np.concatenate(
-                [np.minimum(-lo / tu, BIG), np.minimum(hi / tu, BIG), c_vec, c_vec]
-            ) + EVENT_EPS
+            h0 = (
+                np.concatenate([np.minimum(-lo / tu, BIG), np.minimum(hi / tu, BIG), c_vec, c_vec])
+                + EVENT_EPS
+            )
 
             def gfun(yy, h0=h0):
                 return float(np.min(g_rows @ yy[:n] + h0))
@@ -318,7 +227,7 @@ def integrate(
                 else:
                     # a surface touched and left inside the step: the cubic Hermite
                     # of each distance has an interior minimum below zero
-                    t_min = _hermite_dip(d_old, d_new, dd_old, dd_new, t_new - t_old)
+                    t_min = hermite_dip(d_old, d_new, dd_old, dd_new, t_new - t_old)
                     if t_min is not None:
                         dense = integ.dense_output()
                         if gfun(dense(t_old + t_min)) < 0.0:
@@ -329,7 +238,9 @@ def integrate(
                     if gfun(dense(t_old)) <= 0.0:
                         t_e = t_old
                     else:
-                        t_e = brentq(lambda s: gfun(dense(s)), t_old, t_hit, xtol=1e-14)
+                        t_e = brentq(
+                            lambda s, dense=dense: gfun(dense(s)), t_old, t_hit, xtol=1e-14
+                        )
                     y_new = dense(t_e)
                     t_new = t_e
                     if record:
@@ -340,7 +251,7 @@ def integrate(
                 # peaks and friction demand over [t_old, t_new]
                 z_new = track @ y_new[:n]
                 dz_new = track @ y_new[n:]
-                peaks = _hermite_peaks(z_old, z_new, dz_old, dz_new, t_new - t_old)
+                peaks = hermite_peaks(z_old, z_new, dz_old, dz_new, t_new - t_old)
                 out.max_ratio = np.maximum(out.max_ratio, peaks[:n])
                 out.max_top = max(out.max_top, peaks[n])
                 acc = A @ y_new[:n] + cvec + evec * ag(t_new)
@@ -352,7 +263,11 @@ def integrate(
                 t, y = t_new, y_new
                 if event:
                     break
-                if can_stop and barrier is not None and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]:
+                if (
+                    can_stop
+                    and barrier is not None
+                    and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]
+                ):
                     if float(model.energy(y[:n], y[n:])[0]) < barrier * (1.0 - 1e-9):
                         out.message = "free motion below the collapse barrier: stopped early"
                         out.t_end = t

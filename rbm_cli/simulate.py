@@ -86,7 +86,13 @@ def simulate(
     dt = output_dt if output_dt is not None else 0.002
     try:
         out = integrate(
-            model, motion, theta0, rate0, config.solver, record=record, output_dt=dt,
+            model,
+            motion,
+            theta0,
+            rate0,
+            config.solver,
+            record=record,
+            output_dt=dt,
             early_stop=not record,
         )
     except (FloatingPointError, np.linalg.LinAlgError, ValueError, ZeroDivisionError) as exc:

@@ -109,15 +109,17 @@ class LinearRocking:
             gc = self.alpha - np.abs(th)
             hit_z = np.nonzero(gz <= 0)[0]
             hit_c = np.nonzero(gc <= 0)[0]
-            first = min(
-                hit_z[0] if len(hit_z) else len(ts), hit_c[0] if len(hit_c) else len(ts)
-            )
+            first = min(hit_z[0] if len(hit_z) else len(ts), hit_c[0] if len(hit_c) else len(ts))
             lo_t = t if first == 0 else ts[first - 1]
             # peak over the scanned part up to the event
-            seg_ts = np.concatenate([[t], ts[: first + 1]]) if first < len(ts) else np.concatenate([[t], ts])
+            seg_ts = (
+                np.concatenate([[t], ts[: first + 1]])
+                if first < len(ts)
+                else np.concatenate([[t], ts])
+            )
             rates = self.rate(pc, seg_ts)
             for j in np.nonzero(rates[:-1] * rates[1:] < 0)[0]:
-                tp = brentq(lambda x: self.rate(pc, x), seg_ts[j], seg_ts[j + 1], xtol=1e-15)
+                tp = brentq(lambda x, pc=pc: self.rate(pc, x), seg_ts[j], seg_ts[j + 1], xtol=1e-15)
                 peak = max(peak, abs(float(self.theta(pc, tp))) / self.alpha)
             if first == len(ts):  # no event before `stop`
                 th_end = float(self.theta(pc, stop))
@@ -131,10 +133,13 @@ class LinearRocking:
             is_collapse = len(hit_c) and hit_c[0] == first
             if is_collapse:
                 tc = brentq(
-                    lambda x: self.alpha - abs(float(self.theta(pc, x))), lo_t, ts[first], xtol=1e-15
+                    lambda x, pc=pc: self.alpha - abs(float(self.theta(pc, x))),
+                    lo_t,
+                    ts[first],
+                    xtol=1e-15,
                 )
                 return ClosedFormResult(True, tc, 1.0, impacts)
-            ti = brentq(lambda x: float(self.theta(pc, x)), lo_t, ts[first], xtol=1e-15)
+            ti = brentq(lambda x, pc=pc: float(self.theta(pc, x)), lo_t, ts[first], xtol=1e-15)
             v = float(self.rate(pc, ti)) * self.e
             impacts += 1
             pc = self._make(ti, 0.0, v, -pc.s, pc.forced and ti < self.pulse_end)

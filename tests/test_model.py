@@ -144,10 +144,16 @@ def test_absolute_formulation_does_not_conserve_energy():
 @pytest.mark.parametrize(
     "stiffness,xi", [("rigid", 1.0), (2e6, 1.0), (2e7, 0.6), (5e5, 0.3), (5e8, 0.9)]
 )
-@pytest.mark.parametrize("kind,amplitude,frequency", [("harmonic", 0.5, 1.5), ("half-sine", 0.6, 1.0)])
+@pytest.mark.parametrize(
+    "kind,amplitude,frequency", [("harmonic", 0.5, 1.5), ("half-sine", 0.6, 1.0)]
+)
 def test_formulations_identical_for_monolith(stiffness, xi, kind, amplitude, frequency):
     """For n = 1 the three formulations are the same equation."""
-    stiff = StiffnessConfig("rigid") if stiffness == "rigid" else StiffnessConfig("moment", (stiffness,))
+    stiff = (
+        StiffnessConfig("rigid")
+        if stiffness == "rigid"
+        else StiffnessConfig("moment", (stiffness,))
+    )
     results = [
         simulate(block(kind=kind, stiffness=stiff, xi=xi, formulation=f), amplitude, frequency)
         for f in ("relative", "absolute", "geometric")
@@ -182,8 +188,12 @@ def test_strong_upper_joints_behave_as_monolith(formulation, amplitude, frequenc
     k_base = 2e8
     mono = Config(
         name="mono",
-        column=ColumnConfig(height=4.0, base_width=1.0, top_width=1.0, depth=1.0, drum_heights=(4.0,)),
-        interface=InterfaceConfig(stiffness=StiffnessConfig("moment", (k_base,)), formulation=formulation),
+        column=ColumnConfig(
+            height=4.0, base_width=1.0, top_width=1.0, depth=1.0, drum_heights=(4.0,)
+        ),
+        interface=InterfaceConfig(
+            stiffness=StiffnessConfig("moment", (k_base,)), formulation=formulation
+        ),
     )
     stack = dataclasses.replace(
         mono,

@@ -1,0 +1,366 @@
+"""Read a YAML config into the validated, frozen dataclasses of :mod:`rbm_cli.config_types`.
+
+Every user error raises :class:`rbm_cli.errors.ConfigError` with one line that names
+the YAML key path and the allowed range or values, e.g.
+``cfg.yaml: column.height must be a number > 0 [m], got -1``.
+
+The schema is SPEC section 4, plus ``excitation.initial`` (SPEC section 3) and a
+``solver`` section (our extension: integrator settings). Lengths are in m,
+stiffnesses in N m/rad (K_M) or Pa/m (k_n), times in s, angles in rad; the grid
+keeps amplitudes in g and frequencies in Hz, the edge units.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from ._validate import (
+    choice,
+    describe,
+    fmt,
+    grid_axis,
+    integer,
+    is_number,
+    join,
+    mapping,
+    number,
+    number_list,
+    one_line,
+    read_yaml,
+)
+from .config_types import (
+    EXCITATIONS,
+    FORMULATIONS,
+    METHODS,
+    MODELS,
+    SECTIONS,
+    CollapseConfig,
+    ColumnConfig,
+    Config,
+    ExcitationConfig,
+    GridConfig,
+    InitialConfig,
+    InterfaceConfig,
+    SolverConfig,
+    StiffnessConfig,
+)
+from .errors import ConfigError
+
+__all__ = ["load_config", "parse_config"]
+
+TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
+COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
+INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation")
+EXCITATION_KEYS = ("type", "duration", "phase", "initial")
+INITIAL_KEYS = ("rotations", "velocities")
+GRID_KEYS = ("amplitudes", "frequencies")
+COLLAPSE_KEYS = ("ratio",)
+SOLVER_KEYS = ("method", "rtol", "atol", "max_steps", "max_events")
+
+#: Models of SPEC section 2 that this version does not implement yet.
+PLANNED_MODELS = ("housner", "housner-linear", "bullet")
+#: Default ``excitation.duration`` per type [s] (SPEC section 3).
+DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
+MAX_DURATION = 1e4  # [s]
+MAX_DRUMS = 200
+MAX_TOP_TAPER = 3.0  # top_width <= MAX_TOP_TAPER * base_width
+MAX_FILE_BYTES = 1_000_000
+DRUM_SUM_RTOL = 1e-9
+NAME_RE = re.compile(r"[A-Za-z0-9_.\-]{1,100}")
+
+
+def load_config(path: str | os.PathLike[str]) -> Config:
+    """Read and validate a YAML config file.
+
+    Parameters
+    ----------
+    path : str or path-like  The YAML file
+
+    Returns
+    -------
+    Config  Validated, SI units (the grid in g and Hz)
+
+    Raises
+    ------
+    ConfigError  File missing or unreadable, malformed YAML, or any key missing,
+        unknown, of the wrong type or out of range; one line naming the key path.
+    """
+    source = os.fspath(path)
+    file = Path(source)
+    try:
+        if file.is_dir():
+            raise ConfigError(f"{source} is a directory, not a config file")
+        if file.exists() and not file.is_file():
+            raise ConfigError(f"{source} is not a regular file")
+        with file.open("rb") as handle:
+            raw = handle.read(MAX_FILE_BYTES + 1)
+    except FileNotFoundError:
+        raise ConfigError(f"config file not found: {source}") from None
+    except PermissionError:
+        raise ConfigError(f"cannot read {source}: permission denied") from None
+    except (OSError, ValueError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise ConfigError(f"cannot read {source}: {one_line(str(reason))}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ConfigError(f"{source} is larger than {MAX_FILE_BYTES} bytes: not a config file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"cannot parse {source}: not UTF-8 text (bad byte at offset {exc.start})"
+        ) from None
+    return parse_config(read_yaml(text, source), source)
+
+
+# ------------------------------------------------------------------------ sections
+
+
+def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
+    """Validate the mapping a YAML config holds and build a :class:`Config`.
+
+    Parameters
+    ----------
+    data : mapping  Parsed YAML (keys of SPEC section 4)
+    source : str  Where ``data`` came from, prefixed to error messages
+
+    Returns
+    -------
+    Config  Validated, SI units (the grid in g and Hz)
+
+    Raises
+    ------
+    ConfigError  One line: ``<source>: <key path> must be <allowed>, got <value>``.
+    """
+    try:
+        return _config(data)
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
+
+
+def _config(data: Any) -> Config:
+    if data is None:
+        raise ConfigError("the config is empty (it needs at least name and column)")
+    if isinstance(data, Mapping) and "initial" in data:
+        raise ConfigError("unknown key 'initial' at top level: it goes under excitation")
+    top = mapping(data, "", TOP_KEYS)
+    if "name" not in top:
+        raise ConfigError("name is required (the output folder name)")
+    if "column" not in top:
+        raise ConfigError("column is required (a mapping with height and base_width [m])")
+    name = _name(top["name"])
+    model = top.get("model", "rbm")
+    if isinstance(model, str) and model in PLANNED_MODELS and model not in MODELS:
+        raise ConfigError(
+            f"model {model!r} is not available in this version (allowed: {', '.join(MODELS)})"
+        )
+    model = choice(model, "model", MODELS)
+    column = _column(top["column"])
+    n = column.n_drums
+    return Config(
+        name=name,
+        column=column,
+        model=model,
+        interface=_interface(top.get("interface"), n),
+        excitation=_excitation(top.get("excitation"), n),
+        grid=_grid(top.get("grid")),
+        collapse=CollapseConfig(
+            ratio=number(
+                mapping(top.get("collapse"), "collapse", COLLAPSE_KEYS).get("ratio", 1.0),
+                "collapse.ratio",
+                "",
+                0.0,
+                1.0,
+            )
+        ),
+        solver=_solver(top.get("solver")),
+    )
+
+
+def _name(value: Any) -> str:
+    if not isinstance(value, str):
+        raise ConfigError(f"name must be a string (quote it), got {describe(value)}")
+    if not NAME_RE.fullmatch(value) or set(value) == {"."}:
+        raise ConfigError(
+            "name must be a folder name of 1-100 letters A-Z a-z, digits and _ - . "
+            f"(no spaces or slashes), got {describe(value)}"
+        )
+    return value
+
+
+def _column(raw: Any) -> ColumnConfig:
+    c = mapping(raw, "column", COLUMN_KEYS)
+    for key in ("height", "base_width"):
+        if key not in c:
+            raise ConfigError(f"column.{key} is required (a number > 0 [m])")
+    height = number(c["height"], "column.height", "m", 0.0)
+    base = number(c["base_width"], "column.base_width", "m", 0.0)
+    if base > height:
+        raise ConfigError(
+            f"column.base_width must be <= column.height ({fmt(height)} m), got {fmt(base)}"
+            " (a block wider than tall is outside the model's intent)"
+        )
+    top = number(
+        c.get("top_width", base),
+        "column.top_width",
+        "m",
+        0.0,
+        MAX_TOP_TAPER * base,
+        hint=f"at most {fmt(MAX_TOP_TAPER)} x column.base_width",
+    )
+    section = choice(c.get("section", "rectangular"), "column.section", SECTIONS)
+    depth = None
+    if "depth" in c:
+        if section != "rectangular":
+            raise ConfigError(
+                f"column.depth applies only to section: rectangular (section is {section};"
+                " a circle's diameter is the width): delete it"
+            )
+        depth = number(c["depth"], "column.depth", "m", 0.0)
+    return ColumnConfig(
+        height=height,
+        base_width=base,
+        top_width=top,
+        section=section,
+        depth=depth,
+        density=number(c.get("density", 2700.0), "column.density", "kg/m^3", 0.0),
+        drum_heights=_drums(c.get("drums", 1), height),
+    )
+
+
+def _drums(value: Any, height: float) -> tuple[float, ...]:
+    path = "column.drums"
+    if not isinstance(value, list | tuple):
+        count = integer(
+            value, path, 1, MAX_DRUMS, " (count of equal drums) or a list of drum heights [m]"
+        )
+        return (height / count,) * count
+    if not 1 <= len(value) <= MAX_DRUMS:
+        got = f"{len(value)} heights" if value else "an empty list"
+        raise ConfigError(f"{path} must list 1..{MAX_DRUMS} drum heights [m], got {got}")
+    heights = number_list(value, path, "m", 0.0)
+    total = math.fsum(heights)
+    if abs(total - height) > DRUM_SUM_RTOL * height:
+        raise ConfigError(
+            f"{path} heights sum to {fmt(total)} m but column.height is {fmt(height)} m"
+            " (they must agree within 1e-9 relative)"
+        )
+    return heights
+
+
+def _interface(raw: Any, n: int) -> InterfaceConfig:
+    i = mapping(raw, "interface", INTERFACE_KEYS)
+    restitution = i.get("restitution", 1.0)
+    if isinstance(restitution, str) and restitution == "housner":
+        if n != 1:
+            raise ConfigError(
+                f"interface.restitution: housner needs a monolithic column (drums: 1), got {n}"
+                " drums; give a number in (0, 1]"
+            )
+    elif is_number(restitution):
+        restitution = number(restitution, "interface.restitution", "", 0.0, 1.0)
+    else:
+        raise ConfigError(
+            f"interface.restitution must be a number in (0, 1] or housner, got"
+            f" {describe(restitution)}"
+        )
+    return InterfaceConfig(
+        stiffness=_stiffness(i.get("stiffness", "rigid"), n, given="stiffness" in i),
+        xi=number(i.get("xi", 1.0), "interface.xi", "", 0.0, 1.0),
+        restitution=restitution,
+        formulation=choice(i.get("formulation", "relative"), "interface.formulation", FORMULATIONS),
+    )
+
+
+def _stiffness(value: Any, n: int, *, given: bool = True) -> StiffnessConfig:
+    path = "interface.stiffness"
+    if isinstance(value, str) and value == "rigid":
+        if n > 1:
+            raise ConfigError(
+                f"{path}: rigid{'' if given else ' (the default)'} needs a monolithic column"
+                " (drums: 1); give a finite K_M or {normal: k_n} for multi-drum columns"
+            )
+        return StiffnessConfig("rigid", ())
+    if is_number(value):
+        k_m = number(value, path, "N m/rad", 0.0, inf_hint="use rigid for an infinite stiffness")
+        return StiffnessConfig("moment", (k_m,))
+    if isinstance(value, list | tuple):
+        per = f"one K_M per interface ({n} for {n} drum{'s' if n > 1 else ''})"
+        return StiffnessConfig(
+            "moment", number_list(value, path, "N m/rad", 0.0, length=n, length_text=per)
+        )
+    if isinstance(value, Mapping):
+        m = mapping(value, path, ("normal",))
+        if "normal" not in m:
+            raise ConfigError(f"{path}.normal is required (joint normal stiffness > 0 [Pa/m])")
+        k_n = number(
+            m["normal"],
+            f"{path}.normal",
+            "Pa/m",
+            0.0,
+            inf_hint="use rigid for an infinite stiffness",
+        )
+        return StiffnessConfig("normal", (k_n,))
+    raise ConfigError(
+        f"{path} must be rigid, a K_M > 0 [N m/rad], a list with one K_M per interface,"
+        f" or {{normal: k_n}} [Pa/m], got {describe(value)}"
+    )
+
+
+def _excitation(raw: Any, n: int) -> ExcitationConfig:
+    e = mapping(raw, "excitation", EXCITATION_KEYS)
+    kind = choice(e.get("type", "harmonic"), "excitation.type", EXCITATIONS)
+    duration = number(
+        e.get("duration", DEFAULT_DURATION.get(kind, 10.0)),
+        "excitation.duration",
+        "s",
+        0.0,
+        MAX_DURATION,
+    )
+    phase = number(e.get("phase", 0.0), "excitation.phase", "rad")
+    if phase != 0.0 and kind != "harmonic":
+        raise ConfigError(
+            f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"
+        )
+    path = "excitation.initial"
+    init = mapping(e.get("initial"), path, INITIAL_KEYS)
+    per = f"one value per drum ({n})"
+    values = {
+        key: number_list(init[key], join(path, key), unit, length=n, length_text=per)
+        if key in init
+        else ()
+        for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
+    }
+    if kind == "free" and not any(values["rotations"]) and not any(values["velocities"]):
+        raise ConfigError(
+            f"{path}: excitation type free needs a non-zero initial rotation or velocity"
+            f" ({path}.rotations or .velocities); with none the column stays at rest"
+        )
+    return ExcitationConfig(
+        type=kind, duration=duration, phase=phase, initial=InitialConfig(**values)
+    )
+
+
+def _grid(raw: Any) -> GridConfig:
+    g = mapping(raw, "grid", GRID_KEYS)
+    amplitudes, frequencies = (
+        grid_axis(g[key], join("grid", key), unit, lo_open=lo_open) if key in g else ()
+        for key, unit, lo_open in (("amplitudes", "g", False), ("frequencies", "Hz", True))
+    )
+    return GridConfig(amplitudes_g=amplitudes, frequencies_hz=frequencies)
+
+
+def _solver(raw: Any) -> SolverConfig:
+    s = mapping(raw, "solver", SOLVER_KEYS)
+    default = SolverConfig()
+    return SolverConfig(
+        method=choice(s.get("method", default.method), "solver.method", METHODS),
+        rtol=number(s.get("rtol", default.rtol), "solver.rtol", "", 1e-13, 1e-3, lo_open=False),
+        atol=number(s.get("atol", default.atol), "solver.atol", "", 0.0, 1e-3),
+        max_steps=integer(s.get("max_steps", default.max_steps), "solver.max_steps", 1000),
+        max_events=integer(s.get("max_events", default.max_events), "solver.max_events", 100),
+    )

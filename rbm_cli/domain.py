@@ -1,0 +1,180 @@
+"""Safe-unsafe domains as tables: rows, CSV text, boundary, comparison.
+
+A domain is a pandas DataFrame with the columns of SPEC section 5
+(:data:`rbm_cli.result.CSV_FIELDS`), one row per (amplitude, frequency) cell.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .errors import RbmError
+from .result import CSV_FIELDS, RunResult
+
+#: Columns a domain CSV must have for plotting and comparing.
+REQUIRED = ("amplitude_g", "frequency_hz", "status")
+
+
+def result_row(res: RunResult) -> dict:
+    """The domain.csv fields of a run, in order."""
+    return {
+        "amplitude_g": res.amplitude_g,
+        "frequency_hz": res.frequency_hz,
+        "status": res.status,
+        "collapsed": int(res.collapsed),
+        "t_collapse_s": res.t_collapse_s,
+        "collapse_interface": res.collapse_interface,
+        "max_rotation_ratio": res.max_rotation_ratio,
+        "max_top_displacement_m": res.max_top_displacement_m,
+        "n_uplifts": res.n_uplifts,
+        "n_impacts": res.n_impacts,
+        "n_steps": res.n_steps,
+        "n_rhs": res.n_rhs,
+        "message": res.message,
+    }
+
+
+def format_value(value) -> str:
+    """CSV text of one value: floats with 12 significant digits, empty for None/NaN."""
+    if value is None:
+        return ""
+    if isinstance(value, float | np.floating):
+        if not math.isfinite(value):
+            return ""
+        return f"{float(value):.12g}"
+    if isinstance(value, int | np.integer):
+        return str(int(value))
+    text = str(value)
+    if any(c in text for c in ',"\n'):
+        text = '"' + text.replace('"', '""').replace("\n", " ") + '"'
+    return text
+
+
+def format_row(row: dict, fields=CSV_FIELDS) -> str:
+    return ",".join(format_value(row.get(k)) for k in fields)
+
+
+def csv_text(rows: list[dict], fields=CSV_FIELDS) -> str:
+    return ",".join(fields) + "\n" + "".join(format_row(r, fields) + "\n" for r in rows)
+
+
+def cell_key(amplitude_g: float, frequency_hz: float) -> tuple[str, str]:
+    """Identity of a grid cell, stable through a CSV round trip."""
+    return (f"{float(amplitude_g):.12g}", f"{float(frequency_hz):.12g}")
+
+
+def read_domain(path: str | Path) -> pd.DataFrame:
+    """Read a domain CSV; a missing file or missing columns is an RbmError."""
+    path = Path(path)
+    if not path.is_file():
+        raise RbmError(f"domain file not found: {path}")
+    try:
+        df = pd.read_csv(path, keep_default_na=True)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        reason = " ".join(str(exc).split())
+        raise RbmError(f"cannot read {path} as a domain CSV: {reason}") from None
+    missing = [c for c in REQUIRED if c not in df.columns]
+    if missing:
+        raise RbmError(f"{path} is not a domain CSV: missing column(s) {', '.join(missing)}")
+    if df.empty:
+        raise RbmError(f"{path} has no rows")
+    if "collapsed" not in df.columns:
+        df["collapsed"] = (df["status"] == "collapsed").astype(int)
+    return df
+
+
+def boundary(df: pd.DataFrame) -> pd.DataFrame:
+    """Lowest unsafe (collapsed) amplitude per frequency, and the highest safe one below it.
+
+    Returns a DataFrame sorted by frequency with columns frequency_hz,
+    lowest_unsafe_g (NaN where nothing collapses) and highest_safe_g (largest
+    survived amplitude below lowest_unsafe_g; NaN if none).
+    """
+    rows = []
+    for f, grp in df.groupby("frequency_hz", sort=True):
+        unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
+        low = float(unsafe.min()) if len(unsafe) else math.nan
+        safe = grp.loc[grp["status"] == "survived", "amplitude_g"]
+        if math.isfinite(low):
+            safe = safe[safe < low]
+        high = float(safe.max()) if len(safe) else math.nan
+        rows.append({"frequency_hz": float(f), "lowest_unsafe_g": low, "highest_safe_g": high})
+    return pd.DataFrame(rows, columns=["frequency_hz", "lowest_unsafe_g", "highest_safe_g"])
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """How two domains differ.
+
+    n_common : cells present in both (matched on amplitude and frequency)
+    n_differ : common cells whose collapsed flag differs
+    fraction : n_differ / n_common
+    max_shift_g : largest |boundary shift| over frequencies [g]
+    shifts : per frequency: frequency_hz, boundary_a_g, boundary_b_g, shift_g
+    only_a, only_b : cells present in one domain only
+    """
+
+    n_common: int
+    n_differ: int
+    fraction: float
+    max_shift_g: float
+    shifts: pd.DataFrame
+    only_a: int
+    only_b: int
+
+
+def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
+    """Compare two domains cell by cell and boundary by boundary.
+
+    Where one domain has no collapsed cell at a frequency, its boundary is
+    taken as one grid step above its highest amplitude there (just above the
+    grid), so a boundary that leaves the grid counts as a finite shift.
+    """
+
+    def flags(df):
+        cols = (df.amplitude_g, df.frequency_hz, df.collapsed)
+        return {cell_key(x, y): int(c) for x, y, c in zip(*cols, strict=True)}
+
+    ka, kb = flags(a), flags(b)
+    common = ka.keys() & kb.keys()
+    differ = sum(ka[k] != kb[k] for k in common)
+
+    def edge(df):
+        out = {}
+        for f, grp in df.groupby("frequency_hz"):
+            amps = np.sort(grp["amplitude_g"].to_numpy(float))
+            unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
+            if len(unsafe):
+                out[f"{float(f):.12g}"] = float(unsafe.min())
+            else:
+                step = float(np.min(np.diff(amps))) if len(amps) > 1 else 0.0
+                out[f"{float(f):.12g}"] = float(amps[-1]) + step
+        return out
+
+    ea, eb = edge(a), edge(b)
+    rows = []
+    for f in sorted(ea.keys() & eb.keys(), key=float):
+        rows.append(
+            {
+                "frequency_hz": float(f),
+                "boundary_a_g": ea[f],
+                "boundary_b_g": eb[f],
+                "shift_g": eb[f] - ea[f],
+            }
+        )
+    shifts = pd.DataFrame(rows, columns=["frequency_hz", "boundary_a_g", "boundary_b_g", "shift_g"])
+    max_shift = float(shifts["shift_g"].abs().max()) if len(shifts) else 0.0
+    return Comparison(
+        n_common=len(common),
+        n_differ=int(differ),
+        fraction=differ / len(common) if common else math.nan,
+        max_shift_g=max_shift,
+        shifts=shifts,
+        only_a=len(ka.keys() - kb.keys()),
+        only_b=len(kb.keys() - ka.keys()),
+    )

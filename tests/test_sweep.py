@@ -1,0 +1,114 @@
+"""Sweeps: determinism across workers and backends, interruption and resume, compare."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import pandas as pd
+import pytest
+
+from rbm_cli.config import load_config
+from rbm_cli.config_types import GridConfig
+from rbm_cli.domain import boundary, compare, read_domain
+from rbm_cli.errors import RbmError
+from rbm_cli.sweep import JOURNAL, grid_cells, run_sweep
+
+from .paths import CONFIGS
+
+
+def small_config(amps=(0.2, 0.3, 0.5, 0.8, 1.2), freqs=(0.5, 1.0, 2.0)):
+    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    return dataclasses.replace(cfg, grid=GridConfig(amplitudes_g=amps, frequencies_hz=freqs))
+
+
+def test_grid_order_is_frequency_major():
+    cfg = small_config(amps=(0.1, 0.2), freqs=(1.0, 2.0))
+    assert grid_cells(cfg) == [(0.1, 1.0), (0.2, 1.0), (0.1, 2.0), (0.2, 2.0)]
+
+
+def test_jobs_do_not_change_the_csv(tmp_path):
+    cfg = small_config()
+    one = run_sweep(cfg, tmp_path / "one", jobs=1)
+    two = run_sweep(cfg, tmp_path / "two", jobs=2)
+    a = (one.folder / "domain.csv").read_bytes()
+    b = (two.folder / "domain.csv").read_bytes()
+    assert a == b
+    for name in ("domain.csv", "boundary.csv", "meta.json", "domain.png"):
+        assert (two.folder / name).is_file()
+    meta = json.loads((two.folder / "meta.json").read_text())
+    assert meta["jobs"] == 2 and meta["n_cells"] == 15 and "wall_time_s" in meta
+    assert "wall" not in a.decode()  # wall times go to meta.json only
+
+
+def test_dask_backend_on_a_local_cluster(tmp_path):
+    """The same sweep on a Dask distributed cluster (loopback) gives the same CSV."""
+    distributed = pytest.importorskip("dask.distributed")
+    cfg = small_config(amps=(0.2, 0.5, 1.2), freqs=(0.5, 2.0))
+    ref = run_sweep(cfg, tmp_path / "ref", jobs=1)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+    ) as cluster:
+        got = run_sweep(
+            cfg, tmp_path / "dask", jobs=2, backend="dask", scheduler=cluster.scheduler_address
+        )
+    assert (got.folder / "domain.csv").read_bytes() == (ref.folder / "domain.csv").read_bytes()
+
+
+def test_interrupted_then_resumed_equals_uninterrupted(tmp_path):
+    cfg = small_config()
+    straight = run_sweep(cfg, tmp_path / "straight", jobs=1)
+    with pytest.raises(RbmError, match="stopped after"):
+        run_sweep(cfg, tmp_path / "cut", jobs=1, stop_after=2)
+    folder = tmp_path / "cut" / cfg.name
+    assert not (folder / "domain.csv").exists()  # nothing that looks complete
+    assert (folder / JOURNAL).is_file()
+    # a line cut by the kill is ignored, not trusted
+    with (folder / JOURNAL).open("a") as fh:
+        fh.write('{"amplitude_g": 1.2, "frequency_hz": 2.0, "sta')
+    resumed = run_sweep(cfg, tmp_path / "cut", jobs=2, resume=True)
+    assert resumed.n_resumed > 0 and resumed.n_run < resumed.n_cells
+    assert (folder / "domain.csv").read_bytes() == (straight.folder / "domain.csv").read_bytes()
+    assert not (folder / JOURNAL).exists()
+
+
+def test_resume_refuses_a_journal_of_another_config(tmp_path):
+    cfg = small_config()
+    with pytest.raises(RbmError):
+        run_sweep(cfg, tmp_path, jobs=1, stop_after=1)
+    other = dataclasses.replace(cfg, collapse=dataclasses.replace(cfg.collapse, ratio=0.9))
+    with pytest.raises(RbmError, match="different config"):
+        run_sweep(other, tmp_path, jobs=1, resume=True)
+
+
+def test_rigid_cells_below_uplift_are_not_integrated(tmp_path):
+    cfg = small_config(amps=(0.1, 0.2, 0.24), freqs=(0.5, 3.0))
+    s = run_sweep(cfg, tmp_path, jobs=1)
+    df = read_domain(s.folder / "domain.csv")
+    assert (df["n_steps"] == 0).all() and (df["status"] == "survived").all()
+
+
+def test_boundary_and_compare_on_synthetic_domains():
+    def dom(flags):
+        rows = [
+            {
+                "amplitude_g": a,
+                "frequency_hz": f,
+                "status": "collapsed" if c else "survived",
+                "collapsed": c,
+            }
+            for f, col in flags.items()
+            for a, c in zip((0.1, 0.2, 0.3, 0.4), col, strict=True)
+        ]
+        return pd.DataFrame(rows)
+
+    a = dom({1.0: (0, 0, 1, 1), 2.0: (0, 0, 0, 1)})
+    b = dom({1.0: (0, 1, 1, 1), 2.0: (0, 0, 0, 0)})
+    bnd = boundary(a)
+    assert list(bnd["lowest_unsafe_g"]) == [0.3, 0.4]
+    assert list(bnd["highest_safe_g"]) == [0.2, 0.3]
+    cmp = compare(a, b)
+    assert cmp.n_common == 8 and cmp.n_differ == 2
+    # at 2 Hz b has no collapse: its boundary is one step above the grid (0.5)
+    assert cmp.max_shift_g == pytest.approx(0.1)
+    assert compare(a, a).n_differ == 0 and compare(a, a).max_shift_g == 0.0

@@ -68,6 +68,12 @@ class Outcome:
     n_events: int = 0
     samples: list = field(default_factory=list)  # (t, theta, rate) when recording
 
+    def stop(self, status: str, message: str, t: float) -> Outcome:
+        """End the run at time t with a status and a reason."""
+        self.status, self.t_end = status, t
+        self.message = message if status != "failed" else f"{message} at t={t:.6g} s"
+        return self
+
 
 def integrate(
     model: Model,
@@ -208,14 +214,10 @@ def integrate(
             while integ.status == "running":
                 msg = integ.step()
                 if integ.status == "failed":
-                    out.status, out.message, out.t_end = "failed", f"integrator: {msg}", t
-                    return out
+                    return out.stop("failed", f"integrator: {msg}", t)
                 out.n_steps += 1
                 if out.n_steps > solver.max_steps:
-                    out.status = "failed"
-                    out.message = f"step budget exceeded ({solver.max_steps} steps) at t={t:.6g} s"
-                    out.t_end = t
-                    return out
+                    return out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
                 t_old = integ.t_old
                 t_new, y_new = integ.t, integ.y
                 d_new = g_rows @ y_new[:n] + h0
@@ -280,10 +282,7 @@ def integrate(
             # ---- handle the event at (t, y)
             out.n_events += 1
             if out.n_events > solver.max_events:
-                out.status = "failed"
-                out.message = f"event budget exceeded ({solver.max_events} events) at t={t:.6g} s"
-                out.t_end = t
-                return out
+                return out.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
             row = int(np.argmin(g_rows @ y[:n] + h0))
             which, i = divmod(row, n)
             if which >= 2:

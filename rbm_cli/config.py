@@ -63,7 +63,7 @@ COLLAPSE_KEYS = ("ratio",)
 SOLVER_KEYS = ("method", "rtol", "atol", "max_steps", "max_events")
 
 #: Models of SPEC section 2 that this version does not implement yet.
-PLANNED_MODELS = ("housner", "housner-linear", "bullet")
+PLANNED_MODELS = ("bullet",)
 #: Default ``excitation.duration`` per type [s] (SPEC section 3).
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
 MAX_DURATION = 1e4  # [s]
@@ -161,6 +161,8 @@ def _config(data: Any) -> Config:
     model = choice(model, "model", MODELS)
     column = _column(top["column"])
     n = column.n_drums
+    if model != "rbm" and n != 1:
+        raise ConfigError(f"model {model!r} needs a monolithic column (drums: 1), got {n} drums")
     return Config(
         name=name,
         column=column,

@@ -13,7 +13,10 @@ from dataclasses import dataclass, field
 #: Acceleration of gravity [m/s^2] (SPEC: g = 9.81).
 G = 9.81
 
-MODELS = ("rbm",)
+#: rbm: the Rigid Beam Model; housner: Housner's nonlinear rigid block (large
+#: rotations, true geometry); housner-linear: the piecewise-linear block of
+#: Spanos and Koh (closed form, true geometry). The last two: monolithic only.
+MODELS = ("rbm", "housner", "housner-linear")
 SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
 EXCITATIONS = ("harmonic", "half-sine", "free")

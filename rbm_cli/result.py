@@ -89,7 +89,8 @@ class RunResult:
 
     @property
     def max_friction_demand(self) -> float:
-        return max(self.friction_demand) if self.friction_demand else 0.0
+        finite = [v for v in self.friction_demand if np.isfinite(v)]
+        return max(finite) if finite else float("nan")
 
     def summary(self) -> dict:
         """The domain.csv fields plus friction demand and wall time (JSON-ready)."""
@@ -97,7 +98,7 @@ class RunResult:
         d.pop("history")
         out = {k: d[k] for k in CSV_FIELDS if k in d}
         out["collapsed"] = int(self.collapsed)
-        out["friction_demand"] = list(self.friction_demand)
+        out["friction_demand"] = [v if np.isfinite(v) else None for v in self.friction_demand]
         out["max_friction_demand"] = self.max_friction_demand
         out["wall_time_s"] = self.wall_time_s
         for k, v in out.items():

@@ -76,6 +76,8 @@ def simulate(
         if not (math.isfinite(frequency_hz) and frequency_hz > 0):
             raise RbmError(f"frequency must be a number > 0 [Hz], got {frequency_hz}")
     start = time.perf_counter()
+    if config.model != "rbm":
+        return _reference_run(config, amplitude_g, frequency_hz, record, output_dt, start)
     if model is None:
         model = model_from_config(config)
     n = model.n
@@ -101,9 +103,11 @@ def simulate(
         out = Outcome(status="failed", message=f"numerical failure: {exc}")
         out.max_ratio = np.full(n, np.nan)
         out.friction = np.full(n, np.nan)
-    history = None
-    if record:
-        history = _history(model, motion, out.samples)
+    history = _history(model.node_map, motion, out.samples) if record else None
+    return _result(config, out, amplitude_g, frequency_hz, history, start)
+
+
+def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult:
     wall = time.perf_counter() - start
     if config.excitation.type == "free":
         amplitude_g, frequency_hz = 0.0, 0.0
@@ -130,8 +134,47 @@ def simulate(
     )
 
 
-def _history(model: Model, motion, samples) -> History:
-    n = model.n
+def _reference_run(config, amplitude_g, frequency_hz, record, output_dt, start) -> RunResult:
+    """`housner` and `housner-linear`: single rigid blocks with their true geometry."""
+    from .housner import block_geometry, housner_run
+    from .housner import housner_restitution as block_restitution
+    from .housner_linear import housner_linear_run
+
+    geometry = block_geometry(config.column)
+    motion = make_ground_motion(config.excitation, amplitude_g, frequency_hz)
+    init = config.excitation.initial
+    initial = (
+        float(init.rotations[0]) if init.rotations else 0.0,
+        float(init.velocities[0]) if init.velocities else 0.0,
+    )
+    e = config.interface.restitution
+    e = block_restitution(geometry) if e == "housner" else float(e)
+    dt = output_dt if output_dt is not None else 0.002
+    common = dict(
+        restitution=e,
+        collapse_ratio=config.collapse.ratio,
+        record=record,
+        output_dt=dt,
+        initial=initial,
+        early_stop=not record,
+    )
+    if config.model == "housner":
+        out = housner_run(geometry, motion, solver=config.solver, **common)
+    else:
+        out = housner_linear_run(
+            geometry.slenderness,
+            geometry.frequency_parameter,
+            motion,
+            height=config.column.height,
+            **common,
+        )
+    node_map = np.array([[0.0], [config.column.height]])
+    history = _history(node_map, motion, out.samples) if record else None
+    return _result(config, out, amplitude_g, frequency_hz, history, start)
+
+
+def _history(node_map: np.ndarray, motion, samples) -> History:
+    n = node_map.shape[1]
     if samples:
         t = np.array([s[0] for s in samples])
         theta = np.array([s[1] for s in samples])
@@ -142,7 +185,7 @@ def _history(model: Model, motion, samples) -> History:
         t=t,
         ground_acceleration=np.asarray(motion.accel(t), dtype=float),
         ground_displacement=motion.displacement(t),
-        node_displacements=theta @ model.node_map.T,
+        node_displacements=theta @ node_map.T,
         rotations=theta,
         rates=rates,
     )

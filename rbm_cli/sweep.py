@@ -64,7 +64,7 @@ def run_chunk(config: Config, cells: list[tuple[float, float]]) -> list[dict]:
     """Run cells of one config in this process; a cell that raises is 'failed'."""
     from .simulate import model_from_config, simulate
 
-    model = model_from_config(config)
+    model = model_from_config(config) if config.model == "rbm" else None
     rows = []
     for a, f in cells:
         try:

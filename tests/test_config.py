@@ -289,7 +289,7 @@ BAD = [
 ]
 BAD_EXTRA = [
     ("colum:\n  height: 4\n", ["unknown key 'colum' at top level", "allowed: name, model"]),
-    ("model: housner\n", ["model 'housner' is not available", "allowed: rbm"]),
+    ("model: bullet\n", ["model 'bullet' is not available", "allowed: rbm"]),
     ("model: fem\n", ["model must be one of rbm", "'fem'"]),
     ("interface:\n  stiffness: soft\n", ["interface.stiffness must be rigid"]),
     ("interface:\n  stiffness: -5\n", ["interface.stiffness", "> 0 [N m/rad]"]),
@@ -526,3 +526,17 @@ def test_results_are_frozen():
     with pytest.raises(AttributeError):
         cfg.column.height = 2.0  # type: ignore[misc]
     assert math.isclose(sum(cfg.column.drum_heights), cfg.column.height)
+
+
+@pytest.mark.parametrize("model", ["housner", "housner-linear"])
+def test_reference_models_need_a_monolithic_column(model):
+    data = {
+        "name": "x",
+        "model": model,
+        "column": {"height": 4.0, "base_width": 1.0, "drums": 2},
+        "interface": {"stiffness": 1e9},
+    }
+    with pytest.raises(ConfigError, match=f"model '{model}' needs a monolithic column"):
+        parse_config(data)
+    data["column"]["drums"] = 1
+    assert parse_config(data).model == model

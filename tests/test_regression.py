@@ -33,6 +33,8 @@ STUDIES = {
     "spanos_koh_slender": (CONFIGS / "spanos_koh_slender.yaml", MONOLITHIC),
     "spanos_koh_thick": (CONFIGS / "spanos_koh_thick.yaml", MONOLITHIC),
     "housner_halfsine": (CONFIGS / "housner_halfsine.yaml", MONOLITHIC),
+    "spanos_koh_slender_linear": (CONFIGS / "spanos_koh_slender_linear.yaml", MONOLITHIC),
+    "spanos_koh_thick_linear": (CONFIGS / "spanos_koh_thick_linear.yaml", MONOLITHIC),
     "harmonic_monolithic": (CONFIGS / "harmonic_monolithic.yaml", MONOLITHIC),
     "harmonic_multidrum_ci": (
         CONFIGS / "ci" / "harmonic_multidrum_ci.yaml",

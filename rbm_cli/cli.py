@@ -1,0 +1,329 @@
+"""Command line of rbm: thin click commands over the library.
+
+Each command loads a config, calls one library function and writes or prints
+the result. Errors a user can cause (:class:`rbm_cli.errors.RbmError`, bad
+options) end in one line ``Error: ...`` on stderr and exit status 2.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import click
+import matplotlib
+
+matplotlib.use("Agg")
+
+from . import __version__  # noqa: E402
+from .errors import RbmError  # noqa: E402
+
+#: Exit status of a user error (bad input, unwritable output).
+EXIT_USER_ERROR = 2
+#: Exit status of a run whose integration failed (files are still written).
+EXIT_RUN_FAILED = 1
+
+
+class UserError(click.ClickException):
+    """A one-line error for the user, exit status 2."""
+
+    exit_code = EXIT_USER_ERROR
+
+
+class RbmGroup(click.Group):
+    """A click group whose usage errors are one line, like every other error."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except click.UsageError as exc:
+            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+            message = " ".join(exc.format_message().split())
+            raise UserError(message + hint) from None
+
+
+def _load(config_path: str):
+    """Load a config, turning every library error into a one-line CLI error."""
+    from .config import load_config
+
+    try:
+        return load_config(config_path)
+    except RbmError as exc:
+        raise UserError(_one_line(exc)) from None
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+# --------------------------------------------------------------------------- shared options
+
+config_argument = click.argument("config", metavar="CONFIG.yaml", type=str)
+
+output_option = click.option(
+    "-o",
+    "--output",
+    "output",
+    default="out",
+    show_default=True,
+    type=str,
+    help="Output root folder; results go to OUTPUT/<name>/.",
+)
+
+
+@click.group(cls=RbmGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="rbm")
+def cli() -> None:
+    """Seismic rocking of freestanding stone columns with the Rigid Beam Model.
+
+    \b
+    Example:
+        rbm info configs/spanos_koh_slender.yaml
+        rbm run configs/spanos_koh_slender.yaml --amplitude 0.5 --frequency 1
+    """
+
+
+# --------------------------------------------------------------------------- run
+
+
+def _check_excitation(kind: str, amplitude: float | None, frequency: float | None):
+    """Validate --amplitude [g] and --frequency [Hz] for the excitation type."""
+    if amplitude is not None and not (math.isfinite(amplitude) and amplitude >= 0.0):
+        raise UserError(f"--amplitude must be a finite number >= 0 [g], got {amplitude:g}")
+    if frequency is not None and not (math.isfinite(frequency) and frequency > 0.0):
+        raise UserError(f"--frequency must be a finite number > 0 [Hz], got {frequency:g}")
+    if kind == "free":
+        return 0.0, 0.0
+    if amplitude is None:
+        raise UserError(f"--amplitude [g] is required for excitation.type '{kind}'")
+    if frequency is None:
+        raise UserError(f"--frequency [Hz] is required for excitation.type '{kind}'")
+    return float(amplitude), float(frequency)
+
+
+def _print_summary(result, folder: Path) -> None:
+    lines = [("status", result.status)]
+    if result.collapsed:
+        where = result.collapse_interface if result.collapse_interface is not None else "?"
+        lines.append(("collapse", f"t = {result.t_collapse_s:.6g} s at interface {where}"))
+    lines += [
+        ("max rotation ratio", f"{result.max_rotation_ratio:.4g}"),
+        ("max top displacement", f"{result.max_top_displacement_m:.4g} m (relative to base)"),
+        ("friction demand", f"max |T/N| = {result.max_friction_demand:.4g}"),
+        ("uplifts / impacts", f"{result.n_uplifts} / {result.n_impacts}"),
+        ("steps / rhs", f"{result.n_steps} / {result.n_rhs}"),
+        ("wall time", f"{result.wall_time_s:.3g} s"),
+    ]
+    if result.message:
+        lines.append(("message", result.message))
+    lines.append(("output", str(folder)))
+    width = max(len(k) for k, _ in lines)
+    for key, value in lines:
+        click.echo(f"{key + ':':<{width + 1}} {value}")
+
+
+@cli.command()
+@config_argument
+@click.option(
+    "-a",
+    "--amplitude",
+    type=float,
+    default=None,
+    help="Peak ground acceleration [g], >= 0 (not used by 'free').",
+)
+@click.option(
+    "-f",
+    "--frequency",
+    type=float,
+    default=None,
+    help="Excitation frequency [Hz], > 0 (not used by 'free').",
+)
+@click.option(
+    "--dt",
+    "output_dt",
+    type=float,
+    default=None,
+    help="Sampling interval of history.csv [s]; default: the library's choice.",
+)
+@output_option
+def run(
+    config: str,
+    amplitude: float | None,
+    frequency: float | None,
+    output_dt: float | None,
+    output: str,
+) -> None:
+    """Simulate one excitation and write its history, plots and summary.
+
+    Writes OUTPUT/<name>/run_A<A>_f<F>/ (run_free for a free excitation):
+    history.csv (t, ground acceleration and displacement, node displacements
+    relative to the ground, drum rotations), history.png (base and top
+    displacement, as the paper's fig. 4), shapes.png (the deformed column at six
+    instants, as fig. 3) and summary.json. The folder is created only once the
+    simulation has succeeded. Exit status 1 if the integration failed (the
+    files are still written), 2 on bad input.
+
+    \b
+    Example:
+        rbm run configs/spanos_koh_slender.yaml --amplitude 0.5 --frequency 1
+        rbm run configs/harmonic_multidrum.yaml -a 0.3 -f 2 -o /tmp/rbm-out
+    """
+    from .column import build_column
+    from .output import check_writable_dir, run_folder_name, run_summary, write_run
+    from .simulate import simulate
+
+    cfg = _load(config)
+    kind = cfg.excitation.type
+    amplitude_g, frequency_hz = _check_excitation(kind, amplitude, frequency)
+    if kind == "free" and (amplitude is not None or frequency is not None):
+        click.echo("note: excitation.type is 'free': --amplitude/--frequency are ignored", err=True)
+    if output_dt is not None and not (math.isfinite(output_dt) and output_dt > 0.0):
+        raise UserError(f"--dt must be a finite number > 0 [s], got {output_dt:g}")
+
+    try:
+        check_writable_dir(Path(output) / cfg.name)
+        column = build_column(cfg.column, cfg.interface)
+        result = simulate(cfg, amplitude_g, frequency_hz, record=True, output_dt=output_dt)
+        summary = run_summary(
+            result,
+            cfg,
+            config_path=config,
+            amplitude_g=amplitude_g,
+            frequency_hz=frequency_hz,
+            output_dt=output_dt,
+        )
+        folder = write_run(
+            output,
+            cfg.name,
+            run_folder_name(amplitude_g, frequency_hz, kind),
+            result,
+            summary,
+            widths=column.widths,
+            elevations=list(column.bottoms) + [column.height],
+        )
+    except RbmError as exc:
+        raise UserError(_one_line(exc)) from None
+
+    _print_summary(result, folder)
+    if result.status == "failed":
+        reason = " ".join(str(result.message).split()) or "no reason given"
+        click.echo(f"Error: run failed: {reason}", err=True)
+        sys.exit(EXIT_RUN_FAILED)
+
+
+# --------------------------------------------------------------------------- info
+
+
+def _fmt(value, spec: str = ".4g") -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float) and math.isinf(value):
+        return "inf"
+    if isinstance(value, int | float):
+        return format(value, spec)
+    return str(value)
+
+
+#: Columns of the per-interface table of ``rbm info``: (key, header, unit).
+INTERFACE_COLUMNS = (
+    ("interface", "i", "-"),
+    ("width_m", "B_i", "m"),
+    ("drum_height_m", "h_i", "m"),
+    ("drum_mass_kg", "m_i", "kg"),
+    ("drum_inertia_kgm2", "I_Gi", "kg m2"),
+    ("normal_force_N", "N_i", "N"),
+    ("moment_capacity_Nm", "M_u,i", "N m"),
+    ("rotation_capacity_rad", "theta_u,i", "rad"),
+    ("stiffness_Nm_per_rad", "K_M,i", "N m/rad"),
+    ("elastic_limit_rad", "elastic lim", "rad"),
+)
+
+
+def format_info(info: dict) -> str:
+    """The text printed by ``rbm info``: global figures, then one row per interface."""
+    n = info.get("n_drums")
+    freqs = info.get("elastic_frequencies_hz") or []
+    rows = [
+        ("name", info.get("name")),
+        ("drums", n),
+        ("formulation", info.get("formulation")),
+        ("total mass", f"{_fmt(info.get('total_mass_kg'))} kg"),
+        ("height", f"{_fmt(info.get('height_m'))} m"),
+        ("static multiplier", f"{_fmt(info.get('static_multiplier_g'))} g"),
+        (
+            "uplift acceleration",
+            f"{_fmt(info.get('uplift_acceleration_g'))} g"
+            if info.get("uplift_acceleration_g") is not None
+            else "- (elastic interfaces)",
+        ),
+        ("rocking p", f"{_fmt(info.get('rocking_p_rad_s'))} rad/s"),
+        ("rocking frequency", f"{_fmt(info.get('rocking_frequency_hz'))} Hz"),
+        (
+            "elastic frequencies",
+            (", ".join(_fmt(f) for f in freqs) + " Hz") if freqs else "- (rigid)",
+        ),
+    ]
+    width = max(len(k) for k, _ in rows)
+    lines = [f"{k + ':':<{width + 1}} {v}" for k, v in rows]
+
+    table = [[h for _, h, _ in INTERFACE_COLUMNS], [f"[{u}]" for _, _, u in INTERFACE_COLUMNS]]
+    for row in info.get("interfaces", []):
+        table.append(
+            [
+                _fmt(row.get(key), "d" if key == "interface" else ".4g")
+                for key, _, _ in INTERFACE_COLUMNS
+            ]
+        )
+    widths = [max(len(r[c]) for r in table) for c in range(len(INTERFACE_COLUMNS))]
+    lines.append("")
+    lines.append("interfaces (i = 1 at the ground):")
+    for r in table:
+        lines.append("  ".join(cell.rjust(w) for cell, w in zip(r, widths, strict=True)))
+    return "\n".join(lines)
+
+
+@cli.command()
+@config_argument
+@click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON instead.")
+def info(config: str, as_json: bool) -> None:
+    """Print derived properties of a column: masses, strengths, frequencies.
+
+    Per interface: width B_i, drum height, mass and inertia I_Gi, normal force
+    N_i, moment capacity M_u,i, zero-moment rotation theta_u,i, stiffness K_M,i
+    and elastic limit; globally: total mass, static multiplier, rocking
+    parameter p and the elastic frequencies.
+
+    \b
+    Example:
+        rbm info configs/harmonic_multidrum.yaml
+        rbm info configs/spanos_koh_thick.yaml --json
+    """
+    from .info import describe
+
+    cfg = _load(config)
+    try:
+        figures = describe(cfg)
+    except RbmError as exc:
+        raise UserError(_one_line(exc)) from None
+    if as_json:
+        import json
+
+        from .output import json_ready
+
+        click.echo(json.dumps(json_ready(figures), indent=2))
+    else:
+        click.echo(format_info(figures))
+
+
+# sweep, plot-domain and compare live in their own module, registered on `cli`
+from . import cli_domain  # noqa: E402, F401
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry point (``rbm``)."""
+    cli.main(args=argv, prog_name="rbm")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,290 @@
+"""Domain commands of the CLI: sweep, plot-domain, compare (thin, over rbm_cli.sweep/domain)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from .cli import UserError, _load, _one_line, cli, config_argument, output_option
+from .errors import RbmError
+
+
+@cli.command()
+@config_argument
+@output_option
+@click.option(
+    "-j", "--jobs", type=int, default=2, show_default=True, help="Parallel workers (joblib)."
+)
+@click.option(
+    "--backend",
+    type=click.Choice(["loky", "threading", "sequential", "dask"]),
+    default="loky",
+    show_default=True,
+    help="joblib backend; 'dask' runs on a Dask distributed cluster (see --scheduler).",
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Dask scheduler address (tcp://host:8786) for --backend dask; "
+    "default: a local in-process cluster.",
+)
+@click.option("--resume", is_flag=True, help="Finish an interrupted sweep of the same config.")
+@click.option("--force", is_flag=True, help="Allow grids of more than 100,000 cells.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
+def sweep(
+    config: str,
+    output: str,
+    jobs: int,
+    backend: str,
+    scheduler: str | None,
+    resume: bool,
+    force: bool,
+    quiet: bool,
+) -> None:
+    """Run the config's amplitude x frequency grid and write the safe-unsafe domain.
+
+    Writes OUTPUT/<name>/domain.csv (one row per cell, SPEC section 5),
+    boundary.csv (lowest unsafe amplitude per frequency), meta.json (resolved
+    config, versions, wall time, workers) and domain.png. While it runs, only a
+    journal (domain.partial.jsonl) exists: an interrupted sweep leaves nothing
+    that looks complete, and --resume finishes it without redoing finished cells.
+    Cells that fail numerically are recorded with status 'failed'; the sweep goes on.
+
+    \b
+    Example:
+        rbm sweep configs/spanos_koh_slender.yaml
+        rbm sweep configs/harmonic_multidrum.yaml -o out --jobs 2 --resume
+        rbm sweep configs/harmonic_multidrum.yaml --backend dask --scheduler tcp://10.0.0.5:8786
+    """
+    from .sweep import run_sweep
+
+    cfg = _load(config)
+    if scheduler and backend != "dask":
+        raise UserError("--scheduler needs --backend dask")
+    show = not quiet and sys.stderr.isatty()
+    bar = None
+
+    def progress(done: int, total: int) -> None:
+        nonlocal bar
+        if not show:
+            return
+        if bar is None:
+            bar = click.progressbar(length=total, label=cfg.name, file=sys.stderr, show_eta=True)
+            bar.__enter__()
+        bar.update(done - bar.pos)
+
+    try:
+        summary = run_sweep(
+            cfg,
+            output=output,
+            jobs=jobs,
+            backend=backend,
+            scheduler=scheduler,
+            resume=resume,
+            force=force,
+            progress=progress,
+        )
+    except RbmError as exc:
+        raise UserError(_one_line(exc)) from None
+    finally:
+        if bar is not None:
+            bar.__exit__(None, None, None)
+    click.echo(
+        f"{summary.n_cells} cells ({summary.n_run} run, {summary.n_resumed} resumed): "
+        f"{summary.n_collapsed} collapsed, {summary.n_survived} survived, "
+        f"{summary.n_failed} failed in {summary.wall_time_s:.3g} s on {jobs} worker(s)"
+    )
+    click.echo(f"output: {summary.folder}")
+    if summary.n_failed:
+        click.echo(f"warning: {summary.n_failed} cell(s) failed; see their message", err=True)
+
+
+@cli.command("plot-domain")
+@click.argument("domain_csv", metavar="DOMAIN.csv", type=str)
+@click.option(
+    "-o",
+    "--output",
+    "png",
+    default=None,
+    help="PNG to write; default: domain.png beside DOMAIN.csv.",
+)
+@click.option(
+    "--compare",
+    "others",
+    multiple=True,
+    metavar="OTHER.csv",
+    help="Another domain whose boundary is overlaid (repeatable).",
+)
+@click.option(
+    "--config",
+    "config_path",
+    default=None,
+    help="Config of the domain (for the static multiplier and closed forms); "
+    "default: the meta.json beside DOMAIN.csv if any.",
+)
+def plot_domain_cmd(
+    domain_csv: str, png: str | None, others: tuple[str, ...], config_path: str | None
+) -> None:
+    """Draw a safe-unsafe domain: safe (o) and unsafe (x) cells, the boundary,
+    the static multiplier and, for rigid monolithic half-sine studies, Housner's
+    and the exact linear closed-form curves; other domains overlaid.
+
+    \b
+    Example:
+        rbm plot-domain out/spanos_koh_slender/domain.csv -o slender.png
+        rbm plot-domain out/a/domain.csv --compare results/a/domain.csv
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .domain import read_domain
+    from .output import save_figure_atomic
+    from .plot_domain import plot_domain
+
+    try:
+        df = read_domain(domain_csv)
+        dfs = [read_domain(p) for p in others]
+        cfg = _config_for(domain_csv, config_path)
+        target = Path(png) if png else Path(domain_csv).with_name("domain.png")
+        labels = [Path(domain_csv).parent.name or "domain"] + [Path(p).parent.name for p in others]
+        if cfg is not None:
+            from .sweep import domain_figure
+
+            fig = domain_figure(df, cfg, compare=dfs, labels=labels)
+        else:
+            fig, ax = plt.subplots(figsize=(7, 5))
+            plot_domain(df, ax=ax, compare=dfs, labels=labels)
+            fig.tight_layout()
+        save_figure_atomic(fig, target)
+        plt.close(fig)
+    except RbmError as exc:
+        raise UserError(_one_line(exc)) from None
+    except OSError as exc:
+        raise UserError(f"cannot write {png}: {exc.strerror or exc}") from None
+    click.echo(f"wrote {target}")
+
+
+def _config_for(domain_csv: str, config_path: str | None):
+    """The config of a domain: given, or resolved from meta.json beside it."""
+    if config_path:
+        return _load(config_path)
+    meta = Path(domain_csv).with_name("meta.json")
+    if not meta.is_file():
+        return None
+    import json
+
+    from .config import parse_config
+
+    try:
+        resolved = json.loads(meta.read_text())["config"]
+        return parse_config(_unresolve(resolved), source=str(meta))
+    except (ValueError, KeyError, TypeError, RbmError):
+        return None  # plot without the config-dependent curves
+
+
+def _unresolve(c: dict) -> dict:
+    """meta.json's resolved config (dataclass fields) back into YAML keys."""
+    col, itf, exc = c["column"], c["interface"], c["excitation"]
+    stiff = itf["stiffness"]
+    if stiff["kind"] == "rigid":
+        stiffness = "rigid"
+    elif stiff["kind"] == "normal":
+        stiffness = {"normal": stiff["values"][0]}
+    else:
+        vals = stiff["values"]
+        stiffness = vals[0] if len(vals) == 1 else list(vals)
+    column = {
+        "height": col["height"],
+        "base_width": col["base_width"],
+        "top_width": col["top_width"],
+        "section": col["section"],
+        "density": col["density"],
+        "drums": list(col["drum_heights"]),
+    }
+    if col.get("depth") is not None:
+        column["depth"] = col["depth"]
+    excitation = {"type": exc["type"], "duration": exc["duration"]}
+    if exc["type"] == "harmonic":
+        excitation["phase"] = exc["phase"]
+    return {
+        "name": c["name"],
+        "model": c["model"],
+        "column": column,
+        "interface": {
+            "stiffness": stiffness,
+            "xi": itf["xi"],
+            "restitution": itf["restitution"],
+            "formulation": itf["formulation"],
+        },
+        "excitation": excitation,
+        "collapse": {"ratio": c["collapse"]["ratio"]},
+    }
+
+
+@cli.command()
+@click.argument("a_csv", metavar="A.csv", type=str)
+@click.argument("b_csv", metavar="B.csv", type=str)
+@click.option(
+    "--max-cells",
+    type=float,
+    default=None,
+    metavar="FRACTION",
+    help="Fail if more than this fraction of common cells differ (e.g. 0.01).",
+)
+@click.option(
+    "--max-shift",
+    type=float,
+    default=None,
+    metavar="G",
+    help="Fail if the boundary moves by more than this at any frequency [g].",
+)
+def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | None) -> None:
+    """Compare two domains: cells that differ and the boundary shift per frequency.
+
+    Exit status 0 when within the limits, 1 beyond either (the check CI uses
+    for the stored domains), 2 on bad input. A frequency where a domain has no
+    collapsed cell has its boundary one grid step above its highest amplitude.
+
+    \b
+    Example:
+        rbm compare results/spanos_koh_slender/domain.csv out/spanos_koh_slender/domain.csv \\
+            --max-cells 0.01 --max-shift 0.05
+    """
+    from .domain import compare as compare_domains
+    from .domain import read_domain
+
+    for name, value in (("--max-cells", max_cells), ("--max-shift", max_shift)):
+        if value is not None and not value >= 0:
+            raise UserError(f"{name} must be >= 0, got {value:g}")
+    try:
+        cmp = compare_domains(read_domain(a_csv), read_domain(b_csv))
+    except RbmError as exc:
+        raise UserError(_one_line(exc)) from None
+    if cmp.n_common == 0:
+        raise UserError("the two domains have no cell in common")
+    click.echo(
+        f"cells: {cmp.n_common} in common, {cmp.n_differ} differ "
+        f"({100 * cmp.fraction:.3g} %); only in A: {cmp.only_a}, only in B: {cmp.only_b}"
+    )
+    click.echo(f"largest boundary shift: {cmp.max_shift_g:.4g} g")
+    click.echo(f"{'frequency [Hz]':>15} {'A [g]':>8} {'B [g]':>8} {'shift [g]':>10}")
+    for r in cmp.shifts.itertuples():
+        click.echo(
+            f"{r.frequency_hz:>15.6g} {r.boundary_a_g:>8.4g} {r.boundary_b_g:>8.4g} "
+            f"{r.shift_g:>+10.4g}"
+        )
+    failed = []
+    if max_cells is not None and cmp.fraction > max_cells:
+        failed.append(f"{cmp.fraction:.4g} of cells differ (limit {max_cells:g})")
+    if max_shift is not None and cmp.max_shift_g > max_shift:
+        failed.append(f"boundary shift {cmp.max_shift_g:.4g} g (limit {max_shift:g} g)")
+    if failed:
+        click.echo("FAIL: " + "; ".join(failed), err=True)
+        sys.exit(1)
+    if max_cells is not None or max_shift is not None:
+        click.echo("OK: within the limits")

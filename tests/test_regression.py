@@ -35,6 +35,7 @@ STUDIES = {
     "housner_halfsine": (CONFIGS / "housner_halfsine.yaml", MONOLITHIC),
     "spanos_koh_slender_linear": (CONFIGS / "spanos_koh_slender_linear.yaml", MONOLITHIC),
     "spanos_koh_thick_linear": (CONFIGS / "spanos_koh_thick_linear.yaml", MONOLITHIC),
+    "spanos_koh_thick_housner_e": (CONFIGS / "spanos_koh_thick_housner_e.yaml", MONOLITHIC),
     "harmonic_monolithic": (CONFIGS / "harmonic_monolithic.yaml", MONOLITHIC),
     "harmonic_multidrum_ci": (
         CONFIGS / "ci" / "harmonic_multidrum_ci.yaml",

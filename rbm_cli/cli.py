@@ -110,7 +110,12 @@ def _print_summary(result, folder: Path) -> None:
     lines += [
         ("max rotation ratio", f"{result.max_rotation_ratio:.4g}"),
         ("max top displacement", f"{result.max_top_displacement_m:.4g} m (relative to base)"),
-        ("friction demand", f"max |T/N| = {result.max_friction_demand:.4g}"),
+        (
+            "friction demand",
+            f"max |T/N| = {result.max_friction_demand:.4g}"
+            if math.isfinite(result.max_friction_demand)
+            else "- (not computed by this model)",
+        ),
         ("uplifts / impacts", f"{result.n_uplifts} / {result.n_impacts}"),
         ("steps / rhs", f"{result.n_steps} / {result.n_rhs}"),
         ("wall time", f"{result.wall_time_s:.3g} s"),

@@ -157,7 +157,7 @@ def plot_domain_cmd(
 
             fig = domain_figure(df, cfg, compare=dfs, labels=labels)
         else:
-            fig, ax = plt.subplots(figsize=(7, 5))
+            fig, ax = plt.subplots(figsize=(9.5, 5))
             plot_domain(df, ax=ax, compare=dfs, labels=labels)
             fig.tight_layout()
         save_figure_atomic(fig, target)

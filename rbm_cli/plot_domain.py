@@ -264,7 +264,9 @@ def plot_domain(
     ax.legend(
         handles=proxies + handles,
         labels=[h.get_label() for h in proxies] + texts,
-        loc="best",
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),  # beside the axes: never over the cells
+        borderaxespad=0.0,
         fontsize="small",
     )
     return ax

@@ -293,7 +293,7 @@ def domain_figure(df: pd.DataFrame, config: Config, compare=(), labels=None):
     from .plot_domain import plot_domain
 
     column = build_column(config.column, config.interface)
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = plt.subplots(figsize=(9.5, 5))
     plot_domain(
         df,
         ax=ax,

@@ -209,7 +209,7 @@ def plot_shapes(
         ax.text(x0, z[0] - 0.04 * height, label, ha="center", va="top", fontsize="small")
 
     ax.set_xlim(-pitch / 2, (max(len(idx), 1) - 0.5) * pitch)
-    ax.set_ylim(z[0] - 0.15 * height, z[-1] + 0.05 * height)
+    ax.set_ylim(z[0] - 0.2 * height, z[-1] + 0.05 * height)
     ax.set_aspect("equal")
     ax.set_xlabel("horizontal position [m] (columns side by side)")
     ax.set_ylabel("height [m]")

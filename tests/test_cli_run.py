@@ -155,3 +155,49 @@ def test_unwritable_output(tmp_path):
     blocker.write_text("x")
     res = invoke("run", cfg, "-a", 0.5, "-f", 1, "-o", blocker)
     assert res.exit_code == 2 and "Traceback" not in res.output
+
+
+SHIPPED = sorted(CONFIGS.glob("*.yaml")) + sorted(CONFIGS.glob("*/*.yaml"))
+
+
+@pytest.mark.parametrize("config", SHIPPED, ids=[p.stem for p in SHIPPED])
+def test_info_on_every_shipped_config(config):
+    res = invoke("info", config)
+    assert res.exit_code == 0, res.output
+    assert "static multiplier" in res.output and "Traceback" not in res.output
+
+
+def one_line_error(res):
+    lines = [line for line in res.output.splitlines() if line.strip()]
+    return len(lines) == 1 and lines[0].startswith("Error:") and "Traceback" not in res.output
+
+
+def test_directory_as_config_is_one_line(tmp_path):
+    folder = tmp_path / "configs.yaml"
+    folder.mkdir()
+    for command in (["info"], ["run", "-a", 0.5, "-f", 1, "-o", tmp_path / "out"]):
+        res = invoke(command[0], folder, *command[1:])
+        assert res.exit_code == 2 and one_line_error(res) and "configs.yaml" in res.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_unwritable_output_is_one_line_and_named(tmp_path):
+    """Guards the output check done before the simulation: nothing is created."""
+    cfg = write(tmp_path, GOOD)
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    res = invoke("run", cfg, "-a", 0.5, "-f", 1, "-o", blocker / "deeper")
+    assert res.exit_code == 2 and one_line_error(res) and str(blocker) in res.output
+    assert blocker.read_text() == "x"
+
+
+@pytest.mark.parametrize(
+    "args",
+    [["-a", "abc", "-f", "1"], ["-a", "0.5", "-f", "1", "--bogus"], []],
+    ids=["non-numeric amplitude", "unknown option", "missing config"],
+)
+def test_usage_errors_are_one_line(tmp_path, args):
+    cfg = [write(tmp_path, GOOD)] if args else []
+    res = invoke("run", *cfg, *args, "-o", tmp_path / "out")
+    assert res.exit_code == 2 and one_line_error(res), res.output
+    assert not (tmp_path / "out").exists()

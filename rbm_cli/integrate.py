@@ -113,6 +113,11 @@ def integrate(
     argmap = model.arg_map
     arg_inv = np.linalg.inv(argmap)
     e_rest = model.restitution
+    # impact at joint i: an impulsive moment along the joint's direction P^T e_i,
+    # sized so that the joint's rate becomes e times its value (see _impact_rates)
+    impulse_dir = model.mass_inv @ argmap.T  # column i: M^-1 P^T e_i
+    impulse_w = np.einsum("ij,ji->i", argmap, impulse_dir)  # w_ii = e_i^T P M^-1 P^T e_i
+    literal_impact = model.formulation == "absolute"
     stepper = _METHODS[solver.method]
     atol = solver.atol * np.concatenate([np.full(n, tu.min()), np.full(n, tu.min() * 10.0)])
 
@@ -319,9 +324,16 @@ def integrate(
                 pieces.side[i] = -s
                 pieces.pending[i] = False
                 if e_rest < 1.0:
-                    xdot = argmap @ y[n:]
+                    xdot_i = float(argmap[i] @ y[n:])
                     y = y.copy()
-                    y[n:] += arg_inv[:, i] * (e_rest - 1.0) * xdot[i]
+                    if literal_impact:
+                        # `absolute` (the paper's wording): only theta_i' is scaled
+                        y[n:] += arg_inv[:, i] * (e_rest - 1.0) * xdot_i
+                    else:
+                        # momentum-consistent: the kinetic energy changes by
+                        # -(1 - e^2) xdot_i^2 / (2 w_ii) <= 0; identical for n = 1
+                        lam = (e_rest - 1.0) * xdot_i / impulse_w[i]
+                        y[n:] += impulse_dir[:, i] * lam
                 if rigid_mono and abs(y[n]) < rest_rate:
                     y = np.zeros(2 * n)
                     at_rest = True

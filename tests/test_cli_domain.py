@@ -123,3 +123,16 @@ def test_shipped_configs_validate():
     for path in sorted(CONFIGS.glob("**/*.yaml")):
         res = invoke("info", path)
         assert res.exit_code == 0, (path, res.output)
+
+
+def test_huge_grid_is_refused_without_force(tmp_path):
+    """A 200,000-cell grid (more than MAX_CELLS) needs --force; nothing is written."""
+    path = tmp_path / "huge.yaml"
+    path.write_text(
+        SMALL.replace("[0.2, 0.3, 0.5, 1.0]", "{start: 0.01, stop: 10.0, num: 1000}").replace(
+            "[0.5, 2.0]", "{start: 0.1, stop: 20.0, num: 200}"
+        )
+    )
+    res = invoke("sweep", path, "-o", tmp_path / "out", "--quiet")
+    assert res.exit_code == 2 and "200,000 cells" in res.output and "--force" in res.output
+    assert not (tmp_path / "out").exists()

@@ -14,29 +14,10 @@ import numpy as np
 import pandas as pd
 
 from .errors import RbmError
-from .result import CSV_FIELDS, RunResult
+from .result import CSV_FIELDS
 
 #: Columns a domain CSV must have for plotting and comparing.
 REQUIRED = ("amplitude_g", "frequency_hz", "status")
-
-
-def result_row(res: RunResult) -> dict:
-    """The domain.csv fields of a run, in order."""
-    return {
-        "amplitude_g": res.amplitude_g,
-        "frequency_hz": res.frequency_hz,
-        "status": res.status,
-        "collapsed": int(res.collapsed),
-        "t_collapse_s": res.t_collapse_s,
-        "collapse_interface": res.collapse_interface,
-        "max_rotation_ratio": res.max_rotation_ratio,
-        "max_top_displacement_m": res.max_top_displacement_m,
-        "n_uplifts": res.n_uplifts,
-        "n_impacts": res.n_impacts,
-        "n_steps": res.n_steps,
-        "n_rhs": res.n_rhs,
-        "message": res.message,
-    }
 
 
 def format_value(value) -> str:

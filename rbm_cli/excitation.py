@@ -87,6 +87,25 @@ class GroundMotion:
         return t
 
 
+    def rest_end(self, t: float, seg_end: float, level: float, forced: bool) -> tuple[str, float]:
+        """How the rest of a rigid block, at rest at time t, ends.
+
+        Returns ('end', t_end) when no ground motion is left (it rests to the end
+        of the run), ('segment', seg_end) when |a_g| stays below `level`
+        [m/s^2] in the current segment, or ('uplift', t_up) when it exceeds it.
+        """
+        if not forced:
+            return "end", self.t_end
+        t_up = self.next_exceedance(t, level)
+        if t_up is None or t_up >= seg_end:
+            return "segment", seg_end
+        return "uplift", t_up
+
+    def uplift_side(self, t: float) -> int:
+        """Side (sign of theta) a block lifts on at time t: away from a_g."""
+        return -1 if self.accel(t) > 0.0 else 1
+
+
 def make_ground_motion(
     excitation: ExcitationConfig, amplitude_g: float, frequency_hz: float
 ) -> GroundMotion:

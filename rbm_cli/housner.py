@@ -249,18 +249,15 @@ def housner_run(
         can_stop = early_stop and after_pulse
         while t < seg_end:
             if at_rest:
-                t_up = motion.next_exceedance(t, level) if forced else None
-                if t_up is None or t_up >= seg_end:
-                    if not forced:
-                        rec.rest(motion.t_end)
-                        t = motion.t_end
-                        return finish(message="at rest in free motion: stopped")
-                    rec.rest(seg_end)
-                    t = seg_end
+                kind, t_stop = motion.rest_end(t, seg_end, level, forced)
+                rec.rest(t_stop - (1e-15 if kind == "uplift" else 0.0))
+                t = t_stop
+                if kind == "end":  # no ground motion from here on: rests to the end
+                    return finish(message="at rest in free motion: stopped")
+                if kind == "segment":
                     break
-                rec.rest(t_up - 1e-15)
-                t, y = t_up, np.zeros(2)
-                side = -1 if motion.accel(t) > 0.0 else 1
+                y = np.zeros(2)
+                side = motion.uplift_side(t)
                 at_rest = False
                 out.n_uplifts += 1
                 note((t, "uplift"))

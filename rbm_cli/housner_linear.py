@@ -317,18 +317,15 @@ def housner_linear_run(
         can_stop = early_stop and after_pulse
         while t < seg_end:
             if at_rest:
-                t_up = motion.next_exceedance(t, G * alpha) if forced else None
-                if t_up is None or t_up >= seg_end:
-                    if not forced:  # no ground motion from here on: rests to the end
-                        rec.rest(motion.t_end)
-                        t = motion.t_end
-                        return finish(message="at rest in free motion: stopped")
-                    rec.rest(seg_end)
-                    t = seg_end
+                kind, t_stop = motion.rest_end(t, seg_end, G * alpha, forced)
+                rec.rest(t_stop - (1e-15 if kind == "uplift" else 0.0))
+                t = t_stop
+                if kind == "end":  # no ground motion from here on: rests to the end
+                    return finish(message="at rest in free motion: stopped")
+                if kind == "segment":
                     break
-                rec.rest(t_up - 1e-15)
-                t, theta, rate = t_up, 0.0, 0.0
-                side = -1 if motion.accel(t) > 0.0 else 1
+                theta, rate = 0.0, 0.0
+                side = motion.uplift_side(t)
                 at_rest = False
                 out.n_uplifts += 1
                 note((t, "uplift"))

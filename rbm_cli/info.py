@@ -7,7 +7,7 @@ import math
 import numpy as np
 from scipy.linalg import eig
 
-from .config_types import Config
+from .config_types import Config, G
 from .simulate import model_from_config
 
 
@@ -21,17 +21,13 @@ def describe(config: Config) -> dict:
     model = model_from_config(config)
     col = model.column
     n = col.n
-    ones = np.ones(n)
-    p = math.sqrt(col.normal_forces[0] * col.lever_arms[0] / (ones @ model.mass @ ones))
+    p = model.rocking_p
     freqs: list[float] = []
     if not model.rigid:
         slopes = np.array([law.slopes[0] for law in model.laws])
-        stiff = model.diff.T @ (slopes[:, None] * model.arg_map) - model.gravity
-        w2 = np.real(eig(stiff, model.mass, right=False))
+        w2 = np.real(eig(model.stiffness(slopes), model.mass, right=False))
         freqs = sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
-    uplift = None
-    if n == 1 and model.laws[0].rigid:
-        uplift = float(model.laws[0].intercepts[0] / abs(model.ground_load[0]) / 9.81)
+    uplift = model.uplift_level / G if model.uplift_level is not None else None
     interfaces = []
     for i in range(n):
         interfaces.append(

@@ -121,15 +121,9 @@ def integrate(
     stepper = _METHODS[solver.method]
     atol = solver.atol * np.concatenate([np.full(n, tu.min()), np.full(n, tu.min() * 10.0)])
 
-    # rocking frequency of the rigid stack, to scale the rest threshold
-    ones = np.ones(n)
-    p_stack = math.sqrt(col.normal_forces[0] * col.lever_arms[0] / (ones @ model.mass @ ones))
-    rest_rate = REST_RATE * p_stack * tu.min()
-    rigid_mono = n == 1 and model.laws[0].rigid
-    uplift_level = None
-    if rigid_mono:
-        f0 = model.laws[0].intercepts[0]  # f(0+) = xi M_u
-        uplift_level = f0 / abs(model.ground_load[0])
+    rest_rate = REST_RATE * model.rocking_p * tu.min()
+    uplift_level = model.uplift_level
+    rigid_mono = uplift_level is not None
     # early stop of free motion (after a half-sine pulse), monolithic columns:
     # energy never grows in free motion, so once a peak has been passed with
     # the energy below the collapse barrier, no later peak is larger.
@@ -172,24 +166,17 @@ def integrate(
 
         while t < seg_end:
             if at_rest:
-                if free_seg:
-                    if record:
-                        emit_until(motion.t_end, rest=True)
-                    t = motion.t_end
+                kind, t_stop = motion.rest_end(t, seg_end, uplift_level, not free_seg)
+                if record:
+                    emit_until(t_stop - (1e-15 if kind == "uplift" else 0.0), rest=True)
+                t = t_stop
+                if kind == "end":
                     out.t_end = t
                     return out
-                t_up = motion.next_exceedance(t, uplift_level)
-                if t_up is None or t_up >= seg_end:
-                    if record:
-                        emit_until(seg_end, rest=True)
-                    t = seg_end
+                if kind == "segment":
                     break
-                if record:
-                    emit_until(t_up - 1e-15, rest=True)
-                t = t_up
                 y = np.zeros(2 * n)
-                a_now = motion.accel(t)
-                pieces.side[0] = -1 if a_now > 0 else 1
+                pieces.side[0] = motion.uplift_side(t)
                 pieces.k[0] = 0
                 at_rest = False
                 out.n_uplifts += 1

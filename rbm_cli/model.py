@@ -22,6 +22,7 @@ theta'' = A theta + c + e a_g(t).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,11 +95,32 @@ class Model:
         grav = -0.5 * np.einsum("ki,ij,kj->k", theta, self.gravity, theta)
         return kin + pot + grav
 
+    @property
+    def rocking_p(self) -> float:
+        """p of the column rocking as one rigid stack on its base [rad/s]:
+        p^2 = N_1 zbar_1 / (1^T M 1); for n = 1, m g (H/2) / (I_G + m H^2/4)."""
+        col = self.column
+        ones = np.ones(self.n)
+        return math.sqrt(col.normal_forces[0] * col.lever_arms[0] / (ones @ self.mass @ ones))
+
+    @property
+    def uplift_level(self) -> float | None:
+        """Ground acceleration at which a rigid monolith starts rocking [m/s^2]:
+        f(0+) / (m h / 2) = xi M_u / (m h / 2); None unless n = 1 with a rigid law."""
+        if self.n != 1 or not self.laws[0].rigid:
+            return None
+        return float(self.laws[0].intercepts[0] / abs(self.ground_load[0]))
+
+    def stiffness(self, slopes: np.ndarray) -> np.ndarray:
+        """Stiffness matrix [N m/rad] of active law pieces of the given slopes,
+        gravity of the `geometric` formulation included."""
+        return self.diff.T @ (slopes[:, None] * self.arg_map) - self.gravity
+
     def linear_system(self, intercepts: np.ndarray, slopes: np.ndarray):
         """(A, c, e) of theta'' = A theta + c + e a_g for active pieces
         f_i(x) = intercepts_i + slopes_i x."""
         minv = self.mass_inv
-        stiff = self.diff.T @ (slopes[:, None] * self.arg_map) - self.gravity
+        stiff = self.stiffness(slopes)
         return -minv @ stiff, -minv @ (self.diff.T @ intercepts), -minv @ self.ground_load
 
     def shear_ratios(self, accel: np.ndarray, ground_accel: np.ndarray) -> np.ndarray:

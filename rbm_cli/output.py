@@ -100,12 +100,16 @@ def json_ready(obj: Any) -> Any:
     return obj
 
 
-def write_json_atomic(path: str | os.PathLike, obj: Any) -> Path:
-    """Write ``obj`` as indented, strict JSON (nan/inf as null), atomically."""
-    text = json.dumps(json_ready(obj), indent=2, allow_nan=False) + "\n"
+def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
+    """Write text (UTF-8), atomically."""
     with _atomic_target(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return Path(path)
+
+
+def write_json_atomic(path: str | os.PathLike, obj: Any) -> Path:
+    """Write ``obj`` as indented, strict JSON (nan/inf as null), atomically."""
+    return write_text_atomic(path, json.dumps(json_ready(obj), indent=2, allow_nan=False) + "\n")
 
 
 def save_figure_atomic(fig, path: str | os.PathLike, dpi: int = 150) -> Path:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -92,12 +92,15 @@ class RunResult:
         finite = [v for v in self.friction_demand if np.isfinite(v)]
         return max(finite) if finite else float("nan")
 
+    def row(self) -> dict:
+        """The domain.csv fields, in CSV_FIELDS order (collapsed as 0/1)."""
+        out = {k: getattr(self, k) for k in CSV_FIELDS}
+        out["collapsed"] = int(self.collapsed)
+        return out
+
     def summary(self) -> dict:
         """The domain.csv fields plus friction demand and wall time (JSON-ready)."""
-        d = asdict(self)
-        d.pop("history")
-        out = {k: d[k] for k in CSV_FIELDS if k in d}
-        out["collapsed"] = int(self.collapsed)
+        out = self.row()
         out["friction_demand"] = [v if np.isfinite(v) else None for v in self.friction_demand]
         out["max_friction_demand"] = self.max_friction_demand
         out["wall_time_s"] = self.wall_time_s

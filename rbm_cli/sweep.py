@@ -27,8 +27,9 @@ import pandas as pd
 
 from . import __version__
 from .config_types import Config
-from .domain import boundary, cell_key, csv_text, read_domain, result_row
+from .domain import boundary, cell_key, csv_text
 from .errors import RbmError
+from .result import CSV_FIELDS
 
 JOURNAL = "domain.partial.jsonl"
 STATE = "domain.partial.json"
@@ -68,7 +69,7 @@ def run_chunk(config: Config, cells: list[tuple[float, float]]) -> list[dict]:
     rows = []
     for a, f in cells:
         try:
-            rows.append(result_row(simulate(config, a, f, model=model)))
+            rows.append(simulate(config, a, f, model=model).row())
         except Exception as exc:  # a sweep goes on past one bad cell
             rows.append(
                 {
@@ -203,13 +204,13 @@ def run_sweep(
     wall = time.perf_counter() - start
 
     # the complete domain, in grid order, written atomically
-    from .output import save_figure_atomic, write_json_atomic
+    from .output import save_figure_atomic, write_json_atomic, write_text_atomic
 
-    text = csv_text([done[cell_key(*c)] for c in cells])
-    _write_text_atomic(folder / "domain.csv", text)
-    df = read_domain(folder / "domain.csv")
+    rows = [done[cell_key(*c)] for c in cells]
+    write_text_atomic(folder / "domain.csv", csv_text(rows))
+    df = pd.DataFrame(rows, columns=list(CSV_FIELDS))
     bnd = boundary(df)
-    _write_text_atomic(
+    write_text_atomic(
         folder / "boundary.csv",
         csv_text(bnd.to_dict("records"), tuple(bnd.columns)),
     )
@@ -244,12 +245,6 @@ def run_sweep(
         n_failed=int(counts.get("failed", 0)),
         wall_time_s=wall,
     )
-
-
-def _write_text_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def _parallel(config, chunks, jobs, backend, scheduler) -> Iterable[list[dict]]:

@@ -12,8 +12,10 @@ finding on the step's dense output:
   multiplied by the restitution e and the integrator restarts;
 - a collapse quantity reaching c times its limit: the run stops.
 
-A single scalar event function, the smallest normalised distance to any of
-these surfaces, is evaluated once per step (vectorised over interfaces).
+The normalised distances to these surfaces are evaluated once per step
+(vectorised over interfaces); a step that comes within reach of a surface is
+checked on its dense output, and the earliest crossing of any surface is the
+event (events.first_crossing).
 
 For a rigid monolithic column the column stays at rest, with no integration,
 until the ground demand exceeds the uplift level (found exactly from the
@@ -25,13 +27,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
-from scipy.optimize import brentq
 
 from .config_types import SolverConfig
-from .events import Pieces, hermite_dip, hermite_peaks
+from .events import Pieces, first_crossing, hermite_peaks, within_reach
 from .excitation import GroundMotion
 from .model import Model
 
@@ -194,14 +196,16 @@ def integrate(
                 + EVENT_EPS
             )
 
-            def gfun(yy, h0=h0):
-                return float(np.min(g_rows @ yy[:n] + h0))
+            def dist(dense, ts, h0=h0):
+                yy = dense(ts)
+                return g_rows @ yy[:n] + h0[:, None], g_rows @ yy[n:]
 
             integ = stepper(fun, t, y, seg_end, rtol=solver.rtol, atol=atol)
             z_old = track @ y[:n]
             dz_old = track @ y[n:]
             d_old = g_rows @ y[:n] + h0
             dd_old = g_rows @ y[n:]
+            d2_old = g_rows @ (A @ y[:n] + cvec + evec * ag(t))
             event = False
             while integ.status == "running":
                 msg = integ.step()
@@ -214,46 +218,36 @@ def integrate(
                 t_new, y_new = integ.t, integ.y
                 d_new = g_rows @ y_new[:n] + h0
                 dd_new = g_rows @ y_new[n:]
-                t_hit = None
+                acc = A @ y_new[:n] + cvec + evec * ag(t_new)
+                d2_new = g_rows @ acc
+                hit = None
                 dense = None
-                if d_new.min() < 0.0:
-                    t_hit = t_new
-                else:
-                    # a surface touched and left inside the step: the cubic Hermite
-                    # of each distance has an interior minimum below zero
-                    t_min = hermite_dip(d_old, d_new, dd_old, dd_new, t_new - t_old)
-                    if t_min is not None:
-                        dense = integ.dense_output()
-                        if gfun(dense(t_old + t_min)) < 0.0:
-                            t_hit = t_old + t_min
-                if t_hit is not None:
-                    if dense is None:
-                        dense = integ.dense_output()
-                    if gfun(dense(t_old)) <= 0.0:
-                        t_e = t_old
-                    else:
-                        t_e = brentq(
-                            lambda s, dense=dense: gfun(dense(s)), t_old, t_hit, xtol=1e-14
-                        )
+                # a surface crossed, or touched and left, inside the step: found on
+                # the dense output, the earliest crossing of any row
+                if within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old):
+                    dense = integ.dense_output()
+                    hit = first_crossing(partial(dist, dense), t_old, t_new)
+                if hit is not None:
+                    t_e, event_row = hit
                     y_new = dense(t_e)
+                    acc = A @ y_new[:n] + cvec + evec * ag(t_e)
                     t_new = t_e
                     if record:
                         emit_until(t_e, dense)
                     event = True
                 elif record:
-                    emit_until(t_new, integ.dense_output())
+                    emit_until(t_new, dense if dense is not None else integ.dense_output())
                 # peaks and friction demand over [t_old, t_new]
                 z_new = track @ y_new[:n]
                 dz_new = track @ y_new[n:]
                 peaks = hermite_peaks(z_old, z_new, dz_old, dz_new, t_new - t_old)
                 out.max_ratio = np.maximum(out.max_ratio, peaks[:n])
                 out.max_top = max(out.max_top, peaks[n])
-                acc = A @ y_new[:n] + cvec + evec * ag(t_new)
                 fr = model.shear_ratios(acc[None, :], np.array([ag(t_new)]))[0]
                 out.friction = np.maximum(out.friction, fr)
                 z_prev, dz_prev = z_old, dz_old
                 z_old, dz_old = z_new, dz_new
-                d_old, dd_old = d_new, dd_new
+                d_old, dd_old, d2_old = d_new, dd_new, d2_new
                 t, y = t_new, y_new
                 if event:
                     break
@@ -275,8 +269,7 @@ def integrate(
             out.n_events += 1
             if out.n_events > solver.max_events:
                 return out.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
-            row = int(np.argmin(g_rows @ y[:n] + h0))
-            which, i = divmod(row, n)
+            which, i = divmod(event_row, n)
             if which >= 2:
                 out.status = "collapsed"
                 out.t_collapse = t

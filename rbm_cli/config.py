@@ -55,15 +55,19 @@ __all__ = ["load_config", "parse_config"]
 
 TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
 COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
-INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation")
+INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation", "friction")
 EXCITATION_KEYS = ("type", "duration", "phase", "initial")
 INITIAL_KEYS = ("rotations", "velocities")
 GRID_KEYS = ("amplitudes", "frequencies")
 COLLAPSE_KEYS = ("ratio",)
-SOLVER_KEYS = ("method", "rtol", "atol", "max_steps", "max_events")
+SOLVER_KEYS = ("method", "rtol", "atol", "max_steps", "max_events", "time_step")
 
 #: Models of SPEC section 2 that this version does not implement yet.
-PLANNED_MODELS = ("bullet",)
+PLANNED_MODELS: tuple[str, ...] = ()
+#: Models that accept any number of drums (the reference blocks are monolithic).
+MULTI_DRUM_MODELS = ("rbm", "bullet")
+#: Range of solver.time_step, the contact engine's fixed step [s].
+TIME_STEP_RANGE = (1e-6, 1e-2)
 #: Default ``excitation.duration`` per type [s] (SPEC section 3).
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
 MAX_DURATION = 1e4  # [s]
@@ -161,13 +165,13 @@ def _config(data: Any) -> Config:
     model = choice(model, "model", MODELS)
     column = _column(top["column"])
     n = column.n_drums
-    if model != "rbm" and n != 1:
+    if model not in MULTI_DRUM_MODELS and n != 1:
         raise ConfigError(f"model {model!r} needs a monolithic column (drums: 1), got {n} drums")
     return Config(
         name=name,
         column=column,
         model=model,
-        interface=_interface(top.get("interface"), n),
+        interface=_interface(top.get("interface"), n, model),
         excitation=_excitation(top.get("excitation"), n),
         grid=_grid(top.get("grid")),
         collapse=CollapseConfig(
@@ -254,8 +258,17 @@ def _drums(value: Any, height: float) -> tuple[float, ...]:
     return heights
 
 
-def _interface(raw: Any, n: int) -> InterfaceConfig:
+def _interface(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
     i = mapping(raw, "interface", INTERFACE_KEYS)
+    if "friction" in i and model != "bullet":
+        raise ConfigError(
+            f"interface.friction applies only to model bullet (model is {model}, which does"
+            " not slide): delete it"
+        )
+    friction = number(i.get("friction", 1.0), "interface.friction", "", 0.0)
+    stiffness = i.get("stiffness", "rigid")
+    if model == "bullet" and isinstance(stiffness, str) and stiffness == "rigid":
+        n = 1  # the engine's drums are rigid; the RBM's joint law is not used
     restitution = i.get("restitution", 1.0)
     if isinstance(restitution, str) and restitution == "housner":
         if n != 1:
@@ -275,6 +288,7 @@ def _interface(raw: Any, n: int) -> InterfaceConfig:
         xi=number(i.get("xi", 1.0), "interface.xi", "", 0.0, 1.0),
         restitution=restitution,
         formulation=choice(i.get("formulation", "relative"), "interface.formulation", FORMULATIONS),
+        friction=friction,
     )
 
 
@@ -365,4 +379,11 @@ def _solver(raw: Any) -> SolverConfig:
         atol=number(s.get("atol", default.atol), "solver.atol", "", 0.0, 1e-3),
         max_steps=integer(s.get("max_steps", default.max_steps), "solver.max_steps", 1000),
         max_events=integer(s.get("max_events", default.max_events), "solver.max_events", 100),
+        time_step=number(
+            s.get("time_step", default.time_step),
+            "solver.time_step",
+            "s",
+            *TIME_STEP_RANGE,
+            lo_open=False,
+        ),
     )

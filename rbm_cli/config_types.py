@@ -16,7 +16,8 @@ G = 9.81
 #: rbm: the Rigid Beam Model; housner: Housner's nonlinear rigid block (large
 #: rotations, true geometry); housner-linear: the piecewise-linear block of
 #: Spanos and Koh (closed form, true geometry). The last two: monolithic only.
-MODELS = ("rbm", "housner", "housner-linear")
+#: bullet: stacked rigid drums in Bullet's contact dynamics (PyBullet), any drums.
+MODELS = ("rbm", "housner", "housner-linear", "bullet")
 SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
 EXCITATIONS = ("harmonic", "half-sine", "free")
@@ -68,12 +69,15 @@ class InterfaceConfig:
     """Moment-rotation law of the interfaces.
 
     restitution : float or str  Angular-velocity ratio in (0, 1], or 'housner'
+    friction : float  Coulomb friction coefficient of the joints and the base
+        (model bullet only; the RBM and the reference models do not slide) [-]
     """
 
     stiffness: StiffnessConfig = field(default_factory=StiffnessConfig)
     xi: float = 1.0
     restitution: float | str = 1.0
     formulation: str = "relative"
+    friction: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -124,6 +128,7 @@ class SolverConfig:
     rtol, atol : float  Tolerances (atol relative to the rotation scale theta_u)
     max_steps : int  Step budget of one run; beyond it the run is 'failed'
     max_events : int  Budget of events (kinks, impacts) of one run
+    time_step : float  Fixed time step of the contact engine (model bullet) [s]
     """
 
     method: str = "DOP853"
@@ -131,6 +136,7 @@ class SolverConfig:
     atol: float = 1e-12
     max_steps: int = 2_000_000
     max_events: int = 200_000
+    time_step: float = 1e-4
 
 
 @dataclass(frozen=True)

@@ -76,6 +76,8 @@ def simulate(
         if not (math.isfinite(frequency_hz) and frequency_hz > 0):
             raise RbmError(f"frequency must be a number > 0 [Hz], got {frequency_hz}")
     start = time.perf_counter()
+    if config.model == "bullet":
+        return _engine_run(config, amplitude_g, frequency_hz, record, output_dt, start)
     if config.model != "rbm":
         return _reference_run(config, amplitude_g, frequency_hz, record, output_dt, start)
     if model is None:
@@ -132,6 +134,16 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         wall_time_s=wall,
         history=history,
     )
+
+
+def _engine_run(config, amplitude_g, frequency_hz, record, output_dt, start) -> RunResult:
+    """`bullet`: the drums in PyBullet's contact dynamics (history from drum positions)."""
+    from .bullet import bullet_run
+
+    motion = make_ground_motion(config.excitation, amplitude_g, frequency_hz)
+    dt = output_dt if output_dt is not None else 0.002
+    out, history = bullet_run(config, motion, record=record, output_dt=dt, early_stop=not record)
+    return _result(config, out, amplitude_g, frequency_hz, history, start)
 
 
 def _reference_run(config, amplitude_g, frequency_hz, record, output_dt, start) -> RunResult:

@@ -1,0 +1,198 @@
+"""`model: bullet`: stacked rigid drums in PyBullet's contact dynamics.
+
+Expected values come from outside the engine: the frustum's mass, centroid and
+corner inertia from the independent polynomial integrals of `housner`
+(themselves checked against triple integrals in test_reference.py), Housner's
+impact formula e = 1 - 1.5 sin^2(alpha) written here, the statics of a rigid
+block (no motion below tan(alpha) g), and Housner's model itself run with the
+engine's measured impact loss. CI grid: 3 amplitudes x 2 frequencies per column
+(12 cells; docs/make_engine.py runs the issue's 6 x 5 grid).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from rbm_cli.bullet import EngineSettings, bullet_run, measure_restitution
+from rbm_cli.bullet_geometry import drum_solids, stack_slenderness
+from rbm_cli.cli import cli
+from rbm_cli.config import parse_config
+from rbm_cli.config_types import G
+from rbm_cli.excitation import GroundMotion
+from rbm_cli.housner import block_geometry
+from rbm_cli.simulate import simulate
+
+BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}  # Spanos-Koh slender, H/B = 4
+TAPER = {"height": 5.0, "base_width": 0.96, "top_width": 0.66}  # the paper's column
+
+
+def config(column, model="bullet", duration=10.0, **interface):
+    data = {
+        "name": "t",
+        "model": model,
+        "column": dict(column),
+        "excitation": {"type": "harmonic", "duration": duration},
+    }
+    if interface:
+        data["interface"] = interface
+    return parse_config(data)
+
+
+def harmonic(amplitude_g, frequency_hz, duration):
+    w = 2 * math.pi * frequency_hz
+    return GroundMotion("harmonic", amplitude_g * G, w, 0.0, duration, duration)
+
+
+# ---------------------------------------------------------------------- geometry
+
+
+@pytest.mark.parametrize("column", [BLOCK, TAPER, {**TAPER, "section": "circular"}])
+def test_drum_solid_matches_the_true_block(column):
+    """Mass, centre of mass and corner inertia of the monolith's solid equal the
+    independent integrals of `housner` (guards the inertia handed to Bullet)."""
+    cfg = config(column)
+    (drum,) = drum_solids(cfg.column)
+    geo = block_geometry(cfg.column)
+    assert drum.mass == pytest.approx(geo.mass, rel=1e-12)
+    assert drum.centre == pytest.approx(geo.centre_height, rel=1e-12)
+    corner = drum.inertia[1] + drum.mass * (geo.half_base**2 + drum.centre**2)
+    assert corner == pytest.approx(geo.corner_inertia, rel=1e-12)
+    assert stack_slenderness((drum,))[0] == pytest.approx(geo.slenderness, rel=1e-12)
+
+
+def test_drums_add_up_to_the_monolith():
+    """Eight drums have the monolith's mass and centre of mass; a box drum's
+    inertias are m (h^2 + w^2) / 12 and m (2 w^2) / 12 (square section)."""
+    mono = drum_solids(config(TAPER).column)[0]
+    drums = drum_solids(config({**TAPER, "drums": 8}).column)
+    mass = sum(d.mass for d in drums)
+    centre = sum(d.mass * (d.bottom + d.centre) for d in drums) / mass
+    assert mass == pytest.approx(mono.mass, rel=1e-12)
+    assert centre == pytest.approx(mono.centre, rel=1e-12)
+    (box,) = drum_solids(config(BLOCK).column)
+    m = 2700.0 * 4.0
+    assert box.box and box.mass == pytest.approx(m)
+    assert box.inertia == pytest.approx((m * 17 / 12, m * 17 / 12, m * 2 / 12))
+
+
+# --------------------------------------------------------------------- impacts
+
+
+def housner_e(height, width):
+    """Housner (1963): e = 1 - 1.5 sin^2(alpha) for a uniform rectangle."""
+    return 1.0 - 1.5 * math.sin(math.atan(width / height)) ** 2
+
+
+def test_impact_loss_close_to_housner():
+    """The engine's own impact loss on a 4 x 1 m block (restitution 0 at the
+    contact points): angular-velocity ratios within 0.03 of Housner's 0.912."""
+    ratios = measure_restitution(config(BLOCK), tilt_fraction=0.5, impacts=4)
+    assert len(ratios) == 4
+    assert np.all(np.abs(ratios - housner_e(4.0, 1.0)) < 0.03), ratios
+
+
+def test_impact_loss_grows_with_slenderness_ratio():
+    """A squat block loses more at an impact than a slender one (Housner:
+    0.70 at H/B = 2 against 0.91 at H/B = 4); guards a loss that ignores geometry.
+    (Measured: the engine loses more than Housner on the squat block, 0.60-0.69;
+    docs/engine.md.)"""
+    thick = measure_restitution(config({**BLOCK, "height": 2.0}), impacts=3)
+    assert np.all((thick > 0.0) & (thick < housner_e(2.0, 1.0) + 0.03)), thick
+    assert np.max(thick) < np.min(measure_restitution(config(BLOCK), impacts=3))
+
+
+# ------------------------------------------------------------------------- runs
+
+
+def test_rest_below_the_uplift_level():
+    """Below tan(alpha) g the rigid block cannot move (statics): the engine,
+    run without the shortcut, keeps it still, and the shortcut skips the run."""
+    cfg = config(BLOCK, duration=2.0)
+    motion = harmonic(0.9 * 0.25, 2.0, 2.0)  # tan(alpha) = B / H = 0.25
+    out, history = bullet_run(cfg, motion, record=True, output_dt=0.01)
+    assert out.status == "survived"
+    assert np.max(np.abs(history.rotations)) < 1e-4
+    assert np.max(out.max_ratio) < 1e-3
+    skipped = simulate(cfg, 0.9 * 0.25, 2.0)
+    assert skipped.status == "survived" and skipped.n_steps == 0
+
+
+def test_big_pulse_collapses_and_is_reported():
+    """A 4 x 1 m block under 1 g at 0.5 Hz overturns within the first cycles
+    (Housner's model does too); collapse time, base joint and ratio reported."""
+    r = simulate(config(BLOCK, duration=6.0), 1.0, 0.5)
+    ref = simulate(config(BLOCK, model="housner", duration=6.0, restitution=0.91), 1.0, 0.5)
+    assert r.status == ref.status == "collapsed"
+    assert r.collapse_interface == 1
+    assert r.t_collapse_s == pytest.approx(ref.t_collapse_s, abs=0.05)
+    assert r.max_rotation_ratio >= 1.0
+    assert "max slip" in r.message
+
+
+def test_multidrum_run_records_drum_positions():
+    """An 8-drum column runs; its history holds n + 1 node positions and n tilts,
+    and the top moves more than the base node (guards the node order)."""
+    cfg = config({**TAPER, "drums": 8}, duration=1.5)
+    r = simulate(cfg, 0.5, 1.5, record=True, output_dt=0.01)
+    h = r.history
+    assert h.node_displacements.shape == (len(h.t), 9)
+    assert h.rotations.shape == (len(h.t), 8)
+    assert np.max(np.abs(h.node_displacements[:, -1])) > np.max(np.abs(h.node_displacements[:, 0]))
+    assert r.n_steps == 15000
+
+
+def test_same_cell_same_answer():
+    """Runs are reproducible (the engine is reset between runs): a sweep's
+    file must not depend on what a worker ran before."""
+    cfg = config(TAPER, duration=3.0)
+    a = simulate(cfg, 0.5, 1.0)
+    simulate(config(BLOCK, duration=1.0), 0.6, 2.0)
+    b = simulate(cfg, 0.5, 1.0)
+    assert a.row() == b.row()
+
+
+# ------------------------------------------------------------ against Housner
+
+#: CI grid: 3 amplitudes x 2 frequencies per column (amplitudes over the uplift level).
+CI_LEVELS = (1.3, 2.0, 3.0)
+CI_FREQUENCIES = (1.0, 2.0)
+
+
+@pytest.mark.parametrize("column", [BLOCK, TAPER], ids=["block", "tapered"])
+def test_engine_agrees_with_housner(column):
+    """The issue's bar: a monolithic block and the tapered column agree with
+    `housner` (run with the engine's measured impact loss) on >= 95 % of cells."""
+    engine = config(column)
+    e = float(np.mean(measure_restitution(engine, impacts=4)))
+    ref = config(column, model="housner", restitution=round(e, 3))
+    level = math.tan(stack_slenderness(drum_solids(engine.column))[0])
+    cells = [(round(k * level, 3), f) for k in CI_LEVELS for f in CI_FREQUENCIES]
+    same = [simulate(engine, a, f).status == simulate(ref, a, f).status for a, f in cells]
+    assert sum(same) >= 0.95 * len(cells), list(zip(cells, same, strict=True))
+
+
+# ------------------------------------------------------------------- bad input
+
+
+def test_bad_friction_is_one_line(tmp_path):
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "name: x\nmodel: bullet\ncolumn: {height: 4, base_width: 1}\ninterface: {friction: 0}\n"
+    )
+    result = CliRunner().invoke(cli, ["run", str(path), "-a", "0.5", "-f", "1"])
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "interface.friction must be a number > 0" in lines[0]
+    assert "Traceback" not in result.output
+
+
+def test_engine_settings_are_the_scoped_ones():
+    """The issue's scoping values; a change must be deliberate."""
+    s = EngineSettings()
+    assert (s.time_step, s.solver_iterations, s.erp, s.friction) == (1e-4, 100, 0.2, 1.0)
+    assert dataclasses.replace(s, friction=0.5).friction == 0.5

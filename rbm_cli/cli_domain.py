@@ -141,16 +141,25 @@ def plot_domain_cmd(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.backend_bases import FigureCanvasBase
 
     from .domain import read_domain
     from .output import save_figure_atomic
     from .plot_domain import plot_domain
 
+    if png is not None and not png.strip():
+        raise UserError("--output must name an image file (e.g. domain.png), got ''")
     try:
         df = read_domain(domain_csv)
         dfs = [read_domain(p) for p in others]
         cfg = _config_for(domain_csv, config_path)
         target = Path(png) if png else Path(domain_csv).with_name("domain.png")
+        kinds = FigureCanvasBase.get_supported_filetypes()
+        if target.suffix and target.suffix.lstrip(".").lower() not in kinds:
+            raise UserError(
+                f"--output {target}: unknown image type {target.suffix!r}"
+                f" (allowed: {', '.join(sorted(kinds))})"
+            )
         labels = [Path(domain_csv).parent.name or "domain"] + [Path(p).parent.name for p in others]
         if cfg is not None:
             from .sweep import domain_figure

@@ -72,7 +72,10 @@ TIME_STEP_RANGE = (1e-6, 1e-2)
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
 MAX_DURATION = 1e4  # [s]
 MAX_DRUMS = 200
-MAX_TOP_TAPER = 3.0  # top_width <= MAX_TOP_TAPER * base_width
+MAX_TOP_TAPER = 3.0  # top_width <= MAX_TOP_TAPER * base_width (and <= height)
+#: Heights of a column or block the tool accepts [m] [assumption]: a laboratory
+#: block to a tower; far outside, masses and inertias overflow or underflow.
+HEIGHT_RANGE = (1e-3, 1e3)
 MAX_FILE_BYTES = 1_000_000
 DRUM_SUM_RTOL = 1e-9
 NAME_RE = re.compile(r"[A-Za-z0-9_.\-]{1,100}")
@@ -204,6 +207,11 @@ def _column(raw: Any) -> ColumnConfig:
         if key not in c:
             raise ConfigError(f"column.{key} is required (a number > 0 [m])")
     height = number(c["height"], "column.height", "m", 0.0)
+    if not HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]:
+        raise ConfigError(
+            f"column.height must be in [{fmt(HEIGHT_RANGE[0])}, {fmt(HEIGHT_RANGE[1])}] [m]"
+            f" (a laboratory block to a tower), got {fmt(height)}"
+        )
     base = number(c["base_width"], "column.base_width", "m", 0.0)
     if base > height:
         raise ConfigError(
@@ -215,8 +223,8 @@ def _column(raw: Any) -> ColumnConfig:
         "column.top_width",
         "m",
         0.0,
-        MAX_TOP_TAPER * base,
-        hint=f"at most {fmt(MAX_TOP_TAPER)} x column.base_width",
+        min(MAX_TOP_TAPER * base, height),
+        hint=f"at most {fmt(MAX_TOP_TAPER)} x column.base_width and at most column.height",
     )
     section = choice(c.get("section", "rectangular"), "column.section", SECTIONS)
     depth = None

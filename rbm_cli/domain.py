@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import RbmError
-from .result import CSV_FIELDS
+from .result import CSV_FIELDS, STATUSES
 
 #: Columns a domain CSV must have for plotting and comparing.
 REQUIRED = ("amplitude_g", "frequency_hz", "status")
@@ -59,14 +59,62 @@ def read_domain(path: str | Path) -> pd.DataFrame:
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         reason = " ".join(str(exc).split())
         raise RbmError(f"cannot read {path} as a domain CSV: {reason}") from None
+    except OSError as exc:  # unreadable (permissions), I/O error
+        raise RbmError(f"cannot read {path}: {exc.strerror or exc}") from None
     missing = [c for c in REQUIRED if c not in df.columns]
     if missing:
         raise RbmError(f"{path} is not a domain CSV: missing column(s) {', '.join(missing)}")
+    if not isinstance(df.index, pd.RangeIndex):
+        raise RbmError(
+            f"{path} is not a domain CSV: some rows have more fields than its header"
+            f" ({len(df.columns)})"
+        )
     if df.empty:
         raise RbmError(f"{path} has no rows")
+    _check_cells(df, path)
     if "collapsed" not in df.columns:
         df["collapsed"] = (df["status"] == "collapsed").astype(int)
     return df
+
+
+def _check_cells(df: pd.DataFrame, path: Path) -> None:
+    """Values of the required columns: amplitude_g finite >= 0 [g], frequency_hz
+    finite > 0 [Hz], status one of STATUSES, and each cell once. Raises an
+    RbmError naming the first bad line (the header is line 1); converts the two
+    numeric columns to float in place."""
+
+    def got(value) -> str:
+        return "an empty field" if pd.isna(value) else repr(str(value))
+
+    for col, unit, positive in (("amplitude_g", "g", False), ("frequency_hz", "Hz", True)):
+        raw = df[col]
+        x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isfinite(x) | ((x <= 0.0) if positive else (x < 0.0))
+        if bad.any():
+            i = int(np.argmax(bad))
+            rng = "> 0" if positive else ">= 0"
+            raise RbmError(
+                f"{path}: line {i + 2}: {col} must be a finite number {rng} [{unit}],"
+                f" got {got(raw.iloc[i])}"
+            )
+        df[col] = x
+    bad = ~df["status"].isin(STATUSES).to_numpy()
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RbmError(
+            f"{path}: line {i + 2}: status must be one of {', '.join(STATUSES)},"
+            f" got {got(df['status'].iloc[i])}"
+        )
+    keys = [cell_key(a, f) for a, f in zip(df["amplitude_g"], df["frequency_hz"], strict=True)]
+    seen: dict[tuple[str, str], int] = {}
+    for i, key in enumerate(keys):
+        if key in seen:
+            raise RbmError(
+                f"{path}: line {i + 2} repeats the cell of line {seen[key] + 2}"
+                f" (amplitude {key[0]} g, frequency {key[1]} Hz)"
+            )
+        seen[key] = i
 
 
 def boundary(df: pd.DataFrame) -> pd.DataFrame:

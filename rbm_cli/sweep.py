@@ -152,13 +152,15 @@ def run_sweep(
     progress : callable(done, total)  Called as chunks finish
     stop_after : int  Stop after this many chunks (tests of interruption)
     """
-    cells = grid_cells(config)
-    if not cells:
+    # counted before the cells are listed: a 10^8-cell grid is refused at once
+    n_cells = len(config.grid.amplitudes_g) * len(config.grid.frequencies_hz)
+    if not n_cells:
         raise RbmError("the config has no grid: give grid.amplitudes and grid.frequencies")
-    if len(cells) > MAX_CELLS and not force:
+    if n_cells > MAX_CELLS and not force:
         raise RbmError(
-            f"the grid has {len(cells):,} cells (more than {MAX_CELLS:,}); use --force to run it"
+            f"the grid has {n_cells:,} cells (more than {MAX_CELLS:,}); use --force to run it"
         )
+    cells = grid_cells(config)
     if jobs < 1:
         raise RbmError(f"--jobs must be >= 1, got {jobs}")
     if backend not in BACKENDS:

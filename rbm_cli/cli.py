@@ -322,7 +322,7 @@ def info(config: str, as_json: bool) -> None:
 
 
 # sweep, plot-domain and compare live in their own module, registered on `cli`
-from . import cli_domain  # noqa: E402, F401
+from . import cli_bench, cli_domain  # noqa: E402, F401
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -33,6 +33,15 @@ from .errors import RbmError
 )
 @click.option("--resume", is_flag=True, help="Finish an interrupted sweep of the same config.")
 @click.option("--force", is_flag=True, help="Allow grids of more than 100,000 cells.")
+@click.option(
+    "--ensemble",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    metavar="K",
+    help="Run each cell K times, phase and amplitude perturbed by up to 1e-6 (rad, "
+    "relative), and add the collapse_fraction column: which cells are robust.",
+)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
 def sweep(
     config: str,
@@ -42,6 +51,7 @@ def sweep(
     scheduler: str | None,
     resume: bool,
     force: bool,
+    ensemble: int,
     quiet: bool,
 ) -> None:
     """Run the config's amplitude x frequency grid and write the safe-unsafe domain.
@@ -86,6 +96,7 @@ def sweep(
             resume=resume,
             force=force,
             progress=progress,
+            ensemble=ensemble,
         )
     except RbmError as exc:
         raise UserError(_one_line(exc)) from None

@@ -36,6 +36,7 @@ from ._validate import (
 from .config_types import (
     EXCITATIONS,
     FORMULATIONS,
+    IMPLEMENTATIONS,
     METHODS,
     MODELS,
     SECTIONS,
@@ -60,7 +61,15 @@ EXCITATION_KEYS = ("type", "duration", "phase", "initial")
 INITIAL_KEYS = ("rotations", "velocities")
 GRID_KEYS = ("amplitudes", "frequencies")
 COLLAPSE_KEYS = ("ratio",)
-SOLVER_KEYS = ("method", "rtol", "atol", "max_steps", "max_events", "time_step")
+SOLVER_KEYS = (
+    "method",
+    "rtol",
+    "atol",
+    "max_steps",
+    "max_events",
+    "time_step",
+    "implementation",
+)
 
 #: Models of SPEC section 2 that this version does not implement yet.
 PLANNED_MODELS: tuple[str, ...] = ()
@@ -393,5 +402,10 @@ def _solver(raw: Any) -> SolverConfig:
             "s",
             *TIME_STEP_RANGE,
             lo_open=False,
+        ),
+        implementation=choice(
+            s.get("implementation", default.implementation),
+            "solver.implementation",
+            IMPLEMENTATIONS,
         ),
     )

@@ -22,6 +22,7 @@ SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
 EXCITATIONS = ("harmonic", "half-sine", "free")
 METHODS = ("DOP853", "RK45", "RK23")
+IMPLEMENTATIONS = ("compiled", "python")
 
 
 @dataclass(frozen=True)
@@ -129,6 +130,8 @@ class SolverConfig:
     max_steps : int  Step budget of one run; beyond it the run is 'failed'
     max_events : int  Budget of events (kinks, impacts) of one run
     time_step : float  Fixed time step of the contact engine (model bullet) [s]
+    implementation : str  'compiled' (the numba kernel, rbm_cli.kernel) or
+        'python' (the reference loop, rbm_cli.integrate); same algorithm
     """
 
     method: str = "DOP853"
@@ -137,6 +140,7 @@ class SolverConfig:
     max_steps: int = 2_000_000
     max_events: int = 200_000
     time_step: float = 1e-4
+    implementation: str = "compiled"
 
 
 @dataclass(frozen=True)

@@ -88,8 +88,11 @@ def simulate(
     theta0 = np.zeros(n) if not init.rotations else np.asarray(init.rotations, float)
     rate0 = np.zeros(n) if not init.velocities else np.asarray(init.velocities, float)
     dt = output_dt if output_dt is not None else 0.002
+    run = integrate
+    if config.solver.implementation == "compiled":
+        from .kernel import integrate_compiled as run
     try:
-        out = integrate(
+        out = run(
             model,
             motion,
             theta0,

@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 import os
 import platform
 import time
@@ -36,6 +37,11 @@ STATE = "domain.partial.json"
 #: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s).
 MAX_CELLS = 100_000
 BACKENDS = ("loky", "threading", "sequential", "dask")
+#: Ensemble members (--ensemble K): member j > 0 has the phase shifted by up to
+#: ENSEMBLE_PHASE [rad] and the amplitude scaled by 1 + up to ENSEMBLE_AMPLITUDE,
+#: with deterministic offsets (see ensemble_offsets); member 0 is the cell itself.
+ENSEMBLE_PHASE = 1e-6
+ENSEMBLE_AMPLITUDE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -61,25 +67,60 @@ def config_hash(config: Config) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def run_chunk(config: Config, cells: list[tuple[float, float]]) -> list[dict]:
-    """Run cells of one config in this process; a cell that raises is 'failed'."""
-    from .simulate import model_from_config, simulate
+def ensemble_offsets(k: int) -> list[tuple[float, float]]:
+    """(phase shift [rad], relative amplitude change) of ensemble members 0..k-1.
+
+    Member 0 is unperturbed; member j spreads the offsets over
+    [-ENSEMBLE_PHASE, ENSEMBLE_PHASE] and [-ENSEMBLE_AMPLITUDE, ENSEMBLE_AMPLITUDE]
+    with two incommensurate (golden-ratio and sqrt 2) sequences, the same for every cell,
+    so an ensemble domain is reproducible byte for byte."""
+    out = [(0.0, 0.0)]
+    for j in range(1, k):
+        u = 2.0 * ((j * 0.6180339887498949) % 1.0) - 1.0
+        v = 2.0 * ((j * 0.41421356237309515) % 1.0) - 1.0
+        out.append((ENSEMBLE_PHASE * u, ENSEMBLE_AMPLITUDE * v))
+    return out
+
+
+def _run_cell(config: Config, a: float, f: float, model) -> dict:
+    from .simulate import simulate
+
+    try:
+        return simulate(config, a, f, model=model).row()
+    except Exception as exc:  # a sweep goes on past one bad cell
+        return {
+            "amplitude_g": a,
+            "frequency_hz": f,
+            "status": "failed",
+            "collapsed": 0,
+            "message": f"{type(exc).__name__}: {' '.join(str(exc).split())}",
+        }
+
+
+def run_chunk(config: Config, cells: list[tuple[float, float]], ensemble: int = 1) -> list[dict]:
+    """Run cells of one config in this process; a cell that raises is 'failed'.
+
+    With ensemble K > 1 each cell is run K times (ensemble_offsets) and its row
+    is member 0's, plus collapse_fraction: the fraction of the members that did
+    not fail which collapsed (NaN if all failed)."""
+    from .simulate import model_from_config
 
     model = model_from_config(config) if config.model == "rbm" else None
     rows = []
+    offsets = ensemble_offsets(ensemble)
     for a, f in cells:
-        try:
-            rows.append(simulate(config, a, f, model=model).row())
-        except Exception as exc:  # a sweep goes on past one bad cell
-            rows.append(
-                {
-                    "amplitude_g": a,
-                    "frequency_hz": f,
-                    "status": "failed",
-                    "collapsed": 0,
-                    "message": f"{type(exc).__name__}: {' '.join(str(exc).split())}",
-                }
-            )
+        row = _run_cell(config, a, f, model)
+        if ensemble > 1:
+            flags = [row["collapsed"]] if row["status"] != "failed" else []
+            for dphi, da in offsets[1:]:
+                exc = dataclasses.replace(config.excitation, phase=config.excitation.phase + dphi)
+                member = _run_cell(
+                    dataclasses.replace(config, excitation=exc), a * (1 + da), f, model
+                )
+                if member["status"] != "failed":
+                    flags.append(member["collapsed"])
+            row["collapse_fraction"] = float(np.mean(flags)) if flags else math.nan
+        rows.append(row)
     return rows
 
 
@@ -137,6 +178,7 @@ def run_sweep(
     force: bool = False,
     progress: Callable[[int, int], None] | None = None,
     stop_after: int | None = None,
+    ensemble: int = 1,
 ) -> SweepSummary:
     """Run the grid of a config and write OUTPUT/<name>/domain.csv and friends.
 
@@ -151,6 +193,8 @@ def run_sweep(
     force : bool  Allow grids of more than MAX_CELLS cells
     progress : callable(done, total)  Called as chunks finish
     stop_after : int  Stop after this many chunks (tests of interruption)
+    ensemble : int  Runs per cell (>1 adds the collapse_fraction column; see
+        ensemble_offsets for the perturbations)
     """
     # counted before the cells are listed: a 10^8-cell grid is refused at once
     n_cells = len(config.grid.amplitudes_g) * len(config.grid.frequencies_hz)
@@ -163,6 +207,8 @@ def run_sweep(
     cells = grid_cells(config)
     if jobs < 1:
         raise RbmError(f"--jobs must be >= 1, got {jobs}")
+    if ensemble < 1:
+        raise RbmError(f"--ensemble must be >= 1, got {ensemble}")
     if backend not in BACKENDS:
         raise RbmError(f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
     folder = Path(output) / config.name
@@ -174,7 +220,8 @@ def run_sweep(
     except OSError as exc:
         raise RbmError(f"cannot write to output folder {folder}: {exc.strerror or exc}") from None
 
-    digest = config_hash(config)
+    digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
+    fields = CSV_FIELDS + (("collapse_fraction",) if ensemble > 1 else ())
     done = _read_journal(folder, digest) if resume else {}
     finals = ("domain.csv", "boundary.csv", "meta.json", "domain.png")
     for name in finals:  # a new or resumed sweep: no stale result may look complete
@@ -184,6 +231,10 @@ def run_sweep(
         journal.write_text("")
         (folder / STATE).write_text(json.dumps({"config_hash": digest}))
     todo = [c for c in cells if cell_key(*c) not in done]
+    if todo and config.model == "rbm" and config.solver.implementation == "compiled":
+        from .kernel import warm_up
+
+        warm_up()  # compile (or load) once here, so the workers load it from numba's cache
 
     start = time.perf_counter()
     chunks = _chunks(todo, jobs)
@@ -193,7 +244,7 @@ def run_sweep(
     if progress:
         progress(n_done, len(cells))
     with journal.open("a") as fh:
-        for rows in _parallel(config, chunks, jobs, backend, scheduler):
+        for rows in _parallel(config, chunks, jobs, backend, scheduler, ensemble):
             for row in rows:
                 fh.write(json.dumps(row) + "\n")
                 done[cell_key(row["amplitude_g"], row["frequency_hz"])] = row
@@ -209,8 +260,8 @@ def run_sweep(
     from .output import save_figure_atomic, write_json_atomic, write_text_atomic
 
     rows = [done[cell_key(*c)] for c in cells]
-    write_text_atomic(folder / "domain.csv", csv_text(rows))
-    df = pd.DataFrame(rows, columns=list(CSV_FIELDS))
+    write_text_atomic(folder / "domain.csv", csv_text(rows, fields))
+    df = pd.DataFrame(rows, columns=list(fields))
     bnd = boundary(df)
     write_text_atomic(
         folder / "boundary.csv",
@@ -230,6 +281,11 @@ def run_sweep(
         "n_run": len(todo),
         "n_resumed": len(cells) - len(todo),
         "status_counts": counts,
+        "ensemble": {
+            "members": ensemble,
+            "phase_rad": ENSEMBLE_PHASE if ensemble > 1 else 0.0,
+            "amplitude_relative": ENSEMBLE_AMPLITUDE if ensemble > 1 else 0.0,
+        },
         "cpu_count": os.cpu_count(),
     }
     write_json_atomic(folder / "meta.json", meta)
@@ -249,13 +305,13 @@ def run_sweep(
     )
 
 
-def _parallel(config, chunks, jobs, backend, scheduler) -> Iterable[list[dict]]:
+def _parallel(config, chunks, jobs, backend, scheduler, ensemble=1) -> Iterable[list[dict]]:
     """Yield the rows of each chunk as it finishes."""
     if not chunks:
         return
     if jobs == 1 and backend in ("loky", "sequential"):
         for chunk in chunks:
-            yield run_chunk(config, chunk)
+            yield run_chunk(config, chunk, ensemble)
         return
     if backend == "dask":
         try:
@@ -271,12 +327,12 @@ def _parallel(config, chunks, jobs, backend, scheduler) -> Iterable[list[dict]]:
         try:
             with joblib.parallel_config(backend="dask"):
                 par = joblib.Parallel(n_jobs=jobs, return_as="generator_unordered")
-                yield from par(joblib.delayed(run_chunk)(config, c) for c in chunks)
+                yield from par(joblib.delayed(run_chunk)(config, c, ensemble) for c in chunks)
         finally:
             client.close()
         return
     par = joblib.Parallel(n_jobs=jobs, backend=backend, return_as="generator_unordered")
-    yield from par(joblib.delayed(run_chunk)(config, c) for c in chunks)
+    yield from par(joblib.delayed(run_chunk)(config, c, ensemble) for c in chunks)
 
 
 def domain_figure(df: pd.DataFrame, config: Config, compare=(), labels=None):

@@ -1,0 +1,399 @@
+"""Work-precision benchmark (`rbm bench`): run time against error, measured.
+
+For each problem (a column, an excitation and a 40 x 40 grid) every method
+and tolerance rbm offers is run over the whole grid, timed on `jobs`
+workers, and compared with a reference:
+
+- rigid monolithic columns: the closed-form `housner-linear` solution with
+  the RBM's inertia (SPEC section 2 mapping), exact to round-off;
+  A peak counts only where it is well-conditioned: a 1e-9 relative change of
+  the amplitude moves the closed-form peak by at most 1e-6 relative;
+- otherwise: converged compiled DOP853 runs at rtol 1e-10, 1e-11 and 1e-12.
+  A cell is *converged* when its outcome (collapsed or not) is the same at
+  all three; the others are *sensitive* (chaos), counted but not scored.
+  The reference values are those of the rtol 1e-12 run.
+
+Errors: (a) cells whose outcome differs from the reference (converged cells
+only), (b) the largest boundary shift [g], (c) relative errors of the peak
+rotation ratio (runs that survive in both; for converged references only
+where rtol 1e-11 and 1e-12 agree to 1e-6) and of the collapse time (runs that
+collapse in both), median and max.
+
+The baseline is scipy's solve_ivp (RK45, rtol 1e-6, events), once per cell
+(rbm_cli.baseline), on a sample of cells measured in the same run; its domain
+time is extrapolated from the mean time per run (marked `estimated`).
+
+`rbm bench --quick` runs the default method (and a few baseline cells) on a
+10 x 10 sub-grid of each problem against the stored references (made by the
+full benchmark in results/bench/) and fails if the default's error exceeds
+the accuracy targets.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import joblib
+import numpy as np
+import pandas as pd
+
+from .config import load_config
+from .config_types import Config, GridConfig, SolverConfig
+from .domain import compare
+from .errors import RbmError
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@dataclass(frozen=True)
+class Problem:
+    name: str
+    config: str  # path relative to the repository
+    amplitudes: tuple[float, float, int]  # g: start, stop, count
+    frequencies: tuple[float, float, int]  # Hz
+    reference: str  # 'closed-form' or 'converged'
+    max_cells: float  # accuracy target: fraction of (converged) cells that may differ
+    label: str
+
+
+PROBLEMS = (
+    Problem("slender", "configs/spanos_koh_slender.yaml", (0.1, 2.0, 40), (0.25, 3.0, 40),
+            "closed-form", 0.005, "rigid monolithic Spanos-Koh slender block"),
+    Problem("tapered", "configs/harmonic_monolithic.yaml", (0.1, 1.5, 40), (0.25, 4.0, 40),
+            "converged", 0.01, "tapered monolithic column, finite K_M (k_n 5e9 Pa/m)"),
+    Problem("multidrum", "configs/harmonic_multidrum.yaml", (0.1, 1.5, 40), (0.25, 4.0, 40),
+            "converged", 0.01, "8-drum tapered column, k_n 5e9 Pa/m"),
+    Problem("halfsine", "configs/housner_halfsine.yaml", (0.1, 3.0, 40), (0.1, 3.0, 40),
+            "closed-form", 0.005, "rigid monolithic column, half-sine pulse"),
+)  # fmt: skip
+
+#: Methods of the full benchmark: (implementation, method, rtol).
+METHODS = (
+    [("compiled", "DOP853", r) for r in (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)]
+    + [("compiled", "RK45", r) for r in (1e-5, 1e-6, 1e-7, 1e-8)]
+    + [("python", "DOP853", 1e-9)]
+)
+#: Methods run on a sample of cells only (slow), with their sample size.
+SAMPLED = {"python": 24, "baseline": 24}
+QUICK_SAMPLED = {"baseline": 4}
+REFERENCE_RTOLS = (1e-10, 1e-11, 1e-12)
+#: Relative agreement of the peak at rtol 1e-11 and 1e-12 for a converged peak.
+PEAK_CONVERGED = 1e-6
+#: Accuracy target of the peak rotation (issue 5), runs that survive.
+PEAK_TARGET = 1e-4
+REFERENCE_DIR = ROOT / "results" / "bench"
+
+
+def default_solver() -> SolverConfig:
+    return SolverConfig()
+
+
+def problem_config(problem: Problem, stride: int = 1) -> Config:
+    cfg = load_config(ROOT / problem.config)
+    a0, a1, na = problem.amplitudes
+    f0, f1, nf = problem.frequencies
+    amps = np.round(np.linspace(a0, a1, na), 10)[::stride]
+    freqs = np.round(np.linspace(f0, f1, nf), 10)[::stride]
+    grid = GridConfig(tuple(float(a) for a in amps), tuple(float(f) for f in freqs))
+    return dataclasses.replace(cfg, grid=grid, name=f"bench_{problem.name}")
+
+
+def _cells(cfg: Config) -> list[tuple[float, float]]:
+    return [(a, f) for f in cfg.grid.frequencies_hz for a in cfg.grid.amplitudes_g]
+
+
+def _with_solver(cfg: Config, implementation: str, method: str, rtol: float) -> Config:
+    solver = dataclasses.replace(cfg.solver, implementation=implementation, method=method,
+                                 rtol=rtol)  # fmt: skip
+    return dataclasses.replace(cfg, solver=solver)
+
+
+# ---------------------------------------------------------------- running cells
+def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
+    from .simulate import model_from_config, simulate
+
+    model = model_from_config(cfg)
+    rows = []
+    for a, f in cells:
+        r = simulate(cfg, a, f, model=model)
+        rows.append({"amplitude_g": a, "frequency_hz": f, "status": r.status,
+                     "collapsed": int(r.status == "collapsed"), "t_collapse_s": r.t_collapse_s,
+                     "max_rotation_ratio": r.max_rotation_ratio, "wall_time_s": r.wall_time_s,
+                     "n_steps": r.n_steps})  # fmt: skip
+    return rows
+
+
+def _run_baseline_chunk(cfg: Config, cells) -> list[dict]:
+    from .baseline import baseline_run
+    from .excitation import make_ground_motion
+    from .simulate import model_from_config
+
+    model = model_from_config(cfg)
+    rows = []
+    for a, f in cells:
+        out = baseline_run(model, make_ground_motion(cfg.excitation, a, f))
+        rows.append({"amplitude_g": a, "frequency_hz": f, "status": out["status"],
+                     "collapsed": int(out["status"] == "collapsed"),
+                     "t_collapse_s": out["t_collapse_s"],
+                     "max_rotation_ratio": out["max_rotation_ratio"],
+                     "wall_time_s": out["wall_time_s"], "n_steps": -1})  # fmt: skip
+    return rows
+
+
+def _run_closed_form_chunk(cfg: Config, cells) -> list[dict]:
+    from .closed_forms import linear_rocking_parameters
+    from .column import build_column
+    from .excitation import make_ground_motion
+    from .housner_linear import housner_linear_run
+    from .simulate import model_from_config
+
+    alpha, p = linear_rocking_parameters(build_column(cfg.column, cfg.interface))
+    e = model_from_config(cfg).restitution
+    rows = []
+    for a, f in cells:
+        start = time.perf_counter()
+        out = housner_linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f),
+                                 restitution=e, collapse_ratio=cfg.collapse.ratio)  # fmt: skip
+        rows.append({"amplitude_g": a, "frequency_hz": f, "status": out.status,
+                     "collapsed": int(out.status == "collapsed"), "t_collapse_s": out.t_collapse,
+                     "max_rotation_ratio": float(np.max(out.max_ratio)),
+                     "wall_time_s": time.perf_counter() - start, "n_steps": 0})  # fmt: skip
+    return rows
+
+
+def run_cells(kind: str, cfg: Config, cells, jobs: int) -> tuple[pd.DataFrame, float]:
+    """Rows of `cells` and the wall time [s] on `jobs` workers."""
+    fn = {"rbm": _run_rbm_chunk, "baseline": _run_baseline_chunk,
+          "closed-form": _run_closed_form_chunk}[kind]  # fmt: skip
+    size = max(1, min(32, len(cells) // max(1, 8 * jobs)))
+    chunks = [cells[i : i + size] for i in range(0, len(cells), size)]
+    start = time.perf_counter()
+    if jobs == 1:
+        parts = [fn(cfg, c) for c in chunks]
+    else:
+        parts = joblib.Parallel(n_jobs=jobs)(joblib.delayed(fn)(cfg, c) for c in chunks)
+    wall = time.perf_counter() - start
+    return pd.DataFrame([r for p in parts for r in p]), wall
+
+
+# ---------------------------------------------------------------- references
+def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
+    cells = _cells(cfg)
+    if problem.reference == "closed-form":
+        ref, _ = run_cells("closed-form", cfg, cells, jobs)
+        ref["converged"] = 1
+        # a peak is scored only where it is well-conditioned: a 1e-9 relative change
+        # of the amplitude moves it by at most PEAK_CONVERGED (error amplification
+        # <= 1000); a long rocking run amplifies errors as exp(p t) between impacts
+        nudged = [(a * (1.0 + 1e-9), f) for a, f in cells]
+        other, _ = run_cells("closed-form", cfg, nudged, jobs)
+        p0, p1 = ref["max_rotation_ratio"].to_numpy(), other["max_rotation_ratio"].to_numpy()
+        same = ref["collapsed"].to_numpy() == other["collapsed"].to_numpy()
+        ref["peak_converged"] = (same & (np.abs(p1 - p0) <= PEAK_CONVERGED * p0)).astype(int)
+        return ref[_REF_COLUMNS]
+    runs = [run_cells("rbm", _with_solver(cfg, "compiled", "DOP853", r), cells, jobs)[0]
+            for r in REFERENCE_RTOLS]  # fmt: skip
+    ref = runs[-1].copy()
+    same = np.ones(len(ref), dtype=bool)
+    for other in runs[:-1]:
+        same &= other["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
+    ref["converged"] = same.astype(int)
+    p11, p12 = runs[-2]["max_rotation_ratio"].to_numpy(), ref["max_rotation_ratio"].to_numpy()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        close = np.abs(p11 - p12) <= PEAK_CONVERGED * np.abs(p12)
+    ref["peak_converged"] = (same & close).astype(int)
+    return ref[_REF_COLUMNS]
+
+
+_REF_COLUMNS = ["amplitude_g", "frequency_hz", "status", "collapsed", "t_collapse_s",
+                "max_rotation_ratio", "converged", "peak_converged"]  # fmt: skip
+
+
+def _key(df: pd.DataFrame) -> pd.Series:
+    return df["amplitude_g"].round(9).astype(str) + "|" + df["frequency_hz"].round(9).astype(str)
+
+
+def errors(run: pd.DataFrame, ref: pd.DataFrame) -> dict:
+    """Errors of a run's rows against the reference rows of the same cells."""
+    m = run.assign(key=_key(run)).merge(ref.assign(key=_key(ref)), on="key",
+                                        suffixes=("", "_ref"))  # fmt: skip
+    conv = m[m["converged"] == 1]
+    differ = int((conv["collapsed"] != conv["collapsed_ref"]).sum())
+    both_surv = m[(m["peak_converged"] == 1) & (m["collapsed"] == 0) & (m["collapsed_ref"] == 0)]
+    both_surv = both_surv[both_surv["max_rotation_ratio_ref"] > 0]
+    peak = (both_surv["max_rotation_ratio"] - both_surv["max_rotation_ratio_ref"]).abs()
+    peak = (peak / both_surv["max_rotation_ratio_ref"]).to_numpy()
+    both_col = conv[(conv["collapsed"] == 1) & (conv["collapsed_ref"] == 1)]
+    tcol = ((both_col["t_collapse_s"] - both_col["t_collapse_s_ref"]).abs()
+            / both_col["t_collapse_s_ref"]).to_numpy()  # fmt: skip
+    shift = math.nan
+    if len(conv) and conv["frequency_hz"].nunique() > 0:
+        a = conv[["amplitude_g", "frequency_hz", "collapsed"]].assign(
+            status=np.where(conv["collapsed"] == 1, "collapsed", "survived")
+        )
+        b = conv[["amplitude_g", "frequency_hz", "collapsed_ref"]].rename(
+            columns={"collapsed_ref": "collapsed"}
+        )
+        b = b.assign(status=np.where(b["collapsed"] == 1, "collapsed", "survived"))
+        shift = compare(a, b).max_shift_g
+    return {
+        "n_cells": len(m),
+        "n_converged": len(conv),
+        "n_sensitive": len(m) - len(conv),
+        "cells_differ": differ,
+        "fraction_differ": differ / len(conv) if len(conv) else math.nan,
+        "boundary_err_g": shift,
+        "n_peak": len(peak),
+        "peak_err_median": float(np.median(peak)) if len(peak) else math.nan,
+        "peak_err_max": float(np.max(peak)) if len(peak) else math.nan,
+        "n_tcol": len(tcol),
+        "tcol_err_median": float(np.median(tcol)) if len(tcol) else math.nan,
+        "tcol_err_max": float(np.max(tcol)) if len(tcol) else math.nan,
+    }
+
+
+# ---------------------------------------------------------------- the benchmark
+def _sample(cells, k: int, seed: int = 5) -> list:
+    rng = np.random.default_rng(seed)
+    idx = np.sort(rng.choice(len(cells), size=min(k, len(cells)), replace=False))
+    return [cells[i] for i in idx]
+
+
+def run_bench(
+    quick: bool = False,
+    jobs: int = 2,
+    output: str | os.PathLike = "bench",
+    reference_dir: str | os.PathLike | None = None,
+    problems: tuple[str, ...] | None = None,
+    log=print,
+) -> pd.DataFrame:
+    """Run the benchmark; write bench.csv and bench.png (and, full, the references)."""
+    from .kernel import warm_up
+    from .output import write_text_atomic
+
+    ref_dir = Path(reference_dir) if reference_dir else REFERENCE_DIR
+    out_dir = Path(output)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RbmError(f"cannot write to output folder {out_dir}: {exc.strerror}") from None
+    warm_up()
+    chosen = [p for p in PROBLEMS if problems is None or p.name in problems]
+    rows = []
+    for prob in chosen:
+        cfg = problem_config(prob, stride=4 if quick else 1)
+        cells = _cells(cfg)
+        ref_path = ref_dir / f"{prob.name}_reference.csv"
+        if quick:
+            if not ref_path.is_file():
+                raise RbmError(f"no stored reference {ref_path}: run the full `rbm bench` first")
+            ref = pd.read_csv(ref_path)
+        else:
+            start = time.perf_counter()
+            ref = make_reference(prob, cfg, jobs)
+            ref_dir.mkdir(parents=True, exist_ok=True)
+            write_text_atomic(ref_path, ref.to_csv(index=False, float_format="%.12g"))
+            log(f"{prob.name}: reference ({prob.reference}) in {time.perf_counter() - start:.1f} s")
+        default = default_solver()
+        methods = [("compiled", default.method, default.rtol)] if quick else list(METHODS)
+        sampled = QUICK_SAMPLED if quick else SAMPLED
+        results = []
+        for impl, method, rtol in methods:
+            run_cfg = _with_solver(cfg, impl, method, rtol)
+            part = _sample(cells, sampled[impl]) if impl in sampled else cells
+            df, wall = run_cells("rbm", run_cfg, part, jobs)
+            results.append((impl, method, rtol, df, wall, len(part) < len(cells)))
+        base_cells = _sample(cells, sampled["baseline"])
+        df, wall = run_cells("baseline", cfg, base_cells, jobs)
+        results.append(("baseline", "solve_ivp RK45", 1e-6, df, wall, True))
+        base_mean = float(df["wall_time_s"].mean())
+        for impl, method, rtol, df, wall, estimated in results:
+            mean = float(df["wall_time_s"].mean())
+            row = {
+                "problem": prob.name,
+                "implementation": impl,
+                "method": method,
+                "rtol": rtol,
+                "default": int(
+                    impl == "compiled" and method == default.method and rtol == default.rtol
+                ),  # fmt: skip
+                "cells_run": len(df),
+                "time_per_run_ms_median": 1e3 * float(df["wall_time_s"].median()),
+                "time_per_run_ms_mean": 1e3 * mean,
+                "domain_wall_s": mean * len(cells) / jobs if estimated else wall,
+                "domain_estimated": int(estimated),
+                "jobs": jobs,
+                "speedup_vs_baseline": base_mean / mean if mean > 0 else math.nan,
+            }
+            row.update(errors(df, ref))
+            rows.append(row)
+            log(_line(row))
+    table = pd.DataFrame(rows)
+    write_text_atomic(out_dir / "bench.csv", table.to_csv(index=False, float_format="%.6g"))
+    figure(table, out_dir / "bench.png")
+    return table
+
+
+def _line(r: dict) -> str:
+    return (
+        f"{r['problem']:10s} {r['implementation']:9s} {r['method']:15s} rtol {r['rtol']:.0e}: "
+        f"{r['time_per_run_ms_mean']:9.3f} ms/run, domain {r['domain_wall_s']:8.2f} s"
+        f"{' (est.)' if r['domain_estimated'] else ''}, x{r['speedup_vs_baseline']:.0f} vs "
+        f"baseline; differ {r['cells_differ']}/{r['n_converged']} "
+        f"(sensitive {r['n_sensitive']}), boundary {r['boundary_err_g']:.3g} g, "
+        f"peak err median {r['peak_err_median']:.2g} max {r['peak_err_max']:.2g}"
+    )
+
+
+def check_targets(table: pd.DataFrame) -> list[str]:
+    """Accuracy targets of the default method; returns the failures."""
+    fails = []
+    for prob in PROBLEMS:
+        rows = table[(table["problem"] == prob.name) & (table["default"] == 1)]
+        if rows.empty:
+            continue
+        r = rows.iloc[0]
+        if r["fraction_differ"] > prob.max_cells:
+            fails.append(f"{prob.name}: {r['cells_differ']} of {r['n_converged']} cells differ "
+                         f"from the reference (target <= {prob.max_cells:.1%})")  # fmt: skip
+        if r["n_peak"] and r["peak_err_max"] >= PEAK_TARGET:
+            fails.append(f"{prob.name}: peak rotation error {r['peak_err_max']:.2g} "
+                         f"(target < {PEAK_TARGET:g})")  # fmt: skip
+    return fails
+
+
+def figure(table: pd.DataFrame, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .output import save_figure_atomic
+
+    probs = list(dict.fromkeys(table["problem"]))
+    fig, axes = plt.subplots(2, len(probs), figsize=(4.2 * len(probs), 7.5), squeeze=False)
+    for j, name in enumerate(probs):
+        sub = table[table["problem"] == name]
+        for (impl, method), grp in sub.groupby(["implementation", "method"], sort=False):
+            grp = grp.sort_values("rtol")
+            x = grp["domain_wall_s"].to_numpy()
+            label = f"{method} ({impl})" if impl != "baseline" else "baseline: solve_ivp RK45"
+            y1 = np.maximum(grp["peak_err_median"].to_numpy(float), 1e-16)
+            y2 = np.maximum(grp["fraction_differ"].to_numpy(float), 1e-4)
+            style = "o-" if impl == "compiled" else "s"
+            axes[0, j].loglog(x, y1, style, label=label)
+            axes[1, j].loglog(x, y2, style, label=label)
+        axes[0, j].set_title(name)
+        axes[1, j].set_xlabel("domain wall time [s] (2 workers)")
+        axes[0, j].axhline(PEAK_TARGET, color="0.6", lw=0.8, ls="--")
+    axes[0, 0].set_ylabel("peak rotation error, median (relative)")
+    axes[1, 0].set_ylabel("fraction of converged cells differing\n(1e-4 = none)")
+    axes[0, -1].legend(fontsize=7)
+    fig.tight_layout()
+    save_figure_atomic(fig, path)
+    plt.close(fig)

@@ -1,0 +1,502 @@
+"""Compiled event-driven integrator of the Rigid Beam Model (numba).
+
+The same algorithm as rbm_cli.integrate (which stays as the readable Python
+reference and serves time histories): an explicit Runge-Kutta pair (scipy's
+DOP853, RK45 or RK23 tableaux and step-size control, transcribed), stopped
+exactly at every event (kink of a law, impact, collapse) by Brent's method
+on the step's dense output. The whole run, piece changes, impacts, rest
+phases of rigid blocks and the early stop of free motion included, runs in
+one compiled call: no Python per step or per event.
+
+The step sequence follows scipy's (same initial step, same error norm, same
+controller), so for non-chaotic runs the kernel reproduces the Python path to
+round-off; the tests compare the two.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .excitation import GroundMotion
+from .integrate import BIG, EVENT_EPS, REST_RATE, Outcome
+from .kernel_events import (
+    CHECK_INTERVALS,
+    _affine,
+    _bounds,
+    _brentq,
+    _emit,
+    _emit_rest,
+    _energy1,
+    _first_crossing,
+    _n_below,
+    _next_exceedance,
+    _system,
+    _within_reach,
+)
+from .kernel_rk import (
+    _MAX_FACTOR,
+    _MIN_FACTOR,
+    _NS_MAX,
+    _SAFETY,
+    COLLAPSED,
+    FAILED_EVENTS,
+    FAILED_STEP,
+    FAILED_STEPS,
+    METHOD_CODES,
+    STOPPED_EARLY,
+    SURVIVED,
+    TAB_EST,
+    TAB_NS,
+    _dense_eval,
+    _dense_prepare,
+    _error_norm,
+    _ground,
+    _initial_step,
+    _rhs,
+    _rk_attempt,
+)
+from .model import Model
+
+
+# ---------------------------------------------------------------- the run
+@njit(cache=True)
+def run_kernel(
+    mc, rtol, atol, max_steps, max_events,
+    mass, minv, diff, argmap, arg_inv, gravity, ground_load,
+    edges, nedges, intercepts, slopes, rigid,
+    tu, cmap, top, c_ratio, e_rest, literal_impact, impulse_dir, impulse_w,
+    centre_map, masses, normal_forces,
+    kind, amplitude, omega, phase, pulse_end, t_end,
+    uplift_level, rest_rate, barrier, early_stop, theta0, rate0, record, output_dt, samples,
+):  # fmt: skip
+    n = theta0.size
+    n_out = 0
+    next_out = 0.0
+    m = 2 * n
+    max_ratio = np.zeros(n)
+    friction = np.zeros(n)
+    max_top = 0.0
+    n_upl, n_imp, n_steps, n_rhs, n_ev = 0, 0, 0, 0, 0
+    status = SURVIVED
+    t_col, c_if = np.nan, -1
+
+    side = np.ones(n, dtype=np.int64)
+    k = np.zeros(n, dtype=np.int64)
+    pending = np.zeros(n, dtype=np.bool_)
+    lo, hi = np.empty(n), np.empty(n)
+    G = np.empty((4 * n, n))
+    for i in range(n):
+        for j in range(n):
+            G[i, j] = argmap[i, j] / tu[i]
+            G[n + i, j] = -argmap[i, j] / tu[i]
+            G[2 * n + i, j] = -cmap[i, j]
+            G[3 * n + i, j] = cmap[i, j]
+    nt = n + 1
+    track = np.empty((nt, n))
+    track[:n, :] = cmap
+    track[n, :] = top
+    es = -(minv @ ground_load)
+    peaks = np.zeros(nt)
+    As, cs = np.empty((n, n)), np.empty(n)
+    h0 = np.empty(4 * n)
+    K = np.empty((_NS_MAX, m))
+    F = np.empty((8, m))
+    f = np.empty(m)
+    ynew = np.empty(m)
+    tmp = np.empty(m)
+    buf = np.empty(m)
+    work = np.empty(m)
+    scale = np.empty(m)
+    nrow = 4 * n
+    d_old, d_new = np.empty(nrow), np.empty(nrow)
+    dd_old, dd_new = np.empty(nrow), np.empty(nrow)
+    d2_old, d2_new = np.empty(nrow), np.empty(nrow)
+    Dq, Rq = np.empty((nrow, CHECK_INTERVALS + 1)), np.empty((nrow, CHECK_INTERVALS + 1))
+    dc0, dc1, rc0, rc1 = np.empty(nrow), np.empty(nrow), np.empty(nrow), np.empty(nrow)
+    z_old, z_new, z_prev = np.empty(nt), np.empty(nt), np.empty(nt)
+    dz_old, dz_new, dz_prev = np.empty(nt), np.empty(nt), np.empty(nt)
+    acc = np.empty(n)
+    no_offset = np.empty(0)
+    y_new = np.empty(m)
+    est_order = TAB_EST[mc]
+    err_exp = -1.0 / (est_order + 1)
+    ns = TAB_NS[mc]
+    stage_rhs = ns  # rhs calls per attempt (stages 1..ns-1 and f_new)
+
+    t = 0.0
+    y = np.empty(m)
+    y[:n] = theta0
+    y[n:] = rate0
+    rigid_mono = uplift_level >= 0.0
+    at_rest = rigid_mono
+    for i in range(m):
+        if y[i] != 0.0:
+            at_rest = False
+    x0 = argmap @ y[:n]
+    r0 = argmap @ y[n:]
+    for i in range(n):
+        s = 1 if x0[i] > 0 else (-1 if x0[i] < 0 else (1 if r0[i] >= 0 else -1))
+        side[i] = s
+        k[i] = _n_below(edges[i], nedges[i], abs(x0[i]))
+        pending[i] = k[i] > 0 and not rigid[i]
+
+    n_seg = 2 if (kind == 1 and pulse_end < t_end) else 1
+    for seg in range(n_seg):
+        seg_start = 0.0 if seg == 0 else pulse_end
+        seg_end = t_end if (seg == n_seg - 1) else pulse_end
+        if t >= seg_end:
+            continue
+        free_seg = amplitude == 0.0 or (kind == 1 and seg_start >= pulse_end)
+        amp = 0.0 if free_seg else amplitude
+        can_stop = early_stop and free_seg and kind == 1 and n == 1
+        while t < seg_end:
+            if at_rest:
+                if free_seg:
+                    if record:
+                        n_out, next_out = _emit_rest(t_end, samples, n_out, next_out, output_dt)
+                    return (status, t_end, t_col, c_if, max_ratio, max_top, friction,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                last = min(pulse_end, t_end)
+                t_up = _next_exceedance(t, uplift_level, amplitude, omega, phase, last)
+                if t_up < 0.0 or t_up >= seg_end:
+                    if record:
+                        n_out, next_out = _emit_rest(seg_end, samples, n_out, next_out, output_dt)
+                    t = seg_end
+                    break
+                if record:
+                    n_out, next_out = _emit_rest(t_up - 1e-15, samples, n_out, next_out, output_dt)
+                t = t_up
+                for i in range(m):
+                    y[i] = 0.0
+                side[0] = -1 if _ground(t, amplitude, omega, phase) > 0.0 else 1
+                k[0] = 0
+                at_rest = False
+                n_upl += 1
+
+            _system(side, k, intercepts, slopes, minv, diff, argmap, gravity, As, cs)
+            for i in range(n):
+                _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi)
+                h0[i] = min(-lo[i] / tu[i], BIG) + EVENT_EPS
+                h0[n + i] = min(hi[i] / tu[i], BIG) + EVENT_EPS
+                h0[2 * n + i] = c_ratio + EVENT_EPS
+                h0[3 * n + i] = c_ratio + EVENT_EPS
+
+            # a new stepper from (t, y)
+            _rhs(t, y, n, As, cs, es, amp, omega, phase, f)
+            h_abs = _initial_step(t, y, f, seg_end, est_order, rtol, atol, n, As, cs, es,
+                                  amp, omega, phase, work)  # fmt: skip
+            n_rhs += 2
+            _affine(track, y, 0, no_offset, z_old)
+            _affine(track, y, n, no_offset, dz_old)
+            _affine(G, y, 0, h0, d_old)
+            _affine(G, y, n, no_offset, dd_old)
+            g0 = _ground(t, amp, omega, phase)
+            _affine(As, y, 0, cs, acc)
+            for i in range(n):
+                acc[i] += es[i] * g0
+            _affine(G, acc, 0, no_offset, d2_old)
+            event = False
+            running = True
+            while running:
+                # ---- one accepted step (scipy RungeKutta._step_impl)
+                min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+                if h_abs < min_step:
+                    h_abs = min_step
+                rejected = False
+                while True:
+                    if h_abs < min_step:
+                        t_fail = t
+                        return (FAILED_STEP, t_fail, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                    t_new = t + h_abs
+                    if t_new - seg_end > 0:
+                        t_new = seg_end
+                    h = t_new - t
+                    h_abs = abs(h)
+                    _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, amp, omega, phase)
+                    n_rhs += stage_rhs
+                    err = _error_norm(mc, K, h, y, ynew, atol, rtol, scale)
+                    if err < 1.0:
+                        if err == 0.0:
+                            factor = _MAX_FACTOR
+                        else:
+                            factor = min(_MAX_FACTOR, _SAFETY * err**err_exp)
+                        if rejected:
+                            factor = min(1.0, factor)
+                        h_abs *= factor
+                        break
+                    h_abs *= max(_MIN_FACTOR, _SAFETY * err**err_exp)
+                    rejected = True
+                n_steps += 1
+                if n_steps > max_steps:
+                    return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                if t_new - seg_end >= 0:
+                    running = False
+                t_old = t
+                y_old = y
+                y_new[:] = ynew
+                _affine(G, y_new, 0, h0, d_new)
+                _affine(G, y_new, n, no_offset, dd_new)
+                dense_ready = False
+                g_new = _ground(t_new, amp, omega, phase)
+                _affine(As, y_new, 0, cs, acc)
+                for i in range(n):
+                    acc[i] += es[i] * g_new
+                _affine(G, acc, 0, no_offset, d2_new)
+                event_row = -1
+                t_e = t_new
+                if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old):
+                    n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
+                                            cs, es, amp, omega, phase)  # fmt: skip
+                    dense_ready = True
+                    t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, G, h0, n, buf,
+                                                     Dq, Rq, dc0, dc1, rc0, rc1)  # fmt: skip
+                if event_row >= 0:
+                    _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
+                    t_new = t_e
+                    event = True
+                    g_new = _ground(t_new, amp, omega, phase)
+                    _affine(As, y_new, 0, cs, acc)
+                    for i in range(n):
+                        acc[i] += es[i] * g_new
+                    if record:
+                        n_out, next_out = _emit(mc, t_e, t_old, h, y_old, F, samples, n_out,
+                                                next_out, output_dt)  # fmt: skip
+                elif record:
+                    if not dense_ready:
+                        n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
+                                                cs, es, amp, omega, phase)  # fmt: skip
+                        dense_ready = True
+                    n_out, next_out = _emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
+                                            next_out, output_dt)  # fmt: skip
+                # peaks and friction demand over [t_old, t_new]
+                _affine(track, y_new, 0, no_offset, z_new)
+                _affine(track, y_new, n, no_offset, dz_new)
+                # peaks inside the step: at the root of the rate, on the dense output
+                for r in range(nt):
+                    v = max(abs(z_old[r]), abs(z_new[r]))
+                    if dz_old[r] * dz_new[r] < 0.0:
+                        if not dense_ready:
+                            n_rhs += _dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
+                                                    As, cs, es, amp, omega, phase)  # fmt: skip
+                            dense_ready = True
+                        t_pk = _brentq(mc, t_old, t_new, t_old, h, y_old, F, track, h0, n, buf,
+                                       1e-14, 8.881784197001252e-16, 100, r)  # fmt: skip
+                        _dense_eval(mc, t_pk, t_old, h, y_old, F, buf)
+                        zp = 0.0
+                        for j in range(n):
+                            zp += track[r, j] * buf[j]
+                        v = max(v, abs(zp))
+                    if v > peaks[r]:
+                        peaks[r] = v
+                for i in range(n):
+                    if peaks[i] > max_ratio[i]:
+                        max_ratio[i] = peaks[i]
+                if peaks[n] > max_top:
+                    max_top = peaks[n]
+                shear = 0.0
+                for i in range(n - 1, -1, -1):
+                    a_abs = g_new
+                    for j in range(n):
+                        a_abs += centre_map[i, j] * acc[j]
+                    shear += a_abs * masses[i]
+                    fr = abs(shear) / normal_forces[i]
+                    if fr > friction[i]:
+                        friction[i] = fr
+                z_prev, z_old, z_new = z_old, z_new, z_prev
+                dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
+                d_old, d_new = d_new, d_old
+                dd_old, dd_new = dd_new, dd_old
+                d2_old, d2_new = d2_new, d2_old
+                t = t_new
+                y, y_new = y_new, y
+                f[:] = K[ns]
+                if event:
+                    break
+                if can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]:
+                    en = _energy1(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
+                                  intercepts, slopes)  # fmt: skip
+                    if en < barrier * (1.0 - 1e-9):
+                        return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+            if not event:
+                t = seg_end if not running else t
+                continue
+
+            # ---- the event at (t, y)
+            n_ev += 1
+            if n_ev > max_events:
+                return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction,
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+            which, i = event_row // n, event_row % n
+            if which >= 2:
+                t_col, c_if = t, i + 1
+                if c_ratio > max_ratio[i]:
+                    max_ratio[i] = c_ratio
+                return (COLLAPSED, t, t_col, c_if, max_ratio, max_top, friction,
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+            going_up = which == 1
+            bound = hi[i] if going_up else lo[i]
+            x_i = 0.0
+            for j in range(n):
+                x_i += argmap[i, j] * y[j]
+            for j in range(n):
+                y[j] += arg_inv[j, i] * (bound - x_i)
+            s, ki = side[i], k[i]
+            outward = going_up == (s > 0)
+            if ki == 0 and not (rigid[i] or pending[i]):
+                side[i] = 1 if going_up else -1
+                k[i] = 1
+                pending[i] = True
+                n_upl += 1
+            elif outward:
+                k[i] = ki + 1
+            elif ki > 0:
+                k[i] = ki - 1
+            else:
+                n_imp += 1
+                side[i] = -s
+                pending[i] = False
+                if e_rest < 1.0:
+                    xdot = 0.0
+                    for j in range(n):
+                        xdot += argmap[i, j] * y[n + j]
+                    if literal_impact:
+                        for j in range(n):
+                            y[n + j] += arg_inv[j, i] * (e_rest - 1.0) * xdot
+                    else:
+                        lam = (e_rest - 1.0) * xdot / impulse_w[i]
+                        for j in range(n):
+                            y[n + j] += impulse_dir[j, i] * lam
+                if rigid_mono and abs(y[n]) < rest_rate:
+                    for j in range(m):
+                        y[j] = 0.0
+                    at_rest = True
+    return (status, t, t_col, c_if, max_ratio, max_top, friction,
+            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+
+
+# ---------------------------------------------------------------- Python side
+def _pad_laws(model: Model):
+    n = model.n
+    ne = max(len(law.edges) for law in model.laws)
+    edges = np.full((n, max(ne, 1)), np.inf)
+    inter = np.zeros((n, ne + 1))
+    slopes = np.zeros((n, ne + 1))
+    nedges = np.zeros(n, dtype=np.int64)
+    for i, law in enumerate(model.laws):
+        m = len(law.edges)
+        edges[i, :m] = law.edges
+        inter[i, : m + 1] = law.intercepts
+        slopes[i, : m + 1] = law.slopes
+        nedges[i] = m
+    rigid = np.array([law.rigid for law in model.laws], dtype=np.bool_)
+    return edges, nedges, inter, slopes, rigid
+
+
+def model_arrays(model: Model) -> tuple:
+    """The model's arrays in the kernel's argument order (assembled once per column)."""
+    col = model.column
+    tu = col.rotation_capacity.astype(float)
+    argmap = model.arg_map.astype(float)
+    impulse_dir = model.mass_inv @ argmap.T
+    impulse_w = np.einsum("ij,ji->i", argmap, impulse_dir)
+    edges, nedges, inter, slopes, rigid = _pad_laws(model)
+    return (
+        model.mass, model.mass_inv, model.diff.astype(float), argmap,
+        np.linalg.inv(argmap), model.gravity, model.ground_load,
+        edges, nedges, inter, slopes, rigid,
+        tu, model.collapse_map / model.collapse_limit[:, None], col.heights.astype(float),
+        float(model.collapse_ratio), float(model.restitution), model.formulation == "absolute",
+        impulse_dir, impulse_w, model.centre_map, col.masses.astype(float),
+        col.normal_forces.astype(float),
+    )  # fmt: skip
+
+
+_KIND = {"harmonic": 0, "half-sine": 1, "free": 2}
+#: The last model run and its kernel arrays (a sweep runs one model many times).
+_LAST: tuple = (None, ())
+
+
+def integrate_compiled(
+    model: Model,
+    motion: GroundMotion,
+    theta0: np.ndarray,
+    rate0: np.ndarray,
+    solver,
+    record: bool = False,
+    output_dt: float = 0.002,
+    early_stop: bool = True,
+    arrays: tuple | None = None,
+) -> Outcome:
+    """rbm_cli.integrate.integrate, compiled (same arguments and Outcome)."""
+    n = model.n
+    global _LAST
+    if arrays is None:
+        if _LAST[0] is not model:
+            _LAST = (model, model_arrays(model))
+        arrays = _LAST[1]
+    n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
+    samples = np.zeros((n_max, 1 + 2 * n))
+    tu = model.column.rotation_capacity
+    atol = solver.atol * np.concatenate([np.full(n, tu.min()), np.full(n, tu.min() * 10.0)])
+    uplift = model.uplift_level
+    barrier = math.nan
+    if n == 1:
+        barrier = float(model.energy(np.array([model.collapse_ratio * tu[0]]), np.zeros(1))[0])
+    res = run_kernel(
+        METHOD_CODES[solver.method], float(solver.rtol), atol,
+        int(solver.max_steps), int(solver.max_events), *arrays,
+        _KIND[motion.kind], float(motion.amplitude), float(motion.omega), float(motion.phase),
+        float(motion.pulse_end), float(motion.t_end),
+        -1.0 if uplift is None else float(uplift),
+        REST_RATE * model.rocking_p * float(tu.min()), barrier, bool(early_stop),
+        np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
+        bool(record), float(output_dt), samples,
+    )  # fmt: skip
+    (code, t_end, t_col, c_if, max_ratio, max_top, friction,
+     n_upl, n_imp, n_steps, n_rhs, n_ev, n_out) = res  # fmt: skip
+    out = Outcome(
+        t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=friction,
+        n_uplifts=int(n_upl), n_impacts=int(n_imp), n_steps=int(n_steps), n_rhs=int(n_rhs),
+        n_events=int(n_ev),
+    )  # fmt: skip
+    if record:
+        out.samples = [
+            (float(r[0]), r[1 : 1 + n].copy(), r[1 + n :].copy()) for r in samples[:n_out]
+        ]
+    if code == COLLAPSED:
+        out.status = "collapsed"
+        out.t_collapse = float(t_col)
+        out.collapse_interface = int(c_if)
+        out.message = f"interface {int(c_if)} reached its collapse limit"
+    elif code == STOPPED_EARLY:
+        out.message = "free motion below the collapse barrier: stopped early"
+    elif code == FAILED_STEP:
+        out.stop("failed", "integrator: Required step size is less than spacing between "
+                 "numbers.", t_end)  # fmt: skip
+    elif code == FAILED_STEPS:
+        out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t_end)
+    elif code == FAILED_EVENTS:
+        out.stop("failed", f"event budget exceeded ({solver.max_events} events)", t_end)
+    return out
+
+
+def warm_up() -> None:
+    """Compile (or load from the cache) the kernel once, e.g. in a worker."""
+    from .column import build_column
+    from .config_types import ColumnConfig, InterfaceConfig, SolverConfig
+    from .model import build_model
+
+    geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=(2.0,))
+    col = build_column(geometry, InterfaceConfig())
+    model = build_model(col)
+    motion = GroundMotion("harmonic", 5.0, 6.0, 0.0, 0.1, 0.1)
+    integrate_compiled(model, motion, np.zeros(1), np.zeros(1), SolverConfig())
+
+
+__all__ = ["integrate_compiled", "model_arrays", "warm_up"]

@@ -1,0 +1,315 @@
+"""Event search and law bookkeeping for the compiled kernel (numba): the
+transcriptions of rbm_cli.events (earliest crossing on the dense output,
+cubic Hermite dips) and rbm_cli.events.Pieces (law pieces), plus the exact
+uplift time of a rigid block at rest and time-history sampling."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .kernel_rk import _dense_eval
+
+
+@njit(cache=True)
+def _affine(G, y, off, h0, out):
+    """out = G @ y[off:off + cols] (+ h0 if given): no allocation."""
+    for r in range(G.shape[0]):
+        d = 0.0 if h0.size == 0 else h0[r]
+        for j in range(G.shape[1]):
+            d += G[r, j] * y[off + j]
+        out[r] = d
+
+
+@njit(cache=True)
+def _gmin(G, h0, y, n):
+    best = np.inf
+    for r in range(G.shape[0]):
+        d = h0[r]
+        for j in range(n):
+            d += G[r, j] * y[j]
+        if d < best:
+            best = d
+    return best
+
+
+@njit(cache=True)
+def _fval(mode, t, mc, t_old, h, y_old, F, G, h0, n, buf):
+    """On the dense output at t: mode -1, the smallest event distance; mode r >= 0,
+    the rate of row r of G; mode -2 - r, the distance of row r (G[r] theta + h0[r])."""
+    _dense_eval(mc, t, t_old, h, y_old, F, buf)
+    if mode == -1:
+        return _gmin(G, h0, buf, n)
+    if mode <= -2:
+        r = -2 - mode
+        v = h0[r]
+        for j in range(n):
+            v += G[r, j] * buf[j]
+        return v
+    v = 0.0
+    for j in range(n):
+        v += G[mode, j] * buf[n + j]
+    return v
+
+
+@njit(cache=True)
+def _brentq(mc, xa, xb, t_old, h, y_old, F, G, h0, n, buf, xtol, rtol, maxiter, mode=-1):
+    """scipy's brentq (zeros.c), on the smallest event distance along the step
+    (mode -1) or on the rate of row `mode` of G (mode >= 0)."""
+    xpre, xcur = xa, xb
+    xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
+    fpre = _fval(mode, xpre, mc, t_old, h, y_old, F, G, h0, n, buf)
+    fcur = _fval(mode, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    for _ in range(maxiter):
+        if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = (xtol + rtol * abs(xcur)) / 2.0
+        sbis = (xblk - xcur) / 2.0
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre, scur = sbis, sbis
+        else:
+            spre, scur = sbis, sbis
+        xpre, fpre = xcur, fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0 else -delta
+        fcur = _fval(mode, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
+    return xcur
+
+
+@njit(cache=True)
+def _quad_roots(qa, qb, qc):
+    """Real roots of qa s^2 + qb s + qc (as np.roots: leading zeros dropped)."""
+    r = np.full(2, np.nan)
+    if qa == 0.0:
+        if qb != 0.0:
+            r[0] = -qc / qb
+        return r
+    disc = qb * qb - 4.0 * qa * qc
+    if disc < 0.0:
+        return r
+    sq = math.sqrt(disc)
+    q = -0.5 * (qb + sq if qb >= 0.0 else qb - sq)
+    if q != 0.0:
+        r[0] = q / qa
+        r[1] = qc / q
+    else:
+        r[0] = 0.0
+        r[1] = 0.0
+    return r
+
+
+@njit(cache=True)
+def _lowest_dip(d0, d1, r0, r1, dt):
+    """events._lowest_dip: (time from the start, row) of the lowest interior minimum
+    below zero of the cubic Hermite interpolants, or (-1, -1)."""
+    best, t_best, row = 0.0, -1.0, -1
+    for r in range(d0.size):
+        if not (r0[r] < 0.0 and r1[r] > 0.0):
+            continue
+        p0, m0, p1, m1 = d0[r], dt * r0[r], d1[r], dt * r1[r]
+        if min(p0, p1) > 0.5 * (abs(m0) + abs(m1)):
+            continue
+        a = 2 * p0 + m0 - 2 * p1 + m1
+        b = -3 * p0 - 2 * m0 + 3 * p1 - m1
+        if abs(a) + abs(b) == 0.0:
+            continue
+        roots = _quad_roots(3 * a, 2 * b, m0)
+        for s in roots:
+            if 0.0 < s < 1.0:
+                val = ((a * s + b) * s + m0) * s + p0
+                if val < best:
+                    best, t_best, row = val, s * dt, r
+    return t_best, row
+
+
+#: Sub-intervals of a step checked on the dense output (events.CHECK_INTERVALS).
+CHECK_INTERVALS = 8
+
+
+@njit(cache=True)
+def _within_reach(d0, d1, r0, r1, a0, a1, dt):
+    """events.within_reach."""
+    for r in range(d0.size):
+        reach = dt * (abs(r0[r]) + abs(r1[r])) + dt * dt * (abs(a0[r]) + abs(a1[r]))
+        if min(d0[r], d1[r]) <= reach:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, buf, D, R, dcol0, dcol1, rcol0, rcol1):
+    """events.first_crossing on the step's dense output: (t, row) of the earliest
+    crossing of any event surface in [t0, t1], or (-1, -1)."""
+    nseg = CHECK_INTERVALS
+    h = t1 - t0
+    nrow = G.shape[0]
+    for q in range(nseg + 1):
+        tq = t0 + h * q / nseg if q < nseg else t1
+        _dense_eval(mc, tq, t0, h, y_old, F, buf)
+        for r in range(nrow):
+            d, v = h0[r], 0.0
+            for j in range(n):
+                d += G[r, j] * buf[j]
+                v += G[r, j] * buf[n + j]
+            D[r, q], R[r, q] = d, v
+    best, brow = np.inf, -1
+    for r in range(nrow):
+        if D[r, 0] < best:
+            best, brow = D[r, 0], r
+    if best <= 0.0:
+        return t0, brow
+    ds = h / nseg
+    for q in range(nseg):
+        a = t0 + h * q / nseg
+        b = t0 + h * (q + 1) / nseg if q + 1 < nseg else t1
+        look = False
+        for r in range(nrow):
+            if D[r, q + 1] < 0.0:
+                look = True
+            elif R[r, q] < 0.0 and R[r, q + 1] > 0.0:
+                if min(D[r, q], D[r, q + 1]) <= 0.5 * ds * (abs(R[r, q]) + abs(R[r, q + 1])):
+                    look = True
+        if not look:
+            continue
+        t_first, r_first = np.inf, -1
+        for r in range(nrow):
+            dcol0[r], dcol1[r] = D[r, q], D[r, q + 1]
+            rcol0[r], rcol1[r] = R[r, q], R[r, q + 1]
+        for r in range(nrow):
+            if D[r, q + 1] < 0.0:
+                tr = _brentq(mc, a, b, t0, h, y_old, F, G, h0, n, buf, 1e-14,
+                             8.881784197001252e-16, 100, -2 - r)  # fmt: skip
+                if tr < t_first:
+                    t_first, r_first = tr, r
+        s_dip, r_dip = _lowest_dip(dcol0, dcol1, rcol0, rcol1, b - a)
+        if r_dip >= 0:
+            if _fval(-2 - r_dip, a + s_dip, mc, t0, h, y_old, F, G, h0, n, buf) < 0.0:
+                tr = _brentq(mc, a, a + s_dip, t0, h, y_old, F, G, h0, n, buf, 1e-14,
+                             8.881784197001252e-16, 100, -2 - r_dip)  # fmt: skip
+                if tr < t_first:
+                    t_first, r_first = tr, r_dip
+        if r_first >= 0:
+            return t_first, r_first
+    return -1.0, -1
+
+
+# ---------------------------------------------------------------- laws, pieces
+@njit(cache=True)
+def _n_below(edges, ne, x):
+    k = 0
+    while k < ne and edges[k] <= x:
+        k += 1
+    return k
+
+
+@njit(cache=True)
+def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
+    ne = nedges[i]
+    start = 0.0 if k[i] == 0 else edges[i, k[i] - 1]
+    end = edges[i, k[i]] if k[i] < ne else np.inf
+    if k[i] == 0 and not (rigid[i] or pending[i]):
+        start = -end
+    if side[i] > 0:
+        lo[i], hi[i] = start, end
+    else:
+        lo[i], hi[i] = -end, -start
+
+
+@njit(cache=True)
+def _system(side, k, intercepts, slopes, minv, diff, argmap, gravity, As, cs):
+    """(A, c) of theta'' = A theta + c + e a_g for the active pieces."""
+    n = side.size
+    stiff = -gravity.copy()
+    a = np.empty(n)
+    for i in range(n):
+        a[i] = side[i] * intercepts[i, k[i]]
+        b = slopes[i, k[i]]
+        for p in range(n):
+            if diff[i, p] != 0.0:
+                for q in range(n):
+                    stiff[p, q] += diff[i, p] * b * argmap[i, q]
+    rhs_c = diff.T @ a
+    As[:, :] = -(minv @ stiff)
+    cs[:] = -(minv @ rhs_c)
+
+
+@njit(cache=True)
+def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
+    """Model.energy for one state."""
+    n = theta.size
+    e = 0.5 * rate @ (mass @ rate) - 0.5 * theta @ (gravity @ theta)
+    x = argmap @ theta
+    for i in range(n):
+        ax = abs(x[i])
+        ne = nedges[i]
+        cum, x0 = 0.0, 0.0
+        kk = _n_below(edges[i], ne, ax)
+        for q in range(kk):
+            x1 = edges[i, q]
+            cum += intercepts[i, q] * (x1 - x0) + 0.5 * slopes[i, q] * (x1 * x1 - x0 * x0)
+            x0 = x1
+        e += cum + intercepts[i, kk] * (ax - x0) + 0.5 * slopes[i, kk] * (ax * ax - x0 * x0)
+    return e
+
+
+@njit(cache=True)
+def _next_exceedance(t0, level, amp, om, ph, last):
+    """GroundMotion.next_exceedance; -1 for none before `last`."""
+    if amp <= level or t0 >= last:
+        return -1.0
+    s = level / amp
+    psi0 = om * t0 + ph
+    if abs(math.sin(psi0)) > s:
+        return t0
+    lo = math.asin(s)
+    kk = math.ceil((psi0 - lo) / math.pi)
+    psi = lo + kk * math.pi
+    if psi < psi0:
+        psi += math.pi
+    t = (psi - ph) / om
+    if t >= last:
+        return -1.0
+    return t
+
+
+@njit(cache=True)
+def _emit_rest(t_stop, samples, n_out, next_out, dt):
+    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
+        samples[n_out, 0] = next_out
+        samples[n_out, 1:] = 0.0
+        n_out += 1
+        next_out += dt
+    return n_out, next_out
+
+
+@njit(cache=True)
+def _emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
+    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
+        samples[n_out, 0] = next_out
+        _dense_eval(mc, next_out, t_old, h, y_old, F, samples[n_out, 1:])
+        n_out += 1
+        next_out += dt
+    return n_out, next_out

@@ -39,7 +39,15 @@ import math
 import numpy as np
 
 from .bullet_geometry import drum_solids, stack_slenderness
-from .bullet_scene import EngineSettings, Frame, Joints, build_scene, joint_state, read_frame
+from .bullet_scene import (
+    EngineSettings,
+    Frame,
+    Joints,
+    build_scene,
+    joint_state,
+    keep_in_plane,
+    read_frame,
+)
 from .config_types import Config, G
 from .errors import RbmError
 from .excitation import GroundMotion
@@ -146,6 +154,7 @@ def bullet_run(
         set_gravity(-motion.accel(t_mid), 0.0, -G, physicsClientId=cid)
         step(physicsClientId=cid)
         k += 1
+        keep_in_plane(p, cid, bodies, pose=k % check == 0)
         if k % check and not (sample and k % sample == 0) and k != n_steps:
             continue
         t = k * dt
@@ -224,6 +233,7 @@ def measure_restitution(
     while found < impacts and k * dt < t_max:
         p.stepSimulation(physicsClientId=cid)
         k += 1
+        keep_in_plane(p, cid, bodies, pose=k % 10 == 0)
         _, quat = p.getBasePositionAndOrientation(base, physicsClientId=cid)
         _, ang = p.getBaseVelocity(base, physicsClientId=cid)
         m = p.getMatrixFromQuaternion(quat)
@@ -240,6 +250,7 @@ def measure_restitution(
             continue
         while hi > len(rate_a) and k * dt < t_max:  # run on to fill the fitting window
             p.stepSimulation(physicsClientId=cid)
+            keep_in_plane(p, cid, bodies)
             _, ang = p.getBaseVelocity(base, physicsClientId=cid)
             rate_a = np.append(rate_a, ang[1])
             k += 1

@@ -37,8 +37,9 @@ def _event(row, offset):
     return ev
 
 
-def baseline_run(model: Model, motion: GroundMotion) -> dict:
-    """One run of the baseline; returns status, t_collapse_s, max_rotation_ratio, wall_time_s."""
+def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) -> dict:
+    """One run of the baseline; returns status, t_collapse_s, max_rotation_ratio, wall_time_s.
+    A run longer than budget_s [s] of wall time stops as 'failed' (its time still counts)."""
     start = time.perf_counter()
     n = model.n
     tu = model.column.rotation_capacity
@@ -71,6 +72,9 @@ def baseline_run(model: Model, motion: GroundMotion) -> dict:
                 y = np.zeros(2 * n)
                 pieces.side[0], pieces.k[0] = motion.uplift_side(t), 0
                 at_rest = False
+            if time.perf_counter() - start > budget_s:
+                return {"status": "failed", "t_collapse_s": math.nan, "max_rotation_ratio": peak,
+                        "wall_time_s": time.perf_counter() - start}  # fmt: skip
             A, cvec, evec = pieces.system()
             lo, hi = pieces.bounds()
             events = []

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from .cli import UserError, _one_line, cli
@@ -24,7 +26,9 @@ from .errors import RbmError
 @click.option("--scaling", is_flag=True,
               help="Also measure time per run against drums, K_M and duration, and the "
               "speed-up of 2 workers over 1 (scaling.csv, scaling.png).")  # fmt: skip
-def bench(quick, output, jobs, problems, references, scaling) -> None:
+@click.option("--reuse-references", is_flag=True,
+              help="Full run: keep the stored references instead of re-making them.")  # fmt: skip
+def bench(quick, output, jobs, problems, references, scaling, reuse_references) -> None:
     """Measure run time against error for every method and tolerance rbm offers.
 
     Problems: the rigid Spanos-Koh slender block, the tapered monolithic column
@@ -40,14 +44,18 @@ def bench(quick, output, jobs, problems, references, scaling) -> None:
     """
     from .bench import check_targets, run_bench
 
+    def log(line: str) -> None:
+        click.echo(line)
+        sys.stdout.flush()  # progress shows when stdout is a file
+
     try:
         table = run_bench(quick=quick, jobs=jobs, output=output, reference_dir=references,
-                          problems=tuple(problems) or None,
-                          log=lambda s: click.echo(s))  # fmt: skip
+                          problems=tuple(problems) or None, reuse_references=reuse_references,
+                          log=log)  # fmt: skip
         if scaling:
             from .bench_scaling import run_scaling
 
-            run_scaling(output=output, log=lambda s: click.echo(s))
+            run_scaling(output=output, log=log)
     except RbmError as exc:
         raise UserError(_one_line(exc)) from None
     click.echo(f"output: {output}/bench.csv, {output}/bench.png")

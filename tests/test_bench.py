@@ -1,0 +1,71 @@
+"""`rbm bench`: the quick benchmark against the stored references (CI), and the
+error bookkeeping on hand-made frames (so the scoring itself can fail)."""
+
+from __future__ import annotations
+
+import pandas as pd
+from click.testing import CliRunner
+
+from rbm_cli.bench import PEAK_TARGET, check_targets, errors
+from rbm_cli.cli import cli
+
+
+def frame(rows):
+    df = pd.DataFrame(rows, columns=["amplitude_g", "frequency_hz", "collapsed",
+                                     "t_collapse_s", "max_rotation_ratio"])  # fmt: skip
+    df["status"] = ["collapsed" if c else "survived" for c in df["collapsed"]]
+    return df
+
+
+def reference(rows, converged, peak_converged):
+    ref = frame(rows)
+    ref["converged"] = converged
+    ref["peak_converged"] = peak_converged
+    return ref
+
+
+def test_errors_count_only_converged_cells_and_well_conditioned_peaks():
+    ref = reference(
+        [(0.1, 1.0, 0, None, 0.5), (0.2, 1.0, 1, 2.0, 1.0), (0.3, 1.0, 1, 1.0, 1.0),
+         (0.1, 2.0, 0, None, 0.2), (0.2, 2.0, 0, None, 0.4)],
+        converged=[1, 1, 1, 1, 0], peak_converged=[1, 0, 0, 0, 0],
+    )  # fmt: skip
+    run = frame([(0.1, 1.0, 0, None, 0.5005), (0.2, 1.0, 0, None, 0.9), (0.3, 1.0, 1, 1.1, 1.0),
+                 (0.1, 2.0, 0, None, 0.3), (0.2, 2.0, 1, 3.0, 1.0)])  # fmt: skip
+    e = errors(run, ref)
+    assert e["n_converged"] == 4 and e["n_sensitive"] == 1
+    assert e["cells_differ"] == 1  # (0.2, 1.0); the sensitive (0.2, 2.0) is not scored
+    assert e["n_peak"] == 1 and abs(e["peak_err_max"] - 1e-3) < 1e-12  # (0.1, 2.0) not scored
+    assert e["n_tcol"] == 1 and abs(e["tcol_err_max"] - 0.1) < 1e-12
+    assert abs(e["boundary_err_g"] - 0.1) < 1e-12  # 1 Hz boundary 0.2 -> 0.3 g
+
+
+def test_targets_fail_when_the_default_misses_them():
+    good = {"problem": "slender", "default": 1, "fraction_differ": 0.0, "cells_differ": 0,
+            "n_converged": 1600, "n_peak": 10, "peak_err_max": 1e-6}  # fmt: skip
+    assert check_targets(pd.DataFrame([good])) == []
+    many = dict(good, fraction_differ=0.01, cells_differ=16)
+    assert "cells differ" in check_targets(pd.DataFrame([many]))[0]
+    peak = dict(good, peak_err_max=2 * PEAK_TARGET)
+    assert "peak rotation" in check_targets(pd.DataFrame([peak]))[0]
+    other = dict(many, default=0)  # only the default method is held to the targets
+    assert check_targets(pd.DataFrame([other])) == []
+
+
+def test_quick_bench_meets_the_accuracy_targets(tmp_path):
+    res = CliRunner().invoke(cli, ["bench", "--quick", "-o", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    table = pd.read_csv(tmp_path / "bench.csv")
+    assert set(table["problem"]) == {"slender", "tapered", "multidrum", "halfsine"}
+    default = table[table["default"] == 1]
+    assert len(default) == 4 and (default["n_converged"] > 0).all()
+    assert (table["implementation"] == "baseline").sum() == 4
+    assert (tmp_path / "bench.png").stat().st_size > 0
+
+
+def test_quick_bench_without_references_is_a_one_line_error(tmp_path):
+    res = CliRunner().invoke(cli, ["bench", "--quick", "-o", str(tmp_path / "o"),
+                                   "--references", str(tmp_path / "none")])  # fmt: skip
+    assert res.exit_code == 2
+    assert res.output.strip().startswith("Error:") and "reference" in res.output
+    assert len(res.output.strip().splitlines()) == 1

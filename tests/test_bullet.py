@@ -5,8 +5,8 @@ corner inertia from the independent polynomial integrals of `housner`
 (themselves checked against triple integrals in test_reference.py), Housner's
 impact formula e = 1 - 1.5 sin^2(alpha) written here, the statics of a rigid
 block (no motion below tan(alpha) g), and Housner's model itself run with the
-engine's measured impact loss. CI grid: 3 amplitudes x 2 frequencies per column
-(12 cells; docs/make_engine.py runs the issue's 6 x 5 grid).
+engine's measured impact loss. CI runs the issue's 6 x 5 grid with 3 s of
+excitation per cell (docs/make_engine.py runs it for 10 s).
 """
 
 from __future__ import annotations
@@ -158,22 +158,24 @@ def test_same_cell_same_answer():
 
 # ------------------------------------------------------------ against Housner
 
-#: CI grid: 3 amplitudes x 2 frequencies per column (amplitudes over the uplift level).
-CI_LEVELS = (1.3, 2.0, 3.0)
-CI_FREQUENCIES = (1.0, 2.0)
+#: The issue's 6 x 5 harmonic grid (the one docs/make_engine.py runs for 10 s).
+GRID_AMPLITUDES = (0.3, 0.5, 0.7, 0.9, 1.1, 1.3)  # g
+GRID_FREQUENCIES = (0.5, 1.0, 1.5, 2.0, 2.5)  # Hz
+#: CI runs it with 3 s of excitation instead of 10 s (both models see the same motion).
+CI_DURATION = 3.0  # s
 
 
 @pytest.mark.parametrize("column", [BLOCK, TAPER], ids=["block", "tapered"])
 def test_engine_agrees_with_housner(column):
     """The issue's bar: a monolithic block and the tapered column agree with
-    `housner` (run with the engine's measured impact loss) on >= 95 % of cells."""
-    engine = config(column)
+    `housner` (run with the engine's measured impact loss) on >= 95 % of the cells
+    of a 6 x 5 harmonic grid (here 3 s of excitation; 10 s in docs/engine.md)."""
+    engine = config(column, duration=CI_DURATION)
     e = float(np.mean(measure_restitution(engine, impacts=4)))
-    ref = config(column, model="housner", restitution=round(e, 3))
-    level = math.tan(stack_slenderness(drum_solids(engine.column))[0])
-    cells = [(round(k * level, 3), f) for k in CI_LEVELS for f in CI_FREQUENCIES]
+    ref = config(column, model="housner", duration=CI_DURATION, restitution=round(e, 3))
+    cells = [(a, f) for a in GRID_AMPLITUDES for f in GRID_FREQUENCIES]
     same = [simulate(engine, a, f).status == simulate(ref, a, f).status for a, f in cells]
-    assert sum(same) >= 0.95 * len(cells), list(zip(cells, same, strict=True))
+    assert sum(same) >= 0.95 * len(cells), [c for c, ok in zip(cells, same, strict=True) if not ok]
 
 
 # ------------------------------------------------------------------- bad input

@@ -1,0 +1,332 @@
+"""Measure the numbers and draw the figures of docs/engine.md (issue 7: `model: bullet`).
+
+    python docs/make_engine.py impact      # the engine's impact loss vs Housner's e (~10 s)
+    python docs/make_engine.py grid        # 6 x 5 grid, engine vs housner, 3 time steps (~5 min)
+    python docs/make_engine.py timestep    # 8-drum cells at 3 time steps (~6 min)
+    python docs/make_engine.py chaos       # one chaotic 8-drum cell, K = 4, 2 time steps
+    python docs/make_engine.py monolithic  # the monolithic study: RBM, housner, engine (~2 min)
+    python docs/make_engine.py multidrum   # RBM formulations vs engine fractions (figure;
+                                           # runs the RBM on the engine's grid)
+
+Everything goes through the library API. Each part prints what it measures and
+stores it in docs/engine_data/<part>.json; figures go to docs/figures/engine_*.png.
+CPU times are process times of this machine (2 cores, shared).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses as dc
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from rbm_cli.bullet import measure_restitution  # noqa: E402
+from rbm_cli.config import load_config, parse_config  # noqa: E402
+from rbm_cli.config_types import GridConfig  # noqa: E402
+from rbm_cli.domain import read_domain  # noqa: E402
+from rbm_cli.housner import block_geometry, housner_restitution  # noqa: E402
+from rbm_cli.simulate import simulate  # noqa: E402
+from rbm_cli.sweep import run_sweep  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT / "docs" / "engine_data"
+FIGURES = ROOT / "docs" / "figures"
+
+COLUMNS = {
+    "block 4 x 1 m": {"height": 4.0, "base_width": 1.0, "depth": 1.0},
+    "block 2 x 1 m": {"height": 2.0, "base_width": 1.0, "depth": 1.0},
+    "tapered 5 m column": {"height": 5.0, "base_width": 0.96, "top_width": 0.66},
+}
+#: The issue's 6 x 5 harmonic grid (g, Hz), for both monolithic columns.
+GRID_AMPLITUDES = (0.3, 0.5, 0.7, 0.9, 1.1, 1.3)
+GRID_FREQUENCIES = (0.5, 1.0, 1.5, 2.0, 2.5)
+TIME_STEPS = (1e-4, 2e-4, 5e-4)
+#: 8-drum cells of the time-step study (g, Hz).
+MULTI_CELLS = [(a, f) for f in (1.0, 2.5) for a in (0.25, 0.4, 0.6, 0.9)]
+
+
+def column_config(column: dict, model: str = "bullet", **interface):
+    data = {"name": "engine_doc", "model": model, "column": dict(column)}
+    if interface:
+        data["interface"] = interface
+    return parse_config(data)
+
+
+def with_step(cfg, dt: float):
+    return dc.replace(cfg, solver=dc.replace(cfg.solver, time_step=dt))
+
+
+def dump(part: str, data) -> None:
+    DATA.mkdir(parents=True, exist_ok=True)
+    (DATA / f"{part}.json").write_text(json.dumps(data, indent=1, default=float) + "\n")
+
+
+def timed(fn, *args):
+    t = time.process_time()
+    out = fn(*args)
+    return out, time.process_time() - t
+
+
+# ------------------------------------------------------------------------- parts
+
+
+def part_impact() -> None:
+    rows = []
+    for name, column in COLUMNS.items():
+        cfg = column_config(column)
+        e_h = housner_restitution(block_geometry(cfg.column))
+        for frac in (0.2, 0.5, 0.8):
+            ratios = measure_restitution(cfg, tilt_fraction=frac, impacts=4)
+            rows.append(dict(column=name, tilt=frac, housner=e_h, ratios=list(ratios)))
+            print(f"{name:20s} tilt {frac} alpha: e = {np.round(ratios, 3)}  Housner {e_h:.3f}")
+    dump("impact", rows)
+
+
+def part_grid() -> None:
+    """Engine vs housner (e: the mean measured ratio) on the 6 x 5 grid: friction 1.0
+    at three time steps, and friction 2.0 (no sliding below 2 g, Housner's assumption).
+    A differing cell is 'sensitive' when housner's own outcome changes for an e
+    within the measured spread (min..max of the ratios)."""
+    out = {}
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    cells = [(a, f) for f in GRID_FREQUENCIES for a in GRID_AMPLITUDES]
+    for ax, name in zip(axes, ("block 4 x 1 m", "tapered 5 m column"), strict=True):
+        ratios = measure_restitution(column_config(COLUMNS[name]), impacts=4)
+        e = float(np.mean(ratios))
+        spread = np.linspace(ratios.min(), ratios.max(), 5)
+
+        def housner(e_, name=name):
+            ref = column_config(COLUMNS[name], model="housner", restitution=round(float(e_), 4))
+            return {c: simulate(ref, *c).status for c in cells}
+
+        ref = housner(e)
+        varied = [housner(x) for x in spread]
+        res = {"e": e, "e_min": float(ratios.min()), "e_max": float(ratios.max())}
+        res["housner"] = {f"{a} {f}": s for (a, f), s in ref.items()}
+        for friction, dt in [(1.0, t) for t in TIME_STEPS] + [(2.0, TIME_STEPS[0])]:
+            cfg = with_step(column_config(COLUMNS[name], friction=friction), dt)
+            runs = [timed(simulate, cfg, a, f) for a, f in cells]
+            status = {c: r.status for c, (r, _) in zip(cells, runs, strict=True)}
+            differ = [c for c in cells if status[c] != ref[c]]
+            sensitive = [c for c in differ if len({v[c] for v in varied}) > 1]
+            slip = {
+                f"{a} {f}": r.message.split("max slip: ")[-1]
+                for (a, f), (r, _) in zip(cells, runs, strict=True)
+                if (a, f) in differ
+            }
+            cpu = sum(t for _, t in runs)
+            res[f"mu {friction} dt {dt:g}"] = dict(
+                status={f"{a} {f}": s for (a, f), s in status.items()},
+                differ=differ,
+                sensitive=sensitive,
+                slip_of_differing=slip,
+                cpu_s=cpu,
+            )
+            print(
+                f"{name}, e = {e:.3f} ({ratios.min():.3f}-{ratios.max():.3f}), friction"
+                f" {friction}, dt {dt:g}: {len(differ)} of {len(cells)} differ {differ}"
+                f" (sensitive to e: {sensitive}), slips {slip}, {cpu:.1f} s CPU"
+            )
+            if friction == 1.0 and dt == TIME_STEPS[0]:
+                _grid_axes(ax, name, cells, ref, res[f"mu {friction} dt {dt:g}"]["status"], e)
+        out[name] = res
+    axes[0].set_ylabel("amplitude [g]")
+    fig.tight_layout()
+    fig.savefig(FIGURES / "engine_monolithic_vs_housner.png", dpi=110, bbox_inches="tight")
+    dump("grid", out)
+
+
+def _grid_axes(ax, name, cells, housner, engine_status, e) -> None:
+    for a, f in cells:
+        h = housner[(a, f)] == "collapsed"
+        b = engine_status[f"{a} {f}"] == "collapsed"
+        ax.plot(f, a, "x" if h else "o", color="k", mfc="none", ms=9)
+        if h != b:
+            ax.plot(f, a, "s", color="tab:red", mfc="none", ms=15)
+    ax.set_title(
+        f"{name}: housner (e = {e:.3f}, o safe / x collapsed);\nred square: engine differs"
+    )
+    ax.set_xlabel("frequency [Hz]")
+
+
+def part_timestep() -> None:
+    cfg = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
+    rows = []
+    for dt in TIME_STEPS:
+        for a, f in MULTI_CELLS:
+            r, cpu = timed(simulate, with_step(cfg, dt), a, f)
+            rows.append(
+                dict(
+                    dt=dt,
+                    a=a,
+                    f=f,
+                    status=r.status,
+                    t_c=r.t_collapse_s,
+                    ratio=r.max_rotation_ratio,
+                    cpu_s=cpu,
+                    message=r.message,
+                )
+            )
+            print(json.dumps(rows[-1]))
+    dump("timestep", rows)
+
+
+def part_chaos() -> None:
+    """The 8-drum cell (0.6 g, 1 Hz) that changed with the time step: K = 4 runs with
+    the sweep's ensemble offsets (phase, relative amplitude up to 1e-6) at 1e-4 and 5e-4 s."""
+    from rbm_cli.sweep import ensemble_offsets
+
+    base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
+    rows = []
+    for dt in (1e-4, 5e-4):
+        for phase, rel in ensemble_offsets(4):
+            cfg = with_step(base, dt)
+            cfg = dc.replace(cfg, excitation=dc.replace(cfg.excitation, phase=phase))
+            r, cpu = timed(simulate, cfg, 0.6 * (1.0 + rel), 1.0)
+            rows.append(
+                dict(
+                    dt=dt,
+                    phase=phase,
+                    rel=rel,
+                    status=r.status,
+                    t_c=r.t_collapse_s,
+                    ratio=r.max_rotation_ratio,
+                    cpu_s=cpu,
+                )
+            )
+            print(json.dumps(rows[-1]))
+    dump("chaos", rows)
+
+
+def part_monolithic(jobs: int) -> None:
+    """The monolithic study: RBM, housner (e = 1 and e = 0.929, the engine's mean e of
+    the column) and the engine's stored domain, cells that differ pairwise."""
+    base = load_config(ROOT / "configs" / "harmonic_monolithic.yaml")
+    eng = read_domain(ROOT / "results" / "harmonic_monolithic_bullet" / "domain.csv")
+    rbm = read_domain(ROOT / "results" / "harmonic_monolithic" / "domain.csv")
+    ref = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for e in (1.0, 0.929):
+            cfg = dc.replace(
+                base,
+                name=f"h{e}",
+                model="housner",
+                interface=dc.replace(base.interface, restitution=e),
+            )
+            ref[e] = read_domain(run_sweep(cfg, tmp, jobs=jobs).folder / "domain.csv")
+
+    def differ(a, b):
+        m = a.merge(b, on=["amplitude_g", "frequency_hz"])
+        return int((m.collapsed_x != m.collapsed_y).sum()), len(m)
+
+    out = {
+        "rbm vs housner e=1": differ(rbm, ref[1.0]),
+        "housner e=1 vs e=0.929": differ(ref[1.0], ref[0.929]),
+        "housner e=0.929 vs engine": differ(ref[0.929], eng),
+        "rbm vs engine": differ(rbm, eng),
+    }
+    print(out)
+    dump("monolithic", out)
+
+
+def part_multidrum(jobs: int) -> None:
+    """RBM (relative, absolute, geometric) vs the engine's collapse fraction."""
+    engine = pd.read_csv(ROOT / "results" / "harmonic_multidrum_bullet" / "domain.csv")
+    rbm_cfg = load_config(ROOT / "configs" / "harmonic_multidrum.yaml")
+    amps = tuple(sorted(engine["amplitude_g"].unique()))
+    freqs = tuple(sorted(engine["frequency_hz"].unique()))
+    grid = GridConfig(amplitudes_g=amps, frequencies_hz=freqs)
+    domains, summary = {}, {}
+    for form in ("relative", "absolute", "geometric"):
+        cfg = dc.replace(
+            rbm_cfg,
+            name=f"engine_doc_{form}",
+            grid=grid,
+            interface=dc.replace(rbm_cfg.interface, formulation=form),
+        )
+        with tempfile.TemporaryDirectory() as tmp:
+            summary_ = run_sweep(cfg, tmp, jobs=jobs)
+            df = read_domain(summary_.folder / "domain.csv")
+        domains[form] = df
+        print(f"RBM {form}: {len(df)} cells in {summary_.wall_time_s:.0f} s wall")
+    frac_col = "collapse_fraction" if "collapse_fraction" in engine else "collapsed"
+    eng = engine.set_index(["amplitude_g", "frequency_hz"])[frac_col]
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), sharey=True)
+    for ax, (form, df) in zip(axes, domains.items(), strict=True):
+        r = df.set_index(["amplitude_g", "frequency_hz"])["collapsed"].reindex(eng.index)
+        agree = float(np.mean(np.abs(r.to_numpy() - eng.to_numpy()) < 0.5))
+        mean_diff = float(np.mean(r.to_numpy() - eng.to_numpy()))
+        summary[form] = dict(
+            agree=agree,
+            rbm_minus_engine=mean_diff,
+            rbm_boundary=_boundary(df),
+            engine_boundary=_boundary_frac(engine, frac_col),
+        )
+        sc = ax.scatter(
+            [f for _, f in eng.index],
+            [a for a, _ in eng.index],
+            c=eng.to_numpy(),
+            cmap="coolwarm",
+            vmin=0,
+            vmax=1,
+            s=60,
+            marker="s",
+        )
+        for (a, f), c in r.items():
+            ax.plot(f, a, "x" if c else ".", color="k", ms=6 if c else 3)
+        ax.set_title(f"RBM {form} (x collapsed, . safe)\nover engine collapse fraction (colour)")
+        ax.set_xlabel("frequency [Hz]")
+        print(form, summary[form])
+    axes[0].set_ylabel("amplitude [g]")
+    fig.colorbar(sc, ax=axes, label="engine collapse fraction")
+    fig.savefig(FIGURES / "engine_multidrum_rbm_vs_engine.png", dpi=110, bbox_inches="tight")
+    dump("multidrum", summary)
+
+
+def _boundary(df) -> dict:
+    out = {}
+    for f, g in df.groupby("frequency_hz"):
+        c = g[g["collapsed"] == 1]["amplitude_g"]
+        out[float(f)] = float(c.min()) if len(c) else None
+    return out
+
+
+def _boundary_frac(df, col) -> dict:
+    out = {}
+    for f, g in df.groupby("frequency_hz"):
+        c = g[g[col] >= 0.5]["amplitude_g"]
+        out[float(f)] = float(c.min()) if len(c) else None
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parts = ["impact", "grid", "timestep", "chaos", "monolithic", "multidrum"]
+    ap.add_argument("part", choices=parts)
+    ap.add_argument("--jobs", type=int, default=2)
+    args = ap.parse_args(argv)
+    FIGURES.mkdir(parents=True, exist_ok=True)
+    if args.part == "multidrum":
+        part_multidrum(args.jobs)
+    elif args.part == "monolithic":
+        part_monolithic(args.jobs)
+    else:
+        parts = {"impact": part_impact, "grid": part_grid, "timestep": part_timestep}
+        parts["chaos"] = part_chaos
+        parts[args.part]()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

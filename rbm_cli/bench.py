@@ -79,7 +79,7 @@ PROBLEMS = (
 METHODS = (
     [("compiled", "DOP853", r) for r in (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)]
     + [("compiled", "RK45", r) for r in (1e-5, 1e-6, 1e-7, 1e-8)]
-    + [("python", "DOP853", 1e-9)]
+    + [("python", "DOP853", SolverConfig().rtol)]
 )
 #: Cells of the sample on which the slow methods (the Python loop and the
 #: baseline) run: the same cells for both, and the speed-up of every method is

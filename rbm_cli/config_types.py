@@ -135,7 +135,7 @@ class SolverConfig:
     """
 
     method: str = "DOP853"
-    rtol: float = 1e-9
+    rtol: float = 1e-10
     atol: float = 1e-12
     max_steps: int = 2_000_000
     max_events: int = 200_000

@@ -118,7 +118,9 @@ def _plot_fraction_cells(ax, df: pd.DataFrame) -> list:
     if failed.any():
         ax.scatter(f[failed], a[failed], marker="s", c="0.55", s=22, gid="failed")
         handles.append(Line2D([], [], marker="s", label="failed run", **{**proxy, "color": "0.55"}))
-    ax.figure.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, label="collapse fraction [-]")
+    # below the axes: the legend sits beside them
+    ax.figure.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, label="collapse fraction [-]",
+                       location="bottom", pad=0.16, fraction=0.06, aspect=40)  # fmt: skip
     return handles
 
 

@@ -209,7 +209,8 @@ def test_collapse_fraction_colours_points_with_colourbar():
     assert len(safe.get_offsets()) == int((df.status == "survived").sum())
     assert len(failed.get_offsets()) == 1
     assert len(fig.axes) == 2  # the colour bar
-    assert fig.axes[1].get_ylabel() == "collapse fraction [-]"
+    cbar = fig.axes[1]  # below the axes (horizontal): the label is on its x axis
+    assert cbar.get_xlabel() == "collapse fraction [-]"
     # colours follow the fraction: collapsed cells (fraction 1) share one colour
     assert len(np.unique(np.asarray(unsafe.get_facecolors()), axis=0)) == 1
     assert len(np.unique(np.asarray(safe.get_edgecolors()), axis=0)) > 1

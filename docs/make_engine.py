@@ -5,6 +5,7 @@
     python docs/make_engine.py timestep    # 8-drum cells at 3 time steps (~6 min)
     python docs/make_engine.py chaos       # one chaotic 8-drum cell, K = 4, 2 time steps
     python docs/make_engine.py monolithic  # the monolithic study: RBM, housner, engine (~2 min)
+    python docs/make_engine.py rbm_e       # 8-drum RBM with e < 1 vs engine; friction demand
     python docs/make_engine.py multidrum   # RBM formulations vs engine fractions (figure;
                                            # runs the RBM on the engine's grid)
 
@@ -294,6 +295,36 @@ def part_multidrum(jobs: int) -> None:
     dump("multidrum", summary)
 
 
+def part_rbm_e(jobs: int) -> None:
+    """The 8-drum RBM (relative) with impact loss e < 1 against the engine's fractions,
+    and the RBM's friction demand max |T/N| in three cells (no sliding needs mu above it)."""
+    engine = pd.read_csv(ROOT / "results" / "harmonic_multidrum_bullet" / "domain.csv")
+    eng = engine.set_index(["amplitude_g", "frequency_hz"])["collapse_fraction"]
+    base = load_config(ROOT / "configs" / "harmonic_multidrum.yaml")
+    grid = GridConfig(
+        amplitudes_g=tuple(sorted({a for a, _ in eng.index})),
+        frequencies_hz=tuple(sorted({f for _, f in eng.index})),
+    )
+    out = {}
+    for e in (1.0, 0.929, 0.8):
+        cfg = dc.replace(
+            base, name=f"rbm_e{e}", grid=grid, interface=dc.replace(base.interface, restitution=e)
+        )
+        with tempfile.TemporaryDirectory() as tmp:
+            df = read_domain(run_sweep(cfg, tmp, jobs=jobs).folder / "domain.csv")
+        r = df.set_index(["amplitude_g", "frequency_hz"])["collapsed"].reindex(eng.index)
+        agree = float(np.mean(np.abs(r.to_numpy() - eng.to_numpy()) < 0.5))
+        out[f"e {e}"] = dict(agree=agree, rbm_boundary=_boundary(df))
+        print(f"RBM relative, e = {e}: agrees with the engine on {agree:.3f}", _boundary(df))
+    demand = []
+    for a, f in ((0.25, 1.0), (0.25, 3.0), (0.45, 3.5)):
+        r = simulate(base, a, f)
+        demand.append(dict(a=a, f=f, status=r.status, max_friction_demand=r.max_friction_demand))
+        print(demand[-1])
+    out["friction_demand"] = demand
+    dump("rbm_e", out)
+
+
 def _boundary(df) -> dict:
     out = {}
     for f, g in df.groupby("frequency_hz"):
@@ -312,7 +343,7 @@ def _boundary_frac(df, col) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parts = ["impact", "grid", "timestep", "chaos", "monolithic", "multidrum"]
+    parts = ["impact", "grid", "timestep", "chaos", "monolithic", "multidrum", "rbm_e"]
     ap.add_argument("part", choices=parts)
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args(argv)
@@ -321,6 +352,8 @@ def main(argv=None) -> int:
         part_multidrum(args.jobs)
     elif args.part == "monolithic":
         part_monolithic(args.jobs)
+    elif args.part == "rbm_e":
+        part_rbm_e(args.jobs)
     else:
         parts = {"impact": part_impact, "grid": part_grid, "timestep": part_timestep}
         parts["chaos"] = part_chaos

@@ -193,6 +193,24 @@ def test_bad_friction_is_one_line(tmp_path):
     assert "Traceback" not in result.output
 
 
+def test_rbm_run_writes_the_engine_history(tmp_path):
+    """`rbm run` on an engine config writes the RBM's four files, the history from
+    the drums' positions (8 drums: 9 node columns, 8 rotations)."""
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "name: e\nmodel: bullet\ncolumn: {height: 5, base_width: 0.96, top_width: 0.66,"
+        " drums: 8}\nexcitation: {duration: 0.5}\n"
+    )
+    res = CliRunner().invoke(cli, ["run", str(path), "-a", "0.6", "-f", "2", "-o", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    folder = tmp_path / "e" / "run_A0.6_f2"
+    for name in ("history.csv", "history.png", "shapes.png", "summary.json"):
+        assert (folder / name).is_file(), name
+    header = (folder / "history.csv").read_text().splitlines()[0].split(",")
+    assert sum(h[0] == "u" and h[1:-2].isdigit() and h.endswith("_m") for h in header) == 9
+    assert sum(h.startswith("theta") for h in header) == 8
+
+
 def test_engine_settings_are_the_scoped_ones():
     """The issue's scoping values; a change must be deliberate."""
     s = EngineSettings()

@@ -116,6 +116,7 @@ def run_kernel(
     d2_old, d2_new = np.empty(nrow), np.empty(nrow)
     Dq, Rq = np.empty((nrow, CHECK_INTERVALS + 1)), np.empty((nrow, CHECK_INTERVALS + 1))
     dc0, dc1, rc0, rc1 = np.empty(nrow), np.empty(nrow), np.empty(nrow), np.empty(nrow)
+    near = np.zeros(nrow, dtype=np.bool_)
     z_old, z_new, z_prev = np.empty(nt), np.empty(nt), np.empty(nt)
     dz_old, dz_new, dz_prev = np.empty(nt), np.empty(nt), np.empty(nt)
     acc = np.empty(n)
@@ -249,12 +250,12 @@ def run_kernel(
                 _affine(G, acc, 0, no_offset, d2_new)
                 event_row = -1
                 t_e = t_new
-                if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old):
+                if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
                     n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
                                             cs, es, amp, omega, phase)  # fmt: skip
                     dense_ready = True
                     t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, G, h0, n, buf,
-                                                     Dq, Rq, dc0, dc1, rc0, rc1)  # fmt: skip
+                                                     Dq, Rq, dc0, dc1, rc0, rc1, near)  # fmt: skip
                 if event_row >= 0:
                     _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e
@@ -279,7 +280,12 @@ def run_kernel(
                 # peaks inside the step: at the root of the rate, on the dense output
                 for r in range(nt):
                     v = max(abs(z_old[r]), abs(z_new[r]))
-                    if dz_old[r] * dz_new[r] < 0.0:
+                    # a turn inside the step that may beat the running maximum: the
+                    # step's cubic Hermite exceeds its end values by at most
+                    # 4/27 h (|rate0| + |rate1|); the margin used is 1/2 (the dense
+                    # output is of higher order than the Hermite)
+                    reach = v + 0.5 * (t_new - t_old) * (abs(dz_old[r]) + abs(dz_new[r]))
+                    if dz_old[r] * dz_new[r] < 0.0 and reach > peaks[r]:
                         if not dense_ready:
                             n_rhs += _dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
                                                     As, cs, es, amp, omega, phase)  # fmt: skip
@@ -437,9 +443,11 @@ def integrate_compiled(
     n = model.n
     global _LAST
     if arrays is None:
-        if _LAST[0] is not model:
-            _LAST = (model, model_arrays(model))
-        arrays = _LAST[1]
+        last = _LAST  # one read: threads (Dask in-process, joblib threading) may swap it
+        if last[0] is not model:
+            last = (model, model_arrays(model))
+            _LAST = last
+        arrays = last[1]
     n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((n_max, 1 + 2 * n))
     tu = model.column.rotation_capacity

@@ -150,19 +150,22 @@ CHECK_INTERVALS = 8
 
 
 @njit(cache=True)
-def _within_reach(d0, d1, r0, r1, a0, a1, dt):
-    """events.within_reach."""
+def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
+    """events.within_reach, row by row: mask[r] marks the rows within reach (only
+    they are searched in _first_crossing; the others cannot cross by the same
+    criterion that lets a step with no row within reach go unchecked)."""
+    anyrow = False
     for r in range(d0.size):
         reach = dt * (abs(r0[r]) + abs(r1[r])) + dt * dt * (abs(a0[r]) + abs(a1[r]))
-        if min(d0[r], d1[r]) <= reach:
-            return True
-    return False
+        mask[r] = min(d0[r], d1[r]) <= reach
+        anyrow = anyrow or mask[r]
+    return anyrow
 
 
 @njit(cache=True)
-def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, buf, D, R, dcol0, dcol1, rcol0, rcol1):
-    """events.first_crossing on the step's dense output: (t, row) of the earliest
-    crossing of any event surface in [t0, t1], or (-1, -1)."""
+def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, buf, D, R, dcol0, dcol1, rcol0, rcol1, mask):
+    """events.first_crossing on the step's dense output, over the rows in `mask`:
+    (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1)."""
     nseg = CHECK_INTERVALS
     h = t1 - t0
     nrow = G.shape[0]
@@ -170,6 +173,9 @@ def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, buf, D, R, dcol0, dcol1, rco
         tq = t0 + h * q / nseg if q < nseg else t1
         _dense_eval(mc, tq, t0, h, y_old, F, buf)
         for r in range(nrow):
+            if not mask[r]:
+                D[r, q], R[r, q] = np.inf, 0.0  # inert: never below zero, never turning
+                continue
             d, v = h0[r], 0.0
             for j in range(n):
                 d += G[r, j] * buf[j]

@@ -48,8 +48,6 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
     arg_inv = np.linalg.inv(argmap)
     cmap = model.collapse_map / model.collapse_limit[:, None]
     c = model.collapse_ratio
-    impulse_dir = model.mass_inv @ argmap.T
-    impulse_w = np.einsum("ij,ji->i", argmap, impulse_dir)
     atol = BASELINE_ATOL * np.concatenate([np.full(n, tu.min()), np.full(n, 10 * tu.min())])
     uplift = model.uplift_level
     rest_rate = REST_RATE * model.rocking_p * tu.min()
@@ -60,9 +58,7 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
     pieces.locate(np.zeros(n), np.zeros(n))
     status, t_col = "survived", math.nan
     for seg_start, seg_end in motion.segments():
-        forced = motion.amplitude > 0 and not (
-            motion.kind == "half-sine" and seg_start >= motion.pulse_end
-        )
+        forced = motion.forced(seg_start)
         amp = motion.amplitude if forced else 0.0
         while t < seg_end:
             if at_rest:
@@ -122,19 +118,9 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
             going_up = which == 1
             bound = hi[i] if going_up else lo[i]
             y[:n] += arg_inv[:, i] * (bound - float(argmap[i] @ y[:n]))
-            s, k = pieces.side[i], pieces.k[i]
-            if k == 0 and not pieces.zero_active(i):
-                pieces.side[i], pieces.k[i], pieces.pending[i] = (1 if going_up else -1), 1, True
-            elif going_up == (s > 0):
-                pieces.k[i] = k + 1
-            elif k > 0:
-                pieces.k[i] = k - 1
-            else:
-                pieces.side[i], pieces.pending[i] = -s, False
+            if pieces.cross(i, going_up) == "impact":
                 if model.restitution < 1.0:
-                    xdot = float(argmap[i] @ y[n:])
-                    lam = (model.restitution - 1.0) * xdot / impulse_w[i]
-                    y[n:] += impulse_dir[:, i] * lam
+                    y[n:] = model.impact_rates(y[n:], i)
                 if uplift is not None and abs(y[n]) < rest_rate:
                     y, at_rest = np.zeros(2 * n), True
     return {"status": status, "t_collapse_s": t_col, "max_rotation_ratio": peak,

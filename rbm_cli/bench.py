@@ -95,10 +95,6 @@ PEAK_TARGET = 1e-4
 REFERENCE_DIR = ROOT / "results" / "bench"
 
 
-def default_solver() -> SolverConfig:
-    return SolverConfig()
-
-
 def problem_config(problem: Problem, stride: int = 1) -> Config:
     cfg = load_config(ROOT / problem.config)
     a0, a1, na = problem.amplitudes
@@ -120,6 +116,13 @@ def _with_solver(cfg: Config, implementation: str, method: str, rtol: float) -> 
 
 
 # ---------------------------------------------------------------- running cells
+def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: float) -> dict:
+    """One cell's outcome, as every runner of the benchmark reports it."""
+    return {"amplitude_g": a, "frequency_hz": f, "status": status,
+            "collapsed": int(status == "collapsed"), "t_collapse_s": t_collapse,
+            "max_rotation_ratio": peak, "wall_time_s": wall}  # fmt: skip
+
+
 def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
     from .kernel import warm_up
     from .simulate import model_from_config, simulate
@@ -129,10 +132,7 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
     rows = []
     for a, f in cells:
         r = simulate(cfg, a, f, model=model)
-        rows.append({"amplitude_g": a, "frequency_hz": f, "status": r.status,
-                     "collapsed": int(r.status == "collapsed"), "t_collapse_s": r.t_collapse_s,
-                     "max_rotation_ratio": r.max_rotation_ratio, "wall_time_s": r.wall_time_s,
-                     "n_steps": r.n_steps})  # fmt: skip
+        rows.append(_row(a, f, r.status, r.t_collapse_s, r.max_rotation_ratio, r.wall_time_s))
     return rows
 
 
@@ -145,32 +145,27 @@ def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dic
     rows = []
     for a, f in cells:
         out = baseline_run(model, make_ground_motion(cfg.excitation, a, f), budget_s=budget_s)
-        rows.append({"amplitude_g": a, "frequency_hz": f, "status": out["status"],
-                     "collapsed": int(out["status"] == "collapsed"),
-                     "t_collapse_s": out["t_collapse_s"],
-                     "max_rotation_ratio": out["max_rotation_ratio"],
-                     "wall_time_s": out["wall_time_s"], "n_steps": -1})  # fmt: skip
+        rows.append(_row(a, f, out["status"], out["t_collapse_s"], out["max_rotation_ratio"],
+                         out["wall_time_s"]))  # fmt: skip
     return rows
 
 
 def _run_closed_form_chunk(cfg: Config, cells) -> list[dict]:
     from .closed_forms import linear_rocking_parameters
-    from .column import build_column
     from .excitation import make_ground_motion
     from .housner_linear import housner_linear_run
     from .simulate import model_from_config
 
-    alpha, p = linear_rocking_parameters(build_column(cfg.column, cfg.interface))
-    e = model_from_config(cfg).restitution
+    model = model_from_config(cfg)
+    alpha, p = linear_rocking_parameters(model.column)
     rows = []
     for a, f in cells:
         start = time.perf_counter()
         out = housner_linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f),
-                                 restitution=e, collapse_ratio=cfg.collapse.ratio)  # fmt: skip
-        rows.append({"amplitude_g": a, "frequency_hz": f, "status": out.status,
-                     "collapsed": int(out.status == "collapsed"), "t_collapse_s": out.t_collapse,
-                     "max_rotation_ratio": float(np.max(out.max_ratio)),
-                     "wall_time_s": time.perf_counter() - start, "n_steps": 0})  # fmt: skip
+                                 restitution=model.restitution,
+                                 collapse_ratio=cfg.collapse.ratio)  # fmt: skip
+        rows.append(_row(a, f, out.status, out.t_collapse, float(np.max(out.max_ratio)),
+                         time.perf_counter() - start))  # fmt: skip
     return rows
 
 
@@ -193,35 +188,42 @@ def run_cells(
 
 
 # ---------------------------------------------------------------- references
+def _close(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """|p - q| <= PEAK_CONVERGED |q|, elementwise (False where either is NaN)."""
+    with np.errstate(invalid="ignore"):
+        return np.abs(p - q) <= PEAK_CONVERGED * np.abs(q)
+
+
 def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
+    """The reference rows of a problem, with its `converged` and `peak_converged` flags.
+
+    A peak is scored only where it is well-conditioned: a 1e-9 relative change of
+    the amplitude moves it by at most PEAK_CONVERGED (error amplification <= 1000);
+    a long rocking run amplifies errors as exp(p t) between impacts."""
     cells = _cells(cfg)
+    nudged = [(a * (1.0 + 1e-9), f) for a, f in cells]
     if problem.reference == "closed-form":
         ref, _ = run_cells("closed-form", cfg, cells, jobs)
-        ref["converged"] = 1
-        # a peak is scored only where it is well-conditioned: a 1e-9 relative change
-        # of the amplitude moves it by at most PEAK_CONVERGED (error amplification
-        # <= 1000); a long rocking run amplifies errors as exp(p t) between impacts
-        nudged = [(a * (1.0 + 1e-9), f) for a, f in cells]
         other, _ = run_cells("closed-form", cfg, nudged, jobs)
-        p0, p1 = ref["max_rotation_ratio"].to_numpy(), other["max_rotation_ratio"].to_numpy()
+        ref["converged"] = 1
         same = ref["collapsed"].to_numpy() == other["collapsed"].to_numpy()
-        ref["peak_converged"] = (same & (np.abs(p1 - p0) <= PEAK_CONVERGED * p0)).astype(int)
-        return ref[_REF_COLUMNS]
-    runs = [run_cells("rbm", _with_solver(cfg, "compiled", "DOP853", r), cells, jobs)[0]
-            for r in REFERENCE_RTOLS]  # fmt: skip
-    ref = runs[-1].copy()
-    same = np.ones(len(ref), dtype=bool)
-    for other in runs[:-1]:
-        same &= other["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
-    ref["converged"] = same.astype(int)
-    nudged = [(a * (1.0 + 1e-9), f) for a, f in cells]
-    tight = _with_solver(cfg, "compiled", "DOP853", REFERENCE_RTOLS[-1])
-    other = run_cells("rbm", tight, nudged, jobs)[0]["max_rotation_ratio"].to_numpy()
-    p11, p12 = runs[-2]["max_rotation_ratio"].to_numpy(), ref["max_rotation_ratio"].to_numpy()
-    with np.errstate(invalid="ignore", divide="ignore"):
-        close = np.abs(p11 - p12) <= PEAK_CONVERGED * np.abs(p12)
-        close &= np.abs(other - p12) <= PEAK_CONVERGED * np.abs(p12)
-    ref["peak_converged"] = (same & close).astype(int)
+        peak_ok = _close(
+            other["max_rotation_ratio"].to_numpy(), ref["max_rotation_ratio"].to_numpy()
+        )
+    else:
+        runs = [run_cells("rbm", _with_solver(cfg, "compiled", "DOP853", r), cells, jobs)[0]
+                for r in REFERENCE_RTOLS]  # fmt: skip
+        ref = runs[-1].copy()
+        same = np.ones(len(ref), dtype=bool)
+        for run in runs[:-1]:
+            same &= run["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
+        ref["converged"] = same.astype(int)
+        tight = _with_solver(cfg, "compiled", "DOP853", REFERENCE_RTOLS[-1])
+        other, _ = run_cells("rbm", tight, nudged, jobs)
+        p12 = ref["max_rotation_ratio"].to_numpy()
+        peak_ok = _close(runs[-2]["max_rotation_ratio"].to_numpy(), p12)
+        peak_ok &= _close(other["max_rotation_ratio"].to_numpy(), p12)
+    ref["peak_converged"] = (same & peak_ok).astype(int)
     return ref[_REF_COLUMNS]
 
 
@@ -321,50 +323,44 @@ def run_bench(
             ref_dir.mkdir(parents=True, exist_ok=True)
             write_text_atomic(ref_path, ref.to_csv(index=False, float_format="%.12g"))
             log(f"{prob.name}: reference ({prob.reference}) in {time.perf_counter() - start:.1f} s")
-        default = default_solver()
-        results_rows: list[dict] = []
-        methods = [("compiled", default.method, default.rtol)] if quick else list(METHODS)
+        default = ("compiled", SolverConfig().method, SolverConfig().rtol)
+        methods = [default] if quick else list(METHODS)
         sample = _sample(cells, QUICK_SAMPLE if quick else SAMPLE[prob.name])
-        results = []
+        results = []  # (method triple, rows, wall time [s], on the sample only)
         for impl, method, rtol in methods:
-            run_cfg = _with_solver(cfg, impl, method, rtol)
             part = sample if impl == "python" else cells
-            df, wall = run_cells("rbm", run_cfg, part, jobs)
-            results.append((impl, method, rtol, df, wall, len(part) < len(cells)))
+            df, wall = run_cells("rbm", _with_solver(cfg, impl, method, rtol), part, jobs)
+            results.append(((impl, method, rtol), df, wall, part is sample))
         df, wall = run_cells("baseline", cfg, sample, jobs, budget_s=20.0 if quick else 60.0)
-        results.append(("baseline", "solve_ivp RK45", 1e-6, df, wall, True))
+        results.append((("baseline", "solve_ivp RK45", 1e-6), df, wall, True))
+
+        # paired times: each method's run times summed over the sample's cells
         on_sample = set(_key(pd.DataFrame(sample, columns=["amplitude_g", "frequency_hz"])))
-        base_sum = float(df["wall_time_s"].sum())
-        key_default = ("compiled", default.method, default.rtol)
-        default_wall = next(w for i, m_, r_, _, w, _ in results if (i, m_, r_) == key_default)
-        default_sum = None
-        for impl, method, rtol, df, wall, estimated in results:
-            paired = float(df.loc[_key(df).isin(on_sample), "wall_time_s"].sum())
-            if (impl, method, rtol) == ("compiled", default.method, default.rtol):
-                default_sum = paired
+        paired = [
+            float(d.loc[_key(d).isin(on_sample), "wall_time_s"].sum()) for _, d, _, _ in results
+        ]
+        base_sum = paired[-1]
+        k_default = next(k for k, r in enumerate(results) if r[0] == default)
+        for (triple, df, wall, sampled), own in zip(results, paired, strict=True):
+            impl, method, rtol = triple
             row = {
                 "problem": prob.name,
                 "implementation": impl,
                 "method": method,
                 "rtol": rtol,
-                "default": int(
-                    impl == "compiled" and method == default.method and rtol == default.rtol
-                ),  # fmt: skip
+                "default": int(triple == default),
                 "cells_run": len(df),
                 "time_per_run_ms_median": 1e3 * float(df["wall_time_s"].median()),
                 "time_per_run_ms_mean": 1e3 * float(df["wall_time_s"].mean()),
-                "sample_time_s": paired,
-                "domain_wall_s": wall,
-                "domain_estimated": int(estimated),
+                "sample_time_s": own,
+                # a sampled method's whole domain: the default's wall time x the paired ratio
+                "domain_wall_s": results[k_default][2] * own / paired[k_default]
+                if sampled and paired[k_default] > 0
+                else (math.nan if sampled else wall),
+                "domain_estimated": int(sampled),
                 "jobs": jobs,
-                "speedup_vs_baseline": base_sum / paired if paired > 0 else math.nan,
+                "speedup_vs_baseline": base_sum / own if own > 0 else math.nan,
             }
-            if estimated:  # the whole domain: the default's wall time x the paired ratio
-                row["domain_wall_s"] = math.nan
-            results_rows.append(row)
-        for row, (_, _, _, df, _, _) in zip(results_rows, results, strict=True):
-            if row["domain_estimated"] and default_sum:
-                row["domain_wall_s"] = default_wall * row["sample_time_s"] / default_sum
             row.update(errors(df, ref))
             rows.append(row)
             log(_line(row))

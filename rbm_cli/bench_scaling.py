@@ -106,8 +106,11 @@ def _figure(table: pd.DataFrame, path: Path) -> None:
     fig, axes = plt.subplots(1, 4, figsize=(16, 3.8))
     for ax, (series, xlabel) in zip(
         axes[:3],
-        [("drums", "drums"), ("k_n", "joint normal stiffness k_n [Pa/m] (4 drums)"),
-         ("duration", "duration [s] (8 drums)")],  # fmt: skip
+        [
+            ("drums", "drums"),
+            ("k_n", "joint normal stiffness k_n [Pa/m] (4 drums)"),
+            ("duration", "duration [s] (8 drums)"),
+        ],  # fmt: skip
         strict=True,
     ):
         sub = table[table["series"] == series]

@@ -33,6 +33,24 @@ class Pieces:
     def zero_active(self, i: int) -> bool:
         return bool(self.rigid[i] or self.pending[i])
 
+    def cross(self, i: int, going_up: bool) -> str:
+        """Move interface i to its next piece as its argument crosses the current
+        piece's upper (going_up) or lower bound. Returns what the crossing is:
+        'uplift' (leaving the elastic branch), 'kink' (another piece of the same
+        side) or 'impact' (a zero crossing after an excursion: the side flips)."""
+        s, k = self.side[i], self.k[i]
+        if k == 0 and not self.zero_active(i):
+            self.side[i], self.k[i], self.pending[i] = (1 if going_up else -1), 1, True
+            return "uplift"
+        if going_up == (s > 0):
+            self.k[i] = k + 1
+            return "kink"
+        if k > 0:
+            self.k[i] = k - 1
+            return "kink"
+        self.side[i], self.pending[i] = -s, False
+        return "impact"
+
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         n = self.model.n
         lo, hi = np.empty(n), np.empty(n)

@@ -60,6 +60,14 @@ class GroundMotion:
             return [(0.0, self.pulse_end), (self.pulse_end, self.t_end)]
         return [(0.0, self.t_end)]
 
+    def after_pulse(self, seg_start: float) -> bool:
+        """Whether the segment starting at seg_start [s] is the free motion after a half-sine."""
+        return self.kind == "half-sine" and seg_start >= self.pulse_end
+
+    def forced(self, seg_start: float) -> bool:
+        """Whether a_g is non-zero on the segment starting at seg_start [s]."""
+        return self.amplitude > 0.0 and not self.after_pulse(seg_start)
+
     def next_exceedance(self, t0: float, level: float) -> float | None:
         """First time t >= t0 with |a_g(t)| > level, or None before t_end.
 
@@ -85,7 +93,6 @@ class GroundMotion:
         if t >= last:
             return None
         return t
-
 
     def rest_end(self, t: float, seg_end: float, level: float, forced: bool) -> tuple[str, float]:
         """How the rest of a rigid block, at rest at time t, ends.

@@ -244,9 +244,8 @@ def housner_run(
     for seg_start, seg_end in motion.segments():
         if t >= seg_end:
             continue
-        after_pulse = motion.kind == "half-sine" and seg_start >= motion.pulse_end
-        forced = motion.amplitude > 0.0 and not after_pulse
-        can_stop = early_stop and after_pulse
+        forced = motion.forced(seg_start)
+        can_stop = early_stop and motion.after_pulse(seg_start)
         while t < seg_end:
             if at_rest:
                 kind, t_stop = motion.rest_end(t, seg_end, level, forced)

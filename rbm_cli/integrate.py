@@ -115,11 +115,6 @@ def integrate(
     argmap = model.arg_map
     arg_inv = np.linalg.inv(argmap)
     e_rest = model.restitution
-    # impact at joint i: an impulsive moment along the joint's direction P^T e_i,
-    # sized so that the joint's rate becomes e times its value (see _impact_rates)
-    impulse_dir = model.mass_inv @ argmap.T  # column i: M^-1 P^T e_i
-    impulse_w = np.einsum("ij,ji->i", argmap, impulse_dir)  # w_ii = e_i^T P M^-1 P^T e_i
-    literal_impact = model.formulation == "absolute"
     stepper = _METHODS[solver.method]
     atol = solver.atol * np.concatenate([np.full(n, tu.min()), np.full(n, tu.min() * 10.0)])
 
@@ -151,9 +146,7 @@ def integrate(
     for seg_start, seg_end in motion.segments():
         if t >= seg_end:
             continue
-        free_seg = motion.amplitude == 0.0 or (
-            motion.kind == "half-sine" and seg_start >= motion.pulse_end
-        )
+        free_seg = not motion.forced(seg_start)
         if free_seg:
 
             def ag(tt):
@@ -286,34 +279,13 @@ def integrate(
             x_i = float(argmap[i] @ y[:n])
             y = y.copy()
             y[:n] += arg_inv[:, i] * (bound - x_i)
-            s, k = pieces.side[i], pieces.k[i]
-            outward = going_up == (s > 0)
-            if k == 0 and not pieces.zero_active(i):
-                # leaving the elastic branch through +-elastic limit
-                pieces.side[i] = 1 if going_up else -1
-                pieces.k[i] = 1
-                pieces.pending[i] = True
+            crossing = pieces.cross(i, going_up)
+            if crossing == "uplift":
                 out.n_uplifts += 1
-            elif outward:
-                pieces.k[i] = k + 1
-            elif k > 0:
-                pieces.k[i] = k - 1
-            else:
-                # zero crossing: an impact
+            elif crossing == "impact":
                 out.n_impacts += 1
-                pieces.side[i] = -s
-                pieces.pending[i] = False
                 if e_rest < 1.0:
-                    xdot_i = float(argmap[i] @ y[n:])
-                    y = y.copy()
-                    if literal_impact:
-                        # `absolute` (the paper's wording): only theta_i' is scaled
-                        y[n:] += arg_inv[:, i] * (e_rest - 1.0) * xdot_i
-                    else:
-                        # momentum-consistent: the kinetic energy changes by
-                        # -(1 - e^2) xdot_i^2 / (2 w_ii) <= 0; identical for n = 1
-                        lam = (e_rest - 1.0) * xdot_i / impulse_w[i]
-                        y[n:] += impulse_dir[:, i] * lam
+                    y[n:] = model.impact_rates(y[n:], i)
                 if rigid_mono and abs(y[n]) < rest_rate:
                     y = np.zeros(2 * n)
                     at_rest = True

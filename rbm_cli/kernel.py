@@ -291,7 +291,7 @@ def run_kernel(
                                                     As, cs, es, amp, omega, phase)  # fmt: skip
                             dense_ready = True
                         t_pk = _brentq(mc, t_old, t_new, t_old, h, y_old, F, track, h0, n, buf,
-                                       1e-14, 8.881784197001252e-16, 100, r)  # fmt: skip
+                                       r, True)  # fmt: skip
                         _dense_eval(mc, t_pk, t_old, h, y_old, F, buf)
                         zp = 0.0
                         for j in range(n):
@@ -409,8 +409,7 @@ def model_arrays(model: Model) -> tuple:
     col = model.column
     tu = col.rotation_capacity.astype(float)
     argmap = model.arg_map.astype(float)
-    impulse_dir = model.mass_inv @ argmap.T
-    impulse_w = np.einsum("ij,ji->i", argmap, impulse_dir)
+    impulse_dir, impulse_w = model.impulse_directions
     edges, nedges, inter, slopes, rigid = _pad_laws(model)
     return (
         model.mass, model.mass_inv, model.diff.astype(float), argmap,
@@ -423,8 +422,25 @@ def model_arrays(model: Model) -> tuple:
     )  # fmt: skip
 
 
+def _prepare(model: Model) -> tuple:
+    """Everything of a model the kernel needs, once per model: its arrays, the
+    scale of atol (theta_u for rotations, 10 theta_u for rates), the uplift
+    level of a rigid monolith (-1: none), the rest rate and the energy barrier
+    of the early stop (NaN unless n = 1); as rbm_cli.integrate computes them."""
+    n = model.n
+    tu = float(model.column.rotation_capacity.min())
+    atol_scale = np.concatenate([np.full(n, tu), np.full(n, 10.0 * tu)])
+    uplift = model.uplift_level
+    barrier = math.nan
+    if n == 1:
+        theta_c = model.collapse_ratio * model.column.rotation_capacity
+        barrier = float(model.energy(theta_c, np.zeros(1))[0])
+    rest_rate = REST_RATE * model.rocking_p * tu
+    return model_arrays(model), atol_scale, -1.0 if uplift is None else uplift, rest_rate, barrier
+
+
 _KIND = {"harmonic": 0, "half-sine": 1, "free": 2}
-#: The last model run and its kernel arrays (a sweep runs one model many times).
+#: The last model run and what _prepare made of it (a sweep runs one model many times).
 _LAST: tuple = (None, ())
 
 
@@ -437,33 +453,23 @@ def integrate_compiled(
     record: bool = False,
     output_dt: float = 0.002,
     early_stop: bool = True,
-    arrays: tuple | None = None,
 ) -> Outcome:
     """rbm_cli.integrate.integrate, compiled (same arguments and Outcome)."""
     n = model.n
     global _LAST
-    if arrays is None:
-        last = _LAST  # one read: threads (Dask in-process, joblib threading) may swap it
-        if last[0] is not model:
-            last = (model, model_arrays(model))
-            _LAST = last
-        arrays = last[1]
+    last = _LAST  # one read: threads (Dask in-process, joblib threading) may swap it
+    if last[0] is not model:
+        last = (model, _prepare(model))
+        _LAST = last
+    arrays, atol_scale, uplift, rest_rate, barrier = last[1]
     n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((n_max, 1 + 2 * n))
-    tu = model.column.rotation_capacity
-    atol = solver.atol * np.concatenate([np.full(n, tu.min()), np.full(n, tu.min() * 10.0)])
-    uplift = model.uplift_level
-    barrier = math.nan
-    if n == 1:
-        barrier = float(model.energy(np.array([model.collapse_ratio * tu[0]]), np.zeros(1))[0])
     res = run_kernel(
-        METHOD_CODES[solver.method], float(solver.rtol), atol,
+        METHOD_CODES[solver.method], float(solver.rtol), solver.atol * atol_scale,
         int(solver.max_steps), int(solver.max_events), *arrays,
         _KIND[motion.kind], float(motion.amplitude), float(motion.omega), float(motion.phase),
-        float(motion.pulse_end), float(motion.t_end),
-        -1.0 if uplift is None else float(uplift),
-        REST_RATE * model.rocking_p * float(tu.min()), barrier, bool(early_stop),
-        np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
+        float(motion.pulse_end), float(motion.t_end), uplift, rest_rate, barrier,
+        bool(early_stop), np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
         bool(record), float(output_dt), samples,
     )  # fmt: skip
     (code, t_end, t_col, c_if, max_ratio, max_top, friction,

@@ -24,56 +24,44 @@ def _affine(G, y, off, h0, out):
 
 
 @njit(cache=True)
-def _gmin(G, h0, y, n):
-    best = np.inf
-    for r in range(G.shape[0]):
-        d = h0[r]
-        for j in range(n):
-            d += G[r, j] * y[j]
-        if d < best:
-            best = d
-    return best
-
-
-@njit(cache=True)
-def _fval(mode, t, mc, t_old, h, y_old, F, G, h0, n, buf):
-    """On the dense output at t: mode -1, the smallest event distance; mode r >= 0,
-    the rate of row r of G; mode -2 - r, the distance of row r (G[r] theta + h0[r])."""
+def _fval(row, rate, t, mc, t_old, h, y_old, F, G, h0, n, buf):
+    """On the dense output at t: the distance G[row] theta + h0[row] of an event
+    row, or (rate) the rate G[row] theta' of a tracked quantity."""
     _dense_eval(mc, t, t_old, h, y_old, F, buf)
-    if mode == -1:
-        return _gmin(G, h0, buf, n)
-    if mode <= -2:
-        r = -2 - mode
-        v = h0[r]
+    if rate:
+        v = 0.0
         for j in range(n):
-            v += G[r, j] * buf[j]
+            v += G[row, j] * buf[n + j]
         return v
-    v = 0.0
+    v = h0[row]
     for j in range(n):
-        v += G[mode, j] * buf[n + j]
+        v += G[row, j] * buf[j]
     return v
 
 
+#: Tolerances of the root finding: scipy brentq's rtol (4 eps) and our xtol [s].
+XTOL, RTOL, MAXITER = 1e-14, 8.881784197001252e-16, 100
+
+
 @njit(cache=True)
-def _brentq(mc, xa, xb, t_old, h, y_old, F, G, h0, n, buf, xtol, rtol, maxiter, mode=-1):
-    """scipy's brentq (zeros.c), on the smallest event distance along the step
-    (mode -1) or on the rate of row `mode` of G (mode >= 0)."""
+def _brentq(mc, xa, xb, t_old, h, y_old, F, G, h0, n, buf, row, rate):
+    """scipy's brentq (zeros.c) along the step's dense output, on _fval(row, rate)."""
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
-    fpre = _fval(mode, xpre, mc, t_old, h, y_old, F, G, h0, n, buf)
-    fcur = _fval(mode, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
+    fpre = _fval(row, rate, xpre, mc, t_old, h, y_old, F, G, h0, n, buf)
+    fcur = _fval(row, rate, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
     if fpre == 0.0:
         return xpre
     if fcur == 0.0:
         return xcur
-    for _ in range(maxiter):
+    for _ in range(MAXITER):
         if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
             xblk, fblk = xpre, fpre
             spre = scur = xcur - xpre
         if abs(fblk) < abs(fcur):
             xpre, xcur, xblk = xcur, xblk, xcur
             fpre, fcur, fblk = fcur, fblk, fcur
-        delta = (xtol + rtol * abs(xcur)) / 2.0
+        delta = (XTOL + RTOL * abs(xcur)) / 2.0
         sbis = (xblk - xcur) / 2.0
         if fcur == 0.0 or abs(sbis) < delta:
             return xcur
@@ -95,7 +83,7 @@ def _brentq(mc, xa, xb, t_old, h, y_old, F, G, h0, n, buf, xtol, rtol, maxiter, 
             xcur += scur
         else:
             xcur += delta if sbis > 0 else -delta
-        fcur = _fval(mode, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
+        fcur = _fval(row, rate, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
     return xcur
 
 
@@ -206,15 +194,13 @@ def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, buf, D, R, dcol0, dcol1, rco
             rcol0[r], rcol1[r] = R[r, q], R[r, q + 1]
         for r in range(nrow):
             if D[r, q + 1] < 0.0:
-                tr = _brentq(mc, a, b, t0, h, y_old, F, G, h0, n, buf, 1e-14,
-                             8.881784197001252e-16, 100, -2 - r)  # fmt: skip
+                tr = _brentq(mc, a, b, t0, h, y_old, F, G, h0, n, buf, r, False)
                 if tr < t_first:
                     t_first, r_first = tr, r
         s_dip, r_dip = _lowest_dip(dcol0, dcol1, rcol0, rcol1, b - a)
         if r_dip >= 0:
-            if _fval(-2 - r_dip, a + s_dip, mc, t0, h, y_old, F, G, h0, n, buf) < 0.0:
-                tr = _brentq(mc, a, a + s_dip, t0, h, y_old, F, G, h0, n, buf, 1e-14,
-                             8.881784197001252e-16, 100, -2 - r_dip)  # fmt: skip
+            if _fval(r_dip, False, a + s_dip, mc, t0, h, y_old, F, G, h0, n, buf) < 0.0:
+                tr = _brentq(mc, a, a + s_dip, t0, h, y_old, F, G, h0, n, buf, r_dip, False)
                 if tr < t_first:
                     t_first, r_first = tr, r_dip
         if r_first >= 0:

@@ -114,19 +114,26 @@ def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, amp, om
 
 
 @njit(cache=True)
+def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, amp, om, ph):
+    """Stage s from the stages before it: K[s] = f(t + c_s h, y + h sum_j a_sj K_j)."""
+    A = TAB_A[mc]
+    for i in range(y.size):
+        acc = 0.0
+        for j in range(s):
+            acc += A[s, j] * K[j, i]
+        tmp[i] = y[i] + h * acc
+    _rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, amp, om, ph, K[s])
+
+
+@njit(cache=True)
 def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, amp, om, ph):
     """One Runge-Kutta step of size h; stages in K (row ns = f(t + h, y_new))."""
-    A, B, C = TAB_A[mc], TAB_B[mc], TAB_C[mc]
+    B = TAB_B[mc]
     ns = TAB_NS[mc]
     m = y.size
     K[0, :] = f
     for s in range(1, ns):
-        for i in range(m):
-            acc = 0.0
-            for j in range(s):
-                acc += A[s, j] * K[j, i]
-            tmp[i] = y[i] + h * acc
-        _rhs(t + C[s] * h, tmp, n, As, cs, es, amp, om, ph, K[s])
+        _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, amp, om, ph)
     for i in range(m):
         acc = 0.0
         for j in range(ns):
@@ -174,14 +181,8 @@ def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, amp, om
     ns = TAB_NS[mc]
     P = TAB_P[mc]
     if mc == 2:
-        A, C = TAB_A[mc], TAB_C[mc]
         for s in range(ns + 1, _NS_MAX):
-            for i in range(m):
-                acc = 0.0
-                for j in range(s):
-                    acc += A[s, j] * K[j, i]
-                tmp[i] = y_old[i] + h * acc
-            _rhs(t_old + C[s] * h, tmp, n, As, cs, es, amp, om, ph, K[s])
+            _stage(mc, s, t_old, y_old, h, K, tmp, n, As, cs, es, amp, om, ph)
         for i in range(m):
             dy = y_new[i] - y_old[i]
             F[0, i] = dy

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -110,6 +111,26 @@ class Model:
         if self.n != 1 or not self.laws[0].rigid:
             return None
         return float(self.laws[0].intercepts[0] / abs(self.ground_load[0]))
+
+    @cached_property
+    def impulse_directions(self) -> tuple[np.ndarray, np.ndarray]:
+        """(D, w) of an impact at joint i: the impulsive moment acts along P^T e_i, so
+        the rates change along column i of D = M^-1 P^T; w_i = e_i^T P M^-1 P^T e_i."""
+        directions = self.mass_inv @ self.arg_map.T
+        return directions, np.einsum("ij,ji->i", self.arg_map, directions)
+
+    def impact_rates(self, rate: np.ndarray, i: int) -> np.ndarray:
+        """Drum rates [rad/s] after an impact at joint i (its argument's rate times e).
+
+        Momentum-consistent: an impulsive moment along the joint's direction, so the
+        kinetic energy changes by -(1 - e^2) xdot_i^2 / (2 w_i) <= 0 (identical to the
+        paper's rule for n = 1). `absolute` keeps the paper's wording: only the
+        joint's own rate is scaled, the others unchanged."""
+        xdot = float(self.arg_map[i] @ rate)
+        if self.formulation == "absolute":
+            return rate + np.linalg.inv(self.arg_map)[:, i] * (self.restitution - 1.0) * xdot
+        directions, w = self.impulse_directions
+        return rate + directions[:, i] * ((self.restitution - 1.0) * xdot / w[i])
 
     def stiffness(self, slopes: np.ndarray) -> np.ndarray:
         """Stiffness matrix [N m/rad] of active law pieces of the given slopes,

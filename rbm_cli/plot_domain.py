@@ -170,6 +170,7 @@ def plot_domain(
     column: Column | None = None,
     excitation_type: str | None = None,
     static_multiplier: float | None = None,
+    static_label: str = "static multiplier",
 ):
     """Plot a safe-unsafe domain: cells, boundary, static multiplier, closed forms.
 
@@ -195,6 +196,8 @@ def plot_domain(
     static_multiplier : float, optional
         Uplift acceleration [g], drawn as a dashed horizontal line; defaults
         to ``column.static_multiplier`` when a column is given
+    static_label : str, optional
+        Legend name of that line (the contact engine's is its 'uplift level')
 
     Returns
     -------
@@ -240,7 +243,7 @@ def plot_domain(
             color="0.3",
             linestyle="--",
             linewidth=1.0,
-            label=f"static multiplier {static_multiplier:.3g} g",
+            label=f"{static_label} {static_multiplier:.3g} g",
             gid="static",
         )
 

@@ -346,6 +346,14 @@ def domain_figure(df: pd.DataFrame, config: Config, compare=(), labels=None):
     from .plot_domain import plot_domain
 
     column = build_column(config.column, config.interface)
+    level, level_label = column.static_multiplier, "static multiplier"
+    if config.model == "bullet":  # the engine's true solids: its own uplift level
+        from .bullet import uplift_level
+        from .bullet_geometry import drum_solids
+        from .config_types import G
+
+        level = uplift_level(drum_solids(config.column), config.interface.friction) / G
+        level_label = "engine uplift level"
     fig, ax = plt.subplots(figsize=(9.5, 5))
     plot_domain(
         df,
@@ -354,7 +362,8 @@ def domain_figure(df: pd.DataFrame, config: Config, compare=(), labels=None):
         labels=labels,
         column=column,
         excitation_type=config.excitation.type,
-        static_multiplier=column.static_multiplier,
+        static_multiplier=level,
+        static_label=level_label,
     )
     ax.set_title(f"{config.name}: safe (o) / unsafe (x) domain")
     fig.tight_layout()

@@ -10,7 +10,12 @@ workers, and compared with a reference:
   the amplitude moves the closed-form peak by at most 1e-6 relative;
 - otherwise: converged compiled DOP853 runs at rtol 1e-10, 1e-11 and 1e-12.
   A cell is *converged* when its outcome (collapsed or not) is the same at
-  all three; the others are *sensitive* (chaos), counted but not scored.
+  all three and under a 1e-9 relative change of the amplitude (at rtol
+  1e-12); the others are *sensitive* (chaos), counted but not scored. The
+  amplitude test was added when 21 of 1521 8-drum cells that agreed at the
+  three tolerances flipped under a change of the event handling that moves
+  the state by about 1e-13 rad per impact: tolerance alone misses chaos that
+  every run of one algorithm shares.
   The reference values are those of the rtol 1e-12 run. A peak counts where
   rtol 1e-11 and 1e-12 agree to 1e-6 and a 1e-9 relative change of the
   amplitude moves it by at most 1e-6 (well-conditioned, as for the closed form).
@@ -217,9 +222,10 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
         same = np.ones(len(ref), dtype=bool)
         for run in runs[:-1]:
             same &= run["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
-        ref["converged"] = same.astype(int)
         tight = _with_solver(cfg, "compiled", "DOP853", REFERENCE_RTOLS[-1])
         other, _ = run_cells("rbm", tight, nudged, jobs)
+        same &= other["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
+        ref["converged"] = same.astype(int)
         p12 = ref["max_rotation_ratio"].to_numpy()
         peak_ok = _close(runs[-2]["max_rotation_ratio"].to_numpy(), p12)
         peak_ok &= _close(other["max_rotation_ratio"].to_numpy(), p12)

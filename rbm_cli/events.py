@@ -13,13 +13,25 @@ from .model import Model
 class Pieces:
     """Which piece of its law each interface is on: side s = +-1 and index k."""
 
-    def __init__(self, model: Model):
+    def __init__(self, model: Model, silent: bool = False):
         self.model = model
         n = model.n
         self.side = np.ones(n, dtype=int)
         self.k = np.zeros(n, dtype=int)
         self.pending = np.zeros(n, dtype=bool)  # excursion beyond elastic branch
         self.rigid = np.array([law.rigid for law in model.laws])
+        # silent impacts (`silent`): with e = 1 and a law linear through zero on its
+        # first piece, a zero crossing after an excursion changes neither the state
+        # nor the equations, so it is no event: it is counted by `settle` instead
+        self.silent = np.array(
+            [
+                silent and model.restitution == 1.0 and not law.rigid
+                and len(law.edges) > 0 and law.intercepts[0] == 0.0
+                for law in model.laws
+            ],
+            dtype=bool,
+        )  # fmt: skip
+        self.awaiting = np.zeros(n, dtype=bool)  # back on piece 0, zero not crossed yet
         self.tu = model.column.rotation_capacity
         self._cache: dict = {}
 
@@ -41,15 +53,29 @@ class Pieces:
         s, k = self.side[i], self.k[i]
         if k == 0 and not self.zero_active(i):
             self.side[i], self.k[i], self.pending[i] = (1 if going_up else -1), 1, True
+            self.awaiting[i] = False
             return "uplift"
         if going_up == (s > 0):
             self.k[i] = k + 1
             return "kink"
         if k > 0:
             self.k[i] = k - 1
+            if k == 1 and self.silent[i]:
+                self.pending[i], self.awaiting[i] = False, True
             return "kink"
         self.side[i], self.pending[i] = -s, False
         return "impact"
+
+    def settle(self, x: np.ndarray) -> int:
+        """Count the silent impacts up to a point where the law arguments are x:
+        interfaces back on their first piece whose argument has changed sign
+        (checked at every step's end, so a crossing and return inside one step
+        is not counted). Returns how many."""
+        hits = self.awaiting & (self.side * x < 0.0)
+        if hits.any():
+            self.side[hits] *= -1
+            self.awaiting[hits] = False
+        return int(hits.sum())
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         n = self.model.n

@@ -30,9 +30,12 @@ from .kernel_events import (
     _emit,
     _emit_rest,
     _energy1,
+    _event_rows,
     _first_crossing,
     _n_below,
     _next_exceedance,
+    _poly_val,
+    _row_poly,
     _system,
     _within_reach,
 )
@@ -86,6 +89,12 @@ def run_kernel(
     side = np.ones(n, dtype=np.int64)
     k = np.zeros(n, dtype=np.int64)
     pending = np.zeros(n, dtype=np.bool_)
+    # silent impacts (events.Pieces.silent): counted at step ends, not stopped at
+    silent = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        silent[i] = e_rest == 1.0 and not rigid[i] and nedges[i] > 0 and intercepts[i, 0] == 0.0
+    any_silent = silent.any()
+    awaiting = np.zeros(n, dtype=np.bool_)
     lo, hi = np.empty(n), np.empty(n)
     G = np.empty((4 * n, n))
     for i in range(n):
@@ -94,6 +103,13 @@ def run_kernel(
             G[n + i, j] = -argmap[i, j] / tu[i]
             G[2 * n + i, j] = -cmap[i, j]
             G[3 * n + i, j] = cmap[i, j]
+    gx, gc = G[:n], G[3 * n :]
+    same = True
+    for i in range(n):
+        for j in range(n):
+            same = same and gx[i, j] == gc[i, j]
+    md = minv @ diff.T
+    mg = minv @ gravity
     nt = n + 1
     track = np.empty((nt, n))
     track[:n, :] = cmap
@@ -107,7 +123,6 @@ def run_kernel(
     f = np.empty(m)
     ynew = np.empty(m)
     tmp = np.empty(m)
-    buf = np.empty(m)
     work = np.empty(m)
     scale = np.empty(m)
     nrow = 4 * n
@@ -117,6 +132,10 @@ def run_kernel(
     Dq, Rq = np.empty((nrow, CHECK_INTERVALS + 1)), np.empty((nrow, CHECK_INTERVALS + 1))
     dc0, dc1, rc0, rc1 = np.empty(nrow), np.empty(nrow), np.empty(nrow), np.empty(nrow)
     near = np.zeros(nrow, dtype=np.bool_)
+    CP, CR = np.empty((nrow, 7)), np.empty((nrow, 7))
+    BP, BR = np.empty(nrow), np.empty(nrow)
+    coef = np.empty(7)
+    zero_t = np.zeros(nt)
     z_old, z_new, z_prev = np.empty(nt), np.empty(nt), np.empty(nt)
     dz_old, dz_new, dz_prev = np.empty(nt), np.empty(nt), np.empty(nt)
     acc = np.empty(n)
@@ -153,6 +172,7 @@ def run_kernel(
         free_seg = amplitude == 0.0 or (kind == 1 and seg_start >= pulse_end)
         amp = 0.0 if free_seg else amplitude
         can_stop = early_stop and free_seg and kind == 1 and n == 1
+        h_carry = -1.0  # the step size proposed before an event, carried over it
         while t < seg_end:
             if at_rest:
                 if free_seg:
@@ -176,8 +196,9 @@ def run_kernel(
                 k[0] = 0
                 at_rest = False
                 n_upl += 1
+                h_carry = -1.0
 
-            _system(side, k, intercepts, slopes, minv, diff, argmap, gravity, As, cs)
+            _system(side, k, intercepts, slopes, md, mg, argmap, As, cs)
             for i in range(n):
                 _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi)
                 h0[i] = min(-lo[i] / tu[i], BIG) + EVENT_EPS
@@ -187,18 +208,22 @@ def run_kernel(
 
             # a new stepper from (t, y)
             _rhs(t, y, n, As, cs, es, amp, omega, phase, f)
-            h_abs = _initial_step(t, y, f, seg_end, est_order, rtol, atol, n, As, cs, es,
-                                  amp, omega, phase, work)  # fmt: skip
-            n_rhs += 2
+            if h_carry > 0.0:
+                h_abs = min(h_carry, seg_end - t)
+                n_rhs += 1
+            else:
+                h_abs = _initial_step(t, y, f, seg_end, est_order, rtol, atol, n, As, cs, es,
+                                      amp, omega, phase, work)  # fmt: skip
+                n_rhs += 2
             _affine(track, y, 0, no_offset, z_old)
             _affine(track, y, n, no_offset, dz_old)
-            _affine(G, y, 0, h0, d_old)
-            _affine(G, y, n, no_offset, dd_old)
+            _event_rows(gx, gc, same, y, 0, h0, True, d_old)
+            _event_rows(gx, gc, same, y, n, h0, False, dd_old)
             g0 = _ground(t, amp, omega, phase)
             _affine(As, y, 0, cs, acc)
             for i in range(n):
                 acc[i] += es[i] * g0
-            _affine(G, acc, 0, no_offset, d2_old)
+            _event_rows(gx, gc, same, acc, 0, h0, False, d2_old)
             event = False
             running = True
             while running:
@@ -240,22 +265,23 @@ def run_kernel(
                 t_old = t
                 y_old = y
                 y_new[:] = ynew
-                _affine(G, y_new, 0, h0, d_new)
-                _affine(G, y_new, n, no_offset, dd_new)
+                _event_rows(gx, gc, same, y_new, 0, h0, True, d_new)
+                _event_rows(gx, gc, same, y_new, n, h0, False, dd_new)
                 dense_ready = False
                 g_new = _ground(t_new, amp, omega, phase)
                 _affine(As, y_new, 0, cs, acc)
                 for i in range(n):
                     acc[i] += es[i] * g_new
-                _affine(G, acc, 0, no_offset, d2_new)
+                _event_rows(gx, gc, same, acc, 0, h0, False, d2_new)
                 event_row = -1
                 t_e = t_new
                 if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
                     n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
                                             cs, es, amp, omega, phase)  # fmt: skip
                     dense_ready = True
-                    t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, G, h0, n, buf,
-                                                     Dq, Rq, dc0, dc1, rc0, rc1, near)  # fmt: skip
+                    t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, G, h0, n, Dq,
+                                                     Rq, dc0, dc1, rc0, rc1, near, CP, BP, CR,
+                                                     BR)  # fmt: skip
                 if event_row >= 0:
                     _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e
@@ -274,6 +300,16 @@ def run_kernel(
                         dense_ready = True
                     n_out, next_out = _emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
                                             next_out, output_dt)  # fmt: skip
+                if any_silent:
+                    for i in range(n):
+                        if awaiting[i]:
+                            x_i = 0.0
+                            for j in range(n):
+                                x_i += argmap[i, j] * y_new[j]
+                            if side[i] * x_i < 0.0:
+                                side[i] = -side[i]
+                                awaiting[i] = False
+                                n_imp += 1
                 # peaks and friction demand over [t_old, t_new]
                 _affine(track, y_new, 0, no_offset, z_new)
                 _affine(track, y_new, n, no_offset, dz_new)
@@ -290,13 +326,10 @@ def run_kernel(
                             n_rhs += _dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
                                                     As, cs, es, amp, omega, phase)  # fmt: skip
                             dense_ready = True
-                        t_pk = _brentq(mc, t_old, t_new, t_old, h, y_old, F, track, h0, n, buf,
-                                       r, True)  # fmt: skip
-                        _dense_eval(mc, t_pk, t_old, h, y_old, F, buf)
-                        zp = 0.0
-                        for j in range(n):
-                            zp += track[r, j] * buf[j]
-                        v = max(v, abs(zp))
+                        base = _row_poly(mc, F, y_old, track, r, zero_t, n, True, coef)
+                        t_pk = _brentq(mc, t_old, t_new, t_old, h, coef, base)
+                        base = _row_poly(mc, F, y_old, track, r, zero_t, n, False, coef)
+                        v = max(v, abs(_poly_val(mc, t_pk, t_old, h, coef, base)))
                     if v > peaks[r]:
                         peaks[r] = v
                 for i in range(n):
@@ -334,6 +367,7 @@ def run_kernel(
                 continue
 
             # ---- the event at (t, y)
+            h_carry = h_abs
             n_ev += 1
             if n_ev > max_events:
                 return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction,
@@ -358,11 +392,15 @@ def run_kernel(
                 side[i] = 1 if going_up else -1
                 k[i] = 1
                 pending[i] = True
+                awaiting[i] = False
                 n_upl += 1
             elif outward:
                 k[i] = ki + 1
             elif ki > 0:
                 k[i] = ki - 1
+                if ki == 1 and silent[i]:
+                    pending[i] = False
+                    awaiting[i] = True
             else:
                 n_imp += 1
                 side[i] = -s

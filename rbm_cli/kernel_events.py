@@ -10,7 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .kernel_rk import _dense_eval
+from .kernel_rk import TAB_NP, _dense_eval
 
 
 @njit(cache=True)
@@ -24,19 +24,39 @@ def _affine(G, y, off, h0, out):
 
 
 @njit(cache=True)
-def _fval(row, rate, t, mc, t_old, h, y_old, F, G, h0, n, buf):
-    """On the dense output at t: the distance G[row] theta + h0[row] of an event
-    row, or (rate) the rate G[row] theta' of a tracked quantity."""
-    _dense_eval(mc, t, t_old, h, y_old, F, buf)
-    if rate:
+def _row_poly(mc, F, y_old, G, row, h0, n, rate, coef):
+    """One row of the step's interpolant, projected: the distance G[row] theta +
+    h0[row] (or, rate, the rate G[row] theta') as a polynomial in the step's
+    fraction, with _dense_eval's form. Fills coef, returns the constant term;
+    _poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
+    off = n if rate else 0
+    nc = 7 if mc == 2 else TAB_NP[mc]
+    for q in range(nc):
         v = 0.0
         for j in range(n):
-            v += G[row, j] * buf[n + j]
-        return v
-    v = h0[row]
+            v += G[row, j] * F[q, off + j]
+        coef[q] = v
+    base = 0.0 if rate else h0[row]
     for j in range(n):
-        v += G[row, j] * buf[j]
-    return v
+        base += G[row, j] * y_old[off + j]
+    return base
+
+
+@njit(cache=True)
+def _poly_val(mc, t, t_old, h, coef, base):
+    """A projected row (_row_poly) at time t: _dense_eval for one row."""
+    x = (t - t_old) / h
+    v = 0.0
+    if mc == 2:
+        for q in range(7):
+            v += coef[6 - q]
+            v *= x if q % 2 == 0 else 1.0 - x
+        return v + base
+    p = 1.0
+    for r in range(TAB_NP[mc]):
+        p *= x
+        v += coef[r] * p
+    return base + v
 
 
 #: Tolerances of the root finding: scipy brentq's rtol (4 eps) and our xtol [s].
@@ -44,12 +64,12 @@ XTOL, RTOL, MAXITER = 1e-14, 8.881784197001252e-16, 100
 
 
 @njit(cache=True)
-def _brentq(mc, xa, xb, t_old, h, y_old, F, G, h0, n, buf, row, rate):
-    """scipy's brentq (zeros.c) along the step's dense output, on _fval(row, rate)."""
+def _brentq(mc, xa, xb, t_old, h, coef, base):
+    """scipy's brentq (zeros.c) along a projected row of the step's interpolant."""
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
-    fpre = _fval(row, rate, xpre, mc, t_old, h, y_old, F, G, h0, n, buf)
-    fcur = _fval(row, rate, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
+    fpre = _poly_val(mc, xpre, t_old, h, coef, base)
+    fcur = _poly_val(mc, xcur, t_old, h, coef, base)
     if fpre == 0.0:
         return xpre
     if fcur == 0.0:
@@ -83,7 +103,7 @@ def _brentq(mc, xa, xb, t_old, h, y_old, F, G, h0, n, buf, row, rate):
             xcur += scur
         else:
             xcur += delta if sbis > 0 else -delta
-        fcur = _fval(row, rate, xcur, mc, t_old, h, y_old, F, G, h0, n, buf)
+        fcur = _poly_val(mc, xcur, t_old, h, coef, base)
     return xcur
 
 
@@ -151,24 +171,27 @@ def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
 
 
 @njit(cache=True)
-def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, buf, D, R, dcol0, dcol1, rcol0, rcol1, mask):
+def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
+                    CP, BP, CR, BR):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
-    (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1)."""
+    (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
+    The masked rows' interpolants are projected once (CP, BP: distances; CR, BR:
+    rates) and evaluated as scalars."""
     nseg = CHECK_INTERVALS
     h = t1 - t0
     nrow = G.shape[0]
+    for r in range(nrow):
+        if mask[r]:
+            BP[r] = _row_poly(mc, F, y_old, G, r, h0, n, False, CP[r])
+            BR[r] = _row_poly(mc, F, y_old, G, r, h0, n, True, CR[r])
     for q in range(nseg + 1):
         tq = t0 + h * q / nseg if q < nseg else t1
-        _dense_eval(mc, tq, t0, h, y_old, F, buf)
         for r in range(nrow):
             if not mask[r]:
                 D[r, q], R[r, q] = np.inf, 0.0  # inert: never below zero, never turning
                 continue
-            d, v = h0[r], 0.0
-            for j in range(n):
-                d += G[r, j] * buf[j]
-                v += G[r, j] * buf[n + j]
-            D[r, q], R[r, q] = d, v
+            D[r, q] = _poly_val(mc, tq, t0, h, CP[r], BP[r])
+            R[r, q] = _poly_val(mc, tq, t0, h, CR[r], BR[r])
     best, brow = np.inf, -1
     for r in range(nrow):
         if D[r, 0] < best:
@@ -194,13 +217,13 @@ def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, buf, D, R, dcol0, dcol1, rco
             rcol0[r], rcol1[r] = R[r, q], R[r, q + 1]
         for r in range(nrow):
             if D[r, q + 1] < 0.0:
-                tr = _brentq(mc, a, b, t0, h, y_old, F, G, h0, n, buf, r, False)
+                tr = _brentq(mc, a, b, t0, h, CP[r], BP[r])
                 if tr < t_first:
                     t_first, r_first = tr, r
         s_dip, r_dip = _lowest_dip(dcol0, dcol1, rcol0, rcol1, b - a)
         if r_dip >= 0:
-            if _fval(r_dip, False, a + s_dip, mc, t0, h, y_old, F, G, h0, n, buf) < 0.0:
-                tr = _brentq(mc, a, a + s_dip, t0, h, y_old, F, G, h0, n, buf, r_dip, False)
+            if _poly_val(mc, a + s_dip, t0, h, CP[r_dip], BP[r_dip]) < 0.0:
+                tr = _brentq(mc, a, a + s_dip, t0, h, CP[r_dip], BP[r_dip])
                 if tr < t_first:
                     t_first, r_first = tr, r_dip
         if r_first >= 0:
@@ -231,21 +254,48 @@ def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
 
 
 @njit(cache=True)
-def _system(side, k, intercepts, slopes, minv, diff, argmap, gravity, As, cs):
-    """(A, c) of theta'' = A theta + c + e a_g for the active pieces."""
+def _system(side, k, intercepts, slopes, md, mg, argmap, As, cs):
+    """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place:
+    A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :], c = -(M^-1 D^T) a,
+    with md = M^-1 D^T and mg = M^-1 K_g assembled once (Model.linear_system)."""
     n = side.size
-    stiff = -gravity.copy()
-    a = np.empty(n)
+    for p in range(n):
+        cs[p] = 0.0
+        for q in range(n):
+            As[p, q] = mg[p, q]
     for i in range(n):
-        a[i] = side[i] * intercepts[i, k[i]]
+        a = side[i] * intercepts[i, k[i]]
         b = slopes[i, k[i]]
         for p in range(n):
-            if diff[i, p] != 0.0:
-                for q in range(n):
-                    stiff[p, q] += diff[i, p] * b * argmap[i, q]
-    rhs_c = diff.T @ a
-    As[:, :] = -(minv @ stiff)
-    cs[:] = -(minv @ rhs_c)
+            w = md[p, i]
+            if w == 0.0:
+                continue
+            cs[p] -= w * a
+            for q in range(n):
+                if argmap[i, q] != 0.0:
+                    As[p, q] -= w * b * argmap[i, q]
+
+
+@njit(cache=True)
+def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
+    """The event rows G v[off:off + n] (+ h0) of the kernel, from their two
+    distinct blocks: G = [gx; -gx; -gc; gc] (gx = argmap / theta_u, gc the
+    normalised collapse map; `same` when gc == gx, as for `relative`)."""
+    n = gx.shape[0]
+    for i in range(n):
+        a = 0.0
+        for j in range(n):
+            a += gx[i, j] * v[off + j]
+        c = a
+        if not same:
+            c = 0.0
+            for j in range(n):
+                c += gc[i, j] * v[off + j]
+        if with_h0:
+            out[i], out[n + i] = a + h0[i], h0[n + i] - a
+            out[2 * n + i], out[3 * n + i] = h0[2 * n + i] - c, c + h0[3 * n + i]
+        else:
+            out[i], out[n + i], out[2 * n + i], out[3 * n + i] = a, -a, -c, c
 
 
 @njit(cache=True)

@@ -34,16 +34,17 @@ References
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from .bullet_geometry import drum_solids, stack_slenderness
+from .bullet_impact import impact_rate_ratios, measure_restitution
 from .bullet_scene import (
     EngineSettings,
     Frame,
     Joints,
+    StackGeometry,
     build_scene,
+    contact_friction,
     joint_state,
     keep_in_plane,
     read_frame,
@@ -53,6 +54,15 @@ from .errors import RbmError
 from .excitation import GroundMotion
 from .integrate import Outcome
 from .result import History
+
+__all__ = [
+    "EngineSettings",
+    "bullet_run",
+    "impact_rate_ratios",
+    "measure_restitution",
+    "settings_from_config",
+    "uplift_level",
+]
 
 #: Interval of the collapse, sliding and contact checks [s].
 CHECK_DT = 1e-3
@@ -109,8 +119,10 @@ def bullet_run(
         t_collapse, collapse_interface (1-based joint, 1 = base on ground),
         max_ratio (per joint), max_top (top relative to the base [m]),
         n_uplifts / n_impacts (joint openings / closures seen at the 1 ms
-        checks), n_steps = n_rhs = engine steps; the message gives the largest
-        slips. Friction demand is not computed (nan).
+        checks), n_steps = n_rhs = engine steps; friction (per joint) the
+        largest mobilised friction |T| / N seen at the 1 ms checks
+        (:func:`rbm_cli.bullet_scene.contact_friction`; nan if never loaded);
+        the message gives the largest slips.
     """
     solids = drum_solids(config.column)
     n = len(solids)
@@ -119,14 +131,16 @@ def bullet_run(
     alpha = stack_slenderness(solids)
     out = Outcome()
     out.max_ratio = np.zeros(n)
-    out.friction = np.full(n, np.nan)
     limit = config.collapse.ratio
     level = uplift_level(solids, settings.friction)
     if not record and tilt == 0.0 and rate == 0.0 and motion.amplitude < level * (1 - 1e-9):
+        # the stack moves with the ground: every joint carries m_above a_g on m_above g
+        out.friction = np.full(n, motion.amplitude / G)
         out.message = "at rest: ground acceleration below the uplift and sliding levels"
         return out.stop("survived", out.message, motion.t_end), None
 
     p, cid, bodies = build_scene(solids, settings, tilt, rate)
+    stack = StackGeometry.of(solids)
     dt = settings.time_step
     n_steps = int(round(motion.t_end / dt))
     check = max(1, int(round(CHECK_DT / dt)))
@@ -135,36 +149,37 @@ def bullet_run(
     drop = np.array([DROP_FRACTION * d.height for d in solids])
     open_tol = OPEN_FRACTION * alpha
     max_slip = np.zeros(n)
+    out.friction = np.full(n, np.nan)
     was_open = np.zeros(n, bool)
     last_sign = np.zeros(n)
     prev_ratio, prev_t, quiet_since = 0.0, 0.0, None
     samples: list = []
     set_gravity, step = p.setGravity, p.stepSimulation
+    # a_g at every mid-step, at once (the same numbers as one call per step)
+    accel = np.asarray(motion.accel((np.arange(n_steps) + 0.5) * dt), dtype=float).tolist()
 
-    def observe(k: int):
-        frame = read_frame(p, cid, bodies)
-        return frame, joint_state(frame, solids, alpha)
-
-    frame, joints = observe(0)
+    frame = read_frame(p, cid, bodies)
+    joints = joint_state(frame, stack, alpha)
     if record:
         samples.append(_sample(0.0, frame, joints))
     k = 0
     while k < n_steps:
-        t_mid = (k + 0.5) * dt
-        set_gravity(-motion.accel(t_mid), 0.0, -G, physicsClientId=cid)
+        set_gravity(-accel[k], 0.0, -G, physicsClientId=cid)
         step(physicsClientId=cid)
         k += 1
-        keep_in_plane(p, cid, bodies, pose=k % check == 0)
-        if k % check and not (sample and k % sample == 0) and k != n_steps:
+        checked = keep_in_plane(p, cid, bodies, pose=k % check == 0)
+        if checked is None and not (sample and k % sample == 0) and k != n_steps:
             continue
         t = k * dt
-        frame, joints = observe(k)
+        frame = checked if checked is not None else read_frame(p, cid, bodies)
+        joints = joint_state(frame, stack, alpha)
         if sample and k % sample == 0:
             samples.append(_sample(t, frame, joints))
         if not (np.all(np.isfinite(frame.centres)) and np.max(frame.speeds) < BLOWUP):
             out.n_steps = out.n_rhs = k
             out.stop("failed", "the engine diverged (non-finite or runaway drum)", t)
             break
+        out.friction = np.fmax(out.friction, contact_friction(p, cid, bodies, stack))
         out.max_ratio = np.maximum(out.max_ratio, joints.ratio)
         out.max_top = max(out.max_top, abs(joints.top[0] - joints.bottoms[0, 0]))
         max_slip = np.maximum(max_slip, np.abs(joints.slip))
@@ -202,65 +217,6 @@ def bullet_run(
     out.message += "; " + _slip_text(max_slip)
     history = _history(samples, motion) if record else None
     return out, history
-
-
-def measure_restitution(
-    config: Config,
-    tilt_fraction: float = 0.5,
-    impacts: int = 4,
-    settings: EngineSettings | None = None,
-) -> np.ndarray:
-    """The engine's own impact loss: angular-velocity ratios of free rocking [-].
-
-    The stack (rigid, turned by tilt_fraction * alpha_1 on its base corner) is
-    released from rest with no ground motion; at each of the first `impacts`
-    impacts (sign changes of the base drum's tilt) the in-plane angular velocity
-    just before and just after is extrapolated to the crossing from straight
-    lines fitted over 2 ms on either side (leaving out 0.5 ms around it, where
-    the contact switches corners), and their ratio returned.
-    """
-    solids = drum_solids(config.column)
-    settings = settings or settings_from_config(config)
-    alpha = stack_slenderness(solids)
-    p, cid, bodies = build_scene(solids, settings, tilt_fraction * alpha[0], 0.0)
-    p.setGravity(0.0, 0.0, -G, physicsClientId=cid)
-    dt = settings.time_step
-    base = bodies[0]
-    t_max = 20.0 * (impacts + 1)  # s, far beyond `impacts` half-cycles of any column
-    tilt, rate = [], []
-    found, k = 0, 0
-    fit, gap = max(3, int(round(2e-3 / dt))), max(1, int(round(5e-4 / dt)))
-    while found < impacts and k * dt < t_max:
-        p.stepSimulation(physicsClientId=cid)
-        k += 1
-        keep_in_plane(p, cid, bodies, pose=k % 10 == 0)
-        _, quat = p.getBasePositionAndOrientation(base, physicsClientId=cid)
-        _, ang = p.getBaseVelocity(base, physicsClientId=cid)
-        m = p.getMatrixFromQuaternion(quat)
-        tilt.append(math.atan2(m[2], m[8]))
-        rate.append(ang[1])
-        if len(tilt) > 1 and tilt[-1] * tilt[-2] < 0.0:
-            found += 1
-    tilt_a, rate_a = np.array(tilt), np.array(rate)
-    crossings = np.nonzero(tilt_a[1:] * tilt_a[:-1] < 0.0)[0]
-    ratios = []
-    for c in crossings:
-        lo, hi = c - gap - fit, c + 1 + gap + fit
-        if lo < 0:
-            continue
-        while hi > len(rate_a) and k * dt < t_max:  # run on to fill the fitting window
-            p.stepSimulation(physicsClientId=cid)
-            keep_in_plane(p, cid, bodies)
-            _, ang = p.getBaseVelocity(base, physicsClientId=cid)
-            rate_a = np.append(rate_a, ang[1])
-            k += 1
-        t_c = (c + tilt_a[c] / (tilt_a[c] - tilt_a[c + 1])) * dt
-        before = np.arange(c - gap - fit, c - gap)
-        after = np.arange(c + 1 + gap, c + 1 + gap + fit)
-        w_b = np.polyval(np.polyfit(before * dt, rate_a[before], 1), t_c)
-        w_a = np.polyval(np.polyfit(after * dt, rate_a[after], 1), t_c)
-        ratios.append(w_a / w_b)
-    return np.array(ratios)
 
 
 def _initial(config: Config) -> tuple[float, float]:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bullet_engine import engine
+from .config_types import G
 
 
 @dataclass(frozen=True)
@@ -54,6 +55,7 @@ def build_scene(solids, settings: EngineSettings, tilt: float = 0.0, rate: float
         contactERP=settings.erp,
         frictionERP=settings.erp,
         deterministicOverlappingPairs=1,
+        enableConeFriction=1,  # Coulomb's cone (the pyramid lets |T| reach 1.41 mu N)
         physicsClientId=cid,
     )
     plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=cid)
@@ -102,29 +104,48 @@ def build_scene(solids, settings: EngineSettings, tilt: float = 0.0, rate: float
     return p, cid, bodies
 
 
-def keep_in_plane(p, cid, bodies, pose: bool = False) -> None:
+def keep_in_plane(p, cid, bodies, pose: bool = False) -> Frame | None:
     """Hold the drums in the plane of motion (x, z), as UDEC's 2D model and the RBM are.
 
     Zeroes every drum's out-of-plane velocities (v_y, omega_x, omega_z); with
-    `pose`, also puts its centre back on y = 0 and keeps only its in-plane tilt.
+    `pose`, also puts its centre back on y = 0 and keeps only its in-plane tilt,
+    and returns the :class:`Frame` it leaves the drums in (the state
+    :func:`read_frame` would read back: no second round of engine calls).
     Without this a 3D stack under in-plane shaking picks up out-of-plane rocking
     from the contact solver's round-off (one corner of an edge loaded before
     the other) and 'walks': measured, a 4 x 1 m block at 1.1 g, 1.5 Hz with
     friction 2 slid 0.38 m standing on one corner.
     """
-    for b in bodies:
-        lin, ang = p.getBaseVelocity(b, physicsClientId=cid)
-        if pose:  # (this zeroes a multibody's velocities: they are set again below)
-            pos, quat = p.getBasePositionAndOrientation(b, physicsClientId=cid)
-            m = p.getMatrixFromQuaternion(quat)
-            half = 0.5 * math.atan2(m[2], m[8])
-            p.resetBasePositionAndOrientation(
-                b,
-                (pos[0], 0.0, pos[2]),
-                (0.0, math.sin(half), 0.0, math.cos(half)),
-                physicsClientId=cid,
-            )
-        p.resetBaseVelocity(b, (lin[0], 0.0, lin[2]), (0.0, ang[1], 0.0), physicsClientId=cid)
+    get_vel, set_vel = p.getBaseVelocity, p.resetBaseVelocity
+    if not pose:
+        for b in bodies:
+            lin, ang = get_vel(b, physicsClientId=cid)
+            set_vel(b, (lin[0], 0.0, lin[2]), (0.0, ang[1], 0.0), physicsClientId=cid)
+        return None
+    n = len(bodies)
+    centres, rots = np.empty((n, 3)), []
+    rates, speeds = np.empty(n), np.empty(n)
+    get_pose, set_pose, matrix = (
+        p.getBasePositionAndOrientation,
+        p.resetBasePositionAndOrientation,
+        p.getMatrixFromQuaternion,
+    )
+    for i, b in enumerate(bodies):
+        lin, ang = get_vel(b, physicsClientId=cid)
+        pos, quat = get_pose(b, physicsClientId=cid)
+        m = matrix(quat)
+        half = 0.5 * math.atan2(m[2], m[8])
+        centre = (pos[0], 0.0, pos[2])
+        quat = (0.0, math.sin(half), 0.0, math.cos(half))
+        # (resetting the pose zeroes a multibody's velocities: they are set again below)
+        set_pose(b, centre, quat, physicsClientId=cid)
+        lin = (lin[0], 0.0, lin[2])
+        set_vel(b, lin, (0.0, ang[1], 0.0), physicsClientId=cid)
+        centres[i] = centre
+        rots.append(matrix(quat))
+        rates[i] = ang[1]
+        speeds[i] = math.sqrt(sum(v * v for v in lin))
+    return Frame(centres, np.reshape(rots, (n, 3, 3)), rates, speeds)
 
 
 def _contact_dynamics(p, cid, body, settings: EngineSettings) -> None:
@@ -185,7 +206,31 @@ class Joints:
     top: np.ndarray  # (3,) centre of the top face of the top drum (world) [m]
 
 
-def joint_state(frame: Frame, solids, alpha: np.ndarray) -> Joints:
+@dataclass(frozen=True)
+class StackGeometry:
+    """Per-drum constants of the joint readings (bottom first), computed once per run."""
+
+    masses: np.ndarray  # (n,) [kg]
+    centres: np.ndarray  # (n,) centre of mass above the drum's bottom face [m]
+    heights: np.ndarray  # (n,) [m]
+    half_bottom: np.ndarray  # (n,) half-width of the drum's bottom face [m]
+    support_half: np.ndarray  # (n,) half-width of the support's top face (inf: ground) [m]
+    mass_above: np.ndarray  # (n,) mass of drums i..n [kg]
+
+    @classmethod
+    def of(cls, solids) -> StackGeometry:
+        masses = np.array([d.mass for d in solids])
+        return cls(
+            masses=masses,
+            centres=np.array([d.centre for d in solids]),
+            heights=np.array([d.height for d in solids]),
+            half_bottom=np.array([d.half_bottom for d in solids]),
+            support_half=np.array([math.inf] + [d.half_top for d in solids[:-1]]),
+            mass_above=np.cumsum(masses[::-1])[::-1],
+        )
+
+
+def joint_state(frame: Frame, stack: StackGeometry, alpha: np.ndarray) -> Joints:
     """Relative rotations, overturning ratios and slips of every joint.
 
     Notes
@@ -198,35 +243,62 @@ def joint_state(frame: Frame, solids, alpha: np.ndarray) -> Joints:
     its rest value (for a block on a corner, theta / alpha). Slip: the offset
     of the bottom-face centre from the support's top-face centre, less the
     offset b (1 - cos phi) that rocking on a corner gives without sliding.
+    All joints at once (arrays over the joints).
     """
-    n = len(solids)
-    masses = np.array([d.mass for d in solids])
-    local_bottom = np.array([[0.0, 0.0, -d.centre] for d in solids])
-    local_top = np.array([[0.0, 0.0, d.height - d.centre] for d in solids])
-    bottoms = frame.centres + np.einsum("nij,nj->ni", frame.rotations, local_bottom)
-    tops = frame.centres + np.einsum("nij,nj->ni", frame.rotations, local_top)
+    rot, centres = frame.rotations, frame.centres
+    axis_z = rot[:, :, 2]
+    bottoms = centres - stack.centres[:, None] * axis_z
+    tops = centres + (stack.heights - stack.centres)[:, None] * axis_z
     tilts = frame.tilts
-    relative, ratio, slip = np.empty(n), np.empty(n), np.empty(n)
-    for i, d in enumerate(solids):
-        if i == 0:
-            rot_s, origin, half_s, tilt_s = np.eye(3), np.zeros(3), math.inf, 0.0
-        else:
-            rot_s, origin = frame.rotations[i - 1], tops[i - 1]
-            half_s, tilt_s = solids[i - 1].half_top, tilts[i - 1]
-        phi = tilts[i] - tilt_s
-        relative[i] = phi
-        to_support = rot_s.T
-        b = to_support @ (bottoms[i] - origin)
-        axis_x = to_support @ frame.rotations[i][:, 0]
-        corner_r = b + d.half_bottom * axis_x
-        corner_l = b - d.half_bottom * axis_x
-        right = min(max(corner_r[0], corner_l[0]), half_s)
-        left = max(min(corner_r[0], corner_l[0]), -half_s)
-        m = masses[i:]
-        com = (m[:, None] * frame.centres[i:]).sum(axis=0) / m.sum()
-        c = to_support @ (com - origin)
-        psi_r = math.atan2(right - c[0], c[2])
-        psi_l = math.atan2(c[0] - left, c[2])
-        ratio[i] = 1.0 - min(psi_r, psi_l) / alpha[i]
-        slip[i] = b[0] - math.copysign(d.half_bottom * (1.0 - math.cos(phi)), phi)
-    return Joints(relative, ratio, slip, bottoms, tops[-1])
+    rot_s = np.concatenate([np.eye(3)[None], rot[:-1]])
+    origin = np.concatenate([np.zeros((1, 3)), tops[:-1]])
+    phi = tilts - np.concatenate([[0.0], tilts[:-1]])
+
+    def in_support(v):  # rot_s^T v, per joint
+        return np.einsum("nji,nj->ni", rot_s, v)
+
+    b = in_support(bottoms - origin)
+    axis_x = in_support(rot[:, :, 0])
+    x_r = b[:, 0] + stack.half_bottom * axis_x[:, 0]
+    x_l = b[:, 0] - stack.half_bottom * axis_x[:, 0]
+    right = np.minimum(np.maximum(x_r, x_l), stack.support_half)
+    left = np.maximum(np.minimum(x_r, x_l), -stack.support_half)
+    moment = np.cumsum((stack.masses[:, None] * centres)[::-1], axis=0)[::-1]
+    c = in_support(moment / stack.mass_above[:, None] - origin)
+    psi = np.minimum(np.arctan2(right - c[:, 0], c[:, 2]), np.arctan2(c[:, 0] - left, c[:, 2]))
+    ratio = 1.0 - psi / alpha
+    slip = b[:, 0] - np.copysign(stack.half_bottom * (1.0 - np.cos(phi)), phi)
+    return Joints(phi, ratio, slip, bottoms, tops[-1])
+
+
+def contact_friction(p, cid, bodies, stack: StackGeometry) -> np.ndarray:
+    """Mobilised friction of every joint: |sum of tangential forces| / sum of normal
+    forces over its contact points, from the engine's last step [-] (nan: not loaded).
+
+    Joint i is drum i on its support (joint 1: the base drum on the ground).
+    Contacts between drums that are not neighbours (a falling drum) are left
+    out. Coulomb's law caps each point's ratio at the friction coefficient, so
+    the joint's ratio is at most `interface.friction`: it reaches it when the
+    joint slides.
+    """
+    n = len(bodies)
+    out = np.full(n, np.nan)
+    points = p.getContactPoints(physicsClientId=cid)
+    if not points:
+        return out
+    # per point: body A, body B, normal force, the two friction forces and directions
+    rows = np.array([(q[1], q[2], q[9], q[10], q[12], *q[11], *q[13]) for q in points])
+    lookup = np.full(max(bodies) + 2, -1)  # engine id -> drum index (-1: the ground)
+    lookup[list(bodies)] = np.arange(n)
+    ids = np.clip(rows[:, :2].astype(int), -1, len(lookup) - 1)
+    a, b = lookup[ids[:, 0]], lookup[ids[:, 1]]
+    keep = np.abs(a - b) == 1  # neighbours only
+    j = np.maximum(a, b)[keep]
+    sign = np.where(a < b, 1.0, -1.0)[keep]  # forces on the upper body
+    r = rows[keep]
+    force = sign[:, None] * (r[:, 3:4] * r[:, 5:8] + r[:, 4:5] * r[:, 8:11])
+    normal = np.bincount(j, r[:, 2], minlength=n)
+    tangential = np.stack([np.bincount(j, force[:, x], minlength=n) for x in range(3)], axis=1)
+    loaded = normal > 1e-6 * G * stack.mass_above
+    out[loaded] = np.linalg.norm(tangential[loaded], axis=1) / normal[loaded]
+    return out

@@ -53,6 +53,15 @@ def _load(config_path: str):
         raise UserError(_one_line(exc)) from None
 
 
+def compile_notice(cfg) -> None:
+    """One line on stderr before a run that will compile the kernel (first use)."""
+    if cfg.model == "rbm" and cfg.solver.implementation == "compiled":
+        from .kernel import needs_compile
+
+        if needs_compile():
+            click.echo("note: compiling the integrator (first use only, about 20 s)", err=True)
+
+
 def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split()) or type(exc).__name__
 
@@ -189,6 +198,7 @@ def run(
     try:
         check_writable_dir(Path(output) / cfg.name)
         column = build_column(cfg.column, cfg.interface)
+        compile_notice(cfg)
         result = simulate(cfg, amplitude_g, frequency_hz, record=True, output_dt=output_dt)
         summary = run_summary(
             result,

@@ -7,7 +7,15 @@ from pathlib import Path
 
 import click
 
-from .cli import UserError, _load, _one_line, cli, config_argument, output_option
+from .cli import (
+    UserError,
+    _load,
+    _one_line,
+    cli,
+    compile_notice,
+    config_argument,
+    output_option,
+)
 from .errors import RbmError
 
 
@@ -76,6 +84,8 @@ def sweep(
         raise UserError("--scheduler needs --backend dask")
     show = not quiet and sys.stderr.isatty()
     bar = None
+    if not quiet:
+        compile_notice(cfg)
 
     def progress(done: int, total: int) -> None:
         nonlocal bar

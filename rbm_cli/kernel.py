@@ -538,6 +538,17 @@ def integrate_compiled(
     return out
 
 
+def needs_compile() -> bool:
+    """Whether the kernel has no on-disk cache yet: its first use then compiles it
+    (about 15-20 s, once per installation). False if that cannot be told."""
+    try:
+        from pathlib import Path
+
+        return not any(Path(run_kernel._cache.cache_path).glob("kernel.run_kernel-*.nbi"))
+    except Exception:  # a numba without this attribute: no notice, nothing else changes
+        return False
+
+
 def warm_up() -> None:
     """Compile (or load from the cache) the kernel once, e.g. in a worker."""
     from .column import build_column
@@ -551,4 +562,4 @@ def warm_up() -> None:
     integrate_compiled(model, motion, np.zeros(1), np.zeros(1), SolverConfig())
 
 
-__all__ = ["integrate_compiled", "model_arrays", "warm_up"]
+__all__ = ["integrate_compiled", "model_arrays", "needs_compile", "warm_up"]

@@ -201,3 +201,26 @@ def test_usage_errors_are_one_line(tmp_path, args):
     res = invoke("run", *cfg, *args, "-o", tmp_path / "out")
     assert res.exit_code == 2 and one_line_error(res), res.output
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("cold", [True, False])
+def test_run_says_when_it_compiles_the_kernel(tmp_path, monkeypatch, cold):
+    """A first run compiles the kernel (15-20 s of silence otherwise): one note on
+    stderr then, none when numba's cache is there."""
+    import rbm_cli.kernel as kernel
+
+    monkeypatch.setattr(kernel, "needs_compile", lambda: cold)
+    res = CliRunner().invoke(
+        cli, ["run", str(CONFIGS / "spanos_koh_slender.yaml"), "-a", "0.5", "-f", "1",
+              "-o", str(tmp_path)],  # fmt: skip
+    )
+    assert res.exit_code == 0, res.output
+    assert ("compiling the integrator" in res.stderr) == cold
+
+
+def test_needs_compile_sees_the_cache():
+    """After a compiled run in this process, the on-disk cache exists."""
+    from rbm_cli.kernel import needs_compile, warm_up
+
+    warm_up()
+    assert needs_compile() is False

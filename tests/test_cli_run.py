@@ -210,10 +210,7 @@ def test_run_says_when_it_compiles_the_kernel(tmp_path, monkeypatch, cold):
     import rbm_cli.kernel as kernel
 
     monkeypatch.setattr(kernel, "needs_compile", lambda: cold)
-    res = CliRunner().invoke(
-        cli, ["run", str(CONFIGS / "spanos_koh_slender.yaml"), "-a", "0.5", "-f", "1",
-              "-o", str(tmp_path)],  # fmt: skip
-    )
+    res = invoke("run", CONFIGS / "spanos_koh_slender.yaml", "-a", 0.5, "-f", 1, "-o", tmp_path)
     assert res.exit_code == 0, res.output
     assert ("compiling the integrator" in res.stderr) == cold
 

@@ -100,6 +100,7 @@ def _figure(table: pd.DataFrame, path: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     from .output import save_figure_atomic
 
@@ -114,7 +115,11 @@ def _figure(table: pd.DataFrame, path: Path) -> None:
         strict=True,
     ):
         sub = table[table["series"] == series]
-        ax.loglog(sub["x"].astype(float), sub["time_per_run_s"], "o-")
+        xs = sub["x"].astype(float)
+        ax.loglog(xs, sub["time_per_run_s"], "o-")
+        if series != "k_n":  # label the points themselves (the log axis's minor labels overlap)
+            ax.set_xticks(xs, [f"{x:g}" for x in xs])
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel(xlabel)
         ax.set_ylabel("time per run [s]")
         ax.grid(True, which="both", alpha=0.3)

@@ -44,7 +44,7 @@ from .bullet_scene import (
     Joints,
     StackGeometry,
     build_scene,
-    contact_friction,
+    joint_friction,
     joint_state,
     keep_in_plane,
     read_frame,
@@ -66,6 +66,10 @@ __all__ = [
 
 #: Interval of the collapse, sliding and contact checks [s].
 CHECK_DT = 1e-3
+#: Interval over which a joint's mean force gives its friction demand [s]: long
+#: enough to average out the contact's step-to-step chatter (measured: +-10 % of
+#: a_g / g on a block at rest over 1 ms, docs/engine.md), short against rocking.
+FRICTION_DT = 1e-2
 #: A joint is open when its relative rotation exceeds this fraction of alpha_i.
 OPEN_FRACTION = 1e-3
 #: Drop of a drum's centre of mass, as a fraction of its height, that is collapse.
@@ -120,8 +124,9 @@ def bullet_run(
         max_ratio (per joint), max_top (top relative to the base [m]),
         n_uplifts / n_impacts (joint openings / closures seen at the 1 ms
         checks), n_steps = n_rhs = engine steps; friction (per joint) the
-        largest mobilised friction |T| / N seen at the 1 ms checks
-        (:func:`rbm_cli.bullet_scene.contact_friction`; nan if never loaded);
+        largest mobilised friction |T| / N of the joint's mean force over each
+        FRICTION_DT interval (:func:`rbm_cli.bullet_scene.joint_friction`; nan
+        if never loaded);
         the message gives the largest slips.
     """
     solids = drum_solids(config.column)
@@ -156,13 +161,17 @@ def bullet_run(
     samples: list = []
     set_gravity, step = p.setGravity, p.stepSimulation
     # a_g at every mid-step, at once (the same numbers as one call per step)
-    accel = np.asarray(motion.accel((np.arange(n_steps) + 0.5) * dt), dtype=float).tolist()
+    accel_array = np.asarray(motion.accel((np.arange(n_steps) + 0.5) * dt), dtype=float)
+    accel = accel_array.tolist()
+    accel_sum = np.concatenate([[0.0], np.cumsum(accel_array)])  # for the mean over a check
 
     frame = read_frame(p, cid, bodies)
     joints = joint_state(frame, stack, alpha)
     if record:
         samples.append(_sample(0.0, frame, joints))
-    k = 0
+    k = k_prev = 0
+    frame_prev = frame
+    friction_steps = max(1, int(round(FRICTION_DT / dt)))
     while k < n_steps:
         set_gravity(-accel[k], 0.0, -G, physicsClientId=cid)
         step(physicsClientId=cid)
@@ -179,7 +188,11 @@ def bullet_run(
             out.n_steps = out.n_rhs = k
             out.stop("failed", "the engine diverged (non-finite or runaway drum)", t)
             break
-        out.friction = np.fmax(out.friction, contact_friction(p, cid, bodies, stack))
+        if k - k_prev >= friction_steps:
+            mean_accel = (accel_sum[k] - accel_sum[k_prev]) / (k - k_prev)
+            demand = joint_friction(frame_prev, frame, stack, (k - k_prev) * dt, mean_accel)
+            out.friction = np.fmax(out.friction, demand)
+            frame_prev, k_prev = frame, k
         out.max_ratio = np.maximum(out.max_ratio, joints.ratio)
         out.max_top = max(out.max_top, abs(joints.top[0] - joints.bottoms[0, 0]))
         max_slip = np.maximum(max_slip, np.abs(joints.slip))

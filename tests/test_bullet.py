@@ -18,13 +18,14 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from rbm_cli.bullet import EngineSettings, bullet_run, measure_restitution
+from rbm_cli.bullet import EngineSettings, bullet_run, impact_rate_ratios, measure_restitution
 from rbm_cli.bullet_geometry import drum_solids, stack_slenderness
+from rbm_cli.bullet_scene import build_scene, keep_in_plane, read_frame
 from rbm_cli.cli import cli
 from rbm_cli.config import parse_config
 from rbm_cli.config_types import G
 from rbm_cli.excitation import GroundMotion
-from rbm_cli.housner import block_geometry
+from rbm_cli.housner import block_geometry, housner_restitution
 from rbm_cli.simulate import simulate
 
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}  # Spanos-Koh slender, H/B = 4
@@ -88,22 +89,73 @@ def housner_e(height, width):
     return 1.0 - 1.5 * math.sin(math.atan(width / height)) ** 2
 
 
-def test_impact_loss_close_to_housner():
+def test_impact_loss_is_housners():
     """The engine's own impact loss on a 4 x 1 m block (restitution 0 at the
-    contact points): angular-velocity ratios within 0.03 of Housner's 0.912."""
+    contact points), read from the energy of successive rocking peaks, is
+    Housner's 0.912 to within 0.002 at every impact (measured: 0.9116-0.9121)."""
     ratios = measure_restitution(config(BLOCK), tilt_fraction=0.5, impacts=4)
     assert len(ratios) == 4
-    assert np.all(np.abs(ratios - housner_e(4.0, 1.0)) < 0.03), ratios
+    assert np.all(np.abs(ratios - housner_e(4.0, 1.0)) < 0.002), ratios
 
 
-def test_impact_loss_grows_with_slenderness_ratio():
-    """A squat block loses more at an impact than a slender one (Housner:
-    0.70 at H/B = 2 against 0.91 at H/B = 4); guards a loss that ignores geometry.
-    (Measured: the engine loses more than Housner on the squat block, 0.60-0.69;
-    docs/engine.md.)"""
+def test_impact_loss_follows_slenderness():
+    """A squat block loses more at an impact than a slender one, as Housner's
+    formula says (0.70 at H/B = 2 against 0.91 at H/B = 4); guards a loss that
+    ignores geometry. (The earlier reading from the rates around the impact
+    gave 0.60-0.70 here, biased by the contact's position correction.)"""
     thick = measure_restitution(config({**BLOCK, "height": 2.0}), impacts=3)
-    assert np.all((thick > 0.0) & (thick < housner_e(2.0, 1.0) + 0.03)), thick
-    assert np.max(thick) < np.min(measure_restitution(config(BLOCK), impacts=3))
+    assert np.all(np.abs(thick - housner_e(2.0, 1.0)) < 0.004), thick
+
+
+def test_rate_reading_of_the_impact_is_biased_by_erp():
+    """Why rbm reads e from the peaks: the angular velocity fitted in the 0.5-2.5 ms
+    after an impact still carries Bullet's push-out of the contact penetration
+    (erp; no split impulse for multibody contacts), so on the tapered column it
+    reads below Housner's e and moves with erp; the peaks' energy does not."""
+    cfg = config(TAPER)
+    e_h = housner_restitution(block_geometry(cfg.column))
+    rates = impact_rate_ratios(cfg, impacts=4)
+    assert np.min(rates) < e_h - 0.005, rates
+    for erp in (0.2, 0.05):
+        peaks = measure_restitution(cfg, impacts=4, settings=EngineSettings(erp=erp))
+        assert np.all(np.abs(peaks - e_h) < 0.001), (erp, peaks)
+
+
+def test_split_impulse_does_not_reach_multibody_contacts():
+    """Bullet's split impulse is not applied to multibody contacts (the branch is
+    commented out in btMultiBodyConstraintSolver::setupMultiBodyContactConstraint):
+    switching it off leaves free rocking bit for bit the same. Guards the
+    statement in docs/engine.md for the installed PyBullet."""
+    solids = drum_solids(config(TAPER).column)
+    alpha = stack_slenderness(solids)[0]
+    states = []
+    for split in (1, 0):
+        p, cid, bodies = build_scene(solids, EngineSettings(), 0.5 * alpha)
+        p.setPhysicsEngineParameter(useSplitImpulse=split, physicsClientId=cid)
+        p.setGravity(0.0, 0.0, -G, physicsClientId=cid)
+        for k in range(1, 15001):  # 1.5 s: two impacts
+            p.stepSimulation(physicsClientId=cid)
+            keep_in_plane(p, cid, bodies, pose=k % 10 == 0)
+        states.append(read_frame(p, cid, bodies))
+    assert abs(states[0].tilts[0]) > 1e-3  # still rocking
+    assert np.array_equal(states[0].centres, states[1].centres)
+    assert np.array_equal(states[0].rates, states[1].rates)
+
+
+def test_in_plane_reset_returns_what_the_engine_reads_back():
+    """keep_in_plane(pose=True) returns the frame it leaves, so the 1 ms checks
+    skip a second round of engine calls; it must equal what read_frame reads
+    (guards that shortcut)."""
+    solids = drum_solids(config({**TAPER, "drums": 3}).column)
+    p, cid, bodies = build_scene(solids, EngineSettings(), 0.3 * stack_slenderness(solids)[0])
+    p.setGravity(-0.5 * G, 0.0, -G, physicsClientId=cid)
+    for _ in range(2000):
+        p.stepSimulation(physicsClientId=cid)
+    left = keep_in_plane(p, cid, bodies, pose=True)
+    back = read_frame(p, cid, bodies)
+    assert np.abs(left.rates).max() > 1e-3  # moving
+    for name in ("centres", "rotations", "rates", "speeds"):
+        assert np.array_equal(getattr(left, name), getattr(back, name)), name
 
 
 # ------------------------------------------------------------------------- runs
@@ -120,6 +172,21 @@ def test_rest_below_the_uplift_level():
     assert np.max(out.max_ratio) < 1e-3
     skipped = simulate(cfg, 0.9 * 0.25, 2.0)
     assert skipped.status == "survived" and skipped.n_steps == 0
+    # friction demand: the block moves with the ground, T / N = a_g / g (statics;
+    # the 10 ms mean forces keep a little of the contact's chatter)
+    assert out.friction[0] == pytest.approx(0.9 * 0.25, abs=0.002)
+    assert skipped.friction_demand == pytest.approx((0.9 * 0.25,), rel=1e-12)
+
+
+def test_friction_demand_is_capped_by_coulomb_when_sliding():
+    """A squat block (uplift at 0.5 g) with friction 0.2 under 0.4 g slides: the
+    mobilised |T| / N of its base reaches the friction coefficient and no more
+    (Coulomb's cone: Bullet's pyramid let the 8-drum joints reach 1.41 x friction)."""
+    cfg = config({"height": 2.0, "base_width": 1.0, "depth": 1.0}, duration=1.0, friction=0.2)
+    r = simulate(cfg, 0.4, 1.0)
+    assert r.status == "survived"
+    assert r.friction_demand[0] == pytest.approx(0.2, rel=1e-3)
+    assert float(r.message.split("base ")[1].split(" mm")[0]) > 10.0  # it slid
 
 
 def test_big_pulse_collapses_and_is_reported():
@@ -172,7 +239,7 @@ def test_engine_agrees_with_housner(column):
     of a 6 x 5 harmonic grid (here 3 s of excitation; 10 s in docs/engine.md)."""
     engine = config(column, duration=CI_DURATION)
     e = float(np.mean(measure_restitution(engine, impacts=4)))
-    ref = config(column, model="housner", duration=CI_DURATION, restitution=round(e, 3))
+    ref = config(column, model="housner", duration=CI_DURATION, restitution=round(e, 4))
     cells = [(a, f) for a in GRID_AMPLITUDES for f in GRID_FREQUENCIES]
     same = [simulate(engine, a, f).status == simulate(ref, a, f).status for a, f in cells]
     assert sum(same) >= 0.95 * len(cells), [c for c, ok in zip(cells, same, strict=True) if not ok]

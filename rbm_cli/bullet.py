@@ -82,8 +82,18 @@ REST_TIME = 0.2
 BLOWUP = 1e3
 
 
+#: Bullet caps a contact's friction coefficient at this (btManifoldResult's MAX_FRICTION).
+MAX_FRICTION = 10.0
+
+
 def settings_from_config(config: Config) -> EngineSettings:
-    return EngineSettings(time_step=config.solver.time_step, friction=config.interface.friction)
+    friction = config.interface.friction
+    if friction > MAX_FRICTION:
+        raise RbmError(
+            f"interface.friction must be <= {MAX_FRICTION:g} for model bullet (the engine caps"
+            f" a contact's friction there), got {friction:g}"
+        )
+    return EngineSettings(time_step=config.solver.time_step, friction=friction)
 
 
 # ------------------------------------------------------------------------- run

@@ -260,6 +260,20 @@ def test_bad_friction_is_one_line(tmp_path):
     assert "Traceback" not in result.output
 
 
+def test_friction_above_the_engine_cap_is_one_line(tmp_path):
+    """Bullet caps a contact's friction at 10: a larger interface.friction would run
+    silently with 10, so it is refused in one line."""
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "name: x\nmodel: bullet\ncolumn: {height: 4, base_width: 1}\ninterface: {friction: 20}\n"
+    )
+    result = CliRunner().invoke(cli, ["run", str(path), "-a", "0.5", "-f", "1"])
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "interface.friction must be <= 10" in lines[0], result.output
+    assert "Traceback" not in result.output
+
+
 def test_rbm_run_writes_the_engine_history(tmp_path):
     """`rbm run` on an engine config writes the RBM's four files, the history from
     the drums' positions (8 drums: 9 node columns, 8 rotations)."""

@@ -1,8 +1,12 @@
 """Measure the numbers and draw the figures of docs/engine.md (issue 7: `model: bullet`).
 
-    python docs/make_engine.py impact      # the engine's impact loss vs Housner's e (~10 s)
+    python docs/make_engine.py impact      # the engine's impact loss vs Housner's e (~1 min)
     python docs/make_engine.py grid        # 6 x 5 grid, engine vs housner, 3 time steps (~5 min)
-    python docs/make_engine.py timestep    # 8-drum cells at 3 time steps (~6 min)
+    python docs/make_engine.py timestep    # 24 8-drum cells at 3 time steps, each run twice
+                                           # (amplitude x (1 + 1e-6)) (~25 min)
+    python docs/make_engine.py cost        # CPU of 10 s 8-drum cells at 1e-4 s, 3 runs each
+    python docs/make_engine.py emap        # housner's outcome against e in the knife-edge cells
+    python docs/make_engine.py fine        # the 6 x 5 grid at 5e-5 s, engine vs housner (~3 min)
     python docs/make_engine.py chaos       # one chaotic 8-drum cell, K = 4, 2 time steps
     python docs/make_engine.py monolithic  # the monolithic study: RBM, housner, engine (~2 min)
     python docs/make_engine.py rbm_e       # 8-drum RBM with e < 1 vs engine; friction demand
@@ -32,7 +36,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from rbm_cli.bullet import measure_restitution  # noqa: E402
+from rbm_cli.bullet import impact_rate_ratios, measure_restitution  # noqa: E402
+from rbm_cli.bullet_scene import EngineSettings  # noqa: E402
 from rbm_cli.config import load_config, parse_config  # noqa: E402
 from rbm_cli.config_types import GridConfig  # noqa: E402
 from rbm_cli.domain import read_domain  # noqa: E402
@@ -53,8 +58,21 @@ COLUMNS = {
 GRID_AMPLITUDES = (0.3, 0.5, 0.7, 0.9, 1.1, 1.3)
 GRID_FREQUENCIES = (0.5, 1.0, 1.5, 2.0, 2.5)
 TIME_STEPS = (1e-4, 2e-4, 5e-4)
-#: 8-drum cells of the time-step study (g, Hz).
-MULTI_CELLS = [(a, f) for f in (1.0, 2.5) for a in (0.25, 0.4, 0.6, 0.9)]
+#: 8-drum cells of the time-step study (g, Hz): spread over the engine's domain
+#: (results/harmonic_multidrum_bullet), on and away from its boundary.
+MULTI_CELLS = [
+    *[(a, 0.5) for a in (0.25, 0.3, 0.5)],
+    *[(a, 1.0) for a in (0.4, 0.5, 0.6, 0.7, 0.9)],
+    *[(a, 1.5) for a in (0.6, 0.8, 0.9, 1.1)],
+    *[(a, 2.0) for a in (0.8, 1.0, 1.1, 1.3)],
+    *[(a, 2.5) for a in (0.6, 1.0, 1.3, 1.5)],
+    *[(a, 3.0) for a in (1.0, 1.5)],
+    *[(a, 4.0) for a in (0.8, 1.5)],
+]
+#: Engine variants of the time-step study: (label, time step [s]).
+VARIANTS = [("1e-4", 1e-4), ("2e-4", 2e-4), ("5e-4", 5e-4)]
+#: Relative amplitude change of the second run of each cell (chaos marker).
+NUDGE = 1e-6
 
 
 def column_config(column: dict, model: str = "bullet", **interface):
@@ -83,14 +101,32 @@ def timed(fn, *args):
 
 
 def part_impact() -> None:
+    """Both readings of the engine's impact loss (rbm_cli.bullet_impact): from the
+    energy of successive peaks (the one used) and from 2 ms line fits of the
+    angular velocity around each impact; at erp 0.2 (the engine's) and 0.05."""
     rows = []
     for name, column in COLUMNS.items():
         cfg = column_config(column)
         e_h = housner_restitution(block_geometry(cfg.column))
-        for frac in (0.2, 0.5, 0.8):
-            ratios = measure_restitution(cfg, tilt_fraction=frac, impacts=4)
-            rows.append(dict(column=name, tilt=frac, housner=e_h, ratios=list(ratios)))
-            print(f"{name:20s} tilt {frac} alpha: e = {np.round(ratios, 3)}  Housner {e_h:.3f}")
+        for erp in (0.2, 0.05):
+            s = EngineSettings(erp=erp)
+            for frac in (0.2, 0.5, 0.8):
+                energy = measure_restitution(cfg, tilt_fraction=frac, impacts=4, settings=s)
+                rates = impact_rate_ratios(cfg, tilt_fraction=frac, impacts=4, settings=s)
+                rows.append(
+                    dict(
+                        column=name,
+                        erp=erp,
+                        tilt=frac,
+                        housner=e_h,
+                        energy=list(energy),
+                        rates=list(rates),
+                    )
+                )
+                print(
+                    f"{name:20s} erp {erp} tilt {frac} alpha: e from peaks {np.round(energy, 4)},"
+                    f" from rates {np.round(rates, 4)}; Housner {e_h:.4f}"
+                )
     dump("impact", rows)
 
 
@@ -106,6 +142,7 @@ def part_grid() -> None:
         ratios = measure_restitution(column_config(COLUMNS[name]), impacts=4)
         e = float(np.mean(ratios))
         spread = np.linspace(ratios.min(), ratios.max(), 5)
+        e_rates = float(np.mean(impact_rate_ratios(column_config(COLUMNS[name]), impacts=4)))
 
         def housner(e_, name=name):
             ref = column_config(COLUMNS[name], model="housner", restitution=round(float(e_), 4))
@@ -113,7 +150,9 @@ def part_grid() -> None:
 
         ref = housner(e)
         varied = [housner(x) for x in spread]
+        old = housner(e_rates)
         res = {"e": e, "e_min": float(ratios.min()), "e_max": float(ratios.max())}
+        res["e_rates"] = e_rates
         res["housner"] = {f"{a} {f}": s for (a, f), s in ref.items()}
         for friction, dt in [(1.0, t) for t in TIME_STEPS] + [(2.0, TIME_STEPS[0])]:
             cfg = with_step(column_config(COLUMNS[name], friction=friction), dt)
@@ -127,9 +166,11 @@ def part_grid() -> None:
                 if (a, f) in differ
             }
             cpu = sum(t for _, t in runs)
+            differ_rates = [c for c in cells if status[c] != old[c]]
             res[f"mu {friction} dt {dt:g}"] = dict(
                 status={f"{a} {f}": s for (a, f), s in status.items()},
                 differ=differ,
+                differ_with_e_rates=differ_rates,
                 sensitive=sensitive,
                 slip_of_differing=slip,
                 cpu_s=cpu,
@@ -137,7 +178,8 @@ def part_grid() -> None:
             print(
                 f"{name}, e = {e:.3f} ({ratios.min():.3f}-{ratios.max():.3f}), friction"
                 f" {friction}, dt {dt:g}: {len(differ)} of {len(cells)} differ {differ}"
-                f" (sensitive to e: {sensitive}), slips {slip}, {cpu:.1f} s CPU"
+                f" (sensitive to e: {sensitive}), slips {slip}, {cpu:.1f} s CPU; with e from"
+                f" rates ({e_rates:.4f}): {len(differ_rates)} differ {differ_rates}"
             )
             if friction == 1.0 and dt == TIME_STEPS[0]:
                 _grid_axes(ax, name, cells, ref, res[f"mu {friction} dt {dt:g}"]["status"], e)
@@ -162,25 +204,129 @@ def _grid_axes(ax, name, cells, housner, engine_status, e) -> None:
 
 
 def part_timestep() -> None:
+    """24 8-drum cells (MULTI_CELLS), each run by every engine variant (VARIANTS) at
+    its amplitude a and at a (1 + NUDGE): a cell whose two runs differ under one
+    variant is chaotic there. CPU time of every run (the medians are printed)."""
     cfg = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
     rows = []
-    for dt in TIME_STEPS:
-        for a, f in MULTI_CELLS:
-            r, cpu = timed(simulate, with_step(cfg, dt), a, f)
-            rows.append(
-                dict(
-                    dt=dt,
-                    a=a,
-                    f=f,
-                    status=r.status,
-                    t_c=r.t_collapse_s,
-                    ratio=r.max_rotation_ratio,
-                    cpu_s=cpu,
-                    message=r.message,
+    for a, f in MULTI_CELLS:
+        for label, dt in VARIANTS:
+            settings = EngineSettings(time_step=dt, friction=cfg.interface.friction)
+            for amp in (a, a * (1.0 + NUDGE)):
+                r, cpu = timed(_engine_cell, with_step(cfg, dt), amp, f, settings)
+                rows.append(
+                    dict(
+                        variant=label,
+                        a=a,
+                        f=f,
+                        nudged=amp != a,
+                        status=r.status,
+                        t_c=r.t_collapse,
+                        ratio=float(np.max(r.max_ratio)),
+                        friction=[float(v) for v in r.friction],
+                        cpu_s=cpu,
+                        message=r.message,
+                    )
                 )
-            )
-            print(json.dumps(rows[-1]))
-    dump("timestep", rows)
+                print(json.dumps(rows[-1]), flush=True)
+        dump("timestep", rows)
+    _timestep_summary(rows)
+
+
+def _engine_cell(cfg, amplitude_g, frequency_hz, settings):
+    from rbm_cli.bullet import bullet_run
+    from rbm_cli.excitation import make_ground_motion
+
+    motion = make_ground_motion(cfg.excitation, amplitude_g, frequency_hz)
+    out, _ = bullet_run(cfg, motion, settings=settings)
+    return out
+
+
+def _timestep_summary(rows) -> dict:
+    """Per cell: each variant's outcome (C/S, '?' when its two runs differ)."""
+    table, summary = {}, {}
+    for r in rows:
+        table.setdefault((r["a"], r["f"]), {}).setdefault(r["variant"], []).append(r["status"])
+    ref = VARIANTS[0][0]
+    for label, _ in VARIANTS:
+        cpu = [r["cpu_s"] for r in rows if r["variant"] == label]
+        surv = [r["cpu_s"] for r in rows if r["variant"] == label and r["status"] == "survived"]
+        same = differ = chaotic = 0
+        for runs in table.values():
+            mine, base = set(runs[label]), set(runs[ref])
+            if len(mine) > 1 or len(base) > 1:
+                chaotic += 1
+            elif mine == base:
+                same += 1
+            else:
+                differ += 1
+        summary[label] = dict(
+            median_cpu_s=float(np.median(cpu)),
+            median_cpu_survived_s=float(np.median(surv)) if surv else None,
+            n_survived_runs=len(surv),
+            same_as_ref=same,
+            differ_from_ref=differ,
+            chaotic_here_or_ref=chaotic,
+        )
+        print(label, summary[label])
+    for (a, f), runs in table.items():
+        marks = {k: "".join(sorted({s[0].upper() for s in v})) for k, v in runs.items()}
+        print(f"  {a:4.2f} g {f:3.1f} Hz: {marks}")
+    return summary
+
+
+def part_cost() -> None:
+    """CPU of surviving 10 s 8-drum cells at the default step (1e-4 s): three cells,
+    three runs each, one process (the medians are printed)."""
+    cfg = with_step(load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml"), 1e-4)
+    rows = []
+    for _ in range(3):
+        for a, f in ((0.25, 1.0), (0.4, 2.5), (0.6, 2.5)):
+            r, cpu = timed(simulate, cfg, a, f)
+            rows.append(dict(a=a, f=f, status=r.status, cpu_s=cpu))
+            print(json.dumps(rows[-1]), flush=True)
+    cpu = [r["cpu_s"] for r in rows if r["status"] == "survived"]
+    print(f"median {np.median(cpu):.2f} s, range {min(cpu):.2f}-{max(cpu):.2f} s ({len(cpu)} runs)")
+    dump("cost", rows)
+
+
+#: Grid cells where the engine and `housner` have differed at some setting.
+EDGE_CELLS = {
+    "block 4 x 1 m": [(0.3, 0.5), (0.9, 1.5), (1.1, 2.0)],
+    "tapered 5 m column": [(0.9, 1.5), (1.3, 2.0)],
+}
+
+
+def part_emap() -> None:
+    """housner's outcome in EDGE_CELLS for e from 0.895 to 0.950 in steps of 0.0025:
+    how close to a flip each cell is."""
+    out = {}
+    for name, cells in EDGE_CELLS.items():
+        for a, f in cells:
+            row = {}
+            for e in np.round(np.arange(0.895, 0.9501, 0.0025), 4):
+                r = simulate(column_config(COLUMNS[name], model="housner", restitution=e), a, f)
+                row[f"{e:.4f}"] = r.status[0].upper()
+            out[f"{name}: {a} g {f} Hz"] = row
+            print(f"{name:20s} {a} g {f} Hz: " + " ".join(f"{k}:{v}" for k, v in row.items()))
+    dump("emap", out)
+
+
+def part_fine() -> None:
+    """Engine (5e-5 s) against housner (e from the engine's peaks) on the 6 x 5 grid."""
+    cells = [(a, f) for f in GRID_FREQUENCIES for a in GRID_AMPLITUDES]
+    out = {}
+    for name in ("block 4 x 1 m", "tapered 5 m column"):
+        cfg = column_config(COLUMNS[name])
+        e = round(float(np.mean(measure_restitution(cfg, impacts=4))), 4)
+        ref = column_config(COLUMNS[name], model="housner", restitution=e)
+        runs = [timed(simulate, with_step(cfg, 5e-5), a, f) for a, f in cells]
+        differ = [
+            c for c, (r, _) in zip(cells, runs, strict=True) if r.status != simulate(ref, *c).status
+        ]
+        out[name] = dict(e=e, differ=differ, cpu_s=sum(t for _, t in runs))
+        print(f"{name}, dt 5e-5, e = {e}: {len(differ)} of {len(cells)} differ {differ}")
+    dump("fine", out)
 
 
 def part_chaos() -> None:
@@ -211,14 +357,17 @@ def part_chaos() -> None:
 
 
 def part_monolithic(jobs: int) -> None:
-    """The monolithic study: RBM, housner (e = 1 and e = 0.929, the engine's mean e of
-    the column) and the engine's stored domain, cells that differ pairwise."""
+    """The monolithic study: RBM, housner (e = 1; the engine's e of the column from
+    the energy of its peaks; 0.929, the earlier reading from the rates) and the
+    engine's stored domain, cells that differ pairwise."""
     base = load_config(ROOT / "configs" / "harmonic_monolithic.yaml")
     eng = read_domain(ROOT / "results" / "harmonic_monolithic_bullet" / "domain.csv")
     rbm = read_domain(ROOT / "results" / "harmonic_monolithic" / "domain.csv")
+    engine_cfg = load_config(ROOT / "configs" / "harmonic_monolithic_bullet.yaml")
+    e_engine = round(float(np.mean(measure_restitution(engine_cfg, impacts=4))), 4)
     ref = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for e in (1.0, 0.929):
+        for e in (1.0, e_engine, 0.929):
             cfg = dc.replace(
                 base,
                 name=f"h{e}",
@@ -232,8 +381,10 @@ def part_monolithic(jobs: int) -> None:
         return int((m.collapsed_x != m.collapsed_y).sum()), len(m)
 
     out = {
+        "e_engine": e_engine,
         "rbm vs housner e=1": differ(rbm, ref[1.0]),
-        "housner e=1 vs e=0.929": differ(ref[1.0], ref[0.929]),
+        f"housner e=1 vs e={e_engine}": differ(ref[1.0], ref[e_engine]),
+        f"housner e={e_engine} vs engine": differ(ref[e_engine], eng),
         "housner e=0.929 vs engine": differ(ref[0.929], eng),
         "rbm vs engine": differ(rbm, eng),
     }
@@ -296,17 +447,21 @@ def part_multidrum(jobs: int) -> None:
 
 
 def part_rbm_e(jobs: int) -> None:
-    """The 8-drum RBM (relative) with impact loss e < 1 against the engine's fractions,
-    and the RBM's friction demand max |T/N| in three cells (no sliding needs mu above it)."""
+    """The 8-drum RBM (relative) with impact loss e < 1 (the engine's own e of the
+    monolith, read from its peaks, and 0.8) against the engine's fractions; the
+    friction demand max |T/N| of the RBM and of the engine (friction 1.0 and 10,
+    the latter too high to slide) in three cells."""
     engine = pd.read_csv(ROOT / "results" / "harmonic_multidrum_bullet" / "domain.csv")
     eng = engine.set_index(["amplitude_g", "frequency_hz"])["collapse_fraction"]
     base = load_config(ROOT / "configs" / "harmonic_multidrum.yaml")
+    mono = load_config(ROOT / "configs" / "harmonic_monolithic_bullet.yaml")
+    e_engine = round(float(np.mean(measure_restitution(mono, impacts=4))), 3)
     grid = GridConfig(
         amplitudes_g=tuple(sorted({a for a, _ in eng.index})),
         frequencies_hz=tuple(sorted({f for _, f in eng.index})),
     )
-    out = {}
-    for e in (1.0, 0.929, 0.8):
+    out = {"e_engine": e_engine}
+    for e in (1.0, e_engine, 0.8):
         cfg = dc.replace(
             base, name=f"rbm_e{e}", grid=grid, interface=dc.replace(base.interface, restitution=e)
         )
@@ -316,11 +471,21 @@ def part_rbm_e(jobs: int) -> None:
         agree = float(np.mean(np.abs(r.to_numpy() - eng.to_numpy()) < 0.5))
         out[f"e {e}"] = dict(agree=agree, rbm_boundary=_boundary(df))
         print(f"RBM relative, e = {e}: agrees with the engine on {agree:.3f}", _boundary(df))
+    engine_cfg = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
     demand = []
     for a, f in ((0.25, 1.0), (0.25, 3.0), (0.45, 3.5)):
         r = simulate(base, a, f)
-        demand.append(dict(a=a, f=f, status=r.status, max_friction_demand=r.max_friction_demand))
-        print(demand[-1])
+        row = dict(a=a, f=f, status=r.status, max_friction_demand=r.max_friction_demand)
+        for mu in (1.0, 10.0):
+            cfg = dc.replace(engine_cfg, interface=dc.replace(engine_cfg.interface, friction=mu))
+            er = simulate(cfg, a, f)
+            row[f"engine mu {mu:g}"] = dict(
+                status=er.status,
+                friction_demand=list(er.friction_demand),
+                message=er.message,
+            )
+        demand.append(row)
+        print(json.dumps(row))
     out["friction_demand"] = demand
     dump("rbm_e", out)
 
@@ -343,7 +508,8 @@ def _boundary_frac(df, col) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parts = ["impact", "grid", "timestep", "chaos", "monolithic", "multidrum", "rbm_e"]
+    parts = ["impact", "grid", "timestep", "cost", "emap", "fine", "chaos", "monolithic"]
+    parts += ["multidrum", "rbm_e"]
     ap.add_argument("part", choices=parts)
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args(argv)
@@ -356,7 +522,7 @@ def main(argv=None) -> int:
         part_rbm_e(args.jobs)
     else:
         parts = {"impact": part_impact, "grid": part_grid, "timestep": part_timestep}
-        parts["chaos"] = part_chaos
+        parts.update(chaos=part_chaos, cost=part_cost, emap=part_emap, fine=part_fine)
         parts[args.part]()
     return 0
 

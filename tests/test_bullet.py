@@ -297,3 +297,25 @@ def test_engine_settings_are_the_scoped_ones():
     s = EngineSettings()
     assert (s.time_step, s.solver_iterations, s.erp, s.friction) == (1e-4, 100, 0.2, 1.0)
     assert dataclasses.replace(s, friction=0.5).friction == 0.5
+
+
+def test_engine_domain_plot_marks_the_engine_uplift_level():
+    """The sweep's domain figure of an engine config draws the engine's own uplift
+    level (true solid: tan(alpha) g, 0.219 g for the paper's column), not the RBM's
+    static multiplier (0.192 g): guards the plot the sweep and `rbm plot-domain` save."""
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    from rbm_cli.sweep import domain_figure
+
+    cfg = config(TAPER)
+    df = pd.DataFrame(
+        {"amplitude_g": [0.1, 0.5], "frequency_hz": [1.0, 1.0], "status": ["survived"] * 2}
+    )
+    fig = domain_figure(df, cfg)
+    (line,) = [ln for ln in fig.axes[0].get_lines() if ln.get_gid() == "static"]
+    level = math.tan(stack_slenderness(drum_solids(cfg.column))[0])
+    assert line.get_ydata()[0] == pytest.approx(level, rel=1e-12)
+    assert line.get_ydata()[0] == pytest.approx(0.219, abs=5e-4)
+    assert line.get_label().startswith("engine uplift level")
+    plt.close(fig)

@@ -279,6 +279,14 @@ def format_info(info: dict) -> str:
             (", ".join(_fmt(f) for f in freqs) + " Hz") if freqs else "- (rigid)",
         ),
     ]
+    if info.get("engine_uplift_g") is not None:
+        rows.append(
+            (
+                "engine uplift",
+                f"{_fmt(info['engine_uplift_g'])} g (model: bullet, true solids, friction "
+                f"{_fmt(info.get('friction'))}; the figures above are the RBM's)",
+            )
+        )
     width = max(len(k) for k, _ in rows)
     lines = [f"{k + ':':<{width + 1}} {v}" for k, v in rows]
 

@@ -16,7 +16,9 @@ def describe(config: Config) -> dict:
 
     The rocking p is that of the rigid stack, p^2 = N_1 zbar_1 / (1^T M 1)
     (for n = 1: m g (H/2) / (I_G + m H^2 / 4)). Elastic frequencies are those
-    of the elastic branches of the laws in the chosen formulation.
+    of the elastic branches of the laws in the chosen formulation. For
+    `model: bullet` the figures are the RBM's, plus the engine's own uplift
+    level (true solids, min(tan alpha_i, friction) g).
     """
     model = model_from_config(config)
     col = model.column
@@ -44,6 +46,13 @@ def describe(config: Config) -> dict:
                 "elastic_limit_rad": float(model.laws[i].elastic_limit),
             }
         )
+    engine = {}
+    if config.model == "bullet":  # the engine's true solids move at their own level
+        from .bullet import uplift_level
+        from .bullet_geometry import drum_solids
+
+        level = uplift_level(drum_solids(config.column), config.interface.friction)
+        engine = {"engine_uplift_g": level / G, "friction": config.interface.friction}
     return {
         "name": config.name,
         "n_drums": n,
@@ -57,4 +66,5 @@ def describe(config: Config) -> dict:
         "formulation": model.formulation,
         "restitution": model.restitution,
         "interfaces": interfaces,
+        **engine,
     }

@@ -221,3 +221,17 @@ def test_needs_compile_sees_the_cache():
 
     warm_up()
     assert needs_compile() is False
+
+
+def test_info_gives_the_engine_its_own_uplift_level(tmp_path):
+    """For `model: bullet` the engine's true rectangular block uplifts at b/h g (statics,
+    friction 1 > b/h), not at the RBM's level; a low friction caps it (sliding first)."""
+    block = "name: b\nmodel: bullet\ncolumn: {height: 4, base_width: 1, depth: 1}\n"
+    res = invoke("info", write(tmp_path, block), "--json")
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.output)["engine_uplift_g"] == pytest.approx(0.25, rel=1e-12)
+    low = block + "interface: {friction: 0.1}\n"
+    res = invoke("info", write(tmp_path, low, "low.yaml"))
+    assert res.exit_code == 0, res.output
+    assert "engine uplift:" in res.output and "0.1 g" in res.output
+    assert "engine uplift" not in invoke("info", CONFIGS / "harmonic_monolithic.yaml").output

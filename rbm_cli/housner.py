@@ -30,7 +30,7 @@ from scipy.integrate import DOP853, RK23, RK45
 from scipy.optimize import brentq
 
 from .config_types import ColumnConfig, G, SolverConfig
-from .events import hermite_dip
+from .events import first_crossing, hermite_dip
 from .excitation import GroundMotion
 from .housner_linear import STOP_MARGIN, Recorder
 from .integrate import EVENT_EPS, REST_RATE, Outcome
@@ -301,8 +301,8 @@ def housner_run(
                             t_hit = t_old + t_min
                 if t_hit is not None:
                     dense = integ.dense_output() if dense is None else dense
-                    t_e = brentq(lambda x, d=dense: dist(d(x)).min(), t_old, t_hit, xtol=1e-15)
-                    kind = "impact" if np.argmin(dist(dense(t_e))) == 0 else "collapse"
+                    t_e, row = _earliest(dense, dist, ddist, t_old, t_hit)
+                    kind = "impact" if row == 0 else "collapse"
                     if kind == "impact":
                         t_e = _polish_zero(dense, t_e, t_old)
                     t_new, y_new = t_e, dense(t_e)
@@ -344,6 +344,21 @@ def housner_run(
                 y, at_rest = np.zeros(2), True
                 note((t, "rest"))
     return finish()
+
+
+def _earliest(dense, dist, ddist, t_old: float, t_hit: float) -> tuple[float, int]:
+    """(time, row) of the earliest crossing of either event row (0: impact, 1:
+    collapse) in [t_old, t_hit], each row's own root on the dense output
+    (events.first_crossing), not a root of their minimum, which can be a later one."""
+
+    def rows(ts):
+        yy = dense(np.atleast_1d(ts))  # (2, m): theta, rate
+        return dist(yy), ddist(yy)
+
+    hit = first_crossing(rows, t_old, t_hit, xtol=1e-15)
+    if hit is None:  # t_hit is below zero by construction; only round-off gets here
+        return t_hit, int(np.argmin(dist(dense(t_hit))))
+    return hit
 
 
 def _polish_zero(dense, t_e: float, t_lo: float) -> float:

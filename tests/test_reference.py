@@ -442,3 +442,32 @@ def test_rigid_rbm_is_housner_linear(kind, amplitude_g, frequency_hz):
     assert rbm.status == lin.status == "collapsed"
     assert rbm.n_impacts == lin.n_impacts
     assert rbm.t_collapse_s == pytest.approx(lin.t_collapse, rel=1e-8)
+
+
+def test_housner_event_is_the_earliest_crossing_of_either_row():
+    """housner._earliest on a made-up step whose rotation dips below zero on (0.2, 0.3)
+    (an impact) and passes the collapse limit at 0.9: the event is the impact at 0.2.
+    A root of the minimum of the two rows, the earlier rule, may be the one at 0.9."""
+    from rbm_cli.housner import _earliest
+
+    limit, s, eps = 1.0, 1, 0.0
+
+    def dense(t):
+        t = np.asarray(t, dtype=float)
+        # theta: negative on (0.2, 0.3), equal to the limit at t = 0.9
+        theta = (t - 0.2) * (t - 0.3) * (1.0 / ((0.9 - 0.2) * (0.9 - 0.3)))
+        rate = (2 * t - 0.5) * (1.0 / ((0.9 - 0.2) * (0.9 - 0.3)))
+        return np.array([theta, rate])
+
+    def dist(yy):
+        return np.array([s * yy[0] + eps, limit - s * yy[0]])
+
+    def ddist(yy):
+        return np.array([s * yy[1], -s * yy[1]])
+
+    t_e, row = _earliest(dense, dist, ddist, 0.0, 1.0)
+    assert row == 0
+    assert t_e == pytest.approx(0.2, abs=1e-12)
+    # only the collapse row crosses in a later window: it is found, with its row
+    t_e, row = _earliest(dense, dist, ddist, 0.5, 1.0)
+    assert (row, t_e) == (1, pytest.approx(0.9, abs=1e-12))

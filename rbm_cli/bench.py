@@ -138,8 +138,8 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
     rows = []
     for a, f in cells:
         r = simulate(cfg, a, f, model=model)
-        rows.append(_row(a, f, r.status, r.t_collapse_s, r.max_rotation_ratio, r.wall_time_s))
-        rows[-1]["n_uplifts"], rows[-1]["n_impacts"] = r.n_uplifts, r.n_impacts
+        row = _row(a, f, r.status, r.t_collapse_s, r.max_rotation_ratio, r.wall_time_s)
+        rows.append(dict(row, n_uplifts=r.n_uplifts, n_impacts=r.n_impacts))
     return rows
 
 

@@ -58,6 +58,7 @@ from .result import History
 __all__ = [
     "EngineSettings",
     "bullet_run",
+    "engine_uplift_g",
     "impact_rate_ratios",
     "measure_restitution",
     "settings_from_config",
@@ -103,6 +104,11 @@ def uplift_level(solids, friction: float) -> float:
     """Horizontal ground acceleration [m/s^2] below which the rigid stack cannot
     move: min(tan alpha_i, friction) g (statics of the stacks above each joint)."""
     return G * min(float(np.min(np.tan(stack_slenderness(solids)))), friction)
+
+
+def engine_uplift_g(config: Config) -> float:
+    """The engine's uplift level of a configured column [g] (uplift_level of its true solids)."""
+    return uplift_level(drum_solids(config.column), config.interface.friction) / G
 
 
 def bullet_run(

@@ -20,17 +20,9 @@ class Pieces:
         self.k = np.zeros(n, dtype=int)
         self.pending = np.zeros(n, dtype=bool)  # excursion beyond elastic branch
         self.rigid = np.array([law.rigid for law in model.laws])
-        # silent impacts (`silent`): with e = 1 and a law linear through zero on its
-        # first piece, a zero crossing after an excursion changes neither the state
-        # nor the equations, so it is no event: it is counted by `settle` instead
-        self.silent = np.array(
-            [
-                silent and model.restitution == 1.0 and not law.rigid
-                and len(law.edges) > 0 and law.intercepts[0] == 0.0
-                for law in model.laws
-            ],
-            dtype=bool,
-        )  # fmt: skip
+        # silent impacts (`silent`, Model.silent_impacts): a zero crossing that changes
+        # neither the state nor the equations is no event; `settle` counts it instead
+        self.silent = model.silent_impacts & silent
         self.awaiting = np.zeros(n, dtype=bool)  # back on piece 0, zero not crossed yet
         self.tu = model.column.rotation_capacity
         self._cache: dict = {}

@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from scipy.linalg import eig
-
 from .config_types import Config, G
 from .simulate import model_from_config
 
@@ -24,11 +21,7 @@ def describe(config: Config) -> dict:
     col = model.column
     n = col.n
     p = model.rocking_p
-    freqs: list[float] = []
-    if not model.rigid:
-        slopes = np.array([law.slopes[0] for law in model.laws])
-        w2 = np.real(eig(model.stiffness(slopes), model.mass, right=False))
-        freqs = sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
+    freqs = model.elastic_frequencies_hz()
     uplift = model.uplift_level / G if model.uplift_level is not None else None
     interfaces = []
     for i in range(n):
@@ -48,11 +41,9 @@ def describe(config: Config) -> dict:
         )
     engine = {}
     if config.model == "bullet":  # the engine's true solids move at their own level
-        from .bullet import uplift_level
-        from .bullet_geometry import drum_solids
+        from .bullet import engine_uplift_g
 
-        level = uplift_level(drum_solids(config.column), config.interface.friction)
-        engine = {"engine_uplift_g": level / G, "friction": config.interface.friction}
+        engine = {"engine_uplift_g": engine_uplift_g(config), "friction": config.interface.friction}
     return {
         "name": config.name,
         "n_drums": n,

@@ -116,7 +116,7 @@ def integrate(
     g_rows = np.vstack([model.arg_map / tu[:, None], -model.arg_map / tu[:, None], -cmap, cmap])
     c_vec = np.full(n, c_ratio)
     argmap = model.arg_map
-    arg_inv = np.linalg.inv(argmap)
+    arg_inv = model.arg_inverse
     e_rest = model.restitution
     stepper = _METHODS[solver.method]
     atol = solver.atol * np.concatenate([np.full(n, tu.min()), np.full(n, tu.min() * 10.0)])

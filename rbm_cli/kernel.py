@@ -19,6 +19,7 @@ in both (events.Pieces.silent).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -72,7 +73,7 @@ from .model import Model
 def run_kernel(
     mc, rtol, atol, max_steps, max_events,
     mass, minv, diff, argmap, arg_inv, gravity, ground_load,
-    edges, nedges, intercepts, slopes, rigid,
+    edges, nedges, intercepts, slopes, rigid, silent,
     tu, cmap, top, c_ratio, e_rest, literal_impact, impulse_dir, impulse_w,
     centre_map, masses, normal_forces,
     kind, amplitude, omega, phase, pulse_end, t_end,
@@ -92,10 +93,7 @@ def run_kernel(
     side = np.ones(n, dtype=np.int64)
     k = np.zeros(n, dtype=np.int64)
     pending = np.zeros(n, dtype=np.bool_)
-    # silent impacts (events.Pieces.silent): counted at step ends, not stopped at
-    silent = np.zeros(n, dtype=np.bool_)
-    for i in range(n):
-        silent[i] = e_rest == 1.0 and not rigid[i] and nedges[i] > 0 and intercepts[i, 0] == 0.0
+    # silent impacts (Model.silent_impacts): counted at step ends, not stopped at
     any_silent = silent.any()
     awaiting = np.zeros(n, dtype=np.bool_)
     lo, hi = np.empty(n), np.empty(n)
@@ -454,8 +452,8 @@ def model_arrays(model: Model) -> tuple:
     edges, nedges, inter, slopes, rigid = _pad_laws(model)
     return (
         model.mass, model.mass_inv, model.diff.astype(float), argmap,
-        np.linalg.inv(argmap), model.gravity, model.ground_load,
-        edges, nedges, inter, slopes, rigid,
+        model.arg_inverse, model.gravity, model.ground_load,
+        edges, nedges, inter, slopes, rigid, model.silent_impacts,
         tu, model.collapse_map / model.collapse_limit[:, None], col.heights.astype(float),
         float(model.collapse_ratio), float(model.restitution), model.formulation == "absolute",
         impulse_dir, impulse_w, model.centre_map, col.masses.astype(float),
@@ -545,8 +543,6 @@ def needs_compile() -> bool:
     """Whether the kernel has no on-disk cache yet: its first use then compiles it
     (about 15-20 s, once per installation). False if that cannot be told."""
     try:
-        from pathlib import Path
-
         return not any(Path(run_kernel._cache.cache_path).glob("kernel.run_kernel-*.nbi"))
     except Exception:  # a numba without this attribute: no notice, nothing else changes
         return False

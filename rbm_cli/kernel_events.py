@@ -30,8 +30,7 @@ def _row_poly(mc, F, y_old, G, row, h0, n, rate, coef):
     fraction, with _dense_eval's form. Fills coef, returns the constant term;
     _poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
     off = n if rate else 0
-    nc = 7 if mc == 2 else TAB_NP[mc]
-    for q in range(nc):
+    for q in range(TAB_NP[mc]):
         v = 0.0
         for j in range(n):
             v += G[row, j] * F[q, off + j]
@@ -47,13 +46,14 @@ def _poly_val(mc, t, t_old, h, coef, base):
     """A projected row (_row_poly) at time t: _dense_eval for one row."""
     x = (t - t_old) / h
     v = 0.0
-    if mc == 2:
-        for q in range(7):
-            v += coef[6 - q]
+    nq = TAB_NP[mc]
+    if mc == 2:  # DOP853's nested form (_dense_eval)
+        for q in range(nq):
+            v += coef[nq - 1 - q]
             v *= x if q % 2 == 0 else 1.0 - x
         return v + base
     p = 1.0
-    for r in range(TAB_NP[mc]):
+    for r in range(nq):
         p *= x
         v += coef[r] * p
     return base + v

@@ -55,7 +55,7 @@ TAB_E3 = np.stack([t[4] for t in _TAB])
 TAB_P = np.stack([t[5] for t in _TAB])
 TAB_NS = np.array([t[6] for t in _TAB], dtype=np.int64)
 TAB_EST = np.array([t[7] for t in _TAB], dtype=np.int64)
-TAB_NP = np.array([3, 4, 0], dtype=np.int64)  # interpolant order of RK23 / RK45
+TAB_NP = np.array([3, 4, 7], dtype=np.int64)  # interpolant order of RK23 / RK45 / DOP853
 
 # status codes of the kernel
 SURVIVED, STOPPED_EARLY, COLLAPSED, FAILED_STEP, FAILED_STEPS, FAILED_EVENTS = range(6)

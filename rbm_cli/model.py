@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+from scipy.linalg import eig
 
 from .column import Column
 from .law import Law, make_law
@@ -113,6 +114,34 @@ class Model:
         return float(self.laws[0].intercepts[0] / abs(self.ground_load[0]))
 
     @cached_property
+    def arg_inverse(self) -> np.ndarray:
+        """(n, n) inverse of the argument map: law arguments -> drum rotations."""
+        return np.linalg.inv(self.arg_map)
+
+    @cached_property
+    def silent_impacts(self) -> np.ndarray:
+        """(n,) bool: interfaces whose impact changes nothing (e = 1 and a law linear
+        through zero on its first piece), so a zero crossing after an excursion need
+        not stop the integrator (events.Pieces.settle and the kernel count it)."""
+        return np.array(
+            [
+                self.restitution == 1.0 and not law.rigid
+                and len(law.edges) > 0 and law.intercepts[0] == 0.0
+                for law in self.laws
+            ],
+            dtype=bool,
+        )  # fmt: skip
+
+    def elastic_frequencies_hz(self) -> list[float]:
+        """Natural frequencies [Hz] of the column on the elastic branches of its laws,
+        ascending (none for a rigid law)."""
+        if self.rigid:
+            return []
+        slopes = np.array([law.slopes[0] for law in self.laws])
+        w2 = np.real(eig(self.stiffness(slopes), self.mass, right=False))
+        return sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
+
+    @cached_property
     def impulse_directions(self) -> tuple[np.ndarray, np.ndarray]:
         """(D, w) of an impact at joint i: the impulsive moment acts along P^T e_i, so
         the rates change along column i of D = M^-1 P^T; w_i = e_i^T P M^-1 P^T e_i."""
@@ -128,7 +157,7 @@ class Model:
         joint's own rate is scaled, the others unchanged."""
         xdot = float(self.arg_map[i] @ rate)
         if self.formulation == "absolute":
-            return rate + np.linalg.inv(self.arg_map)[:, i] * (self.restitution - 1.0) * xdot
+            return rate + self.arg_inverse[:, i] * (self.restitution - 1.0) * xdot
         directions, w = self.impulse_directions
         return rate + directions[:, i] * ((self.restitution - 1.0) * xdot / w[i])
 

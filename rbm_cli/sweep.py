@@ -348,12 +348,9 @@ def domain_figure(df: pd.DataFrame, config: Config, compare=(), labels=None):
     column = build_column(config.column, config.interface)
     level, level_label = column.static_multiplier, "static multiplier"
     if config.model == "bullet":  # the engine's true solids: its own uplift level
-        from .bullet import uplift_level
-        from .bullet_geometry import drum_solids
-        from .config_types import G
+        from .bullet import engine_uplift_g
 
-        level = uplift_level(drum_solids(config.column), config.interface.friction) / G
-        level_label = "engine uplift level"
+        level, level_label = engine_uplift_g(config), "engine uplift level"
     fig, ax = plt.subplots(figsize=(9.5, 5))
     plot_domain(
         df,

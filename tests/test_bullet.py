@@ -248,29 +248,25 @@ def test_engine_agrees_with_housner(column):
 # ------------------------------------------------------------------- bad input
 
 
-def test_bad_friction_is_one_line(tmp_path):
+@pytest.mark.parametrize(
+    ("friction", "message"),
+    [
+        (0, "interface.friction must be a number > 0"),
+        # Bullet caps a contact's friction at 10: a larger interface.friction would
+        # run silently with 10, so it is refused in one line
+        (20, "interface.friction must be <= 10"),
+    ],
+)
+def test_bad_friction_is_one_line(tmp_path, friction, message):
     path = tmp_path / "c.yaml"
     path.write_text(
-        "name: x\nmodel: bullet\ncolumn: {height: 4, base_width: 1}\ninterface: {friction: 0}\n"
+        "name: x\nmodel: bullet\ncolumn: {height: 4, base_width: 1}\n"
+        f"interface: {{friction: {friction}}}\n"
     )
     result = CliRunner().invoke(cli, ["run", str(path), "-a", "0.5", "-f", "1"])
     assert result.exit_code == 2
     lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and "interface.friction must be a number > 0" in lines[0]
-    assert "Traceback" not in result.output
-
-
-def test_friction_above_the_engine_cap_is_one_line(tmp_path):
-    """Bullet caps a contact's friction at 10: a larger interface.friction would run
-    silently with 10, so it is refused in one line."""
-    path = tmp_path / "c.yaml"
-    path.write_text(
-        "name: x\nmodel: bullet\ncolumn: {height: 4, base_width: 1}\ninterface: {friction: 20}\n"
-    )
-    result = CliRunner().invoke(cli, ["run", str(path), "-a", "0.5", "-f", "1"])
-    assert result.exit_code == 2
-    lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and "interface.friction must be <= 10" in lines[0], result.output
+    assert len(lines) == 1 and message in lines[0], result.output
     assert "Traceback" not in result.output
 
 

@@ -7,9 +7,13 @@
     python docs/make_engine.py cost        # CPU of 10 s 8-drum cells at 1e-4 s, 3 runs each
     python docs/make_engine.py emap        # housner's outcome against e in the knife-edge cells
     python docs/make_engine.py fine        # the 6 x 5 grid at 5e-5 s, engine vs housner (~3 min)
+    python docs/make_engine.py converge    # the 6 x 5 grid as ensembles of 4 at 1e-4, 5e-5
+                                           # and 2.5e-5 s, engine vs housner (~15 min, 2 jobs)
     python docs/make_engine.py chaos       # one chaotic 8-drum cell, K = 4, 2 time steps
     python docs/make_engine.py monolithic  # the monolithic study: RBM, housner, engine (~2 min)
     python docs/make_engine.py rbm_e       # 8-drum RBM with e < 1 vs engine; friction demand
+    python docs/make_engine.py normals     # the engine's contact normals at the 8-drum joints
+                                           # against the faces', with the friction demand
     python docs/make_engine.py multidrum   # RBM formulations vs engine fractions (figure;
                                            # runs the RBM on the engine's grid)
 
@@ -329,6 +333,150 @@ def part_fine() -> None:
     dump("fine", out)
 
 
+#: Time steps of the convergence study of the monolithic grid [s] and its ensemble size.
+CONVERGE_STEPS = (1e-4, 5e-5, 2.5e-5)
+CONVERGE_MEMBERS = 4
+
+
+def _converge_run(name: str, model: str, dt: float, e: float, a: float, f: float, j: int):
+    from rbm_cli.sweep import ensemble_offsets
+
+    phase, rel = ensemble_offsets(CONVERGE_MEMBERS)[j]
+    if model == "bullet":
+        cfg = with_step(column_config(COLUMNS[name]), dt)
+    else:
+        cfg = column_config(COLUMNS[name], model="housner", restitution=e)
+    cfg = dc.replace(cfg, excitation=dc.replace(cfg.excitation, phase=phase))
+    r, cpu = timed(simulate, cfg, a * (1.0 + rel), f)
+    return dict(column=name, model=model, dt=dt, a=a, f=f, member=j, status=r.status, cpu_s=cpu)
+
+
+def part_converge(jobs: int) -> None:
+    """The 6 x 5 grid of both monoliths as ensembles (the sweep's offsets: phase and
+    relative amplitude within 1e-6) at CONVERGE_STEPS, and housner (e from the
+    engine's peaks) at the same offsets. A cell is robust in a model when all its
+    members agree; a chaotic cell counts as a cell that differs."""
+    from joblib import Parallel, delayed
+
+    cells = [(a, f) for f in GRID_FREQUENCIES for a in GRID_AMPLITUDES]
+    names = ("block 4 x 1 m", "tapered 5 m column")
+    e = {
+        n: round(float(np.mean(measure_restitution(column_config(COLUMNS[n]), impacts=4))), 4)
+        for n in names
+    }
+    tasks = [
+        (n, "housner", 0.0, e[n], a, f, j)
+        for n in names
+        for a, f in cells
+        for j in range(CONVERGE_MEMBERS)
+    ]
+    tasks += [
+        (n, "bullet", dt, e[n], a, f, j)
+        for dt in CONVERGE_STEPS
+        for n in names
+        for a, f in cells
+        for j in range(CONVERGE_MEMBERS)
+    ]
+    rows = Parallel(n_jobs=jobs, verbose=5)(delayed(_converge_run)(*t) for t in tasks)
+    dump("converge", dict(e=e, members=CONVERGE_MEMBERS, rows=rows))
+    _converge_summary(rows)
+
+
+def _fraction(rows, name, model, dt, cell) -> float:
+    s = [
+        r["status"] == "collapsed"
+        for r in rows
+        if (r["column"], r["model"], r["dt"], r["a"], r["f"]) == (name, model, dt, *cell)
+    ]
+    return sum(s) / len(s)
+
+
+def _converge_summary(rows) -> dict:
+    """Per column and step: cells where both are robust and agree, where both are
+    robust and differ, and where either is chaotic (listed with both fractions)."""
+    cells = sorted({(r["a"], r["f"]) for r in rows}, key=lambda c: (c[1], c[0]))
+    out = {}
+    for name in sorted({r["column"] for r in rows}):
+        ref = {c: _fraction(rows, name, "housner", 0.0, c) for c in cells}
+        for dt in CONVERGE_STEPS:
+            eng = {c: _fraction(rows, name, "bullet", dt, c) for c in cells}
+            robust = [c for c in cells if eng[c] in (0.0, 1.0) and ref[c] in (0.0, 1.0)]
+            agree = [c for c in robust if eng[c] == ref[c]]
+            chaotic = {
+                f"{a} {f}": (eng[(a, f)], ref[(a, f)]) for a, f in cells if (a, f) not in robust
+            }
+            cpu = sum(r["cpu_s"] for r in rows if r["column"] == name and r["dt"] == dt)
+            res = dict(
+                agree=len(agree),
+                of=len(cells),
+                differ=[c for c in robust if c not in agree],
+                chaotic_engine_housner=chaotic,
+                cpu_s=cpu,
+            )
+            out[f"{name} dt {dt:g}"] = res
+            print(f"{name}, dt {dt:g}: {res}")
+    return out
+
+
+#: 8-drum cells (g, Hz, time step [s]) of the contact-normal census.
+NORMAL_CELLS = [(0.25, 1.0, 2e-4), (0.6, 1.0, 2e-4), (0.9, 1.5, 2e-4), (1.1, 2.0, 2e-4)]
+NORMAL_CELLS += [(0.7, 1.0, 5e-4)]
+#: A contact normal further than this from its joint's faces' normals is "off" [rad].
+NORMAL_OFF = 0.02
+
+
+def part_normals() -> None:
+    """Where the engine's friction demand (friction 1.0) reads above mu: at every 1 ms
+    check, the normal of each of Bullet's contact points at each joint against the
+    range between the joint's two faces' normals (the admissible ones,
+    `joint_friction`); the share of the normal force on points more than NORMAL_OFF
+    off that range and the largest departure. Hooks the engine's per-check call."""
+    import math
+
+    import rbm_cli.bullet as engine_mod
+    from rbm_cli.bullet_scene import face_normal_angles, read_frame
+
+    hold = engine_mod.keep_in_plane
+    base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
+    rows = []
+    for a, f, dt in NORMAL_CELLS:
+        census = dict(force=0.0, force_off=0.0, max_off=0.0)
+
+        def check(p, cid, bodies, pose=False, census=census):
+            faces = face_normal_angles(read_frame(p, cid, bodies))
+            below = [0, *bodies[:-1]]  # the ground is body 0
+            for i, body in enumerate(bodies):
+                for c in p.getContactPoints(bodyA=body, bodyB=below[i], physicsClientId=cid):
+                    if c[9] <= 0.0:
+                        continue
+                    phi = math.atan2(c[7][0], c[7][2])  # the normal on the support, upwards
+                    off = max(0.0, faces[i].min() - phi, phi - faces[i].max())
+                    census["force"] += c[9]
+                    census["force_off"] += c[9] if off > NORMAL_OFF else 0.0
+                    census["max_off"] = max(census["max_off"], off)
+            return hold(p, cid, bodies, pose)
+
+        engine_mod.keep_in_plane = check
+        try:
+            r = simulate(with_step(base, dt), a, f)
+        finally:
+            engine_mod.keep_in_plane = hold
+        rows.append(
+            dict(
+                a=a,
+                f=f,
+                dt=dt,
+                status=r.status,
+                friction_demand=list(r.friction_demand),
+                share_off=census["force_off"] / census["force"],
+                max_off_rad=census["max_off"],
+                message=r.message,
+            )
+        )
+        print(json.dumps(rows[-1]), flush=True)
+    dump("normals", rows)
+
+
 def part_chaos() -> None:
     """The 8-drum cell (0.6 g, 1 Hz) that changed with the time step: K = 4 runs with
     the sweep's ensemble offsets (phase, relative amplitude up to 1e-6) at 1e-4 and 5e-4 s."""
@@ -509,7 +657,7 @@ def _boundary_frac(df, col) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parts = ["impact", "grid", "timestep", "cost", "emap", "fine", "chaos", "monolithic"]
-    parts += ["multidrum", "rbm_e"]
+    parts += ["multidrum", "rbm_e", "converge", "normals"]
     ap.add_argument("part", choices=parts)
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args(argv)
@@ -520,9 +668,12 @@ def main(argv=None) -> int:
         part_monolithic(args.jobs)
     elif args.part == "rbm_e":
         part_rbm_e(args.jobs)
+    elif args.part == "converge":
+        part_converge(args.jobs)
     else:
         parts = {"impact": part_impact, "grid": part_grid, "timestep": part_timestep}
         parts.update(chaos=part_chaos, cost=part_cost, emap=part_emap, fine=part_fine)
+        parts.update(normals=part_normals)
         parts[args.part]()
     return 0
 

@@ -44,6 +44,7 @@ from .bullet_scene import (
     Joints,
     StackGeometry,
     build_scene,
+    face_normal_angles,
     joint_friction,
     joint_state,
     keep_in_plane,
@@ -187,6 +188,8 @@ def bullet_run(
         samples.append(_sample(0.0, frame, joints))
     k = k_prev = 0
     frame_prev = frame
+    faces = face_normal_angles(frame)
+    normals_lo, normals_hi = faces.min(axis=1), faces.max(axis=1)
     friction_steps = max(1, int(round(FRICTION_DT / dt)))
     while k < n_steps:
         set_gravity(-accel[k], 0.0, -G, physicsClientId=cid)
@@ -198,6 +201,9 @@ def bullet_run(
         t = k * dt
         frame = checked if checked is not None else read_frame(p, cid, bodies)
         joints = joint_state(frame, stack, alpha)
+        faces = face_normal_angles(frame)
+        normals_lo = np.minimum(normals_lo, faces.min(axis=1))
+        normals_hi = np.maximum(normals_hi, faces.max(axis=1))
         if sample and k % sample == 0:
             samples.append(_sample(t, frame, joints))
         if not (np.all(np.isfinite(frame.centres)) and np.max(frame.speeds) < BLOWUP):
@@ -206,9 +212,12 @@ def bullet_run(
             break
         if k - k_prev >= friction_steps:
             mean_accel = (accel_sum[k] - accel_sum[k_prev]) / (k - k_prev)
-            demand = joint_friction(frame_prev, frame, stack, (k - k_prev) * dt, mean_accel)
+            demand = joint_friction(
+                frame_prev, frame, stack, (k - k_prev) * dt, mean_accel, (normals_lo, normals_hi)
+            )
             out.friction = np.fmax(out.friction, demand)
             frame_prev, k_prev = frame, k
+            normals_lo, normals_hi = faces.min(axis=1), faces.max(axis=1)
         out.max_ratio = np.maximum(out.max_ratio, joints.ratio)
         out.max_top = max(out.max_top, abs(joints.top[0] - joints.bottoms[0, 0]))
         max_slip = np.maximum(max_slip, np.abs(joints.slip))

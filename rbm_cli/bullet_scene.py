@@ -277,17 +277,36 @@ def joint_state(frame: Frame, stack: StackGeometry, alpha: np.ndarray) -> Joints
     return Joints(phi, ratio, slip, bottoms, tops[-1])
 
 
+def face_normal_angles(frame: Frame) -> np.ndarray:
+    """In-plane angles [rad] of the two faces' normals at every joint, (n, 2): the
+    support's (the ground's, 0, or drum i - 1's top) and drum i's bottom. They differ
+    by the joint's relative rotation; at the ground the only normal is the plane's."""
+    tilts = frame.tilts
+    below = np.concatenate([[0.0], tilts[:-1]])
+    above = np.concatenate([[0.0], tilts[1:]])
+    return np.stack([below, above], axis=1)
+
+
 def joint_friction(
-    before: Frame, after: Frame, stack: StackGeometry, duration: float, mean_accel: float
+    before: Frame,
+    after: Frame,
+    stack: StackGeometry,
+    duration: float,
+    mean_accel: float,
+    normals: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
-    """Mobilised friction of every joint over an interval: |T| / N of the joint's mean
-    force, from the momentum balance of the drums above it [-] (nan: not loaded).
+    """Mobilised friction of every joint over an interval: the least |T| / N of the
+    joint's mean force, from the momentum balance of the drums above it, over the
+    contact normals the joint's faces admit [-] (nan: not loaded).
 
     Parameters
     ----------
     before, after : Frame  The stack at the start and end of the interval
     duration : float  Its length [s]
     mean_accel : float  Mean ground acceleration a_g over it, as the engine applied it [m/s^2]
+    normals : (lo, hi), optional  Range of the in-plane normal angles of each joint's
+        faces over the interval [rad] (:func:`face_normal_angles` of every frame read);
+        by default the range of those at its two ends.
 
     Notes
     -----
@@ -297,21 +316,34 @@ def joint_friction(
 
     .. math:: F_i = \\frac{\\Delta P_i}{\\Delta t} + M_i (\\bar a_g, 0, g),
 
-    P_i the momentum of drums i..n, M_i their mass. N and T are its components
-    along the support's normal and its in-plane tangent (the ground, or drum
-    i - 1 at the end of the interval). Out of plane is left out: the model is
-    2D. Read per 1 ms check rather than from the contact points of one engine
-    step, whose split between points, and so between T and N, jitters by 5-10 %
-    of the weight from step to step (docs/engine.md).
+    P_i the momentum of drums i..n, M_i their mass. At angle psi in the plane
+    and a contact normal at angle phi, T / N = tan(psi - phi). Where an open
+    joint pivots on the corner where its two faces meet, the contact normal is
+    not defined: any phi between the two faces' normals is admissible (Bullet
+    takes one face's), and the faces turn during the interval. So the reading is
+    tan of the distance from psi to that range of phi: the least friction
+    coefficient for which the mean force lies in a Coulomb cone about an
+    admissible normal. It cannot exceed the engine's friction if every contact
+    force obeys Coulomb about a normal in the range, since their sum then lies
+    in the union of those cones. A seated joint has one normal. (Taking the
+    support's normal alone read up to 11.2 with friction 10: at T / N near mu
+    the reading moves by (1 + mu^2) per radian of normal.) Out of plane is left
+    out: the model is 2D. Read per 10 ms rather than from the contact points of
+    one engine step, whose split between points, and so between T and N,
+    jitters by 5-10 % of the weight from step to step (docs/engine.md).
     """
     n = len(stack.masses)
     momentum = stack.masses[:, None] * (after.velocities - before.velocities)
     above = np.cumsum(momentum[::-1], axis=0)[::-1]
     force = above / duration + stack.mass_above[:, None] * np.array([mean_accel, 0.0, G])
-    support = np.concatenate([np.eye(3)[None], after.rotations[:-1]])
-    normal = np.einsum("ni,ni->n", force, support[:, :, 2])
-    tangent = np.einsum("ni,ni->n", force, support[:, :, 0])
+    ends = np.concatenate([face_normal_angles(before), face_normal_angles(after)], axis=1)
+    lo, hi = ends.min(axis=1), ends.max(axis=1)
+    if normals is not None:
+        lo, hi = np.minimum(lo, normals[0]), np.maximum(hi, normals[1])
+    psi = np.arctan2(force[:, 0], force[:, 2])
+    gap = np.maximum(0.0, np.maximum(lo - psi, psi - hi))
+    normal = np.hypot(force[:, 0], force[:, 2]) * np.cos(gap)
     out = np.full(n, np.nan)
-    loaded = normal > 1e-6 * G * stack.mass_above
-    out[loaded] = np.abs(tangent[loaded]) / normal[loaded]
+    loaded = (gap < 0.5 * math.pi) & (normal > 1e-6 * G * stack.mass_above)
+    out[loaded] = np.tan(gap[loaded])
     return out

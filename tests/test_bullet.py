@@ -20,7 +20,14 @@ from click.testing import CliRunner
 
 from rbm_cli.bullet import EngineSettings, bullet_run, impact_rate_ratios, measure_restitution
 from rbm_cli.bullet_geometry import drum_solids, stack_slenderness
-from rbm_cli.bullet_scene import build_scene, keep_in_plane, read_frame
+from rbm_cli.bullet_scene import (
+    Frame,
+    StackGeometry,
+    build_scene,
+    joint_friction,
+    keep_in_plane,
+    read_frame,
+)
 from rbm_cli.cli import cli
 from rbm_cli.config import parse_config
 from rbm_cli.config_types import G
@@ -315,3 +322,49 @@ def test_engine_domain_plot_marks_the_engine_uplift_level():
     assert line.get_ydata()[0] == pytest.approx(0.219, abs=5e-4)
     assert line.get_label().startswith("engine uplift level")
     plt.close(fig)
+
+
+def _frame(tilts):
+    """A two-drum stack at rest with the given in-plane tilts [rad]."""
+    rot = np.array(
+        [[[math.cos(t), 0, math.sin(t)], [0, 1, 0], [-math.sin(t), 0, math.cos(t)]] for t in tilts]
+    )
+    n = len(tilts)
+    return Frame(np.zeros((n, 3)), rot, np.zeros(n), np.zeros(n), np.zeros((n, 3)))
+
+
+def _two_drums():
+    masses = np.array([3.0, 2.0])
+    return StackGeometry(
+        masses, np.ones(2), np.ones(2), np.ones(2), np.array([math.inf, 1.0]), np.array([5.0, 2.0])
+    )
+
+
+@pytest.mark.parametrize("mu, theta", [(1.0, 0.05), (10.0, 0.01), (0.3, -0.02)])
+def test_friction_demand_of_an_open_joint_takes_the_admissible_normals(mu, theta):
+    """With no change of momentum the mean force on each joint is M (a_g, 0, g), at
+    psi = atan(a_g / g) from the vertical. Drum 2 turned by theta on drum 1 (open
+    joint, corner on corner): every normal between the two faces is admissible,
+    so a force on the edge of the Coulomb cone about drum 2's face reads mu, not
+    tan(atan(mu) + theta) (the support's face alone: 11.1 for mu 10, theta 0.01);
+    a force between the two normals needs no friction; a seated joint and the
+    ground (one normal each) read tan(psi - phi)."""
+    stack = _two_drums()
+    psi = theta + math.copysign(math.atan(mu), theta)  # beyond drum 2's normal
+    a_g = G * math.tan(psi)
+    open_ = _frame([0.0, theta])
+    demand = joint_friction(open_, open_, stack, 0.01, a_g)
+    assert demand[1] == pytest.approx(mu, rel=1e-12)
+    assert demand[0] == pytest.approx(abs(math.tan(psi)), rel=1e-12)  # the ground's normal
+    assert abs(math.tan(psi)) > mu * (1 + abs(theta))  # the support's face alone: above mu
+    between = joint_friction(open_, open_, stack, 0.01, G * math.tan(0.5 * theta))
+    assert between[1] == 0.0
+    seated = _frame([theta, theta])  # both drums turned alike: one normal, at theta
+    demand = joint_friction(seated, seated, stack, 0.01, a_g)
+    assert demand[1] == pytest.approx(mu, rel=1e-12)
+    assert demand[0] == pytest.approx(abs(math.tan(psi)), rel=1e-12)  # tilted base, flat ground
+    # the faces' range over the interval widens the admissible normals
+    flat = _frame([0.0, 0.0])
+    assert joint_friction(flat, flat, stack, 0.01, a_g)[1] == pytest.approx(abs(math.tan(psi)))
+    span = (np.array([0.0, min(0.0, theta)]), np.array([0.0, max(0.0, theta)]))
+    assert joint_friction(flat, flat, stack, 0.01, a_g, span)[1] == pytest.approx(mu, rel=1e-12)

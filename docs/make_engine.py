@@ -434,7 +434,7 @@ def part_normals() -> None:
     import math
 
     import rbm_cli.bullet as engine_mod
-    from rbm_cli.bullet_scene import face_normal_angles, read_frame
+    from rbm_cli.bullet_scene import joint_normal_range, read_frame
 
     hold = engine_mod.keep_in_plane
     base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
@@ -443,14 +443,15 @@ def part_normals() -> None:
         census = dict(force=0.0, force_off=0.0, max_off=0.0)
 
         def check(p, cid, bodies, pose=False, census=census):
-            faces = face_normal_angles(read_frame(p, cid, bodies))
+            tilts = read_frame(p, cid, bodies).tilts
+            lo, hi = joint_normal_range(tilts, tilts)
             below = [0, *bodies[:-1]]  # the ground is body 0
             for i, body in enumerate(bodies):
                 for c in p.getContactPoints(bodyA=body, bodyB=below[i], physicsClientId=cid):
                     if c[9] <= 0.0:
                         continue
                     phi = math.atan2(c[7][0], c[7][2])  # the normal on the support, upwards
-                    off = max(0.0, faces[i].min() - phi, phi - faces[i].max())
+                    off = max(0.0, lo[i] - phi, phi - hi[i])
                     census["force"] += c[9]
                     census["force_off"] += c[9] if off > NORMAL_OFF else 0.0
                     census["max_off"] = max(census["max_off"], off)

@@ -44,7 +44,6 @@ from .bullet_scene import (
     Joints,
     StackGeometry,
     build_scene,
-    face_normal_angles,
     joint_friction,
     joint_state,
     keep_in_plane,
@@ -188,8 +187,7 @@ def bullet_run(
         samples.append(_sample(0.0, frame, joints))
     k = k_prev = 0
     frame_prev = frame
-    faces = face_normal_angles(frame)
-    normals_lo, normals_hi = faces.min(axis=1), faces.max(axis=1)
+    tilt_lo = tilt_hi = frame.tilts
     friction_steps = max(1, int(round(FRICTION_DT / dt)))
     while k < n_steps:
         set_gravity(-accel[k], 0.0, -G, physicsClientId=cid)
@@ -201,9 +199,8 @@ def bullet_run(
         t = k * dt
         frame = checked if checked is not None else read_frame(p, cid, bodies)
         joints = joint_state(frame, stack, alpha)
-        faces = face_normal_angles(frame)
-        normals_lo = np.minimum(normals_lo, faces.min(axis=1))
-        normals_hi = np.maximum(normals_hi, faces.max(axis=1))
+        tilts = frame.tilts
+        tilt_lo, tilt_hi = np.minimum(tilt_lo, tilts), np.maximum(tilt_hi, tilts)
         if sample and k % sample == 0:
             samples.append(_sample(t, frame, joints))
         if not (np.all(np.isfinite(frame.centres)) and np.max(frame.speeds) < BLOWUP):
@@ -213,11 +210,11 @@ def bullet_run(
         if k - k_prev >= friction_steps:
             mean_accel = (accel_sum[k] - accel_sum[k_prev]) / (k - k_prev)
             demand = joint_friction(
-                frame_prev, frame, stack, (k - k_prev) * dt, mean_accel, (normals_lo, normals_hi)
+                frame_prev, frame, stack, (k - k_prev) * dt, mean_accel, (tilt_lo, tilt_hi)
             )
             out.friction = np.fmax(out.friction, demand)
             frame_prev, k_prev = frame, k
-            normals_lo, normals_hi = faces.min(axis=1), faces.max(axis=1)
+            tilt_lo = tilt_hi = tilts
         out.max_ratio = np.maximum(out.max_ratio, joints.ratio)
         out.max_top = max(out.max_top, abs(joints.top[0] - joints.bottoms[0, 0]))
         max_slip = np.maximum(max_slip, np.abs(joints.slip))

@@ -277,14 +277,14 @@ def joint_state(frame: Frame, stack: StackGeometry, alpha: np.ndarray) -> Joints
     return Joints(phi, ratio, slip, bottoms, tops[-1])
 
 
-def face_normal_angles(frame: Frame) -> np.ndarray:
-    """In-plane angles [rad] of the two faces' normals at every joint, (n, 2): the
-    support's (the ground's, 0, or drum i - 1's top) and drum i's bottom. They differ
-    by the joint's relative rotation; at the ground the only normal is the plane's."""
-    tilts = frame.tilts
-    below = np.concatenate([[0.0], tilts[:-1]])
-    above = np.concatenate([[0.0], tilts[1:]])
-    return np.stack([below, above], axis=1)
+def joint_normal_range(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Range of the in-plane normal angles of every joint's two faces [rad], from
+    the range [lo, hi] of each drum's tilt: the support's (the ground's, 0, or drum
+    i - 1's top) and drum i's bottom. At the ground the only normal is the plane's."""
+    return (
+        np.concatenate([[0.0], np.minimum(lo[:-1], lo[1:])]),
+        np.concatenate([[0.0], np.maximum(hi[:-1], hi[1:])]),
+    )
 
 
 def joint_friction(
@@ -293,7 +293,7 @@ def joint_friction(
     stack: StackGeometry,
     duration: float,
     mean_accel: float,
-    normals: tuple[np.ndarray, np.ndarray] | None = None,
+    tilt_range: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Mobilised friction of every joint over an interval: the least |T| / N of the
     joint's mean force, from the momentum balance of the drums above it, over the
@@ -304,9 +304,8 @@ def joint_friction(
     before, after : Frame  The stack at the start and end of the interval
     duration : float  Its length [s]
     mean_accel : float  Mean ground acceleration a_g over it, as the engine applied it [m/s^2]
-    normals : (lo, hi), optional  Range of the in-plane normal angles of each joint's
-        faces over the interval [rad] (:func:`face_normal_angles` of every frame read);
-        by default the range of those at its two ends.
+    tilt_range : (lo, hi), optional  Range of each drum's tilt over the interval [rad]
+        (every frame read); by default that of its two ends.
 
     Notes
     -----
@@ -336,10 +335,9 @@ def joint_friction(
     momentum = stack.masses[:, None] * (after.velocities - before.velocities)
     above = np.cumsum(momentum[::-1], axis=0)[::-1]
     force = above / duration + stack.mass_above[:, None] * np.array([mean_accel, 0.0, G])
-    ends = np.concatenate([face_normal_angles(before), face_normal_angles(after)], axis=1)
-    lo, hi = ends.min(axis=1), ends.max(axis=1)
-    if normals is not None:
-        lo, hi = np.minimum(lo, normals[0]), np.maximum(hi, normals[1])
+    if tilt_range is None:
+        tilt_range = (np.minimum(before.tilts, after.tilts), np.maximum(before.tilts, after.tilts))
+    lo, hi = joint_normal_range(*tilt_range)
     psi = np.arctan2(force[:, 0], force[:, 2])
     gap = np.maximum(0.0, np.maximum(lo - psi, psi - hi))
     normal = np.hypot(force[:, 0], force[:, 2]) * np.cos(gap)

@@ -366,5 +366,5 @@ def test_friction_demand_of_an_open_joint_takes_the_admissible_normals(mu, theta
     # the faces' range over the interval widens the admissible normals
     flat = _frame([0.0, 0.0])
     assert joint_friction(flat, flat, stack, 0.01, a_g)[1] == pytest.approx(abs(math.tan(psi)))
-    span = (np.array([0.0, min(0.0, theta)]), np.array([0.0, max(0.0, theta)]))
+    span = (np.array([0.0, min(0.0, theta)]), np.array([0.0, max(0.0, theta)]))  # drum tilts
     assert joint_friction(flat, flat, stack, 0.01, a_g, span)[1] == pytest.approx(mu, rel=1e-12)

@@ -339,15 +339,14 @@ CONVERGE_MEMBERS = 4
 
 
 def _converge_run(name: str, model: str, dt: float, e: float, a: float, f: float, j: int):
-    from rbm_cli.sweep import ensemble_offsets
+    from rbm_cli.sweep import ensemble_member, ensemble_offsets
 
-    phase, rel = ensemble_offsets(CONVERGE_MEMBERS)[j]
     if model == "bullet":
         cfg = with_step(column_config(COLUMNS[name]), dt)
     else:
         cfg = column_config(COLUMNS[name], model="housner", restitution=e)
-    cfg = dc.replace(cfg, excitation=dc.replace(cfg.excitation, phase=phase))
-    r, cpu = timed(simulate, cfg, a * (1.0 + rel), f)
+    cfg, amplitude = ensemble_member(cfg, a, ensemble_offsets(CONVERGE_MEMBERS)[j])
+    r, cpu = timed(simulate, cfg, amplitude, f)
     return dict(column=name, model=model, dt=dt, a=a, f=f, member=j, status=r.status, cpu_s=cpu)
 
 
@@ -382,24 +381,17 @@ def part_converge(jobs: int) -> None:
     _converge_summary(rows)
 
 
-def _fraction(rows, name, model, dt, cell) -> float:
-    s = [
-        r["status"] == "collapsed"
-        for r in rows
-        if (r["column"], r["model"], r["dt"], r["a"], r["f"]) == (name, model, dt, *cell)
-    ]
-    return sum(s) / len(s)
-
-
 def _converge_summary(rows) -> dict:
     """Per column and step: cells where both are robust and agree, where both are
     robust and differ, and where either is chaotic (listed with both fractions)."""
     cells = sorted({(r["a"], r["f"]) for r in rows}, key=lambda c: (c[1], c[0]))
+    df = pd.DataFrame(rows)
+    fraction = (df.status == "collapsed").groupby([df.column, df.model, df.dt, df.a, df.f]).mean()
     out = {}
-    for name in sorted({r["column"] for r in rows}):
-        ref = {c: _fraction(rows, name, "housner", 0.0, c) for c in cells}
+    for name in sorted(df.column.unique()):
+        ref = {c: float(fraction[(name, "housner", 0.0, *c)]) for c in cells}
         for dt in CONVERGE_STEPS:
-            eng = {c: _fraction(rows, name, "bullet", dt, c) for c in cells}
+            eng = {c: float(fraction[(name, "bullet", dt, *c)]) for c in cells}
             robust = [c for c in cells if eng[c] in (0.0, 1.0) and ref[c] in (0.0, 1.0)]
             agree = [c for c in robust if eng[c] == ref[c]]
             chaotic = {
@@ -481,15 +473,14 @@ def part_normals() -> None:
 def part_chaos() -> None:
     """The 8-drum cell (0.6 g, 1 Hz) that changed with the time step: K = 4 runs with
     the sweep's ensemble offsets (phase, relative amplitude up to 1e-6) at 1e-4 and 5e-4 s."""
-    from rbm_cli.sweep import ensemble_offsets
+    from rbm_cli.sweep import ensemble_member, ensemble_offsets
 
     base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
     rows = []
     for dt in (1e-4, 5e-4):
         for phase, rel in ensemble_offsets(4):
-            cfg = with_step(base, dt)
-            cfg = dc.replace(cfg, excitation=dc.replace(cfg.excitation, phase=phase))
-            r, cpu = timed(simulate, cfg, 0.6 * (1.0 + rel), 1.0)
+            cfg, amplitude = ensemble_member(with_step(base, dt), 0.6, (phase, rel))
+            r, cpu = timed(simulate, cfg, amplitude, 1.0)
             rows.append(
                 dict(
                     dt=dt,

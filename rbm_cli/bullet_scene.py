@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -180,9 +181,10 @@ class Frame:
     speeds: np.ndarray  # (n,) |linear velocity| [m/s]
     velocities: np.ndarray  # (n, 3) linear velocities of the centres of mass [m/s]
 
-    @property
+    @cached_property
     def tilts(self) -> np.ndarray:
-        """In-plane absolute rotations of the drums [rad] (positive: top towards +x)."""
+        """In-plane absolute rotations of the drums [rad] (positive: top towards +x);
+        computed once per frame (joints, friction window and samples all read it)."""
         return np.arctan2(self.rotations[:, 0, 2], self.rotations[:, 2, 2])
 
 

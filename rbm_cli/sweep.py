@@ -82,6 +82,14 @@ def ensemble_offsets(k: int) -> list[tuple[float, float]]:
     return out
 
 
+def ensemble_member(config: Config, a: float, offset: tuple[float, float]) -> tuple[Config, float]:
+    """(config, amplitude [g]) of the ensemble member with offset (phase shift [rad],
+    relative amplitude change) of the cell at amplitude a (ensemble_offsets)."""
+    dphi, da = offset
+    exc = dataclasses.replace(config.excitation, phase=config.excitation.phase + dphi)
+    return dataclasses.replace(config, excitation=exc), a * (1 + da)
+
+
 def _run_cell(config: Config, a: float, f: float, model) -> dict:
     from .simulate import simulate
 
@@ -112,11 +120,8 @@ def run_chunk(config: Config, cells: list[tuple[float, float]], ensemble: int = 
         row = _run_cell(config, a, f, model)
         if ensemble > 1:
             flags = [row["collapsed"]] if row["status"] != "failed" else []
-            for dphi, da in offsets[1:]:
-                exc = dataclasses.replace(config.excitation, phase=config.excitation.phase + dphi)
-                member = _run_cell(
-                    dataclasses.replace(config, excitation=exc), a * (1 + da), f, model
-                )
+            for offset in offsets[1:]:
+                member = _run_cell(*ensemble_member(config, a, offset), f, model)
                 if member["status"] != "failed":
                     flags.append(member["collapsed"])
             row["collapse_fraction"] = float(np.mean(flags)) if flags else math.nan

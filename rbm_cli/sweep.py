@@ -296,6 +296,9 @@ def run_sweep(
     write_json_atomic(folder / "meta.json", meta)
     fig = domain_figure(df, config)
     save_figure_atomic(fig, folder / "domain.png")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)  # pyplot holds every figure it made until closed
     journal.unlink(missing_ok=True)
     (folder / STATE).unlink(missing_ok=True)
     return SweepSummary(

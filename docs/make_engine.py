@@ -339,13 +339,14 @@ CONVERGE_MEMBERS = 4
 
 
 def _converge_run(name: str, model: str, dt: float, e: float, a: float, f: float, j: int):
-    from rbm_cli.sweep import ensemble_member, ensemble_offsets
+    from rbm_cli.robustness import members
+    from rbm_cli.sweep import ensemble_member
 
     if model == "bullet":
         cfg = with_step(column_config(COLUMNS[name]), dt)
     else:
         cfg = column_config(COLUMNS[name], model="housner", restitution=e)
-    cfg, amplitude = ensemble_member(cfg, a, ensemble_offsets(CONVERGE_MEMBERS)[j])
+    cfg, amplitude = ensemble_member(cfg, a, members(CONVERGE_MEMBERS)[j])
     r, cpu = timed(simulate, cfg, amplitude, f)
     return dict(column=name, model=model, dt=dt, a=a, f=f, member=j, status=r.status, cpu_s=cpu)
 
@@ -473,13 +474,15 @@ def part_normals() -> None:
 def part_chaos() -> None:
     """The 8-drum cell (0.6 g, 1 Hz) that changed with the time step: K = 4 runs with
     the sweep's ensemble offsets (phase, relative amplitude up to 1e-6) at 1e-4 and 5e-4 s."""
-    from rbm_cli.sweep import ensemble_member, ensemble_offsets
+    from rbm_cli.robustness import members
+    from rbm_cli.sweep import ensemble_member
 
     base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
     rows = []
     for dt in (1e-4, 5e-4):
-        for phase, rel in ensemble_offsets(4):
-            cfg, amplitude = ensemble_member(with_step(base, dt), 0.6, (phase, rel))
+        for member in members(4):
+            phase, rel = member.phase_rad, member.amplitude_relative
+            cfg, amplitude = ensemble_member(with_step(base, dt), 0.6, member)
             r, cpu = timed(simulate, cfg, amplitude, 1.0)
             rows.append(
                 dict(

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from .detmath import matmul, matvec
 from .excitation import GroundMotion
 from .integrate import BIG, EVENT_EPS, REST_RATE, Outcome
 from .kernel_events import (
@@ -109,13 +110,13 @@ def run_kernel(
     for i in range(n):
         for j in range(n):
             same = same and gx[i, j] == gc[i, j]
-    md = minv @ diff.T
-    mg = minv @ gravity
+    md = matmul(minv, diff.T.copy())
+    mg = matmul(minv, gravity)
     nt = n + 1
     track = np.empty((nt, n))
     track[:n, :] = cmap
     track[n, :] = top
-    es = -(minv @ ground_load)
+    es = -matvec(minv, ground_load, np.empty(n))
     peaks = np.zeros(nt)
     As, cs = np.empty((n, n)), np.empty(n)
     h0 = np.empty(4 * n)
@@ -156,8 +157,8 @@ def run_kernel(
     for i in range(m):
         if y[i] != 0.0:
             at_rest = False
-    x0 = argmap @ y[:n]
-    r0 = argmap @ y[n:]
+    x0 = matvec(argmap, y[:n], np.empty(n))
+    r0 = matvec(argmap, y[n:], np.empty(n))
     for i in range(n):
         s = 1 if x0[i] > 0 else (-1 if x0[i] < 0 else (1 if r0[i] >= 0 else -1))
         side[i] = s

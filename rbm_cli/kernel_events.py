@@ -10,6 +10,9 @@ import math
 import numpy as np
 from numba import njit
 
+from .detmath import asin as dasin
+from .detmath import dot, matvec
+from .detmath import sin as dsin
 from .kernel_rk import TAB_NP, _dense_eval
 
 
@@ -302,8 +305,10 @@ def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
 def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
     """Model.energy for one state."""
     n = theta.size
-    e = 0.5 * rate @ (mass @ rate) - 0.5 * theta @ (gravity @ theta)
-    x = argmap @ theta
+    e = 0.5 * dot(rate, matvec(mass, rate, np.empty(n))) - 0.5 * dot(
+        theta, matvec(gravity, theta, np.empty(n))
+    )
+    x = matvec(argmap, theta, np.empty(n))
     for i in range(n):
         ax = abs(x[i])
         ne = nedges[i]
@@ -324,9 +329,9 @@ def _next_exceedance(t0, level, amp, om, ph, last):
         return -1.0
     s = level / amp
     psi0 = om * t0 + ph
-    if abs(math.sin(psi0)) > s:
+    if abs(dsin(psi0)) > s:
         return t0
-    lo = math.asin(s)
+    lo = dasin(s)
     kk = math.ceil((psi0 - lo) / math.pi)
     psi = lo + kk * math.pi
     if psi < psi0:

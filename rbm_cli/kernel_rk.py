@@ -12,6 +12,8 @@ from scipy.integrate._ivp import dop853_coefficients as _dop
 from scipy.integrate._ivp.rk import RK23 as _RK23
 from scipy.integrate._ivp.rk import RK45 as _RK45
 
+from .detmath import sin as dsin
+
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
 
@@ -67,7 +69,7 @@ _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 def _ground(t, amp, om, ph):
     if amp == 0.0:
         return 0.0
-    return amp * math.sin(om * t + ph)
+    return amp * dsin(om * t + ph)
 
 
 @njit(cache=True)

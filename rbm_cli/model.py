@@ -30,6 +30,7 @@ import numpy as np
 from scipy.linalg import eig
 
 from .column import Column
+from .detmath import inverse, product
 from .law import Law, make_law
 
 
@@ -103,7 +104,9 @@ class Model:
         p^2 = N_1 zbar_1 / (1^T M 1); for n = 1, m g (H/2) / (I_G + m H^2/4)."""
         col = self.column
         ones = np.ones(self.n)
-        return math.sqrt(col.normal_forces[0] * col.lever_arms[0] / (ones @ self.mass @ ones))
+        return math.sqrt(
+            col.normal_forces[0] * col.lever_arms[0] / product(ones, product(self.mass, ones))
+        )
 
     @property
     def uplift_level(self) -> float | None:
@@ -116,7 +119,7 @@ class Model:
     @cached_property
     def arg_inverse(self) -> np.ndarray:
         """(n, n) inverse of the argument map: law arguments -> drum rotations."""
-        return np.linalg.inv(self.arg_map)
+        return inverse(self.arg_map)
 
     @cached_property
     def silent_impacts(self) -> np.ndarray:
@@ -145,8 +148,9 @@ class Model:
     def impulse_directions(self) -> tuple[np.ndarray, np.ndarray]:
         """(D, w) of an impact at joint i: the impulsive moment acts along P^T e_i, so
         the rates change along column i of D = M^-1 P^T; w_i = e_i^T P M^-1 P^T e_i."""
-        directions = self.mass_inv @ self.arg_map.T
-        return directions, np.einsum("ij,ji->i", self.arg_map, directions)
+        directions = product(self.mass_inv, self.arg_map.T)
+        w = np.array([product(self.arg_map[i], directions[:, i]) for i in range(self.n)])
+        return directions, w
 
     def impact_rates(self, rate: np.ndarray, i: int) -> np.ndarray:
         """Drum rates [rad/s] after an impact at joint i (its argument's rate times e).
@@ -164,14 +168,15 @@ class Model:
     def stiffness(self, slopes: np.ndarray) -> np.ndarray:
         """Stiffness matrix [N m/rad] of active law pieces of the given slopes,
         gravity of the `geometric` formulation included."""
-        return self.diff.T @ (slopes[:, None] * self.arg_map) - self.gravity
+        return product(self.diff.T, slopes[:, None] * self.arg_map) - self.gravity
 
     def linear_system(self, intercepts: np.ndarray, slopes: np.ndarray):
         """(A, c, e) of theta'' = A theta + c + e a_g for active pieces
         f_i(x) = intercepts_i + slopes_i x."""
         minv = self.mass_inv
         stiff = self.stiffness(slopes)
-        return -minv @ stiff, -minv @ (self.diff.T @ intercepts), -minv @ self.ground_load
+        c = product(self.diff.T, intercepts)
+        return -product(minv, stiff), -product(minv, c), -product(minv, self.ground_load)
 
     def shear_ratios(self, accel: np.ndarray, ground_accel: np.ndarray) -> np.ndarray:
         """|T_i / N_i| (k, n) from drum angular accelerations (k, n) and a_g (k,).
@@ -206,7 +211,7 @@ def build_model(
     h = column.heights
     lower = np.tril(np.ones((n, n)), -1) * h[None, :]
     centre = lower + np.diag(h / 2.0)
-    mass = centre.T @ (column.masses[:, None] * centre) + np.diag(column.inertias)
+    mass = product(centre.T, column.masses[:, None] * centre) + np.diag(column.inertias)
     node = np.vstack([np.zeros(n), np.tril(np.ones((n, n))) * h[None, :]])
     diff = np.eye(n) - np.eye(n, k=-1)
     arg_map = np.eye(n) if formulation == "absolute" else diff.copy()
@@ -235,8 +240,8 @@ def build_model(
     return Model(
         column=column,
         mass=mass,
-        mass_inv=np.linalg.inv(mass),
-        ground_load=centre.T @ column.masses,
+        mass_inv=inverse(mass),
+        ground_load=product(centre.T, column.masses),
         centre_map=centre,
         node_map=node,
         arg_map=arg_map,

@@ -14,7 +14,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import math
 import os
 import platform
 import time
@@ -30,19 +29,18 @@ from . import __version__
 from .config_types import Config
 from .domain import boundary, cell_key, csv_text
 from .errors import RbmError
+from .provenance import provenance
 from .result import CSV_FIELDS
+from .robustness import RULE as ROBUSTNESS_RULE
+from .robustness import Member, member_config, members, summarise
 
 JOURNAL = "domain.partial.jsonl"
 STATE = "domain.partial.json"
 #: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s).
 MAX_CELLS = 100_000
 BACKENDS = ("loky", "threading", "sequential", "dask")
-#: Ensemble members (--ensemble K): member j > 0 has the phase shifted by up to
-#: ENSEMBLE_PHASE [rad] and the amplitude scaled by 1 + up to ENSEMBLE_AMPLITUDE,
-#: with deterministic offsets (see ensemble_offsets); member 0 is the cell itself.
-ENSEMBLE_PHASE = 1e-6
-ENSEMBLE_AMPLITUDE = 1e-6
-
+#: Columns an ensemble sweep adds to domain.csv (rbm_cli.robustness).
+ENSEMBLE_FIELDS = ("collapse_fraction", "robust")
 
 @dataclass(frozen=True)
 class SweepSummary:
@@ -67,27 +65,10 @@ def config_hash(config: Config) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def ensemble_offsets(k: int) -> list[tuple[float, float]]:
-    """(phase shift [rad], relative amplitude change) of ensemble members 0..k-1.
-
-    Member 0 is unperturbed; member j spreads the offsets over
-    [-ENSEMBLE_PHASE, ENSEMBLE_PHASE] and [-ENSEMBLE_AMPLITUDE, ENSEMBLE_AMPLITUDE]
-    with two incommensurate (golden-ratio and sqrt 2) sequences, the same for every cell,
-    so an ensemble domain is reproducible byte for byte."""
-    out = [(0.0, 0.0)]
-    for j in range(1, k):
-        u = 2.0 * ((j * 0.6180339887498949) % 1.0) - 1.0
-        v = 2.0 * ((j * 0.41421356237309515) % 1.0) - 1.0
-        out.append((ENSEMBLE_PHASE * u, ENSEMBLE_AMPLITUDE * v))
-    return out
-
-
-def ensemble_member(config: Config, a: float, offset: tuple[float, float]) -> tuple[Config, float]:
-    """(config, amplitude [g]) of the ensemble member with offset (phase shift [rad],
-    relative amplitude change) of the cell at amplitude a (ensemble_offsets)."""
-    dphi, da = offset
-    exc = dataclasses.replace(config.excitation, phase=config.excitation.phase + dphi)
-    return dataclasses.replace(config, excitation=exc), a * (1 + da)
+def ensemble_member(config: Config, a: float, member: Member) -> tuple[Config, float]:
+    """(config, amplitude [g]) of an ensemble member (rbm_cli.robustness.members)
+    of the cell at amplitude a [g]."""
+    return member_config(config, a, member)
 
 
 def _run_cell(config: Config, a: float, f: float, model) -> dict:
@@ -108,23 +89,22 @@ def _run_cell(config: Config, a: float, f: float, model) -> dict:
 def run_chunk(config: Config, cells: list[tuple[float, float]], ensemble: int = 1) -> list[dict]:
     """Run cells of one config in this process; a cell that raises is 'failed'.
 
-    With ensemble K > 1 each cell is run K times (ensemble_offsets) and its row
-    is member 0's, plus collapse_fraction: the fraction of the members that did
-    not fail which collapsed (NaN if all failed)."""
+    With ensemble K > 1 each cell is run K times (rbm_cli.robustness.members) and
+    its row is member 0's, plus collapse_fraction (the fraction of the members
+    that did not fail which collapsed; NaN if all failed) and robust (1 when all
+    members agree and none failed: the robustness rule)."""
     from .simulate import model_from_config
 
     model = model_from_config(config) if config.model == "rbm" else None
     rows = []
-    offsets = ensemble_offsets(ensemble)
+    others = members(ensemble)[1:]
     for a, f in cells:
         row = _run_cell(config, a, f, model)
         if ensemble > 1:
-            flags = [row["collapsed"]] if row["status"] != "failed" else []
-            for offset in offsets[1:]:
-                member = _run_cell(*ensemble_member(config, a, offset), f, model)
-                if member["status"] != "failed":
-                    flags.append(member["collapsed"])
-            row["collapse_fraction"] = float(np.mean(flags)) if flags else math.nan
+            runs = [row] + [_run_cell(*ensemble_member(config, a, m), f, model) for m in others]
+            flags = [r["collapsed"] for r in runs if r["status"] != "failed"]
+            fraction, robust = summarise(flags, len(runs) - len(flags))
+            row["collapse_fraction"], row["robust"] = fraction, robust
         rows.append(row)
     return rows
 
@@ -226,7 +206,7 @@ def run_sweep(
         raise RbmError(f"cannot write to output folder {folder}: {exc.strerror or exc}") from None
 
     digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
-    fields = CSV_FIELDS + (("collapse_fraction",) if ensemble > 1 else ())
+    fields = CSV_FIELDS + (ENSEMBLE_FIELDS if ensemble > 1 else ())
     done = _read_journal(folder, digest) if resume else {}
     finals = ("domain.csv", "boundary.csv", "meta.json", "domain.png")
     for name in finals:  # a new or resumed sweep: no stale result may look complete
@@ -286,11 +266,8 @@ def run_sweep(
         "n_run": len(todo),
         "n_resumed": len(cells) - len(todo),
         "status_counts": counts,
-        "ensemble": {
-            "members": ensemble,
-            "phase_rad": ENSEMBLE_PHASE if ensemble > 1 else 0.0,
-            "amplitude_relative": ENSEMBLE_AMPLITUDE if ensemble > 1 else 0.0,
-        },
+        "ensemble": {"members": ensemble, "rule": ROBUSTNESS_RULE if ensemble > 1 else None},
+        "provenance": provenance(),
         "cpu_count": os.cpu_count(),
     }
     write_json_atomic(folder / "meta.json", meta)

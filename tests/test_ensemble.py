@@ -1,5 +1,6 @@
 """`rbm sweep --ensemble K`: each cell run K times with tiny, documented
-perturbations of phase and amplitude; collapse_fraction shows robust cells."""
+perturbations of phase, amplitude and tolerance (rbm_cli.robustness);
+collapse_fraction and robust show which cells are robust."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import dataclasses
 import json
 
 import numpy as np
+import pytest
 from click.testing import CliRunner
 
 from rbm_cli.cli import cli
@@ -16,8 +18,9 @@ from rbm_cli.config_types import GridConfig
 from rbm_cli.domain import read_domain
 from rbm_cli.excitation import make_ground_motion
 from rbm_cli.housner_linear import housner_linear_run
-from rbm_cli.simulate import model_from_config
-from rbm_cli.sweep import ENSEMBLE_AMPLITUDE, ENSEMBLE_PHASE, ensemble_offsets, run_sweep
+from rbm_cli.robustness import LARGEST, RULE, SMALLEST, member_config, members, tight_rtol
+from rbm_cli.simulate import model_from_config, simulate
+from rbm_cli.sweep import run_sweep
 
 from .paths import CONFIGS
 
@@ -27,13 +30,20 @@ def slender(amps=(0.2, 0.3, 0.5, 0.8), freqs=(0.5, 1.0, 2.0)):
     return dataclasses.replace(cfg, grid=GridConfig(amplitudes_g=amps, frequencies_hz=freqs))
 
 
-def test_offsets_are_tiny_distinct_and_start_unperturbed():
-    offs = ensemble_offsets(16)
-    assert offs[0] == (0.0, 0.0)
-    phases = [p for p, _ in offs[1:]]
-    amps = [a for _, a in offs[1:]]
-    assert max(map(abs, phases)) <= ENSEMBLE_PHASE and max(map(abs, amps)) <= ENSEMBLE_AMPLITUDE
-    assert len(set(phases)) == 15 and len(set(amps)) == 15
+def test_members_span_the_rule_and_start_unperturbed():
+    """Member 0 is the cell; the others span 1e-12..1e-6 (log-spaced), all four sign
+    pairs of (phase, amplitude), and two tolerances, as the rule says."""
+    ms = members(16)
+    assert (ms[0].phase_rad, ms[0].amplitude_relative, ms[0].tight) == (0.0, 0.0, False)
+    eps = np.array([abs(m.phase_rad) for m in ms[1:]])
+    np.testing.assert_array_equal(eps, [abs(m.amplitude_relative) for m in ms[1:]])
+    assert eps.min() == pytest.approx(SMALLEST, rel=1e-12)
+    assert eps.max() == pytest.approx(LARGEST, rel=1e-12)
+    np.testing.assert_allclose(np.diff(np.log10(eps)), 6 / 14, rtol=1e-9)
+    signs = {(np.sign(m.phase_rad), np.sign(m.amplitude_relative)) for m in ms[1:]}
+    assert signs == {(1, 1), (1, -1), (-1, 1), (-1, -1)}
+    assert {m.tight for m in ms[1:]} == {True, False}
+    assert tight_rtol(1e-10) == pytest.approx(1e-11) and tight_rtol(1e-13) == pytest.approx(1e-12)
 
 
 def closed_form_fraction(cfg, a, f, k):
@@ -42,10 +52,10 @@ def closed_form_fraction(cfg, a, f, k):
     model = model_from_config(cfg)
     alpha, p = linear_rocking_parameters(model.column)
     flags = []
-    for dphi, da in ensemble_offsets(k):
-        exc = dataclasses.replace(cfg.excitation, phase=cfg.excitation.phase + dphi)
-        out = housner_linear_run(alpha, p, make_ground_motion(exc, a * (1 + da), f),
-                                 restitution=model.restitution)  # fmt: skip
+    for m in members(k):
+        exc = dataclasses.replace(cfg.excitation, phase=cfg.excitation.phase + m.phase_rad)
+        motion = make_ground_motion(exc, a * (1 + m.amplitude_relative), f)
+        out = housner_linear_run(alpha, p, motion, restitution=model.restitution)
         flags.append(out.status == "collapsed")
     return float(np.mean(flags))
 
@@ -64,21 +74,27 @@ def test_rigid_block_fractions_match_the_closed_form(tmp_path):
                 zip(df["amplitude_g"], df["frequency_hz"], strict=True)]  # fmt: skip
     np.testing.assert_array_equal(df["collapse_fraction"].to_numpy(), expected)
     assert 0.0 < min(x for x in expected if x > 0) < 1.0  # one sensitive cell in this grid
+    np.testing.assert_array_equal(df["robust"], np.isin(expected, [0.0, 1.0]).astype(int))
     meta = json.loads((ens.folder / "meta.json").read_text())
-    assert meta["ensemble"] == {"members": 4, "phase_rad": ENSEMBLE_PHASE,
-                                "amplitude_relative": ENSEMBLE_AMPLITUDE}  # fmt: skip
+    assert meta["ensemble"] == {"members": 4, "rule": RULE}
 
 
-def test_multidrum_ensemble_gives_fractions_between_zero_and_one(tmp_path):
-    """The 8-drum column is chaotic at some cells: fractions are in [0, 1], and
-    the sweep is reproducible (same bytes twice)."""
+def test_multidrum_ensemble_is_its_members_and_reproducible(tmp_path):
+    """An 8-drum cell near the boundary (chaotic): the row's collapse_fraction and
+    robust flag are those of its members run one by one through simulate (with
+    member_config), and the sweep gives the same bytes on 1 and 2 workers."""
     cfg = load_config(CONFIGS / "harmonic_multidrum.yaml")
     cfg = dataclasses.replace(cfg, grid=GridConfig(amplitudes_g=(0.4,), frequencies_hz=(3.0,)))
     a = run_sweep(cfg, tmp_path / "a", jobs=1, ensemble=5)
     b = run_sweep(cfg, tmp_path / "b", jobs=2, ensemble=5)
     assert (a.folder / "domain.csv").read_bytes() == (b.folder / "domain.csv").read_bytes()
-    frac = read_domain(a.folder / "domain.csv")["collapse_fraction"].to_numpy()
-    assert np.all((frac >= 0) & (frac <= 1))
+    row = read_domain(a.folder / "domain.csv").iloc[0]
+    flags = []
+    for m in members(5):
+        member_cfg, amp = member_config(cfg, 0.4, m)
+        flags.append(simulate(member_cfg, amp, 3.0).status == "collapsed")
+    assert row["collapse_fraction"] == pytest.approx(np.mean(flags))
+    assert row["robust"] == int(len(set(flags)) == 1)
 
 
 def test_cli_ensemble_writes_fractions_and_refuses_zero(tmp_path):

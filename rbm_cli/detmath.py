@@ -1,0 +1,286 @@
+"""Arithmetic that gives the same bits on every x86-64 machine (numba).
+
+Two things in the path from a config to a domain used to round differently from
+one machine to another (measured in docs/reproducibility.md):
+
+- BLAS and LAPACK. OpenBLAS picks its kernels for the CPU at run time
+  (Haswell, SkylakeX, Sandybridge, ...): a kernel with FMA or with wider
+  vectors sums the same products in another order. numpy's ``@`` and
+  ``np.linalg.inv`` in the model's assembly, and numba's ``@`` in the compiled
+  kernel, went through it.
+- The C library's sin and asin. glibc picks an FMA or a plain variant of its
+  libm per CPU; the two differ in the last bit on some arguments.
+
+This module replaces both by plain loops and by fdlibm's algorithms (as musl
+writes them, MIT licence), compiled by numba. Numba compiles without fastmath:
+LLVM then neither contracts ``a * b + c`` into an FMA nor reorders a sum, so a
+loop gives the same bits whatever the CPU and numba's target
+(``NUMBA_CPU_NAME=generic`` included; tests/test_reproducibility.py checks it
+in subprocesses). The matrices are tiny (n <= 200 drums), so the loops cost
+nothing measurable.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+# ---------------------------------------------------------------- linear algebra
+@njit(cache=True)
+def dot(x, y):
+    """sum_i x_i y_i, summed in index order."""
+    s = 0.0
+    for i in range(x.size):
+        s += x[i] * y[i]
+    return s
+
+
+@njit(cache=True)
+def matvec(a, x, out):
+    """out = a @ x (summed in index order), in place; returns out."""
+    for i in range(a.shape[0]):
+        s = 0.0
+        for j in range(a.shape[1]):
+            s += a[i, j] * x[j]
+        out[i] = s
+    return out
+
+
+@njit(cache=True)
+def matmul(a, b):
+    """a @ b (each entry summed in index order), a new array."""
+    n, k = a.shape
+    m = b.shape[1]
+    out = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            s = 0.0
+            for q in range(k):
+                s += a[i, q] * b[q, j]
+            out[i, j] = s
+    return out
+
+
+@njit(cache=True)
+def _inverse(a):
+    """Gauss-Jordan elimination with partial pivoting; (inverse, ok)."""
+    n = a.shape[0]
+    w = a.copy()
+    inv = np.eye(n)
+    for c in range(n):
+        p = c
+        big = abs(w[c, c])
+        for r in range(c + 1, n):
+            if abs(w[r, c]) > big:
+                big, p = abs(w[r, c]), r
+        if big == 0.0 or not math.isfinite(big):
+            return inv, False
+        if p != c:
+            for j in range(n):
+                w[c, j], w[p, j] = w[p, j], w[c, j]
+                inv[c, j], inv[p, j] = inv[p, j], inv[c, j]
+        d = w[c, c]
+        for j in range(n):
+            w[c, j] /= d
+            inv[c, j] /= d
+        for r in range(n):
+            if r != c:
+                f = w[r, c]
+                if f != 0.0:
+                    for j in range(n):
+                        w[r, j] -= f * w[c, j]
+                        inv[r, j] -= f * inv[c, j]
+    return inv, True
+
+
+def inverse(a: np.ndarray) -> np.ndarray:
+    """Inverse of a square matrix, the same bits on every machine.
+
+    Raises numpy.linalg.LinAlgError if the matrix is singular (or not finite).
+    """
+    inv, ok = _inverse(np.ascontiguousarray(a, dtype=float))
+    if not ok:
+        raise np.linalg.LinAlgError("singular matrix")
+    return inv
+
+
+def product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a @ b for 1-D or 2-D float arrays, the same bits on every machine."""
+    a2 = np.ascontiguousarray(a, dtype=float)
+    b2 = np.ascontiguousarray(b, dtype=float)
+    va, vb = a2.ndim == 1, b2.ndim == 1
+    out = matmul(a2.reshape(1, -1) if va else a2, b2.reshape(-1, 1) if vb else b2)
+    if va and vb:
+        return out[0, 0]
+    if va:
+        return out[0]
+    if vb:
+        return out[:, 0]
+    return out
+
+
+# ---------------------------------------------------------------- sin (fdlibm)
+_S1 = -1.66666666666666324348e-01
+_S2 = 8.33333333332248946124e-03
+_S3 = -1.98412698298579493134e-04
+_S4 = 2.75573137070700676789e-06
+_S5 = -2.50507602534068634195e-08
+_S6 = 1.58969099521155010221e-10
+_C1 = 4.16666666666666019037e-02
+_C2 = -1.38888888888741095749e-03
+_C3 = 2.48015872894767294178e-05
+_C4 = -2.75573143513906633035e-07
+_C5 = 2.08757232129817482790e-09
+_C6 = -1.13596475577881948265e-11
+_TOINT = 1.5 / 2.220446049250313e-16
+_PIO4 = 0.7853981633974483
+_INVPIO2 = 6.36619772367581382433e-01
+_PIO2_1 = 1.57079632673412561417e00
+_PIO2_1T = 6.07710050650619224932e-11
+_PIO2_2 = 6.07710050630396597660e-11
+_PIO2_2T = 2.02226624879595063154e-21
+_PIO2_3 = 2.02226624871116645580e-21
+_PIO2_3T = 8.47842766036889956997e-32
+#: |x| up to which sin needs no reduction: high word 0x3fe921fb (fdlibm's test)
+_NO_REDUCTION = 0.7853984832763671
+_TINY = 1.4901161193847656e-08  # 2^-26
+
+
+@njit(cache=True)
+def _ksin(x, y, iy):
+    z = x * x
+    w = z * z
+    r = _S2 + z * (_S3 + z * _S4) + z * w * (_S5 + z * _S6)
+    v = z * x
+    if iy == 0:
+        return x + v * (_S1 + z * r)
+    return x - ((z * (0.5 * y - v * r) - y) - v * _S1)
+
+
+@njit(cache=True)
+def _kcos(x, y):
+    z = x * x
+    w = z * z
+    r = z * (_C1 + z * (_C2 + z * _C3)) + w * w * (_C4 + z * (_C5 + z * _C6))
+    hz = 0.5 * z
+    w = 1.0 - hz
+    return w + (((1.0 - w) - hz) + (z * r - x * y))
+
+
+@njit(cache=True)
+def _exponent(x):
+    """The binary exponent of x (frexp's), very low for 0: fdlibm's test of
+    how many bits a reduction step cancelled."""
+    if x == 0.0:
+        return -2000
+    return math.frexp(x)[1]
+
+
+@njit(cache=True)
+def _rem_pio2(x):
+    """(n, y0, y1): x = n pi/2 + y0 + y1, |y0| <= pi/4 (fdlibm's medium case,
+    three Cody-Waite steps: good to 151 bits up to |x| = 2^20 pi/2 ~ 1.6e6; beyond,
+    n pi/2 is rounded, so the absolute error grows as x's own ulp does)."""
+    fn = x * _INVPIO2 + _TOINT - _TOINT
+    r = x - fn * _PIO2_1
+    w = fn * _PIO2_1T
+    if r - w < -_PIO4:
+        fn -= 1.0
+        r = x - fn * _PIO2_1
+        w = fn * _PIO2_1T
+    elif r - w > _PIO4:
+        fn += 1.0
+        r = x - fn * _PIO2_1
+        w = fn * _PIO2_1T
+    y0 = r - w
+    ex = _exponent(x)
+    if ex - _exponent(y0) > 16:
+        t = r
+        w = fn * _PIO2_2
+        r = t - w
+        w = fn * _PIO2_2T - ((t - r) - w)
+        y0 = r - w
+        if ex - _exponent(y0) > 49:
+            t = r
+            w = fn * _PIO2_3
+            r = t - w
+            w = fn * _PIO2_3T - ((t - r) - w)
+            y0 = r - w
+    y1 = (r - y0) - w
+    return int(fn), y0, y1
+
+
+@njit(cache=True)
+def sin(x):
+    """sin(x) by fdlibm's algorithm: within 1 ulp, the same bits everywhere.
+
+    Exact reduction up to |x| ~ 1.6e6 (a 10 Hz motion for 25,000 s); beyond, the
+    absolute error grows as x's own ulp, the error x already carries. NaN from
+    |x| >= 1e15 (and for an infinite or NaN argument)."""
+    ax = abs(x)
+    if ax <= _NO_REDUCTION:
+        if ax < _TINY:
+            return x
+        return _ksin(x, 0.0, 0)
+    if not ax < 1e15:
+        return math.nan
+    n, y0, y1 = _rem_pio2(x)
+    q = n & 3
+    if q == 0:
+        return _ksin(y0, y1, 1)
+    if q == 1:
+        return _kcos(y0, y1)
+    if q == 2:
+        return -_ksin(y0, y1, 1)
+    return -_kcos(y0, y1)
+
+
+# ---------------------------------------------------------------- asin (fdlibm)
+_PIO2_HI = 1.57079632679489655800e00
+_PIO2_LO = 6.12323399573676603587e-17
+_PS0 = 1.66666666666666657415e-01
+_PS1 = -3.25565818622400915405e-01
+_PS2 = 2.01212532134862925881e-01
+_PS3 = -4.00555345006794114027e-02
+_PS4 = 7.91534994289814532176e-04
+_PS5 = 3.47933107596021167570e-05
+_QS1 = -2.40339491173441421878e00
+_QS2 = 2.02094576023350569471e00
+_QS3 = -6.88283971605453293030e-01
+_QS4 = 7.70381505559019352791e-02
+_NEAR_ONE = 0.9749999046325684  # high word 0x3fef3333
+
+
+@njit(cache=True)
+def _r(z):
+    p = z * (_PS0 + z * (_PS1 + z * (_PS2 + z * (_PS3 + z * (_PS4 + z * _PS5)))))
+    q = 1.0 + z * (_QS1 + z * (_QS2 + z * (_QS3 + z * _QS4)))
+    return p / q
+
+
+@njit(cache=True)
+def asin(x):
+    """asin(x) by fdlibm's algorithm: within 1 ulp, the same bits everywhere."""
+    ax = abs(x)
+    if ax >= 1.0:
+        if ax == 1.0:
+            return x * _PIO2_HI
+        return math.nan
+    if ax < 0.5:
+        if ax < _TINY:
+            return x
+        return x + x * _r(x * x)
+    z = (1.0 - ax) * 0.5
+    s = math.sqrt(z)  # IEEE square root: correctly rounded on every machine
+    r = _r(z)
+    if ax >= _NEAR_ONE:
+        v = _PIO2_HI - (2.0 * (s + s * r) - _PIO2_LO)
+    else:
+        m, e = math.frexp(s)  # f: s with the low 32 bits of its pattern cleared
+        f = math.ldexp(math.floor(m * 2097152.0) / 2097152.0, e)
+        c = (z - f * f) / (s + f)
+        v = 0.5 * _PIO2_HI - (2.0 * s * r - (_PIO2_LO - 2.0 * c) - (0.5 * _PIO2_HI - 2.0 * f))
+    return -v if x < 0.0 else v

@@ -9,17 +9,20 @@ workers, and compared with a reference:
   A peak counts only where it is well-conditioned: a 1e-9 relative change of
   the amplitude moves the closed-form peak by at most 1e-6 relative;
 - otherwise: converged compiled DOP853 runs at rtol 1e-10, 1e-11 and 1e-12.
-  A cell is *converged* when its outcome (collapsed or not) is the same at
-  all three and under a 1e-9 relative change of the amplitude (at rtol
-  1e-12); the others are *sensitive* (chaos), counted but not scored. The
-  amplitude test was added when 21 of 1521 8-drum cells that agreed at the
-  three tolerances flipped under a change of the event handling that moves
-  the state by about 1e-13 rad per impact: tolerance alone misses chaos that
-  every run of one algorithm shares.
   The reference values are those of the rtol 1e-12 run. A peak counts where
   rtol 1e-11 and 1e-12 agree to 1e-6 and a 1e-9 relative change of the
   amplitude moves it by at most 1e-6 (well-conditioned, as for the closed form),
   and these three runs count the same uplifts and impacts.
+
+Which cells are scored: a cell counts (`converged`) only when its reference is
+*robust* by the robustness rule (rbm_cli.robustness: 16 members, perturbations
+1e-12..1e-6 of phase and amplitude, two tolerances, all agree), and, for
+converged references, its outcome is also the same at rtol 1e-10, 1e-11 and
+1e-12 and under a 1e-9 relative change of the amplitude. The others are
+*sensitive* (chaos), counted but not scored. (Tolerance alone misses chaos that
+every run of one algorithm shares: 21 of 1521 8-drum cells that agreed at the
+three tolerances flipped under a change of the event handling that moves the
+state by about 1e-13 rad per impact.)
 
 Errors: (a) cells whose outcome differs from the reference (converged cells
 only), (b) the largest boundary shift [g], (c) relative errors of the peak
@@ -55,6 +58,7 @@ from .config import load_config
 from .config_types import Config, GridConfig, SolverConfig
 from .domain import compare
 from .errors import RbmError
+from .robustness import MEMBERS, member_config, members
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -215,8 +219,8 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
     if problem.reference == "closed-form":
         ref, _ = run_cells("closed-form", cfg, cells, jobs)
         other, _ = run_cells("closed-form", cfg, nudged, jobs)
-        ref["converged"] = 1
         same = ref["collapsed"].to_numpy() == other["collapsed"].to_numpy()
+        robust = robust_flags("closed-form", cfg, cells, ref, jobs)
         peak_ok = _close(
             other["max_rotation_ratio"].to_numpy(), ref["max_rotation_ratio"].to_numpy()
         )
@@ -230,7 +234,7 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
         tight = _with_solver(cfg, "compiled", "DOP853", REFERENCE_RTOLS[-1])
         other, _ = run_cells("rbm", tight, nudged, jobs)
         same &= other["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
-        ref["converged"] = same.astype(int)
+        robust = robust_flags("rbm", tight, cells, ref, jobs)
         p12 = ref["max_rotation_ratio"].to_numpy()
         peak_ok = _close(runs[-2]["max_rotation_ratio"].to_numpy(), p12)
         peak_ok &= _close(other["max_rotation_ratio"].to_numpy(), p12)
@@ -240,12 +244,27 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
         for col in ("n_uplifts", "n_impacts"):
             for run in (runs[-2], other):
                 peak_ok &= run[col].to_numpy() == ref[col].to_numpy()
-    ref["peak_converged"] = (same & peak_ok).astype(int)
+    ref["robust"] = robust.astype(int)
+    ref["converged"] = (robust & same).astype(int)
+    ref["peak_converged"] = (robust & same & peak_ok).astype(int)
     return ref[_REF_COLUMNS]
 
 
+def robust_flags(kind: str, cfg: Config, cells, ref: pd.DataFrame, jobs: int) -> np.ndarray:
+    """The robustness rule (rbm_cli.robustness) on a reference: True where all
+    MEMBERS members (ref is member 0) collapse or all survive and none fails."""
+    flags = ref["collapsed"].to_numpy()
+    robust = (ref["status"] != "failed").to_numpy().copy()
+    for member in members(MEMBERS)[1:]:
+        member_cfg, _ = member_config(cfg, 1.0, member)
+        moved = [(a * (1.0 + member.amplitude_relative), f) for a, f in cells]
+        run, _ = run_cells(kind, member_cfg, moved, jobs)
+        robust &= (run["status"] != "failed").to_numpy() & (run["collapsed"].to_numpy() == flags)
+    return robust
+
+
 _REF_COLUMNS = ["amplitude_g", "frequency_hz", "status", "collapsed", "t_collapse_s",
-                "max_rotation_ratio", "converged", "peak_converged"]  # fmt: skip
+                "max_rotation_ratio", "robust", "converged", "peak_converged"]  # fmt: skip
 
 
 def _key(df: pd.DataFrame) -> pd.Series:

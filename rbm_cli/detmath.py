@@ -8,11 +8,12 @@ one machine to another (measured in docs/reproducibility.md):
   vectors sums the same products in another order. numpy's ``@`` and
   ``np.linalg.inv`` in the model's assembly, and numba's ``@`` in the compiled
   kernel, went through it.
-- The C library's sin and asin. glibc picks an FMA or a plain variant of its
-  libm per CPU; the two differ in the last bit on some arguments.
+- The C library's sin, asin and pow. glibc picks an FMA or a plain variant of
+  its libm per CPU; the two differ in the last bit on some arguments.
 
-This module replaces both by plain loops and by fdlibm's algorithms (as musl
-writes them, MIT licence), compiled by numba. Numba compiles without fastmath:
+This module replaces both by plain loops and by fdlibm's algorithms (sin, asin,
+log, exp, and pow from them; as fdlibm and musl write them, freely licensed),
+compiled by numba. Numba compiles without fastmath:
 LLVM then neither contracts ``a * b + c`` into an FMA nor reorders a sum, so a
 loop gives the same bits whatever the CPU and numba's target
 (``NUMBA_CPU_NAME=generic`` included; tests/test_reproducibility.py checks it
@@ -284,3 +285,92 @@ def asin(x):
         c = (z - f * f) / (s + f)
         v = 0.5 * _PIO2_HI - (2.0 * s * r - (_PIO2_LO - 2.0 * c) - (0.5 * _PIO2_HI - 2.0 * f))
     return -v if x < 0.0 else v
+
+
+# ---------------------------------------------------------------- log, exp, pow (fdlibm)
+_LN2_HI = 6.93147180369123816490e-01
+_LN2_LO = 1.90821492927058770002e-10
+_INVLN2 = 1.44269504088896338700e00
+_LG1 = 6.666666666666735130e-01
+_LG2 = 3.999999999940941908e-01
+_LG3 = 2.857142874366239149e-01
+_LG4 = 2.222219843214978396e-01
+_LG5 = 1.818357216161805012e-01
+_LG6 = 1.531383769920937332e-01
+_LG7 = 1.479819860511658591e-01
+_P1 = 1.66666666666666019037e-01
+_P2 = -2.77777777770155933842e-03
+_P3 = 6.61375632143793436117e-05
+_P4 = -1.65339022054652515390e-06
+_P5 = 4.13813679705723846039e-08
+_SQRT_HALF = 0.7071067811865476
+
+
+@njit(cache=True)
+def log(x):
+    """Natural logarithm by fdlibm's algorithm (x reduced to [sqrt(2)/2, sqrt(2))
+    by frexp, which is exact): within 1 ulp, the same bits everywhere."""
+    if not x > 0.0:
+        if x == 0.0:
+            return -math.inf
+        return math.nan
+    if x == math.inf:
+        return x
+    m, k = math.frexp(x)  # x = m 2^k, m in [0.5, 1)
+    if m < _SQRT_HALF:
+        m *= 2.0
+        k -= 1
+    f = m - 1.0
+    if f == 0.0 and k == 0:
+        return 0.0
+    hfsq = 0.5 * f * f
+    s = f / (2.0 + f)
+    z = s * s
+    w = z * z
+    t1 = w * (_LG2 + w * (_LG4 + w * _LG6))
+    t2 = z * (_LG1 + w * (_LG3 + w * (_LG5 + w * _LG7)))
+    r = t2 + t1
+    dk = float(k)
+    return s * (hfsq + r) + dk * _LN2_LO - hfsq + f + dk * _LN2_HI
+
+
+@njit(cache=True)
+def exp(x):
+    """e^x by fdlibm's algorithm: within 1 ulp, the same bits everywhere."""
+    if x != x:
+        return x
+    if x > 709.782712893383973096:
+        return math.inf
+    if x < -745.13321910194110842:
+        return 0.0
+    ax = abs(x)
+    if ax > 0.5 * _LN2_HI:
+        if ax >= 1.5 * _LN2_HI:
+            k = int(_INVLN2 * x + (0.5 if x >= 0.0 else -0.5))
+        else:
+            k = 1 if x >= 0.0 else -1
+        hi = x - k * _LN2_HI
+        lo = k * _LN2_LO
+        x = hi - lo
+    elif ax > 3.725290298461914e-09:  # 2^-28
+        k, hi, lo = 0, x, 0.0
+    else:
+        return 1.0 + x
+    xx = x * x
+    c = x - xx * (_P1 + xx * (_P2 + xx * (_P3 + xx * (_P4 + xx * _P5))))
+    y = 1.0 + (x * c / (2.0 - c) - lo + hi)
+    if k == 0:
+        return y
+    if k > 1020:  # scale in two exact steps (no overflow in between)
+        return math.ldexp(math.ldexp(y, k - 1000), 1000)
+    return math.ldexp(y, k)
+
+
+@njit(cache=True)
+def pow_pos(x, y):
+    """x^y for x >= 0 as exp(y log x), the same bits everywhere: the error of log
+    is scaled by |y log x|, so within ~16 ulp where that is below ~40 (the step-size
+    control's err^(-1/8) over err in 1e-15..1e15). 0^y: 0 for y > 0, inf for y < 0."""
+    if x == 0.0:
+        return 0.0 if y > 0.0 else (1.0 if y == 0.0 else math.inf)
+    return exp(y * log(x))

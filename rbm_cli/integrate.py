@@ -35,11 +35,56 @@ import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 
 from .config_types import SolverConfig
+from .detmath import pow_pos
 from .events import Pieces, first_crossing, hermite_peaks, within_reach
 from .excitation import GroundMotion
 from .model import Model
 
-_METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23}
+
+class _ErrorNorm(float):
+    """An error norm whose power is rbm_cli.detmath.pow_pos, the compiled kernel's:
+    scipy's step-size control (SAFETY * norm ** exponent) then takes the kernel's
+    steps, whatever the machine's libm."""
+
+    __slots__ = ()
+
+    def __pow__(self, exponent):
+        return pow_pos(float(self), float(exponent))
+
+
+def _with_kernel_power(method):
+    class Stepper(method):
+        def _estimate_error_norm(self, K, h, scale):
+            return _ErrorNorm(super()._estimate_error_norm(K, h, scale))
+
+    Stepper.__name__ = method.__name__
+    return Stepper
+
+
+_METHODS = {m.__name__: _with_kernel_power(m) for m in (DOP853, RK45, RK23)}
+
+
+def initial_step(rhs, t0: float, y0, f0, t_bound: float, order: int, rtol, atol) -> float:
+    """scipy's select_initial_step (Hairer, Norsett and Wanner, II.4) with the kernel's
+    power (rbm_cli.detmath.pow_pos), as rbm_cli.kernel_rk._initial_step computes it.
+    rhs(t, y) is the right-hand side (called once), f0 its value at (t0, y0)."""
+    interval = abs(t_bound - t0)
+    if interval == 0.0:
+        return 0.0
+    scale = atol + np.abs(y0) * rtol
+
+    def rms(v):
+        return math.sqrt(float(np.sum(v * v)) / v.size)
+
+    d0, d1 = rms(y0 / scale), rms(f0 / scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, interval)
+    d2 = rms((rhs(t0 + h0, y0 + h0 * f0) - f0) / scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = pow_pos(0.01 / max(d1, d2), 1.0 / (order + 1))
+    return min(100.0 * h0, h1, interval)
 
 #: Relative offset of event surfaces, so that a restart exactly on a surface
 #: is not taken for a new crossing [fraction of theta_u].
@@ -183,8 +228,8 @@ def integrate(
 
             A, cvec, evec = pieces.system()
 
-            def fun(tt, yy, A=A, cvec=cvec, evec=evec):
-                out.n_rhs += 1
+            def fun(tt, yy, A=A, cvec=cvec, evec=evec, counted=True):
+                out.n_rhs += counted
                 return np.concatenate([yy[n:], A @ yy[:n] + cvec + evec * ag(tt)])
 
             lo, hi = pieces.bounds()
@@ -201,7 +246,11 @@ def integrate(
             # after an event the stepper restarts with the step size its error
             # control proposed before it (the solution stays smooth up to its second
             # derivative; a fresh initial-step guess was rejected 1.4 times per event)
-            first = None if h_carry is None else min(h_carry, seg_end - t)
+            if h_carry is None:  # counted as scipy counts it: its own f0, then one call
+                f0 = fun(t, y, counted=False)
+                first = initial_step(fun, t, y, f0, seg_end, stepper.order, solver.rtol, atol)
+            else:
+                first = min(h_carry, seg_end - t)
             integ = stepper(fun, t, y, seg_end, rtol=solver.rtol, atol=atol, first_step=first)
             z_old = track @ y[:n]
             dz_old = track @ y[n:]

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from .detmath import matmul, matvec
+from .detmath import matmul, matvec, pow_pos
 from .excitation import GroundMotion
 from .integrate import BIG, EVENT_EPS, REST_RATE, Outcome
 from .kernel_events import (
@@ -251,12 +251,12 @@ def run_kernel(
                         if err == 0.0:
                             factor = _MAX_FACTOR
                         else:
-                            factor = min(_MAX_FACTOR, _SAFETY * err**err_exp)
+                            factor = min(_MAX_FACTOR, _SAFETY * pow_pos(err, err_exp))
                         if rejected:
                             factor = min(1.0, factor)
                         h_abs *= factor
                         break
-                    h_abs *= max(_MIN_FACTOR, _SAFETY * err**err_exp)
+                    h_abs *= max(_MIN_FACTOR, _SAFETY * pow_pos(err, err_exp))
                     rejected = True
                 n_steps += 1
                 if n_steps > max_steps:

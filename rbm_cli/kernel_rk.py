@@ -12,6 +12,7 @@ from scipy.integrate._ivp import dop853_coefficients as _dop
 from scipy.integrate._ivp.rk import RK23 as _RK23
 from scipy.integrate._ivp.rk import RK45 as _RK45
 
+from .detmath import pow_pos
 from .detmath import sin as dsin
 
 #: method name -> code in the kernel
@@ -111,7 +112,7 @@ def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, amp, om
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
+        h1 = pow_pos(0.01 / max(d1, d2), 1.0 / (order + 1))
     return min(100.0 * h0, h1, interval)
 
 

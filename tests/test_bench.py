@@ -73,12 +73,13 @@ def test_quick_bench_without_references_is_a_one_line_error(tmp_path):
 
 def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
     """make_reference on hand-made runs (rtol 1e-10, 1e-11, 1e-12, then the 1e-9
-    amplitude nudge at 1e-12): a cell is converged only if its outcome is the same in
-    all four; a peak is scored only if it is converged, 1e-11, 1e-12 and the nudge
-    agree to 1e-6, and those three count the same uplifts and impacts."""
+    amplitude nudge at 1e-12, then the 15 other members of the robustness rule): a
+    cell is converged only if its outcome is the same in all four and it is robust
+    (every member agrees); a peak is scored only if it is converged, 1e-11, 1e-12
+    and the nudge agree to 1e-6, and those three count the same uplifts and impacts."""
     import rbm_cli.bench as bench
 
-    cells = [(0.1, 1.0), (0.2, 1.0), (0.3, 1.0), (0.4, 1.0), (0.5, 1.0)]
+    cells = [(0.1, 1.0), (0.2, 1.0), (0.3, 1.0), (0.4, 1.0), (0.5, 1.0), (0.6, 1.0)]
     # per cell: (collapsed, peak, uplifts) at 1e-10, 1e-11, 1e-12 and nudged
     plan = {
         (0.1, 1.0): [(0, 0.5, 3), (0, 0.5, 3), (0, 0.5, 3), (0, 0.5, 3)],  # all agree
@@ -86,7 +87,9 @@ def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
         (0.3, 1.0): [(1, 0.5, 3), (0, 0.5, 3), (0, 0.5, 3), (0, 0.5, 3)],  # 1e-10 flips
         (0.4, 1.0): [(0, 0.5, 3), (0, 0.5, 5), (0, 0.5, 3), (0, 0.5, 3)],  # events part
         (0.5, 1.0): [(0, 0.5, 3), (0, 0.5, 3), (0, 0.5, 3), (0, 0.501, 3)],  # peak moves
+        (0.6, 1.0): [(0, 0.5, 3)] * 4,  # all agree; one member of the rule flips (below)
     }
+    flipping_member = 9  # call 4 + 9: the rule's member 10
     calls = []
 
     def fake_run_cells(kind, cfg, run_cells, jobs, budget_s=120.0):
@@ -94,7 +97,11 @@ def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
         calls.append(kind)
         rows = []
         for a, f in run_cells:
-            c, p, u = plan[(round(a, 6), f)][k]
+            if k >= 4:  # a member of the robustness rule: as at 1e-12, but one flips
+                c, p, u = plan[(round(a, 4), f)][2]
+                c = 1 - c if (k - 4 == flipping_member and round(a, 4) == 0.6) else c
+            else:
+                c, p, u = plan[(round(a, 6), f)][k]
             row = bench._row(a, f, "collapsed" if c else "survived", float("nan"), p, 0.0)
             rows.append(dict(row, n_uplifts=u, n_impacts=u))
         return pd.DataFrame(rows), 0.0
@@ -102,8 +109,10 @@ def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
     monkeypatch.setattr(bench, "_cells", lambda cfg: cells)
     monkeypatch.setattr(bench, "_with_solver", lambda cfg, *a: cfg)
     monkeypatch.setattr(bench, "run_cells", fake_run_cells)
+    monkeypatch.setattr(bench, "member_config", lambda cfg, a, m: (cfg, a))
     problem = next(p for p in bench.PROBLEMS if p.name == "multidrum")
     ref = bench.make_reference(problem, None, 1)
-    assert calls == ["rbm"] * 4
-    assert ref["converged"].tolist() == [1, 0, 0, 1, 1]
-    assert ref["peak_converged"].tolist() == [1, 0, 0, 0, 0]
+    assert calls == ["rbm"] * (4 + 15)
+    assert ref["robust"].tolist() == [1, 1, 1, 1, 1, 0]
+    assert ref["converged"].tolist() == [1, 0, 0, 1, 1, 0]
+    assert ref["peak_converged"].tolist() == [1, 0, 0, 0, 0, 0]

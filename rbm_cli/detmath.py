@@ -150,41 +150,33 @@ _NO_REDUCTION = 0.7853984832763671
 _TINY = 1.4901161193847656e-08  # 2^-26
 
 
-@njit(cache=True)
-def _ksin(x, y, iy):
-    z = x * x
-    w = z * z
-    r = _S2 + z * (_S3 + z * _S4) + z * w * (_S5 + z * _S6)
-    v = z * x
-    if iy == 0:
-        return x + v * (_S1 + z * r)
-    return x - ((z * (0.5 * y - v * r) - y) - v * _S1)
+@njit(cache=True, inline="always")
+def sin(x):
+    """sin(x) by fdlibm's algorithm: within 1 ulp, the same bits everywhere.
 
+    Exact reduction up to |x| ~ 1.6e6 (a 10 Hz motion for 25,000 s); beyond, the
+    absolute error grows as x's own ulp, the error x already carries. NaN from
+    |x| >= 1e15 (and for an infinite or NaN argument).
 
-@njit(cache=True)
-def _kcos(x, y):
-    z = x * x
-    w = z * z
-    r = z * (_C1 + z * (_C2 + z * _C3)) + w * w * (_C4 + z * (_C5 + z * _C6))
-    hz = 0.5 * z
-    w = 1.0 - hz
-    return w + (((1.0 - w) - hz) + (z * r - x * y))
-
-
-@njit(cache=True)
-def _exponent(x):
-    """The binary exponent of x (frexp's), very low for 0: fdlibm's test of
-    how many bits a reduction step cancelled."""
-    if x == 0.0:
-        return -2000
-    return math.frexp(x)[1]
-
-
-@njit(cache=True)
-def _rem_pio2(x):
-    """(n, y0, y1): x = n pi/2 + y0 + y1, |y0| <= pi/4 (fdlibm's medium case,
-    three Cody-Waite steps: good to 151 bits up to |x| = 2^20 pi/2 ~ 1.6e6; beyond,
-    n pi/2 is rounded, so the absolute error grows as x's own ulp does)."""
+    One body, no calls, and inlined by numba into its caller (inline="always"):
+    a call that LLVM does not inline makes numba take and release a reference
+    to every array the caller holds (atomic NRT operations, ~50 ns a call), which
+    tripled the cost of the kernel's right-hand side."""
+    ax = abs(x)
+    if ax <= _NO_REDUCTION:  # fdlibm's __sin(x, 0, 0)
+        if ax < _TINY:
+            return x
+        z = x * x
+        w = z * z
+        r = _S2 + z * (_S3 + z * _S4) + z * w * (_S5 + z * _S6)
+        return x + z * x * (_S1 + z * r)
+    if not ax < 1e15:
+        return math.nan
+    # fdlibm's __rem_pio2, medium case: x = n pi/2 + y0 + y1, three Cody-Waite
+    # steps (good to 151 bits up to |x| = 2^20 pi/2 ~ 1.6e6; beyond, n pi/2 is
+    # rounded, so the absolute error grows as x's own ulp does). fdlibm skips the
+    # 2nd and 3rd steps when the 1st cancelled few bits; they are always taken
+    # here (the test needs frexp, which costs more in the kernel than the flops).
     fn = x * _INVPIO2 + _TOINT - _TOINT
     r = x - fn * _PIO2_1
     w = fn * _PIO2_1T
@@ -196,47 +188,29 @@ def _rem_pio2(x):
         fn += 1.0
         r = x - fn * _PIO2_1
         w = fn * _PIO2_1T
+    t = r
+    w = fn * _PIO2_2
+    r = t - w
+    w = fn * _PIO2_2T - ((t - r) - w)
+    t = r
+    w = fn * _PIO2_3
+    r = t - w
+    w = fn * _PIO2_3T - ((t - r) - w)
     y0 = r - w
-    ex = _exponent(x)
-    if ex - _exponent(y0) > 16:
-        t = r
-        w = fn * _PIO2_2
-        r = t - w
-        w = fn * _PIO2_2T - ((t - r) - w)
-        y0 = r - w
-        if ex - _exponent(y0) > 49:
-            t = r
-            w = fn * _PIO2_3
-            r = t - w
-            w = fn * _PIO2_3T - ((t - r) - w)
-            y0 = r - w
     y1 = (r - y0) - w
-    return int(fn), y0, y1
-
-
-@njit(cache=True)
-def sin(x):
-    """sin(x) by fdlibm's algorithm: within 1 ulp, the same bits everywhere.
-
-    Exact reduction up to |x| ~ 1.6e6 (a 10 Hz motion for 25,000 s); beyond, the
-    absolute error grows as x's own ulp, the error x already carries. NaN from
-    |x| >= 1e15 (and for an infinite or NaN argument)."""
-    ax = abs(x)
-    if ax <= _NO_REDUCTION:
-        if ax < _TINY:
-            return x
-        return _ksin(x, 0.0, 0)
-    if not ax < 1e15:
-        return math.nan
-    n, y0, y1 = _rem_pio2(x)
-    q = n & 3
-    if q == 0:
-        return _ksin(y0, y1, 1)
-    if q == 1:
-        return _kcos(y0, y1)
-    if q == 2:
-        return -_ksin(y0, y1, 1)
-    return -_kcos(y0, y1)
+    q = int(fn) & 3
+    z = y0 * y0
+    w = z * z
+    if q & 1:  # fdlibm's __cos(y0, y1)
+        r = z * (_C1 + z * (_C2 + z * _C3)) + w * w * (_C4 + z * (_C5 + z * _C6))
+        hz = 0.5 * z
+        w = 1.0 - hz
+        v = w + (((1.0 - w) - hz) + (z * r - y0 * y1))
+    else:  # fdlibm's __sin(y0, y1, 1)
+        r = _S2 + z * (_S3 + z * _S4) + z * w * (_S5 + z * _S6)
+        v = z * y0
+        v = y0 - ((z * (0.5 * y1 - v * r) - y1) - v * _S1)
+    return -v if q & 2 else v
 
 
 # ---------------------------------------------------------------- asin (fdlibm)
@@ -373,4 +347,8 @@ def pow_pos(x, y):
     control's err^(-1/8) over err in 1e-15..1e15). 0^y: 0 for y > 0, inf for y < 0."""
     if x == 0.0:
         return 0.0 if y > 0.0 else (1.0 if y == 0.0 else math.inf)
+    if y == -0.125:  # DOP853's step control: three IEEE square roots, no frexp
+        return 1.0 / math.sqrt(math.sqrt(math.sqrt(x)))
+    if y == 0.125:
+        return math.sqrt(math.sqrt(math.sqrt(x)))
     return exp(y * log(x))

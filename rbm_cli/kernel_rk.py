@@ -66,14 +66,14 @@ _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 
 
 # ---------------------------------------------------------------- small pieces
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _ground(t, amp, om, ph):
     if amp == 0.0:
         return 0.0
     return amp * dsin(om * t + ph)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rhs(t, y, n, As, cs, es, amp, om, ph, out):
     g = _ground(t, amp, om, ph)
     for i in range(n):

@@ -179,7 +179,7 @@ def run_sweep(
     progress : callable(done, total)  Called as chunks finish
     stop_after : int  Stop after this many chunks (tests of interruption)
     ensemble : int  Runs per cell (>1 adds the collapse_fraction column; see
-        ensemble_offsets for the perturbations)
+        rbm_cli.robustness for the perturbations)
     """
     # counted before the cells are listed: a 10^8-cell grid is refused at once
     n_cells = len(config.grid.amplitudes_g) * len(config.grid.frequencies_hz)

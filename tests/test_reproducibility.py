@@ -209,3 +209,24 @@ def test_meta_records_what_a_result_depends_on(tmp_path):
     assert "robust" in prov["robustness_rule"]
     if (ROOT / ".git").exists():
         assert prov["git_commit"] and len(prov["git_commit"].split("-")[0]) == 40
+
+
+# ---------------------------------------------------------------- the README's figures
+def test_readme_states_each_studys_sensitive_cells():
+    """The README's table of sensitive cells is the stored domains' (and lists every
+    regressed study): re-making a study without updating the README fails here."""
+    from .test_regression import STUDIES
+
+    text = (ROOT / "README.md").read_text()
+    section = text.split("## The same answer on any machine", 1)[1].split("\n## ", 1)[0]
+    rows = {}
+    for line in section.splitlines():
+        cells = [c.strip(" `") for c in line.strip().strip("|").split("|")]
+        if len(cells) == 4 and cells[1].isdigit():
+            rows[cells[0]] = tuple(int(c) for c in cells[1:])
+    assert set(rows) == set(STUDIES)
+    for name, (n_cells, members, sensitive) in rows.items():
+        df = read_domain(RESULTS / name / "domain.csv")
+        meta = json.loads((RESULTS / name / "meta.json").read_text())
+        assert (len(df), meta["ensemble"]["members"], int((df["robust"] != 1).sum())) == (
+            n_cells, members, sensitive), name  # fmt: skip

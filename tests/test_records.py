@@ -316,3 +316,17 @@ def test_write_refusals(tmp_path):
         write_at2(tmp_path / "u.AT2", [0.0, 1.0])
     with pytest.raises(RbmError, match="units"):
         write_csv(tmp_path / "u.csv", uneven, units="cm")
+
+
+def test_windows_line_ends_tabs_and_bom(tmp_path):
+    """CRLF line ends, tab separators (AT2) and a UTF-8 byte-order mark (CSV) are read."""
+    at2 = tmp_path / "crlf.AT2"
+    lines = [*HEADER, "NPTS= 4, DT= 0.02 SEC", "0.1\t-0.2", "  .3E-01\t0.0"]
+    at2.write_bytes("\r\n".join(lines).encode() + b"\r\n")
+    rec = read_record(at2)
+    np.testing.assert_allclose(rec.acceleration / G, [0.1, -0.2, 0.03, 0.0], rtol=1e-15)
+    csv = tmp_path / "bom.csv"
+    csv.write_bytes(b"\xef\xbb\xbftime_s,acc_g\r\n0,0.5\r\n0.5,0.25\r\n")
+    rec = read_record(csv)
+    np.testing.assert_array_equal(rec.t, [0.0, 0.5])
+    assert rec.at(0.25) == pytest.approx(0.375 * G)

@@ -251,6 +251,7 @@ INTERFACE_COLUMNS = (
     ("moment_capacity_Nm", "M_u,i", "N m"),
     ("rotation_capacity_rad", "theta_u,i", "rad"),
     ("stiffness_Nm_per_rad", "K_M,i", "N m/rad"),
+    ("normal_stiffness_Pa_per_m", "k_n,i", "Pa/m"),
     ("elastic_limit_rad", "elastic lim", "rad"),
 )
 
@@ -314,7 +315,8 @@ def info(config: str, as_json: bool) -> None:
 
     Per interface: width B_i, drum height, mass and inertia I_Gi, normal force
     N_i, moment capacity M_u,i, zero-moment rotation theta_u,i, stiffness K_M,i
-    and elastic limit; globally: total mass, static multiplier, rocking
+    [N m/rad] and the joint normal stiffness k_n,i [Pa/m] that gives it, and the
+    elastic limit; globally: total mass, static multiplier, rocking
     parameter p and the elastic frequencies.
 
     \b

@@ -227,7 +227,7 @@ def _unresolve(c: dict) -> dict:
         stiffness = {"normal": stiff["values"][0]}
     else:
         vals = stiff["values"]
-        stiffness = vals[0] if len(vals) == 1 else list(vals)
+        stiffness = {"rotational": vals[0] if len(vals) == 1 else list(vals)}
     column = {
         "height": col["height"],
         "base_width": col["base_width"],

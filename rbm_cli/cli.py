@@ -83,6 +83,7 @@ def _one_line(exc: BaseException) -> str:
 
 config_argument = click.argument("config", metavar="CONFIG.yaml", type=str)
 
+
 def check_output(ctx, param, value: str) -> str:
     """--output: a folder name, not empty (-o '' once wrote into the current folder)."""
     if value is not None and not value.strip():

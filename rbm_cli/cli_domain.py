@@ -297,6 +297,13 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         raise UserError(_one_line(exc)) from None
     if cmp.n_common == 0:
         raise UserError("the two domains have no cell in common")
+    if cmp.only_a or cmp.only_b:  # an incomplete domain is not "OK" (issue 14)
+        first = cmp.first_missing
+        raise UserError(
+            f"the domains do not cover the same cells: {cmp.only_a} only in {a_csv}, "
+            f"{cmp.only_b} only in {b_csv} (first: {first[0]} g, {first[1]} Hz); compare "
+            "complete domains of the same grid"
+        )
     click.echo(
         f"cells: {cmp.n_common} in common, {cmp.n_differ} differ "
         f"({100 * cmp.fraction:.3g} %); only in A: {cmp.only_a}, only in B: {cmp.only_b}"

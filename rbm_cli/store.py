@@ -67,6 +67,12 @@ class JournalRead:
     cut: bool = False  # the last line was cut (no newline: a kill while writing)
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def _fsync_dir(folder: Path) -> None:
     with contextlib.suppress(OSError):
         fd = os.open(folder, os.O_RDONLY)
@@ -190,14 +196,35 @@ class SweepStore:
     def __enter__(self) -> SweepStore:
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
-            fd = os.open(self.folder / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise RbmError(
+                f"cannot write to output folder {self.folder}: {exc.strerror or exc}"
+            ) from None
+        for _ in range(100):  # the lock file may be removed by its holder as it ends
+            fd = self._lock_once()
+            if fd is not None:
+                break
+        else:  # pragma: no cover - a hundred holders in a row
+            raise FolderBusy(f"{self.folder} is being written by another sweep")
+        self._lock_fd = fd
+        with contextlib.suppress(OSError):
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        self._remove_stale_staging()
+        return self
+
+    def _lock_once(self) -> int | None:
+        """The locked lock file's descriptor; None if the file was replaced meanwhile."""
+        import fcntl
+
+        path = self.folder / LOCK
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as exc:
             raise RbmError(
                 f"cannot write to output folder {self.folder}: {exc.strerror or exc}"
             ) from None
         try:
-            import fcntl
-
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
             os.close(fd)
@@ -206,15 +233,15 @@ class SweepStore:
                     f"{self.folder} is being written by another sweep"
                     f"{self._holder()}: wait for it to end, or use another -o folder"
                 ) from None
-            raise RbmError(f"cannot lock {self.folder / LOCK}: {exc.strerror or exc}") from None
-        except ImportError:  # pragma: no cover - not POSIX: no lock
-            pass
-        self._lock_fd = fd
-        with contextlib.suppress(OSError):
-            os.ftruncate(fd, 0)
-            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-        self._remove_stale_staging()
-        return self
+            raise RbmError(f"cannot lock {path}: {exc.strerror or exc}") from None
+        try:
+            same = os.stat(path).st_ino == os.fstat(fd).st_ino
+        except FileNotFoundError:
+            same = False
+        if not same:  # its holder removed it after we opened it: lock the new one
+            os.close(fd)
+            return None
+        return fd
 
     def _holder(self) -> str:
         with contextlib.suppress(OSError, ValueError):
@@ -225,6 +252,8 @@ class SweepStore:
     def __exit__(self, *exc) -> None:
         self.close_journal()
         if self._lock_fd is not None:
+            with contextlib.suppress(OSError):
+                (self.folder / LOCK).unlink()  # still held: a waiter re-checks the inode
             os.close(self._lock_fd)  # releases the flock
             self._lock_fd = None
 
@@ -337,6 +366,7 @@ class SweepStore:
     def _write_small(self, path: Path, text: str) -> None:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.folder)
         try:
+            os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0o600 files
             with os.fdopen(fd, "w", encoding="utf-8") as fh:
                 fh.write(text)
                 fh.flush()

@@ -123,18 +123,23 @@ def _dask_client(scheduler: str | None):
         ) from None
     if not scheduler:
         return Client(processes=False)
-    _probe_dask(scheduler)
+    probe_dask(scheduler)
     try:
         return Client(scheduler, timeout=DASK_PROBE_TIMEOUT_S)
     except (OSError, TimeoutError, ValueError) as exc:
         raise RbmError(f"cannot reach the Dask scheduler {scheduler}: {exc}") from None
 
 
-def _probe_dask(address: str) -> None:
+def probe_dask(address: str) -> None:
     """Connect and complete distributed's handshake within DASK_PROBE_TIMEOUT_S."""
     import asyncio
 
-    from distributed.comm import connect
+    try:
+        from distributed.comm import connect
+    except ImportError:
+        raise RbmError(
+            "--backend dask needs dask's distributed scheduler: pip install 'rbm[dask]'"
+        ) from None
 
     async def probe() -> None:
         comm = await connect(address, timeout=DASK_PROBE_TIMEOUT_S / 2)

@@ -158,7 +158,9 @@ def _versions() -> dict:
     }
 
 
-def _check_request(config: Config, jobs: int, ensemble: int, backend: str, force: bool) -> int:
+def _check_request(
+    config: Config, jobs: int, ensemble: int, backend: str, scheduler: str | None, force: bool
+) -> int:
     """The number of cells, once every argument is checked (before any folder exists)."""
     # counted before the cells are listed: a 10^8-cell grid is refused at once
     n_cells = len(config.grid.amplitudes_g) * len(config.grid.frequencies_hz)
@@ -174,6 +176,10 @@ def _check_request(config: Config, jobs: int, ensemble: int, backend: str, force
         raise RbmError(f"--ensemble must be >= 1, got {ensemble}")
     if backend not in BACKENDS:
         raise RbmError(f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
+    if backend == "dask" and scheduler:
+        from .parallel import probe_dask
+
+        probe_dask(scheduler)  # an address that is not a Dask scheduler: one line, bounded
     if config.model == "rbm":
         from .simulate import model_from_config
 
@@ -229,7 +235,7 @@ def run_sweep(
     RbmError  Bad arguments, a busy or unusable folder, a full disk (finished cells kept)
     SweepInterrupted  Ctrl-C (a KeyboardInterrupt): finished cells kept, see its message
     """
-    n_cells = _check_request(config, jobs, ensemble, backend, force)
+    n_cells = _check_request(config, jobs, ensemble, backend, scheduler, force)
     cells = grid_cells(config)
     folder = Path(output) / config.name
     digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")

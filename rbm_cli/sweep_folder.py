@@ -27,6 +27,9 @@ def prepare_folder(store, config, cells, digest, ensemble, resume, force, note, 
         read = store.read_journal(digest, grid, config.column.n_drums, ensemble)
         ours = digest in read.hashes or store.state_hash() == digest
         n = len(read.rows) if ours else 0
+        if not read.rows and not read.rejected and (ours or not read.hashes):
+            store.start_journal(digest, len(cells), command)  # it held no cell: start over
+            return {}
         whose = "of this config" if ours else "of another config"
         if not resume and not force:
             hint = "add --resume to finish it" if ours else "use another -o folder"

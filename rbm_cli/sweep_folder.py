@@ -60,6 +60,8 @@ def prepare_folder(store, config, cells, digest, ensemble, resume, force, note, 
             return dict(read.rows)
     else:
         finished = store.finished_hash()
+        if finished not in (None, digest) and _same_settings(folder, config, ensemble):
+            finished = digest  # made before a setting with a default was added to configs
         if finished == digest and resume:
             return None
         if finished is not None and finished != digest:
@@ -130,3 +132,25 @@ def publish_result(store, figure, rows, df, fields, meta, resume_command) -> Non
             f"cannot draw domain.png ({type(exc).__name__}: {reason}); {kept}, and {resume_command}"
             " publishes it once the cause is fixed"
         ) from None
+
+
+def _same_settings(folder: Path, config, ensemble: int) -> bool:
+    """Whether meta.json's resolved config equals this config on every key both have
+    (a finished domain made before a config key with a default existed has another hash
+    but the same settings)."""
+    import dataclasses
+
+    try:
+        meta = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
+        members = meta.get("ensemble", {}).get("members", 1)
+        stored = meta["config"]
+    except (OSError, ValueError, KeyError, AttributeError, TypeError):
+        return False
+    current = json.loads(json.dumps(dataclasses.asdict(config), default=str))
+    return members == ensemble and isinstance(stored, dict) and _common_equal(stored, current)
+
+
+def _common_equal(a, b) -> bool:
+    if isinstance(a, dict) and isinstance(b, dict):
+        return all(_common_equal(a[k], b[k]) for k in a.keys() & b.keys())
+    return a == b

@@ -129,6 +129,23 @@ def test_case01_a_finished_domain_of_another_config_is_never_replaced_quietly(sm
     assert (kept / "domain.csv").read_bytes() == before
 
 
+def test_case01_a_domain_made_before_a_new_config_key_is_this_configs(small, tmp_path):
+    """A finished domain whose meta.json predates a config key (another hash, a key
+    missing, the same settings otherwise) is recognised: --resume does nothing."""
+    out = tmp_path / "out"
+    assert invoke("sweep", small, "-o", out, "--jobs", "1", "--quiet").exit_code == 0
+    meta_path = out / "small" / "meta.json"
+    meta = json.loads(meta_path.read_text())
+    meta["config_hash"] = "made-by-an-older-rbm"
+    del meta["config"]["solver"]["max_wall_time"], meta["config"]["interface"]["friction"]
+    meta_path.write_text(json.dumps(meta))
+    res = invoke("sweep", small, "-o", out, "--jobs", "1", "--resume")
+    assert res.exit_code == 0 and "already finished" in res.output, res.output
+    meta["config"]["excitation"]["duration"] = 5.0  # a setting that differs: another config
+    meta_path.write_text(json.dumps(meta))
+    one_line_error(invoke("sweep", small, "-o", out, "--resume"), "another config")
+
+
 @pytest.mark.parametrize("damage", ["missing", "garbled", "empty"])
 def test_case02_a_lost_state_file_is_recovered_from_the_journal(small, tmp_path, straight, damage):
     """Defect: a corrupt or missing domain.partial.json made --resume print '0 resumed'

@@ -258,7 +258,11 @@ def run_sweep(
             _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
                        resume_command)  # fmt: skip
         except KeyboardInterrupt:
-            raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
+            # counted from the journal: Ctrl-C may land between a chunk's write and its count
+            read = store.read_journal(digest, {cell_key(*c) for c in cells},
+                                      config.column.n_drums, ensemble)  # fmt: skip
+            kept = max(len(done), len(read.rows))
+            raise SweepInterrupted(folder, kept, n_cells, resume_command) from None
         if stop_after is not None and len(done) < n_cells:
             raise RbmError(
                 f"sweep stopped after {stop_after} chunks (journal kept in {store.journal})"

@@ -22,7 +22,8 @@ still there and valid (less the rows the fault itself damaged); the resume keeps
 all ("N resumed"); no process of the sweep is left; the last resume gives the reference.
 
     pytest tests/test_faults.py                          # small: ~30 s, in the default run
-    RBM_FAULT_TRIALS=300 pytest -m stress tests/test_faults.py -s   # the large version
+    RBM_FAULT_TRIALS=120 pytest -m stress tests/test_faults.py -s   # the large version
+    (RBM_FAULT_LOG=file appends a running tally a trial; RBM_FAULT_SEED another draw)
 
 The figures of the last large run are in docs/stability.md.
 """
@@ -281,7 +282,9 @@ def small_filesystem(path: Path):
             subprocess.run(["umount", "-l", str(path)], capture_output=True)
 
 
-def run_trials(tmp_path: Path, trials: int, budget_s: float, seed: int) -> Tally:
+def run_trials(
+    tmp_path: Path, trials: int, budget_s: float, seed: int, log: str | None = None
+) -> Tally:
     harness = Harness(tmp_path, random.Random(seed))
     start = time.monotonic()
     with small_filesystem(tmp_path / "fs") as mount:
@@ -294,6 +297,9 @@ def run_trials(tmp_path: Path, trials: int, budget_s: float, seed: int) -> Tally
             harness.trial(root, mount)
             if mount is not None and k % 2:
                 subprocess.run(["rm", "-rf", str(root)], check=True)
+            if log:  # a running tally, for the large version
+                with open(log, "a") as fh:
+                    fh.write(f"{time.monotonic() - start:8.1f} s: {harness.tally.line()}\n")
     return harness.tally
 
 
@@ -327,6 +333,7 @@ def test_fault_injection_large(tmp_path, compiled):
     if trials <= 0:
         pytest.skip("set RBM_FAULT_TRIALS to run the large fault-injection suite")
     seed = int(os.environ.get("RBM_FAULT_SEED", "2014"))
-    tally = run_trials(tmp_path, trials, float("inf"), seed=seed)
+    log = os.environ.get("RBM_FAULT_LOG")  # a file: one tally line a trial
+    tally = run_trials(tmp_path, trials, float("inf"), seed=seed, log=log)
     assert tally.trials == trials
     _assert_clean(tally)

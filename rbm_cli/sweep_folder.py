@@ -26,7 +26,7 @@ def prepare_folder(store, config, cells, digest, ensemble, resume, force, note, 
         grid = {cell_key(*c) for c in cells}
         read = store.read_journal(digest, grid, config.column.n_drums, ensemble)
         ours = digest in read.hashes or store.state_hash() == digest
-        n = len(read.rows) if ours else 0
+        n = len(read.rows) if ours else read.rejected  # rows of the other config
         if not read.rows and not read.rejected and (ours or not read.hashes):
             store.start_journal(digest, len(cells), command)  # it held no cell: start over
             return {}

@@ -59,7 +59,10 @@ class Progress:
         left = self.total - self.done
         eta = left / rate if rate > 0 else math.nan
         pct = 100.0 * self.done / self.total if self.total else 100.0
-        rate_text = f"{rate:.3g} cells/s" if math.isfinite(rate) else "rate ?"
+        if not math.isfinite(rate):
+            rate_text = "rate ?"
+        else:
+            rate_text = f"{rate:.0f} cells/s" if rate >= 100 else f"{rate:.3g} cells/s"
         resumed = f", {self.done0} resumed" if self.done0 else ""
         return (
             f"{self.label}: {self.done}/{self.total} cells ({pct:.0f} %{resumed}),"

@@ -52,6 +52,11 @@ def describe(value: Any) -> str:
         return fmt(value)
     if isinstance(value, str):
         text = value if len(value) <= 40 else value[:37] + "..."
+        if _YAML11_NUMBER.match(value):
+            return (
+                f"{text!r} (YAML 1.1 base-60, octal, hex or binary notation is not read as a"
+                " number: write it in decimal)"
+            )
         try:
             float(value)
         except ValueError:
@@ -225,6 +230,24 @@ _Loader.yaml_implicit_resolvers = {
     for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
 }
 _Loader.add_implicit_resolver(_FLOAT_TAG, _FLOAT_RE, list("-+0123456789."))
+# integers as YAML 1.2 reads them: decimal only. YAML 1.1's base 60 (``1:30`` = 90), octal
+# (``012`` = 10), binary and hex forms stay strings, which the checkers refuse by name.
+_INT_TAG = "tag:yaml.org,2002:int"
+_Loader.yaml_implicit_resolvers = {
+    first: [(tag, rx) for tag, rx in resolvers if tag != _INT_TAG]
+    for first, resolvers in _Loader.yaml_implicit_resolvers.items()
+}
+_Loader.add_implicit_resolver(
+    _INT_TAG, re.compile(r"^[-+]?(?:0|[1-9][0-9_]*)$"), list("-+0123456789")
+)
+#: Strings YAML 1.1 would have read as numbers: base 60, octal with a leading zero, hex, binary.
+_YAML11_NUMBER = re.compile(
+    r"^[-+]?(?:[0-9][0-9_]*(?::[0-5]?[0-9])+(?:\.[0-9_]*)?|0[0-9_]+|0x[0-9a-fA-F_]+|0b[01_]+)$"
+)
+#: Largest expansion of a document's aliases and merge keys: its node count, aliases
+#: followed, may be at most this multiple of its distinct nodes (plus EXPANSION_SLACK).
+EXPANSION_FACTOR = 4
+EXPANSION_SLACK = 1000
 
 
 def one_line(text: str) -> str:
@@ -232,8 +255,13 @@ def one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
-def _yaml_problem(exc: yaml.YAMLError) -> str:
+def _yaml_problem(exc: yaml.YAMLError, text: str = "") -> str:
     """``<what is wrong> (line N, column M)`` from a PyYAML error."""
+    if isinstance(exc, yaml.reader.ReaderError):
+        code = exc.character if isinstance(exc.character, int) else ord(exc.character)
+        before = text[: exc.position]
+        line, column = before.count("\n") + 1, exc.position - before.rfind("\n")
+        return f"a control character (U+{code:04X}) at line {line}, column {column}: delete it"
     if not isinstance(exc, yaml.MarkedYAMLError):
         return one_line(str(exc))
     what = ", ".join(p for p in (exc.context, exc.problem) if p) or "invalid YAML"
@@ -267,16 +295,80 @@ def _duplicate_key(root: yaml.Node) -> tuple[str, int] | None:
     return None
 
 
+def _expanded_size(root: yaml.Node, limit: int) -> int:
+    """Nodes of the document with every alias and merge key followed, counted up to
+    ``limit`` (linear in the distinct nodes: shared nodes are counted once and their
+    size reused). Raises ConfigError for a recursive alias."""
+    size: dict[int, int] = {}
+    on_path: set[int] = set()
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        if done:
+            on_path.discard(key)
+            children = _children(node)
+            size[key] = min(limit + 1, 1 + sum(size[id(c)] for c in children))
+            continue
+        if key in size:
+            continue
+        if key in on_path:
+            mark = node.start_mark
+            raise ConfigError(f"a recursive alias (line {mark.line + 1}): a value contains itself")
+        on_path.add(key)
+        stack.append((node, True))
+        for child in _children(node):
+            if id(child) in on_path:
+                mark = child.start_mark
+                raise ConfigError(
+                    f"a recursive alias (line {mark.line + 1}): a value contains itself"
+                )
+            if id(child) not in size:
+                stack.append((child, False))
+    return size[id(root)]
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
+
+
+def _distinct_nodes(root: yaml.Node) -> int:
+    seen: set[int] = set()
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        stack.extend(_children(node))
+    return len(seen)
+
+
 def read_yaml(text: str, source: str) -> Any:
-    """Parse YAML text (YAML 1.2 floats, no duplicate keys); None for an empty document.
+    """Parse YAML text (YAML 1.2 numbers, no duplicate keys); None for an empty document.
+
+    Aliases and merge keys may not expand the document beyond EXPANSION_FACTOR times its
+    distinct nodes (a "billion laughs" document is refused before it is built), so no
+    construct costs more than a small multiple of its size.
 
     Every problem raises ConfigError ``cannot parse <source>: <problem> (line N, ...)``.
     """
-    loader = _Loader(text)
+    loader = None
     try:
+        loader = _Loader(text)  # the reader refuses control characters here
         node = loader.get_single_node()
         if node is None:
             return None
+        limit = EXPANSION_FACTOR * _distinct_nodes(node) + EXPANSION_SLACK
+        if _expanded_size(node, limit) > limit:
+            raise ConfigError(
+                f"cannot parse {source}: its aliases and merge keys (*, <<) expand it to more"
+                f" than {limit} values, {EXPANSION_FACTOR}x its size: write the values out"
+            )
         duplicate = _duplicate_key(node)
         if duplicate is not None:
             raise ConfigError(
@@ -285,20 +377,47 @@ def read_yaml(text: str, source: str) -> Any:
             )
         return loader.construct_document(node)
     except yaml.YAMLError as exc:
-        raise ConfigError(f"cannot parse {source}: {_yaml_problem(exc)}") from None
+        raise ConfigError(f"cannot parse {source}: {_yaml_problem(exc, text)}") from None
+    except ConfigError as exc:
+        message = str(exc)
+        if not message.startswith("cannot parse"):
+            message = f"cannot parse {source}: {message}"
+        raise ConfigError(message) from None
     except RecursionError:
         raise ConfigError(f"cannot parse {source}: nested too deeply") from None
     except (ValueError, TypeError, OverflowError) as exc:  # e.g. a 5000-digit integer
         raise ConfigError(f"cannot parse {source}: {one_line(str(exc).split(';')[0])}") from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 # --------------------------------------------------------------------------- grid
 
 
-def grid_axis(value: Any, path: str, unit: str, *, lo_open: bool) -> tuple[float, ...]:
-    """One grid axis: a number, a list, or {start, stop, step} / {start, stop, num}."""
+def grid_axis(
+    value: Any,
+    path: str,
+    unit: str,
+    *,
+    lo_open: bool,
+    bounds: tuple[float, float] | None = None,
+) -> tuple[float, ...]:
+    """One grid axis: a number, a list, or {start, stop, step} / {start, stop, num};
+    every value > 0 (lo_open) or >= 0, and within ``bounds`` if given."""
+    values = _grid_values(value, path, unit, lo_open=lo_open)
+    if bounds is not None:
+        for i, x in enumerate(values):
+            if not bounds[0] <= x <= bounds[1]:
+                where = path if len(values) == 1 else join(path, i)
+                raise ConfigError(
+                    f"{where} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}]"
+                    f" (the range the tool accepts), got {fmt(x)}"
+                )
+    return values
+
+
+def _grid_values(value: Any, path: str, unit: str, *, lo_open: bool) -> tuple[float, ...]:
     if is_number(value):
         return (number(value, path, unit, 0.0, lo_open=lo_open),)
     if isinstance(value, Mapping):

@@ -23,6 +23,10 @@ from .errors import RbmError  # noqa: E402
 EXIT_USER_ERROR = 2
 #: Exit status of a run whose integration failed (files are still written).
 EXIT_RUN_FAILED = 1
+#: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
+EXIT_INTERRUPTED = 130
+#: Most samples `rbm run --dt` may record (a history of 10^7 rows is ~2 GB of CSV).
+MAX_SAMPLES = 10_000_000
 
 
 class UserError(click.ClickException):
@@ -31,8 +35,15 @@ class UserError(click.ClickException):
     exit_code = EXIT_USER_ERROR
 
 
+class Interrupted(click.ClickException):
+    """Ctrl-C: one line saying what was kept, exit status 130."""
+
+    exit_code = EXIT_INTERRUPTED
+
+
 class RbmGroup(click.Group):
-    """A click group whose usage errors are one line, like every other error."""
+    """A click group whose usage errors are one line, like every other error, and
+    whose Ctrl-C is one line too (click's own says only 'Aborted!')."""
 
     def invoke(self, ctx: click.Context):
         try:
@@ -41,6 +52,8 @@ class RbmGroup(click.Group):
             hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
             message = " ".join(exc.format_message().split())
             raise UserError(message + hint) from None
+        except KeyboardInterrupt:
+            raise Interrupted("interrupted (Ctrl-C)") from None
 
 
 def _load(config_path: str):
@@ -70,6 +83,14 @@ def _one_line(exc: BaseException) -> str:
 
 config_argument = click.argument("config", metavar="CONFIG.yaml", type=str)
 
+
+def check_output(ctx, param, value: str) -> str:
+    """--output: a folder name, not empty (-o '' once wrote into the current folder)."""
+    if value is not None and not value.strip():
+        raise UserError(f"--output must name a folder (e.g. out), got {value!r}")
+    return value
+
+
 output_option = click.option(
     "-o",
     "--output",
@@ -77,6 +98,7 @@ output_option = click.option(
     default="out",
     show_default=True,
     type=str,
+    callback=check_output,
     help="Output root folder; results go to OUTPUT/<name>/.",
 )
 
@@ -97,11 +119,20 @@ def cli() -> None:
 
 
 def _check_excitation(kind: str, amplitude: float | None, frequency: float | None):
-    """Validate --amplitude [g] and --frequency [Hz] for the excitation type."""
+    """Validate --amplitude [g] and --frequency [Hz] for the excitation type (the
+    grid's ranges, rbm_cli.config.AMPLITUDE_RANGE_G and FREQUENCY_RANGE_HZ)."""
+    from .config import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ
+
     if amplitude is not None and not (math.isfinite(amplitude) and amplitude >= 0.0):
         raise UserError(f"--amplitude must be a finite number >= 0 [g], got {amplitude:g}")
     if frequency is not None and not (math.isfinite(frequency) and frequency > 0.0):
         raise UserError(f"--frequency must be a finite number > 0 [Hz], got {frequency:g}")
+    for name, value, (lo, hi), unit in (
+        ("--amplitude", amplitude, AMPLITUDE_RANGE_G, "g"),
+        ("--frequency", frequency, FREQUENCY_RANGE_HZ, "Hz"),
+    ):
+        if value is not None and not lo <= value <= hi:
+            raise UserError(f"{name} must be in [{lo:g}, {hi:g}] [{unit}], got {value:g}")
     if kind == "free":
         return 0.0, 0.0
     if amplitude is None:
@@ -194,6 +225,12 @@ def run(
         click.echo("note: excitation.type is 'free': --amplitude/--frequency are ignored", err=True)
     if output_dt is not None and not (math.isfinite(output_dt) and output_dt > 0.0):
         raise UserError(f"--dt must be a finite number > 0 [s], got {output_dt:g}")
+    if output_dt is not None and cfg.excitation.duration / output_dt > MAX_SAMPLES:
+        samples = cfg.excitation.duration / output_dt
+        raise UserError(
+            f"--dt {output_dt:g} s gives {samples:.3g} samples over {cfg.excitation.duration:g} s"
+            f" (at most {MAX_SAMPLES:,}): use a larger --dt"
+        )
 
     try:
         check_writable_dir(Path(output) / cfg.name)
@@ -219,6 +256,8 @@ def run(
         )
     except RbmError as exc:
         raise UserError(_one_line(exc)) from None
+    except KeyboardInterrupt:
+        raise Interrupted("interrupted (Ctrl-C): no run folder was written") from None
 
     _print_summary(result, folder)
     if result.status == "failed":
@@ -251,6 +290,7 @@ INTERFACE_COLUMNS = (
     ("moment_capacity_Nm", "M_u,i", "N m"),
     ("rotation_capacity_rad", "theta_u,i", "rad"),
     ("stiffness_Nm_per_rad", "K_M,i", "N m/rad"),
+    ("normal_stiffness_Pa_per_m", "k_n,i", "Pa/m"),
     ("elastic_limit_rad", "elastic lim", "rad"),
 )
 
@@ -314,7 +354,8 @@ def info(config: str, as_json: bool) -> None:
 
     Per interface: width B_i, drum height, mass and inertia I_Gi, normal force
     N_i, moment capacity M_u,i, zero-moment rotation theta_u,i, stiffness K_M,i
-    and elastic limit; globally: total mass, static multiplier, rocking
+    [N m/rad] and the joint normal stiffness k_n,i [Pa/m] that gives it, and the
+    elastic limit; globally: total mass, static multiplier, rocking
     parameter p and the elastic frequencies.
 
     \b

@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from .cli import (
+    Interrupted,
     UserError,
     _load,
     _one_line,
@@ -39,8 +40,17 @@ from .errors import RbmError
     help="Dask scheduler address (tcp://host:8786) for --backend dask; "
     "default: a local in-process cluster.",
 )
-@click.option("--resume", is_flag=True, help="Finish an interrupted sweep of the same config.")
-@click.option("--force", is_flag=True, help="Allow grids of more than 100,000 cells.")
+@click.option(
+    "--resume",
+    is_flag=True,
+    help="Finish an interrupted sweep of the same config (on a finished folder: nothing to do).",
+)
+@click.option(
+    "--force",
+    is_flag=True,
+    help="Allow grids of more than 100,000 cells; set aside (to superseded/, never deleted) "
+    "an unfinished journal or another config's result in the folder, and start again.",
+)
 @click.option(
     "--ensemble",
     type=click.IntRange(min=1),
@@ -50,7 +60,7 @@ from .errors import RbmError
     help="Run each cell K times, phase and amplitude perturbed by up to 1e-6 (rad, "
     "relative), and add the collapse_fraction column: which cells are robust.",
 )
-@click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress output and no notes.")
 def sweep(
     config: str,
     output: str,
@@ -66,9 +76,14 @@ def sweep(
 
     Writes OUTPUT/<name>/domain.csv (one row per cell, SPEC section 5),
     boundary.csv (lowest unsafe amplitude per frequency), meta.json (resolved
-    config, versions, wall time, workers) and domain.png. While it runs, only a
-    journal (domain.partial.jsonl) exists: an interrupted sweep leaves nothing
-    that looks complete, and --resume finishes it without redoing finished cells.
+    config, versions, wall time, workers) and domain.png, all published in one
+    step at the end. One sweep at a time writes a folder (a second one is
+    refused). While it runs, finished cells go to a journal
+    (domain.partial.jsonl): an interrupted or killed sweep keeps them and leaves
+    nothing that looks complete, and --resume finishes it without redoing them.
+    A folder with an unfinished journal is never started over without --resume or
+    --force. Progress goes to stderr: a bar on a terminal, otherwise a line at
+    most every 10 s. Ctrl-C says how many cells are kept and how to resume.
     Cells that fail numerically are recorded with status 'failed'; the sweep goes on.
 
     \b
@@ -77,24 +92,21 @@ def sweep(
         rbm sweep configs/harmonic_multidrum.yaml -o out --jobs 2 --resume
         rbm sweep configs/harmonic_multidrum.yaml --backend dask --scheduler tcp://10.0.0.5:8786
     """
-    from .sweep import run_sweep
+    from .progress import Progress, duration
+    from .sweep import SweepInterrupted, run_sweep
 
     cfg = _load(config)
     if scheduler and backend != "dask":
         raise UserError("--scheduler needs --backend dask")
-    show = not quiet and sys.stderr.isatty()
-    bar = None
     if not quiet:
         compile_notice(cfg)
+    reporter = None if quiet else Progress(cfg.name)
+    command = _resume_command(config, output, jobs, backend, scheduler, ensemble, force)
 
-    def progress(done: int, total: int) -> None:
-        nonlocal bar
-        if not show:
-            return
-        if bar is None:
-            bar = click.progressbar(length=total, label=cfg.name, file=sys.stderr, show_eta=True)
-            bar.__enter__()
-        bar.update(done - bar.pos)
+    def note(text: str) -> None:
+        if reporter is not None:
+            reporter.close()
+        click.echo(f"note: {text}", err=True)
 
     try:
         summary = run_sweep(
@@ -105,22 +117,56 @@ def sweep(
             scheduler=scheduler,
             resume=resume,
             force=force,
-            progress=progress,
+            progress=reporter,
             ensemble=ensemble,
+            notify=note,
+            resume_command=command,
         )
     except RbmError as exc:
         raise UserError(_one_line(exc)) from None
+    except SweepInterrupted as exc:
+        raise Interrupted(_one_line(exc)) from None
     finally:
-        if bar is not None:
-            bar.__exit__(None, None, None)
+        if reporter is not None:
+            reporter.close()
+    if summary.already_finished:
+        click.echo(
+            f"{summary.folder} is already finished ({summary.n_cells} cells: domain.csv,"
+            " boundary.csv, domain.png, meta.json): nothing to resume"
+        )
+        return
+    compiled = (
+        f" (+ {duration(summary.compile_s)} loading the integrator)"
+        if (summary.compile_s >= 1.0)
+        else ""
+    )
     click.echo(
         f"{summary.n_cells} cells ({summary.n_run} run, {summary.n_resumed} resumed): "
         f"{summary.n_collapsed} collapsed, {summary.n_survived} survived, "
         f"{summary.n_failed} failed in {summary.wall_time_s:.3g} s on {jobs} worker(s)"
+        f"{compiled}"
     )
     click.echo(f"output: {summary.folder}")
     if summary.n_failed:
         click.echo(f"warning: {summary.n_failed} cell(s) failed; see their message", err=True)
+
+
+def _resume_command(config, output, jobs, backend, scheduler, ensemble, force) -> str:
+    """The exact command that resumes this sweep (quoted for a POSIX shell)."""
+    import shlex
+
+    words = ["rbm", "sweep", config, "-o", output]
+    if jobs != 2:
+        words += ["--jobs", str(jobs)]
+    if backend != "loky":
+        words += ["--backend", backend]
+    if scheduler:
+        words += ["--scheduler", scheduler]
+    if ensemble != 1:
+        words += ["--ensemble", str(ensemble)]
+    if force:
+        words.append("--force")
+    return " ".join(shlex.quote(w) for w in words + ["--resume"])
 
 
 @cli.command("plot-domain")
@@ -227,7 +273,7 @@ def _unresolve(c: dict) -> dict:
         stiffness = {"normal": stiff["values"][0]}
     else:
         vals = stiff["values"]
-        stiffness = vals[0] if len(vals) == 1 else list(vals)
+        stiffness = {"rotational": vals[0] if len(vals) == 1 else list(vals)}
     column = {
         "height": col["height"],
         "base_width": col["base_width"],
@@ -276,9 +322,12 @@ def _unresolve(c: dict) -> dict:
 def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | None) -> None:
     """Compare two domains: cells that differ and the boundary shift per frequency.
 
-    Exit status 0 when within the limits, 1 beyond either (the check CI uses
-    for the stored domains), 2 on bad input. A frequency where a domain has no
-    collapsed cell has its boundary one grid step above its highest amplitude.
+    Exit status 0 when within the limits, 1 beyond either, 2 on bad input. A
+    frequency where a domain has no collapsed cell has its boundary one grid step
+    above its highest amplitude. When A is a stored ensemble domain (it has a
+    `robust` column), the regression rule applies too (the check CI uses): exit 1
+    if a robust cell differs, or if B is an ensemble with more sensitive cells
+    than the stated bound; sensitive cells are reported, not scored.
 
     \b
     Example:
@@ -292,11 +341,19 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         if value is not None and not value >= 0:
             raise UserError(f"{name} must be >= 0, got {value:g}")
     try:
-        cmp = compare_domains(read_domain(a_csv), read_domain(b_csv))
+        dom_a, dom_b = read_domain(a_csv), read_domain(b_csv)
+        cmp = compare_domains(dom_a, dom_b)
     except RbmError as exc:
         raise UserError(_one_line(exc)) from None
     if cmp.n_common == 0:
         raise UserError("the two domains have no cell in common")
+    if cmp.only_a or cmp.only_b:  # an incomplete domain is not "OK" (issue 14)
+        first = cmp.first_missing
+        raise UserError(
+            f"the domains do not cover the same cells: {cmp.only_a} only in {a_csv}, "
+            f"{cmp.only_b} only in {b_csv} (first: {first[0]} g, {first[1]} Hz); compare "
+            "complete domains of the same grid"
+        )
     click.echo(
         f"cells: {cmp.n_common} in common, {cmp.n_differ} differ "
         f"({100 * cmp.fraction:.3g} %); only in A: {cmp.only_a}, only in B: {cmp.only_b}"
@@ -309,6 +366,13 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
             f"{r.shift_g:>+10.4g}"
         )
     failed = []
+    if "robust" in dom_a.columns:
+        from .regression import check
+
+        rule = check(dom_a, dom_b)
+        click.echo(f"regression rule: {rule.summary()}")
+        if not rule.ok:
+            failed.append("the regression rule fails (robust cells must not differ)")
     if max_cells is not None and cmp.fraction > max_cells:
         failed.append(f"{cmp.fraction:.4g} of cells differ (limit {max_cells:g})")
     if max_shift is not None and cmp.max_shift_g > max_shift:
@@ -316,5 +380,5 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
     if failed:
         click.echo("FAIL: " + "; ".join(failed), err=True)
         sys.exit(1)
-    if max_cells is not None or max_shift is not None:
+    if max_cells is not None or max_shift is not None or "robust" in dom_a.columns:
         click.echo("OK: within the limits")

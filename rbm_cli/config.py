@@ -25,7 +25,6 @@ from ._validate import (
     fmt,
     grid_axis,
     integer,
-    is_number,
     join,
     mapping,
     number,
@@ -33,9 +32,9 @@ from ._validate import (
     one_line,
     read_yaml,
 )
+from .config_interface import interface_section
 from .config_types import (
     EXCITATIONS,
-    FORMULATIONS,
     IMPLEMENTATIONS,
     METHODS,
     MODELS,
@@ -46,9 +45,7 @@ from .config_types import (
     ExcitationConfig,
     GridConfig,
     InitialConfig,
-    InterfaceConfig,
     SolverConfig,
-    StiffnessConfig,
 )
 from .errors import ConfigError
 
@@ -56,7 +53,6 @@ __all__ = ["load_config", "parse_config"]
 
 TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
 COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
-INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation", "friction")
 EXCITATION_KEYS = ("type", "duration", "phase", "initial")
 INITIAL_KEYS = ("rotations", "velocities")
 GRID_KEYS = ("amplitudes", "frequencies")
@@ -69,6 +65,7 @@ SOLVER_KEYS = (
     "max_events",
     "time_step",
     "implementation",
+    "max_wall_time",
 )
 
 #: Models of SPEC section 2 that this version does not implement yet.
@@ -85,6 +82,22 @@ MAX_TOP_TAPER = 3.0  # top_width <= MAX_TOP_TAPER * base_width (and <= height)
 #: Heights of a column or block the tool accepts [m] [assumption]: a laboratory
 #: block to a tower; far outside, masses and inertias overflow or underflow.
 HEIGHT_RANGE = (1e-3, 1e3)
+#: Widths, depth and drum heights [m] and density [kg/m^3] the tool accepts [assumption]:
+#: wide enough for any stone column or laboratory model, narrow enough that masses,
+#: inertias and moments stay far inside floating point (density 1e307 overflowed them
+#: and reported a collapsing column as survived: issue 14).
+LENGTH_RANGE = (1e-4, 1e3)
+DENSITY_RANGE = (1.0, 1e5)
+#: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
+INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
+PHASE_MAX = 1e3
+#: Grid and command-line excitation ranges [assumption]: g and Hz at the edges.
+AMPLITUDE_RANGE_G = (0.0, 1e3)
+FREQUENCY_RANGE_HZ = (1e-3, 1e3)
+#: Largest step and event budgets (a 64-bit count; 1e300 failed in the compiled kernel).
+MAX_BUDGET = 1_000_000_000
+#: Range of solver.max_wall_time, the wall-clock budget of one run [s].
+WALL_TIME_RANGE = (0.0, 1e6)
 MAX_FILE_BYTES = 1_000_000
 DRUM_SUM_RTOL = 1e-9
 NAME_RE = re.compile(r"[A-Za-z0-9_.\-]{1,100}")
@@ -183,7 +196,7 @@ def _config(data: Any) -> Config:
         name=name,
         column=column,
         model=model,
-        interface=_interface(top.get("interface"), n, model),
+        interface=interface_section(top.get("interface"), n, model),
         excitation=_excitation(top.get("excitation"), n),
         grid=_grid(top.get("grid")),
         collapse=CollapseConfig(
@@ -221,7 +234,7 @@ def _column(raw: Any) -> ColumnConfig:
             f"column.height must be in [{fmt(HEIGHT_RANGE[0])}, {fmt(HEIGHT_RANGE[1])}] [m]"
             f" (a laboratory block to a tower), got {fmt(height)}"
         )
-    base = number(c["base_width"], "column.base_width", "m", 0.0)
+    base = _bounded(number(c["base_width"], "column.base_width", "m", 0.0), "column.base_width")
     if base > height:
         raise ConfigError(
             f"column.base_width must be <= column.height ({fmt(height)} m), got {fmt(base)}"
@@ -235,6 +248,7 @@ def _column(raw: Any) -> ColumnConfig:
         min(MAX_TOP_TAPER * base, height),
         hint=f"at most {fmt(MAX_TOP_TAPER)} x column.base_width and at most column.height",
     )
+    top = _bounded(top, "column.top_width")
     section = choice(c.get("section", "rectangular"), "column.section", SECTIONS)
     depth = None
     if "depth" in c:
@@ -243,16 +257,33 @@ def _column(raw: Any) -> ColumnConfig:
                 f"column.depth applies only to section: rectangular (section is {section};"
                 " a circle's diameter is the width): delete it"
             )
-        depth = number(c["depth"], "column.depth", "m", 0.0)
+        depth = _bounded(number(c["depth"], "column.depth", "m", 0.0), "column.depth")
     return ColumnConfig(
         height=height,
         base_width=base,
         top_width=top,
         section=section,
         depth=depth,
-        density=number(c.get("density", 2700.0), "column.density", "kg/m^3", 0.0),
+        density=_bounded(
+            number(c.get("density", 2700.0), "column.density", "kg/m^3", 0.0),
+            "column.density",
+            "kg/m^3",
+            DENSITY_RANGE,
+        ),
         drum_heights=_drums(c.get("drums", 1), height),
     )
+
+
+def _bounded(
+    x: float, path: str, unit: str = "m", bounds: tuple[float, float] = LENGTH_RANGE
+) -> float:
+    """x within bounds [assumption: the range where the arithmetic is sound]."""
+    if not bounds[0] <= x <= bounds[1]:
+        raise ConfigError(
+            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
+            f" masses, inertias and moments stay finite), got {fmt(x)}"
+        )
+    return x
 
 
 def _drums(value: Any, height: float) -> tuple[float, ...]:
@@ -266,6 +297,8 @@ def _drums(value: Any, height: float) -> tuple[float, ...]:
         got = f"{len(value)} heights" if value else "an empty list"
         raise ConfigError(f"{path} must list 1..{MAX_DRUMS} drum heights [m], got {got}")
     heights = number_list(value, path, "m", 0.0)
+    for i, h in enumerate(heights):
+        _bounded(h, join(path, i), "m", (1e-6, LENGTH_RANGE[1]))
     total = math.fsum(heights)
     if abs(total - height) > DRUM_SUM_RTOL * height:
         raise ConfigError(
@@ -273,75 +306,6 @@ def _drums(value: Any, height: float) -> tuple[float, ...]:
             " (they must agree within 1e-9 relative)"
         )
     return heights
-
-
-def _interface(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
-    i = mapping(raw, "interface", INTERFACE_KEYS)
-    if "friction" in i and model != "bullet":
-        raise ConfigError(
-            f"interface.friction applies only to model bullet (model is {model}, which does"
-            " not slide): delete it"
-        )
-    friction = number(i.get("friction", 1.0), "interface.friction", "", 0.0)
-    stiffness = i.get("stiffness", "rigid")
-    if model == "bullet" and isinstance(stiffness, str) and stiffness == "rigid":
-        n = 1  # the engine's drums are rigid; the RBM's joint law is not used
-    restitution = i.get("restitution", 1.0)
-    if isinstance(restitution, str) and restitution == "housner":
-        if n != 1:
-            raise ConfigError(
-                f"interface.restitution: housner needs a monolithic column (drums: 1), got {n}"
-                " drums; give a number in (0, 1]"
-            )
-    elif is_number(restitution):
-        restitution = number(restitution, "interface.restitution", "", 0.0, 1.0)
-    else:
-        raise ConfigError(
-            f"interface.restitution must be a number in (0, 1] or housner, got"
-            f" {describe(restitution)}"
-        )
-    return InterfaceConfig(
-        stiffness=_stiffness(i.get("stiffness", "rigid"), n, given="stiffness" in i),
-        xi=number(i.get("xi", 1.0), "interface.xi", "", 0.0, 1.0),
-        restitution=restitution,
-        formulation=choice(i.get("formulation", "relative"), "interface.formulation", FORMULATIONS),
-        friction=friction,
-    )
-
-
-def _stiffness(value: Any, n: int, *, given: bool = True) -> StiffnessConfig:
-    path = "interface.stiffness"
-    if isinstance(value, str) and value == "rigid":
-        if n > 1:
-            raise ConfigError(
-                f"{path}: rigid{'' if given else ' (the default)'} needs a monolithic column"
-                " (drums: 1); give a finite K_M or {normal: k_n} for multi-drum columns"
-            )
-        return StiffnessConfig("rigid", ())
-    if is_number(value):
-        k_m = number(value, path, "N m/rad", 0.0, inf_hint="use rigid for an infinite stiffness")
-        return StiffnessConfig("moment", (k_m,))
-    if isinstance(value, list | tuple):
-        per = f"one K_M per interface ({n} for {n} drum{'s' if n > 1 else ''})"
-        return StiffnessConfig(
-            "moment", number_list(value, path, "N m/rad", 0.0, length=n, length_text=per)
-        )
-    if isinstance(value, Mapping):
-        m = mapping(value, path, ("normal",))
-        if "normal" not in m:
-            raise ConfigError(f"{path}.normal is required (joint normal stiffness > 0 [Pa/m])")
-        k_n = number(
-            m["normal"],
-            f"{path}.normal",
-            "Pa/m",
-            0.0,
-            inf_hint="use rigid for an infinite stiffness",
-        )
-        return StiffnessConfig("normal", (k_n,))
-    raise ConfigError(
-        f"{path} must be rigid, a K_M > 0 [N m/rad], a list with one K_M per interface,"
-        f" or {{normal: k_n}} [Pa/m], got {describe(value)}"
-    )
 
 
 def _excitation(raw: Any, n: int) -> ExcitationConfig:
@@ -355,6 +319,7 @@ def _excitation(raw: Any, n: int) -> ExcitationConfig:
         MAX_DURATION,
     )
     phase = number(e.get("phase", 0.0), "excitation.phase", "rad")
+    phase = _bounded(phase, "excitation.phase", "rad", (-PHASE_MAX, PHASE_MAX))
     if phase != 0.0 and kind != "harmonic":
         raise ConfigError(
             f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"
@@ -363,7 +328,12 @@ def _excitation(raw: Any, n: int) -> ExcitationConfig:
     init = mapping(e.get("initial"), path, INITIAL_KEYS)
     per = f"one value per drum ({n})"
     values = {
-        key: number_list(init[key], join(path, key), unit, length=n, length_text=per)
+        key: tuple(
+            _bounded(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
+            for i, x in enumerate(
+                number_list(init[key], join(path, key), unit, length=n, length_text=per)
+            )
+        )
         if key in init
         else ()
         for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
@@ -381,8 +351,13 @@ def _excitation(raw: Any, n: int) -> ExcitationConfig:
 def _grid(raw: Any) -> GridConfig:
     g = mapping(raw, "grid", GRID_KEYS)
     amplitudes, frequencies = (
-        grid_axis(g[key], join("grid", key), unit, lo_open=lo_open) if key in g else ()
-        for key, unit, lo_open in (("amplitudes", "g", False), ("frequencies", "Hz", True))
+        grid_axis(g[key], join("grid", key), unit, lo_open=lo_open, bounds=bounds)
+        if key in g
+        else ()
+        for key, unit, lo_open, bounds in (
+            ("amplitudes", "g", False, AMPLITUDE_RANGE_G),
+            ("frequencies", "Hz", True, FREQUENCY_RANGE_HZ),
+        )
     )
     return GridConfig(amplitudes_g=amplitudes, frequencies_hz=frequencies)
 
@@ -394,8 +369,12 @@ def _solver(raw: Any) -> SolverConfig:
         method=choice(s.get("method", default.method), "solver.method", METHODS),
         rtol=number(s.get("rtol", default.rtol), "solver.rtol", "", 1e-13, 1e-3, lo_open=False),
         atol=number(s.get("atol", default.atol), "solver.atol", "", 0.0, 1e-3),
-        max_steps=integer(s.get("max_steps", default.max_steps), "solver.max_steps", 1000),
-        max_events=integer(s.get("max_events", default.max_events), "solver.max_events", 100),
+        max_steps=integer(
+            s.get("max_steps", default.max_steps), "solver.max_steps", 1000, MAX_BUDGET
+        ),
+        max_events=integer(
+            s.get("max_events", default.max_events), "solver.max_events", 100, MAX_BUDGET
+        ),
         time_step=number(
             s.get("time_step", default.time_step),
             "solver.time_step",
@@ -407,5 +386,11 @@ def _solver(raw: Any) -> SolverConfig:
             s.get("implementation", default.implementation),
             "solver.implementation",
             IMPLEMENTATIONS,
+        ),
+        max_wall_time=number(
+            s.get("max_wall_time", default.max_wall_time),
+            "solver.max_wall_time",
+            "s",
+            *WALL_TIME_RANGE,
         ),
     )

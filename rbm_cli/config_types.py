@@ -132,6 +132,8 @@ class SolverConfig:
     time_step : float  Fixed time step of the contact engine (model bullet) [s]
     implementation : str  'compiled' (the numba kernel, rbm_cli.kernel) or
         'python' (the reference loop, rbm_cli.integrate); same algorithm
+    max_wall_time : float  Wall-clock budget of one run [s]; beyond it the run is
+        'failed' (a guard against a run that would not end, not a tolerance)
     """
 
     method: str = "DOP853"
@@ -141,6 +143,7 @@ class SolverConfig:
     max_events: int = 200_000
     time_step: float = 1e-4
     implementation: str = "compiled"
+    max_wall_time: float = 3600.0
 
 
 @dataclass(frozen=True)

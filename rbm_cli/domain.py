@@ -106,6 +106,8 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
             f"{path}: line {i + 2}: status must be one of {', '.join(STATUSES)},"
             f" got {got(df['status'].iloc[i])}"
         )
+    if "collapsed" in df.columns:
+        _check_collapsed(df, path, got)
     keys = [cell_key(a, f) for a, f in zip(df["amplitude_g"], df["frequency_hz"], strict=True)]
     seen: dict[tuple[str, str], int] = {}
     for i, key in enumerate(keys):
@@ -115,6 +117,27 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
                 f" (amplitude {key[0]} g, frequency {key[1]} Hz)"
             )
         seen[key] = i
+
+
+def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
+    """collapsed is 0 or 1 on every row and says what status says (collapsed <=> 1):
+    compare counts cells from collapsed and draws boundaries from status, so a row where
+    they disagree would make the two disagree quietly (issue 14). Converts it to int."""
+    raw = df["collapsed"]
+    x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
+    bad = ~np.isin(x, (0.0, 1.0))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RbmError(f"{path}: line {i + 2}: collapsed must be 0 or 1, got {got(raw.iloc[i])}")
+    flags = x.astype(int)
+    disagree = flags != (df["status"] == "collapsed").to_numpy(int)
+    if disagree.any():
+        i = int(np.argmax(disagree))
+        raise RbmError(
+            f"{path}: line {i + 2}: status {df['status'].iloc[i]!r} but collapsed {flags[i]}:"
+            " the two columns disagree (collapsed is 1 exactly when status is collapsed)"
+        )
+    df["collapsed"] = flags
 
 
 def boundary(df: pd.DataFrame) -> pd.DataFrame:
@@ -146,6 +169,7 @@ class Comparison:
     max_shift_g : largest |boundary shift| over frequencies [g]
     shifts : per frequency: frequency_hz, boundary_a_g, boundary_b_g, shift_g
     only_a, only_b : cells present in one domain only
+    first_missing : (amplitude, frequency) text of the first such cell, in grid order
     """
 
     n_common: int
@@ -155,6 +179,7 @@ class Comparison:
     shifts: pd.DataFrame
     only_a: int
     only_b: int
+    first_missing: tuple[str, str] | None = None
 
 
 def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
@@ -206,4 +231,7 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
         shifts=shifts,
         only_a=len(ka.keys() - kb.keys()),
         only_b=len(kb.keys() - ka.keys()),
+        first_missing=min(
+            ka.keys() ^ kb.keys(), key=lambda k: (float(k[1]), float(k[0])), default=None
+        ),
     )

@@ -8,6 +8,15 @@ from .config_types import Config, G
 from .simulate import model_from_config
 
 
+def normal_stiffness(col, i: int) -> float:
+    """The joint normal stiffness k_n [Pa/m] of interface i that gives its K_M,i:
+    K_M = k_n depth B^3 / 12 (rectangle), k_n pi B^4 / 64 (circle); inf if rigid."""
+    k_m, width = float(col.stiffness[i]), float(col.widths[i])
+    if col.section == "circular":
+        return k_m * 64.0 / (math.pi * width**4)
+    return k_m * 12.0 / (float(col.depths[i]) * width**3)
+
+
 def describe(config: Config) -> dict:
     """Masses, capacities, stiffnesses and frequencies of a configured column.
 
@@ -36,6 +45,7 @@ def describe(config: Config) -> dict:
                 "moment_capacity_Nm": float(col.moment_capacity[i]),
                 "rotation_capacity_rad": float(col.rotation_capacity[i]),
                 "stiffness_Nm_per_rad": float(col.stiffness[i]),
+                "normal_stiffness_Pa_per_m": normal_stiffness(col, i),
                 "elastic_limit_rad": float(model.laws[i].elastic_limit),
             }
         )

@@ -28,6 +28,7 @@ rest (rest detection: post-impact rate below REST_RATE * p * theta_u).
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -149,6 +150,7 @@ def integrate(
     n = model.n
     col = model.column
     out = Outcome()
+    deadline = time.monotonic() + solver.max_wall_time
     out.max_ratio = np.zeros(n)
     out.friction = np.zeros(n)
     pieces = Pieces(model, silent=True)
@@ -265,6 +267,9 @@ def integrate(
                 out.n_steps += 1
                 if out.n_steps > solver.max_steps:
                     return out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+                if time.monotonic() > deadline:
+                    budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
+                    return out.stop("failed", f"wall-clock budget exceeded ({budget})", t)
                 t_old = integ.t_old
                 t_new, y_new = integ.t, integ.y
                 d_new = g_rows @ y_new[:n] + h0

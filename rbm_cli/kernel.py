@@ -19,6 +19,7 @@ in both (events.Pieces.silent).
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +45,7 @@ from .kernel_events import (
     _system,
     _within_reach,
 )
+from .kernel_guard import GO_ON, PAST_DEADLINE, POLL_STEPS, arm, disarm, poll
 from .kernel_rk import (
     _MAX_FACTOR,
     _MIN_FACTOR,
@@ -51,8 +53,11 @@ from .kernel_rk import (
     _SAFETY,
     COLLAPSED,
     FAILED_EVENTS,
+    FAILED_NONFINITE,
     FAILED_STEP,
     FAILED_STEPS,
+    FAILED_WALL,
+    INTERRUPTED,
     METHOD_CODES,
     STOPPED_EARLY,
     SURVIVED,
@@ -79,6 +84,7 @@ def run_kernel(
     centre_map, masses, normal_forces,
     kind, amplitude, omega, phase, pulse_end, t_end,
     uplift_level, rest_rate, barrier, early_stop, theta0, rate0, record, output_dt, samples,
+    deadline,
 ):  # fmt: skip
     n = theta0.size
     n_out = 0
@@ -235,7 +241,7 @@ def run_kernel(
                     h_abs = min_step
                 rejected = False
                 while True:
-                    if h_abs < min_step:
+                    if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
                         t_fail = t
                         return (FAILED_STEP, t_fail, t_col, c_if, max_ratio, max_top, friction,
                                 n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
@@ -247,6 +253,9 @@ def run_kernel(
                     _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, amp, omega, phase)
                     n_rhs += stage_rhs
                     err = _error_norm(mc, K, h, y, ynew, atol, rtol, scale)
+                    if not (err == err and abs(err) < math.inf):  # NaN or inf state
+                        return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                     if err < 1.0:
                         if err == 0.0:
                             factor = _MAX_FACTOR
@@ -262,6 +271,12 @@ def run_kernel(
                 if n_steps > max_steps:
                     return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                if n_steps % POLL_STEPS == 0:  # the wall-clock budget and Ctrl-C
+                    guard = poll(deadline)
+                    if guard != GO_ON:
+                        code = FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
+                        return (code, t, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 if t_new - seg_end >= 0:
                     running = False
                 t_old = t
@@ -504,14 +519,19 @@ def integrate_compiled(
     arrays, atol_scale, uplift, rest_rate, barrier = last[1]
     n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((n_max, 1 + 2 * n))
-    res = run_kernel(
-        METHOD_CODES[solver.method], float(solver.rtol), solver.atol * atol_scale,
-        int(solver.max_steps), int(solver.max_events), *arrays,
-        _KIND[motion.kind], float(motion.amplitude), float(motion.omega), float(motion.phase),
-        float(motion.pulse_end), float(motion.t_end), uplift, rest_rate, barrier,
-        bool(early_stop), np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
-        bool(record), float(output_dt), samples,
-    )  # fmt: skip
+    deadline = time.monotonic() + float(solver.max_wall_time)
+    armed = arm()  # Ctrl-C reaches the kernel through poll (kernel_guard)
+    try:
+        res = run_kernel(
+            METHOD_CODES[solver.method], float(solver.rtol), solver.atol * atol_scale,
+            int(solver.max_steps), int(solver.max_events), *arrays,
+            _KIND[motion.kind], float(motion.amplitude), float(motion.omega), float(motion.phase),
+            float(motion.pulse_end), float(motion.t_end), uplift, rest_rate, barrier,
+            bool(early_stop), np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
+            bool(record), float(output_dt), samples, deadline,
+        )  # fmt: skip
+    finally:
+        disarm(armed)
     (code, t_end, t_col, c_if, max_ratio, max_top, friction,
      n_upl, n_imp, n_steps, n_rhs, n_ev, n_out) = res  # fmt: skip
     out = Outcome(
@@ -537,6 +557,13 @@ def integrate_compiled(
         out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t_end)
     elif code == FAILED_EVENTS:
         out.stop("failed", f"event budget exceeded ({solver.max_events} events)", t_end)
+    elif code == FAILED_WALL:
+        out.stop("failed", f"wall-clock budget exceeded ({solver.max_wall_time:g} s, "
+                 "solver.max_wall_time)", t_end)  # fmt: skip
+    elif code == FAILED_NONFINITE:
+        out.stop("failed", "the state became NaN or infinite (non-finite arithmetic)", t_end)
+    elif code == INTERRUPTED:  # pragma: no cover - disarm() raises first
+        raise KeyboardInterrupt
     return out
 
 
@@ -560,6 +587,7 @@ def warm_up() -> None:
     model = build_model(col)
     motion = GroundMotion("harmonic", 5.0, 6.0, 0.0, 0.1, 0.1)
     integrate_compiled(model, motion, np.zeros(1), np.zeros(1), SolverConfig())
+    poll(math.inf)  # its object-mode block loads on first use (~30 ms): not in a timed run
 
 
 __all__ = ["integrate_compiled", "model_arrays", "needs_compile", "warm_up"]

@@ -62,6 +62,8 @@ TAB_NP = np.array([3, 4, 7], dtype=np.int64)  # interpolant order of RK23 / RK45
 
 # status codes of the kernel
 SURVIVED, STOPPED_EARLY, COLLAPSED, FAILED_STEP, FAILED_STEPS, FAILED_EVENTS = range(6)
+# a run past its wall-clock budget, stopped by Ctrl-C, or whose state became NaN or inf
+FAILED_WALL, INTERRUPTED, FAILED_NONFINITE = 6, 7, 8
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 
 

@@ -265,6 +265,31 @@ def _shapes_figure(history: History, widths, elevations, t_collapse: float | Non
     return fig
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_staging(parent: Path, folder: str) -> int:
+    """Remove the staging folders ``.<folder>.<pid>.*`` that a killed ``rbm run`` left
+    behind (their process is gone); a live run's staging is left alone. Returns how
+    many were removed."""
+    removed = 0
+    for item in parent.glob(f".{folder}.*"):
+        parts = item.name[len(folder) + 2 :].split(".", 1)
+        if not (item.is_dir() and not item.is_symlink() and parts[0].isdigit()):
+            continue
+        if int(parts[0]) != os.getpid() and not _alive(int(parts[0])):
+            shutil.rmtree(item, ignore_errors=True)
+            removed += 1
+    return removed
+
+
 def write_run(
     out_dir: str | os.PathLike,
     name: str,
@@ -309,8 +334,9 @@ def write_run(
     if target.exists() and not target.is_dir():
         raise OutputError(f"cannot create run folder {target}: a file of that name exists")
     t_collapse = result.t_collapse_s if result.collapsed else None
+    remove_stale_staging(parent, folder)
     try:
-        staging = Path(tempfile.mkdtemp(prefix=f".{folder}.", dir=parent))
+        staging = Path(tempfile.mkdtemp(prefix=f".{folder}.{os.getpid()}.", dir=parent))
         os.chmod(staging, 0o777 & ~_umask())  # mkdtemp makes 0o700 folders
     except OSError as exc:
         raise OutputError(f"cannot write in output folder {parent}: {exc.strerror}") from None

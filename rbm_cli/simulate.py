@@ -31,18 +31,80 @@ def housner_restitution(column: Column) -> float:
 
 
 def model_from_config(config: Config, column: Column | None = None) -> Model:
-    """Assemble the model of a config (column may be overridden, e.g. in tests)."""
-    if column is None:
-        column = build_column(config.column, config.interface)
-    e = config.interface.restitution
-    if e == "housner":
-        e = housner_restitution(column)
-    return build_model(
-        column,
-        xi=config.interface.xi,
-        restitution=float(e),
-        formulation=config.interface.formulation,
-        collapse_ratio=config.collapse.ratio,
+    """Assemble the model of a config (column may be overridden, e.g. in tests).
+
+    Raises RbmError if a derived quantity (mass, inertia, capacity, stiffness, the
+    mass matrix or its inverse, a law's pieces, p) is not finite: see check_derived."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+        if column is None:
+            column = build_column(config.column, config.interface)
+        e = config.interface.restitution
+        if e == "housner":
+            e = housner_restitution(column)
+        try:
+            model = build_model(
+                column,
+                xi=config.interface.xi,
+                restitution=float(e),
+                formulation=config.interface.formulation,
+                collapse_ratio=config.collapse.ratio,
+            )
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+            raise RbmError(
+                f"the column's model cannot be assembled ({type(exc).__name__}: {exc}): its"
+                " inputs are outside the range where the arithmetic is sound"
+            ) from None
+        check_derived(model)
+    return model
+
+
+def check_derived(model: Model) -> None:
+    """Every derived quantity of a model finite (and positive where it must be), before a
+    run starts: a density of 1e307 once made masses overflow and a collapsing column
+    report 'survived' (issue 14). Raises RbmError naming the first bad quantity."""
+    col = model.column
+    positive = {
+        "drum masses": col.masses,
+        "drum inertias": col.inertias,
+        "normal forces N_i": col.normal_forces,
+        "moment capacities M_u,i": col.moment_capacity,
+        "rotation capacities theta_u,i": col.rotation_capacity,
+        "lever arms": col.lever_arms,
+    }
+    finite = {
+        "mass matrix": model.mass,
+        "inverse mass matrix": model.mass_inv,
+        "gravity matrix": model.gravity,
+        "ground load": model.ground_load,
+        "collapse limits": model.collapse_limit,
+    }
+    for i, law in enumerate(model.laws):
+        finite[f"law of interface {i + 1}"] = np.concatenate(
+            [law.edges, law.intercepts, law.slopes]
+        )
+    stiff = col.stiffness
+    bad_stiffness = not np.all(np.isinf(stiff) | (np.isfinite(stiff) & (stiff > 0)))
+    for name, values in positive.items():
+        v = np.asarray(values, dtype=float)
+        if not (np.all(np.isfinite(v)) and np.all(v > 0)):
+            _derived_error(name, v)
+    for name, values in finite.items():
+        v = np.asarray(values, dtype=float)
+        if not np.all(np.isfinite(v)):
+            _derived_error(name, v)
+    if bad_stiffness:
+        _derived_error("joint stiffnesses K_M,i", stiff)
+    p = model.rocking_p
+    if not (math.isfinite(p) and p > 0):
+        _derived_error("rocking parameter p", np.array([p]))
+
+
+def _derived_error(name: str, values: np.ndarray) -> None:
+    shown = ", ".join(f"{x:.4g}" for x in values.ravel()[:3])
+    raise RbmError(
+        f"the column's {name} are not finite and positive ({shown}...): the inputs are"
+        " outside the range where the arithmetic is sound (check column sizes, density"
+        " and interface.stiffness)"
     )
 
 

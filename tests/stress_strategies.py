@@ -85,9 +85,9 @@ def stiffnesses(draw, column: dict, rigid_ok: bool):
         return {"normal": _round(10 ** draw(st.floats(6.0, 9.0)))}
     k_rock = rocking_stiffness(column)
     if kind == "soft":
-        return _round(k_rock * draw(st.floats(1.5, 10.0)))
+        return {"rotational": _round(k_rock * draw(st.floats(1.5, 10.0)))}
     lo = math.log10(k_rock * 10.0)
-    return _round(10 ** draw(st.floats(min(lo, 12.0), 12.0)))
+    return {"rotational": _round(10 ** draw(st.floats(min(lo, 12.0), 12.0)))}
 
 
 def _solver(rtol: float = 1e-9, n: int = 1) -> dict:

@@ -35,7 +35,7 @@ column:
   density: 2600
   drums: [0.5, 1.0, 1.5, 2.0]
 interface:
-  stiffness: [1e8, 2e8, 3E+8, 4.5e8]
+  stiffness: {rotational: [1e8, 2e8, 3E+8, 4.5e8]}
   xi: 0.8
   restitution: 0.9
   formulation: geometric
@@ -151,7 +151,7 @@ def test_negative_exponent_is_a_float(tmp_path):
 
 def test_single_moment_stiffness():
     data = minimal()
-    data["interface"] = {"stiffness": 2.5e8}
+    data["interface"] = {"stiffness": {"rotational": 2.5e8}}
     assert parse_config(data).interface.stiffness == StiffnessConfig("moment", (2.5e8,))
 
 
@@ -168,14 +168,14 @@ def test_drum_list_equals_drum_count():
     by_count["column"]["drums"] = 4
     by_list["column"]["drums"] = [1, 1, 1, 1]
     for data in (by_count, by_list):
-        data["interface"] = {"stiffness": 1e9}
+        data["interface"] = {"stiffness": {"rotational": 1e9}}
     assert parse_config(by_count).column == parse_config(by_list).column
 
 
 def test_drum_list_sum_within_tolerance():
     data = minimal()
     data["column"]["drums"] = [4.0 / 3, 4.0 / 3, 4.0 / 3 * (1 + 1e-12)]
-    data["interface"] = {"stiffness": 1e9}
+    data["interface"] = {"stiffness": {"rotational": 1e9}}
     assert parse_config(data).column.n_drums == 3
 
 
@@ -294,12 +294,24 @@ BAD_EXTRA = [
     ("solver:\n  time_step: 0.1\n", ["solver.time_step must be a number in", "[s]"]),
     ("model: fem\n", ["model must be one of rbm", "'fem'"]),
     ("interface:\n  stiffness: soft\n", ["interface.stiffness must be rigid"]),
-    ("interface:\n  stiffness: -5\n", ["interface.stiffness", "> 0 [N m/rad]"]),
-    ("interface:\n  stiffness: .inf\n", ["interface.stiffness", "use rigid"]),
+    ("interface:\n  stiffness: {rotational: -5}\n", ["interface.stiffness", "> 0 [N m/rad]"]),
+    ("interface:\n  stiffness: {rotational: .inf}\n", ["interface.stiffness", "use rigid"]),
+    (
+        "interface:\n  stiffness: 5e9\n",
+        ["interface.stiffness: a bare number", "{rotational: K_M}", "{normal: k_n}"],
+    ),
+    (
+        "interface:\n  stiffness: {rotational: 1e9, normal: 1e9}\n",
+        ["interface.stiffness needs exactly one of rotational and normal"],
+    ),
     ("interface:\n  stiffness: {normal: 0}\n", ["interface.stiffness.normal", "[Pa/m]"]),
     ("interface:\n  stiffness: {shear: 1e9}\n", ["unknown key 'shear' in interface.stiffness"]),
-    ("interface:\n  stiffness: {}\n", ["interface.stiffness.normal is required"]),
-    ("interface:\n  stiffness: [1e9, 2e9]\n", ["interface.stiffness", "one K_M per interface"]),
+    ("interface:\n  stiffness: {}\n", ["interface.stiffness needs exactly one of rotational"]),
+    ("interface:\n  stiffness: [1e9, 2e9]\n", ["interface.stiffness: a bare list"]),
+    (
+        "interface:\n  stiffness: {rotational: [1e9, 2e9]}\n",
+        ["interface.stiffness.rotational", "one K_M per interface"],
+    ),
     ("interface:\n  xi: 0\n", ["interface.xi", "(0, 1]"]),
     ("interface:\n  xi: 1.5\n", ["interface.xi", "(0, 1]"]),
     ("interface:\n  restitution: 0\n", ["interface.restitution", "(0, 1]"]),
@@ -336,7 +348,16 @@ BAD_EXTRA = [
     ("solver:\n  method: LSODA\n", ["solver.method", "DOP853"]),
     ("solver:\n  rtol: 1e-14\n", ["solver.rtol", "[1e-13, 0.001]"]),
     ("solver:\n  atol: 0\n", ["solver.atol", "(0, 0.001]"]),
-    ("solver:\n  max_steps: 10\n", ["solver.max_steps", ">= 1000"]),
+    ("solver:\n  max_steps: 10\n", ["solver.max_steps", "in 1000..1000000000"]),
+    ("solver:\n  max_steps: 1e300\n", ["solver.max_steps", "in 1000..1000000000"]),
+    ("solver:\n  max_wall_time: 0\n", ["solver.max_wall_time", "(0, 1000000] [s]"]),
+    (
+        "column:\n  height: 4\n  base_width: 1\n  density: 1e307\n",
+        ["column.density", "[1, 100000]"],
+    ),
+    ("column:\n  height: 1:30\n  base_width: 1\n", ["column.height", "'1:30'", "base-60"]),
+    ("column:\n  height: 012\n  base_width: 1\n", ["column.height", "'012'", "decimal"]),
+    ("grid:\n  frequencies: 1e200\n", ["grid.frequencies must be in [0.001, 1000] [Hz]"]),
     ("solver:\n  max_events: 99.5\n", ["solver.max_events", "integer"]),
 ]
 
@@ -376,7 +397,7 @@ def test_rigid_multidrum_is_refused():
 def test_housner_restitution_needs_one_drum():
     data = minimal()
     data["column"]["drums"] = 2
-    data["interface"] = {"stiffness": 1e9, "restitution": "housner"}
+    data["interface"] = {"stiffness": {"rotational": 1e9}, "restitution": "housner"}
     with pytest.raises(ConfigError, match=r"interface\.restitution: housner needs a monolithic"):
         parse_config(data)
 
@@ -536,7 +557,7 @@ def test_reference_models_need_a_monolithic_column(model):
         "name": "x",
         "model": model,
         "column": {"height": 4.0, "base_width": 1.0, "drums": 2},
-        "interface": {"stiffness": 1e9},
+        "interface": {"stiffness": {"rotational": 1e9}},
     }
     with pytest.raises(ConfigError, match=f"model '{model}' needs a monolithic column"):
         parse_config(data)

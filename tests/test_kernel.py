@@ -126,7 +126,8 @@ def test_kernel_energy_jump_reproducer():
             "name": "energy_jump",
             "column": {"height": 2.00001, "base_width": 0.321197, "top_width": 0.314647,
                        "section": "circular", "density": 2500, "drums": 6},
-            "interface": {"stiffness": 744198000.0, "xi": 0.979606, "formulation": "relative"},
+            "interface": {"stiffness": {"rotational": 744198000.0}, "xi": 0.979606,
+                          "formulation": "relative"},
             "excitation": {"type": "free", "duration": 1.85233, "initial": {
                 "velocities": [0.822687, -1.5755, 0.0, -0.238652, -0.755901, 1.46421]}},
             "solver": {"rtol": 1e-10, "max_steps": 50000, "max_events": 5000},

@@ -236,3 +236,20 @@ def test_readme_states_each_studys_sensitive_cells():
         meta = json.loads((RESULTS / name / "meta.json").read_text())
         assert (len(df), meta["ensemble"]["members"], int((df["robust"] != 1).sum())) == (
             n_cells, members, sensitive), name  # fmt: skip
+
+
+def test_cli_compare_applies_the_rule_to_a_stored_ensemble(tmp_path):
+    """rbm compare STORED FRESH: exit 0 when only sensitive cells differ, 1 when a
+    robust one does."""
+    from click.testing import CliRunner
+
+    from rbm_cli.cli import cli
+
+    stored = _domain([0, 0, 1, 1], robust=[1, 0, 1, 1])
+    stored.to_csv(tmp_path / "a.csv", index=False)
+    _domain([0, 1, 1, 1]).to_csv(tmp_path / "b.csv", index=False)
+    _domain([0, 0, 0, 1]).to_csv(tmp_path / "c.csv", index=False)
+    ok = CliRunner().invoke(cli, ["compare", str(tmp_path / "a.csv"), str(tmp_path / "b.csv")])
+    assert ok.exit_code == 0 and "sensitive cells (stored): 1, 1 differ" in ok.output
+    bad = CliRunner().invoke(cli, ["compare", str(tmp_path / "a.csv"), str(tmp_path / "c.csv")])
+    assert bad.exit_code == 1 and "robust cells: 1 of 3 differ" in bad.output

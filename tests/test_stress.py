@@ -292,7 +292,11 @@ def test_energy_jump_reproducer():
                 "density": 2500,
                 "drums": 6,
             },
-            "interface": {"stiffness": 744198000.0, "xi": 0.979606, "formulation": "relative"},
+            "interface": {
+                "stiffness": {"rotational": 744198000.0},
+                "xi": 0.979606,
+                "formulation": "relative",
+            },
             "excitation": {
                 "type": "free",
                 "duration": 1.85233,
@@ -447,7 +451,7 @@ def test_sweep_reports_failed_cells(tmp_path):
         {
             "name": "budget",
             "column": {"height": 4.0, "base_width": 1.0},
-            "interface": {"stiffness": 1e10, "xi": 0.8},
+            "interface": {"stiffness": {"rotational": 1e10}, "xi": 0.8},
             "excitation": {"type": "harmonic", "duration": 3.0},
             "grid": {"amplitudes": [0.1, 0.2, 5.0], "frequencies": [0.5, 40.0]},
             "solver": {"max_steps": 1000, "max_events": 100},

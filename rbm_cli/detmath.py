@@ -77,7 +77,7 @@ def _inverse(a):
         for r in range(c + 1, n):
             if abs(w[r, c]) > big:
                 big, p = abs(w[r, c]), r
-        if big == 0.0 or not math.isfinite(big):
+        if big == 0.0:  # singular; a non-finite matrix gives NaN/inf, as LAPACK's does
             return inv, False
         if p != c:
             for j in range(n):
@@ -100,7 +100,8 @@ def _inverse(a):
 def inverse(a: np.ndarray) -> np.ndarray:
     """Inverse of a square matrix, the same bits on every machine.
 
-    Raises numpy.linalg.LinAlgError if the matrix is singular (or not finite).
+    Raises numpy.linalg.LinAlgError if the matrix is singular (a zero pivot); a
+    matrix with infinite or NaN entries gives a non-finite inverse, as LAPACK's does.
     """
     inv, ok = _inverse(np.ascontiguousarray(a, dtype=float))
     if not ok:

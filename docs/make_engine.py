@@ -40,14 +40,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from rbm_cli.bullet import impact_rate_ratios, measure_restitution  # noqa: E402
-from rbm_cli.bullet_scene import EngineSettings  # noqa: E402
-from rbm_cli.config import load_config, parse_config  # noqa: E402
-from rbm_cli.config_types import GridConfig  # noqa: E402
-from rbm_cli.domain import read_domain  # noqa: E402
-from rbm_cli.housner import block_geometry, housner_restitution  # noqa: E402
-from rbm_cli.simulate import simulate  # noqa: E402
-from rbm_cli.sweep import run_sweep  # noqa: E402
+from rbm_cli.config.load import load_config, parse_config  # noqa: E402
+from rbm_cli.config.types import GridConfig  # noqa: E402
+from rbm_cli.models.bullet.run import impact_rate_ratios, measure_restitution  # noqa: E402
+from rbm_cli.models.bullet.scene import EngineSettings  # noqa: E402
+from rbm_cli.models.housner import block_geometry, housner_restitution  # noqa: E402
+from rbm_cli.study.domain import read_domain  # noqa: E402
+from rbm_cli.study.simulate import simulate  # noqa: E402
+from rbm_cli.study.sweep import run_sweep  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "engine_data"
@@ -105,7 +105,7 @@ def timed(fn, *args):
 
 
 def part_impact() -> None:
-    """Both readings of the engine's impact loss (rbm_cli.bullet_impact): from the
+    """Both readings of the engine's impact loss (rbm_cli.models.bullet.impact): from the
     energy of successive peaks (the one used) and from 2 ms line fits of the
     angular velocity around each impact; at erp 0.2 (the engine's) and 0.05."""
     rows = []
@@ -238,8 +238,8 @@ def part_timestep() -> None:
 
 
 def _engine_cell(cfg, amplitude_g, frequency_hz, settings):
-    from rbm_cli.bullet import bullet_run
-    from rbm_cli.excitation import make_ground_motion
+    from rbm_cli.models.bullet.run import bullet_run
+    from rbm_cli.physics.excitation import make_ground_motion
 
     motion = make_ground_motion(cfg.excitation, amplitude_g, frequency_hz)
     out, _ = bullet_run(cfg, motion, settings=settings)
@@ -339,8 +339,8 @@ CONVERGE_MEMBERS = 4
 
 
 def _converge_run(name: str, model: str, dt: float, e: float, a: float, f: float, j: int):
-    from rbm_cli.robustness import members
-    from rbm_cli.sweep import ensemble_member
+    from rbm_cli.study.robustness import members
+    from rbm_cli.study.sweep import ensemble_member
 
     if model == "bullet":
         cfg = with_step(column_config(COLUMNS[name]), dt)
@@ -426,8 +426,8 @@ def part_normals() -> None:
     off that range and the largest departure. Hooks the engine's per-check call."""
     import math
 
-    import rbm_cli.bullet as engine_mod
-    from rbm_cli.bullet_scene import joint_normal_range, read_frame
+    import rbm_cli.models.bullet.run as engine_mod
+    from rbm_cli.models.bullet.scene import joint_normal_range, read_frame
 
     hold = engine_mod.keep_in_plane
     base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
@@ -474,8 +474,8 @@ def part_normals() -> None:
 def part_chaos() -> None:
     """The 8-drum cell (0.6 g, 1 Hz) that changed with the time step: K = 4 runs with
     the sweep's ensemble offsets (phase, relative amplitude up to 1e-6) at 1e-4 and 5e-4 s."""
-    from rbm_cli.robustness import members
-    from rbm_cli.sweep import ensemble_member
+    from rbm_cli.study.robustness import members
+    from rbm_cli.study.sweep import ensemble_member
 
     base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
     rows = []

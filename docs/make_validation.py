@@ -32,21 +32,21 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
-from rbm_cli.closed_forms import (  # noqa: E402
+from rbm_cli.config.load import load_config, parse_config  # noqa: E402
+from rbm_cli.config.types import ExcitationConfig, GridConfig, InitialConfig  # noqa: E402
+from rbm_cli.models.housner import block_geometry  # noqa: E402
+from rbm_cli.models.housner_linear import housner_linear_run  # noqa: E402
+from rbm_cli.physics.closed_forms import (  # noqa: E402
     free_rocking_period,
     halfsine_threshold_curves,
     linear_rocking_parameters,
 )
-from rbm_cli.column import build_column  # noqa: E402
-from rbm_cli.config import load_config, parse_config  # noqa: E402
-from rbm_cli.config_types import ExcitationConfig, GridConfig, InitialConfig  # noqa: E402
-from rbm_cli.domain import boundary, compare, read_domain  # noqa: E402
-from rbm_cli.excitation import make_ground_motion  # noqa: E402
-from rbm_cli.housner import block_geometry  # noqa: E402
-from rbm_cli.housner_linear import housner_linear_run  # noqa: E402
-from rbm_cli.plot_domain import plot_domain  # noqa: E402
-from rbm_cli.simulate import housner_restitution, model_from_config, simulate  # noqa: E402
-from rbm_cli.sweep import run_sweep  # noqa: E402
+from rbm_cli.physics.column import build_column  # noqa: E402
+from rbm_cli.physics.excitation import make_ground_motion  # noqa: E402
+from rbm_cli.report.plot_domain import plot_domain  # noqa: E402
+from rbm_cli.study.domain import boundary, compare, read_domain  # noqa: E402
+from rbm_cli.study.simulate import housner_restitution, model_from_config, simulate  # noqa: E402
+from rbm_cli.study.sweep import run_sweep  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIGS = ROOT / "configs"

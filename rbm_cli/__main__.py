@@ -1,5 +1,5 @@
 """`python -m rbm_cli` runs the rbm command line."""
 
-from .cli import main
+from rbm_cli.cli.main import main
 
 main()

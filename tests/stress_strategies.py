@@ -1,7 +1,7 @@
 """Hypothesis strategies over the configurations a user can write (issue 6).
 
 Every strategy builds a plain mapping, as a YAML file would hold, and passes it
-through :func:`rbm_cli.config.parse_config`, so each drawn example is a config
+through :func:`rbm_cli.config.load.parse_config`, so each drawn example is a config
 that validation accepts. Cost is bounded per example: short durations for
 elastic and multi-drum columns (a stiff 8-drum 10 s cell costs seconds), long
 durations (up to 100 s) only for rigid monolithic columns, and a solver budget
@@ -17,9 +17,9 @@ import math
 
 from hypothesis import strategies as st
 
-from rbm_cli.column import build_column
-from rbm_cli.config import parse_config
-from rbm_cli.config_types import FORMULATIONS
+from rbm_cli.config.load import parse_config
+from rbm_cli.config.types import FORMULATIONS
+from rbm_cli.physics.column import build_column
 
 #: Per-example solver budget (a run beyond it is 'failed', never a hang).
 MAX_STEPS = 200_000

@@ -7,12 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rbm_cli.baseline import baseline_run
-from rbm_cli.closed_forms import linear_rocking_parameters
-from rbm_cli.config import load_config
-from rbm_cli.excitation import make_ground_motion
-from rbm_cli.housner_linear import housner_linear_run
-from rbm_cli.simulate import model_from_config
+from rbm_cli.config.load import load_config
+from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.rbm.baseline import baseline_run
+from rbm_cli.physics.closed_forms import linear_rocking_parameters
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.study.simulate import model_from_config
 
 from .paths import CONFIGS
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import pandas as pd
 from click.testing import CliRunner
 
-from rbm_cli.bench import PEAK_TARGET, check_targets, errors
-from rbm_cli.cli import cli
+from rbm_cli.cli.main import cli
+from rbm_cli.study.bench import PEAK_TARGET, check_targets, errors
 
 
 def frame(rows):
@@ -77,7 +77,7 @@ def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
     cell is converged only if its outcome is the same in all four and it is robust
     (every member agrees); a peak is scored only if it is converged, 1e-11, 1e-12
     and the nudge agree to 1e-6, and those three count the same uplifts and impacts."""
-    import rbm_cli.bench as bench
+    import rbm_cli.study.bench as bench
 
     cells = [(0.1, 1.0), (0.2, 1.0), (0.3, 1.0), (0.4, 1.0), (0.5, 1.0), (0.6, 1.0)]
     # per cell: (collapsed, peak, uplifts) at 1e-10, 1e-11, 1e-12 and nudged

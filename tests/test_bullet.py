@@ -18,9 +18,17 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from rbm_cli.bullet import EngineSettings, bullet_run, impact_rate_ratios, measure_restitution
-from rbm_cli.bullet_geometry import drum_solids, stack_slenderness
-from rbm_cli.bullet_scene import (
+from rbm_cli.cli.main import cli
+from rbm_cli.config.load import parse_config
+from rbm_cli.config.types import G
+from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
+from rbm_cli.models.bullet.run import (
+    EngineSettings,
+    bullet_run,
+    impact_rate_ratios,
+    measure_restitution,
+)
+from rbm_cli.models.bullet.scene import (
     Frame,
     StackGeometry,
     build_scene,
@@ -28,12 +36,9 @@ from rbm_cli.bullet_scene import (
     keep_in_plane,
     read_frame,
 )
-from rbm_cli.cli import cli
-from rbm_cli.config import parse_config
-from rbm_cli.config_types import G
-from rbm_cli.excitation import GroundMotion
-from rbm_cli.housner import block_geometry, housner_restitution
-from rbm_cli.simulate import simulate
+from rbm_cli.models.housner import block_geometry, housner_restitution
+from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.study.simulate import simulate
 
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}  # Spanos-Koh slender, H/B = 4
 TAPER = {"height": 5.0, "base_width": 0.96, "top_width": 0.66}  # the paper's column
@@ -309,7 +314,7 @@ def test_engine_domain_plot_marks_the_engine_uplift_level():
     import matplotlib.pyplot as plt
     import pandas as pd
 
-    from rbm_cli.sweep import domain_figure
+    from rbm_cli.study.sweep import domain_figure
 
     cfg = config(TAPER)
     df = pd.DataFrame(

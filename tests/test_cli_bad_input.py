@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from rbm_cli.cli import cli
+from rbm_cli.cli.main import cli
 
 from .paths import RESULTS
 

@@ -7,7 +7,7 @@ import shutil
 import pytest
 from click.testing import CliRunner
 
-from rbm_cli.cli import cli
+from rbm_cli.cli.main import cli
 
 from .paths import CONFIGS, RESULTS
 

@@ -7,7 +7,7 @@ import json
 import pytest
 from click.testing import CliRunner
 
-from rbm_cli.cli import cli
+from rbm_cli.cli.main import cli
 
 from .paths import CONFIGS
 
@@ -207,7 +207,7 @@ def test_usage_errors_are_one_line(tmp_path, args):
 def test_run_says_when_it_compiles_the_kernel(tmp_path, monkeypatch, cold):
     """A first run compiles the kernel (15-20 s of silence otherwise): one note on
     stderr then, none when numba's cache is there."""
-    import rbm_cli.kernel as kernel
+    import rbm_cli.models.rbm.kernel as kernel
 
     monkeypatch.setattr(kernel, "needs_compile", lambda: cold)
     res = invoke("run", CONFIGS / "spanos_koh_slender.yaml", "-a", 0.5, "-f", 1, "-o", tmp_path)
@@ -217,7 +217,7 @@ def test_run_says_when_it_compiles_the_kernel(tmp_path, monkeypatch, cold):
 
 def test_needs_compile_sees_the_cache():
     """After a compiled run in this process, the on-disk cache exists."""
-    from rbm_cli.kernel import needs_compile, warm_up
+    from rbm_cli.models.rbm.kernel import needs_compile, warm_up
 
     warm_up()
     assert needs_compile() is False

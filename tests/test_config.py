@@ -1,4 +1,4 @@
-"""Tests of the YAML config loader (rbm_cli.config): values, defaults and error messages.
+"""Tests of the YAML config loader (rbm_cli.config.load): values, defaults and error messages.
 
 Every file is written under pytest's tmp_path; nothing touches the working tree.
 """
@@ -12,16 +12,16 @@ import textwrap
 
 import pytest
 
-from rbm_cli._validate import read_yaml
-from rbm_cli.config import load_config, parse_config
-from rbm_cli.config_types import (
+from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.load import load_config, parse_config
+from rbm_cli.config.types import (
     Config,
     GridConfig,
     InitialConfig,
     SolverConfig,
     StiffnessConfig,
 )
-from rbm_cli.errors import ConfigError
+from rbm_cli.config.validate import read_yaml
 
 FULL = """\
 name: paper_column-8.drums

@@ -1,5 +1,5 @@
 """`rbm sweep --ensemble K`: each cell run K times with tiny, documented
-perturbations of phase, amplitude and tolerance (rbm_cli.robustness);
+perturbations of phase, amplitude and tolerance (rbm_cli.study.robustness);
 collapse_fraction and robust show which cells are robust."""
 
 from __future__ import annotations
@@ -11,16 +11,16 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from rbm_cli.cli import cli
-from rbm_cli.closed_forms import linear_rocking_parameters
-from rbm_cli.config import load_config
-from rbm_cli.config_types import GridConfig
-from rbm_cli.domain import read_domain
-from rbm_cli.excitation import make_ground_motion
-from rbm_cli.housner_linear import housner_linear_run
-from rbm_cli.robustness import LARGEST, RULE, SMALLEST, member_config, members, tight_rtol
-from rbm_cli.simulate import model_from_config, simulate
-from rbm_cli.sweep import run_sweep
+from rbm_cli.cli.main import cli
+from rbm_cli.config.load import load_config
+from rbm_cli.config.types import GridConfig
+from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.physics.closed_forms import linear_rocking_parameters
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.study.domain import read_domain
+from rbm_cli.study.robustness import LARGEST, RULE, SMALLEST, member_config, members, tight_rtol
+from rbm_cli.study.simulate import model_from_config, simulate
+from rbm_cli.study.sweep import run_sweep
 
 from .paths import CONFIGS
 

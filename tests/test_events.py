@@ -1,4 +1,4 @@
-"""Unit tests of the event search of a solver step (rbm_cli.events).
+"""Unit tests of the event search of a solver step (rbm_cli.models.events).
 
 The functions are given distances whose crossings are known in closed form, so
 the expected times come from the formulas, not from the code.
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rbm_cli.events import first_crossing, hermite_dip, within_reach
+from rbm_cli.models.events import first_crossing, hermite_dip, within_reach
 
 
 def _dist(rows):

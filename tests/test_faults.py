@@ -46,9 +46,9 @@ from pathlib import Path
 
 import pytest
 
-from rbm_cli.config import load_config
-from rbm_cli.store import JOURNAL, STATE, SweepStore
-from rbm_cli.sweep import config_hash, grid_cells, run_sweep
+from rbm_cli.config.load import load_config
+from rbm_cli.study.store import JOURNAL, STATE, SweepStore
+from rbm_cli.study.sweep import config_hash, grid_cells, run_sweep
 
 CONFIG = """\
 name: faults
@@ -312,7 +312,7 @@ def _assert_clean(tally: Tally) -> None:
 
 @pytest.fixture(scope="module")
 def compiled():
-    from rbm_cli.kernel import warm_up
+    from rbm_cli.models.rbm.kernel import warm_up
 
     warm_up()
 

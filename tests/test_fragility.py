@@ -14,9 +14,9 @@ import pytest
 from matplotlib.collections import PolyCollection
 from scipy.stats import norm
 
-from rbm_cli.errors import RbmError
-from rbm_cli.fragility import collapse_probability, fit_lognormal, fragility
-from rbm_cli.fragility_report import plot_fragility, plot_ida, write_fragility
+from rbm_cli.base.errors import RbmError
+from rbm_cli.report.fragility_report import plot_fragility, plot_ida, write_fragility
+from rbm_cli.study.fragility import collapse_probability, fit_lognormal, fragility
 
 LEVELS = np.round(np.arange(0.05, 1.0001, 0.05), 10)
 

@@ -1,5 +1,5 @@
-"""The compiled kernel (rbm_cli.kernel) against the Python reference loop
-(rbm_cli.integrate) and against closed forms.
+"""The compiled kernel (rbm_cli.models.rbm.kernel) against the Python reference loop
+(rbm_cli.models.rbm.python) and against closed forms.
 
 The kernel transcribes the Python loop (same Runge-Kutta tableaux, step-size
 control and event handling), so on runs that are not chaotic the two give the
@@ -16,13 +16,13 @@ import math
 import numpy as np
 import pytest
 
-from rbm_cli.closed_forms import linear_rocking_parameters
-from rbm_cli.config import load_config
-from rbm_cli.excitation import make_ground_motion
-from rbm_cli.housner_linear import housner_linear_run
-from rbm_cli.integrate import integrate
-from rbm_cli.kernel import integrate_compiled
-from rbm_cli.simulate import model_from_config, simulate
+from rbm_cli.config.load import load_config
+from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.rbm.kernel import integrate_compiled
+from rbm_cli.models.rbm.python import integrate
+from rbm_cli.physics.closed_forms import linear_rocking_parameters
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.study.simulate import model_from_config, simulate
 
 from .paths import CONFIGS
 
@@ -119,7 +119,7 @@ def test_kernel_energy_jump_reproducer():
     """Issue 6's energy-jump case (tests/test_stress.py::test_energy_jump_reproducer)
     through the kernel: 6 drums, ultra-stiff joints, e = 1, free motion, >800
     impacts; the earliest crossing in a step must win, or energy jumps by 5e-4."""
-    from rbm_cli.config import parse_config
+    from rbm_cli.config.load import parse_config
 
     config = parse_config(
         {
@@ -149,8 +149,8 @@ def test_silent_impacts_change_nothing_but_the_event_count(monkeypatch):
     than the solver's own spread between rtol 1e-10 and 1e-12 (the 8-drum column
     amplifies round-off fast: 0.4 s, before that spread grows); the kernel counts
     as the Python loop does."""
-    import rbm_cli.integrate as integrate_module
-    from rbm_cli.events import Pieces
+    import rbm_cli.models.rbm.python as integrate_module
+    from rbm_cli.models.events import Pieces
 
     cfg = load_config(CONFIGS / "harmonic_multidrum.yaml")
     model = model_from_config(cfg)

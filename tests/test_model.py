@@ -8,8 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rbm_cli.column import build_column
-from rbm_cli.config_types import (
+from rbm_cli.config.types import (
     ColumnConfig,
     Config,
     ExcitationConfig,
@@ -18,7 +17,8 @@ from rbm_cli.config_types import (
     SolverConfig,
     StiffnessConfig,
 )
-from rbm_cli.simulate import model_from_config, simulate
+from rbm_cli.physics.column import build_column
+from rbm_cli.study.simulate import model_from_config, simulate
 
 from .closed_form import LinearRocking
 

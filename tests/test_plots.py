@@ -11,9 +11,10 @@ import pytest
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
-from rbm_cli.column import build_column
-from rbm_cli.config import load_config
-from rbm_cli.output import (
+from rbm_cli.config.load import load_config
+from rbm_cli.models.result import History
+from rbm_cli.physics.column import build_column
+from rbm_cli.report.files import (
     OutputError,
     check_writable_dir,
     history_frame,
@@ -24,7 +25,7 @@ from rbm_cli.output import (
     write_json_atomic,
     write_run,
 )
-from rbm_cli.plots import (
+from rbm_cli.report.plots import (
     exaggeration_factor,
     infer_elevations,
     plot_history,
@@ -32,8 +33,7 @@ from rbm_cli.plots import (
     plot_top_relative,
     top_relative_displacement,
 )
-from rbm_cli.result import History
-from rbm_cli.simulate import simulate
+from rbm_cli.study.simulate import simulate
 
 THREE_DRUMS = """\
 name: three

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from rbm_cli import pulses
-from rbm_cli.errors import RbmError
-from rbm_cli.pulses import (
+from rbm_cli.base.errors import RbmError
+from rbm_cli.physics import pulses
+from rbm_cli.physics.pulses import (
     cycloidal_pulse,
     mavroeidis_papageorgiou,
     mavroeidis_papageorgiou_duration,

@@ -11,12 +11,12 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from rbm_cli.closed_forms import linear_rocking_parameters
-from rbm_cli.column import build_column
-from rbm_cli.config import load_config
-from rbm_cli.domain import read_domain
-from rbm_cli.excitation import make_ground_motion
-from rbm_cli.housner_linear import housner_linear_run
+from rbm_cli.config.load import load_config
+from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.physics.closed_forms import linear_rocking_parameters
+from rbm_cli.physics.column import build_column
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.study.domain import read_domain
 
 from .paths import CONFIGS, RESULTS
 

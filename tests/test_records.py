@@ -10,9 +10,9 @@ import time
 import numpy as np
 import pytest
 
-from rbm_cli import record_parsers
-from rbm_cli.errors import RbmError
-from rbm_cli.records import G, Record, read_record, write_at2, write_csv
+from rbm_cli.base.errors import RbmError
+from rbm_cli.physics import record_parsers
+from rbm_cli.physics.records import G, Record, read_record, write_at2, write_csv
 
 HEADER = [
     "PEER NGA STRONG MOTION DATABASE RECORD",

@@ -17,10 +17,10 @@ from hypothesis import strategies as st
 from scipy.integrate import quad, tplquad
 from scipy.optimize import brentq
 
-from rbm_cli.config_types import ColumnConfig, SolverConfig
-from rbm_cli.excitation import GroundMotion
-from rbm_cli.housner import block_geometry, housner_restitution, housner_run
-from rbm_cli.housner_linear import housner_linear_run
+from rbm_cli.config.types import ColumnConfig, SolverConfig
+from rbm_cli.models.housner import block_geometry, housner_restitution, housner_run
+from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.physics.excitation import GroundMotion
 
 G = 9.81
 ALPHA = 0.2  # slenderness of the linear test block [rad]
@@ -422,8 +422,8 @@ def test_rigid_rbm_is_housner_linear(kind, amplitude_g, frequency_hz):
     Survived runs are not compared peak by peak: near-chatter runs amplify
     1e-12 differences by ~1e8 over 10 s (measured), a property of the motion.
     """
-    from rbm_cli.config_types import Config, ExcitationConfig
-    from rbm_cli.simulate import simulate
+    from rbm_cli.config.types import Config, ExcitationConfig
+    from rbm_cli.study.simulate import simulate
 
     H, B, duration = 4.0, 1.0, 10.0 if kind == "harmonic" else 20.0
     config = Config(
@@ -448,7 +448,7 @@ def test_housner_event_is_the_earliest_crossing_of_either_row():
     """housner._earliest on a made-up step whose rotation dips below zero on (0.2, 0.3)
     (an impact) and passes the collapse limit at 0.9: the event is the impact at 0.2.
     A root of the minimum of the two rows, the earlier rule, may be the one at 0.9."""
-    from rbm_cli.housner import _earliest
+    from rbm_cli.models.housner import _earliest
 
     limit, s, eps = 1.0, 1, 0.0
 

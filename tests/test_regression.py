@@ -2,15 +2,15 @@
 
 Every stored domain here was made as an ensemble of 16 (`rbm sweep --ensemble
 16 -o results`): its rows are the plain runs, and its `robust` column says,
-by the robustness rule (rbm_cli.robustness), which outcomes are facts and which
-are accidents of rounding. The regression rule (rbm_cli.regression):
+by the robustness rule (rbm_cli.study.robustness), which outcomes are facts and which
+are accidents of rounding. The regression rule (rbm_cli.study.regression):
 
 - each study is re-made whole as a plain domain, and every robust cell must
   have the same outcome: 0 may differ. Sensitive cells are reported, not scored;
 - the 8-drum column is chaotic along its boundary: its CI band
   (configs/ci/harmonic_multidrum_ci.yaml, 66 cells) is re-made as an ensemble
   of 16 too, and its count of sensitive cells may not exceed the stated bound
-  (rbm_cli.regression.sensitive_bound): a change that makes the model noisier
+  (rbm_cli.study.regression.sensitive_bound): a change that makes the model noisier
   fails even if no robust cell moves.
 
 A perturbed model (base width -10 %) must fail the same rule, so this test can
@@ -24,11 +24,11 @@ import json
 
 import pytest
 
-from rbm_cli.config import load_config
-from rbm_cli.domain import compare, read_domain
-from rbm_cli.regression import check
-from rbm_cli.robustness import MEMBERS, RULE
-from rbm_cli.sweep import run_sweep
+from rbm_cli.config.load import load_config
+from rbm_cli.study.domain import compare, read_domain
+from rbm_cli.study.regression import check
+from rbm_cli.study.robustness import MEMBERS, RULE
+from rbm_cli.study.sweep import run_sweep
 
 from .paths import CONFIGS, RESULTS
 

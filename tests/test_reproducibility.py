@@ -5,7 +5,7 @@
    compile target (NUMBA_CPU_NAME=generic: no AVX, no FMA), OpenBLAS's kernel
    (OPENBLAS_CORETYPE), and glibc's libm variant (GLIBC_TUNABLES without FMA
    and AVX2). Each must pass the regression rule against the stored domain,
-   and (rbm_cli.detmath) give the same bytes as this process's run: before
+   and (rbm_cli.base.detmath) give the same bytes as this process's run: before
    detmath, OPENBLAS_CORETYPE=SkylakeX changed 5 and Sandybridge 2 of 100
    8-drum cells, glibc without FMA 5 (docs/reproducibility.md).
 2. The deterministic arithmetic itself: fdlibm's sin and asin within 1 ulp of
@@ -29,11 +29,11 @@ import pandas as pd
 import pytest
 from numba import njit
 
-from rbm_cli import detmath
-from rbm_cli.config import load_config
-from rbm_cli.domain import read_domain
-from rbm_cli.regression import check, sensitive_bound
-from rbm_cli.sweep import run_sweep
+from rbm_cli.base import detmath
+from rbm_cli.config.load import load_config
+from rbm_cli.study.domain import read_domain
+from rbm_cli.study.regression import check, sensitive_bound
+from rbm_cli.study.sweep import run_sweep
 
 from .paths import CONFIGS, RESULTS, ROOT
 
@@ -188,7 +188,7 @@ def test_the_rule_fails_on_missing_cells_and_on_a_noisier_model():
 
 
 def test_the_rule_needs_a_stored_robustness_record():
-    from rbm_cli.errors import RbmError
+    from rbm_cli.base.errors import RbmError
 
     with pytest.raises(RbmError, match="--ensemble 16"):
         check(_domain([0, 1]), _domain([0, 1]))
@@ -203,7 +203,7 @@ def test_meta_records_what_a_result_depends_on(tmp_path):
     cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
     import dataclasses
 
-    from rbm_cli.config_types import GridConfig
+    from rbm_cli.config.types import GridConfig
 
     cfg = dataclasses.replace(cfg, grid=GridConfig(amplitudes_g=(0.3,), frequencies_hz=(1.0,)))
     meta = json.loads((run_sweep(cfg, tmp_path, jobs=1).folder / "meta.json").read_text())
@@ -243,7 +243,7 @@ def test_cli_compare_applies_the_rule_to_a_stored_ensemble(tmp_path):
     robust one does."""
     from click.testing import CliRunner
 
-    from rbm_cli.cli import cli
+    from rbm_cli.cli.main import cli
 
     stored = _domain([0, 0, 1, 1], robust=[1, 0, 1, 1])
     stored.to_csv(tmp_path / "a.csv", index=False)

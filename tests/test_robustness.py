@@ -23,11 +23,11 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from rbm_cli.cli import cli
-from rbm_cli.config import load_config
-from rbm_cli.errors import RbmError
-from rbm_cli.store import JOURNAL, STATE, SweepStore
-from rbm_cli.sweep import run_sweep
+from rbm_cli.base.errors import RbmError
+from rbm_cli.cli.main import cli
+from rbm_cli.config.load import load_config
+from rbm_cli.study.store import JOURNAL, STATE, SweepStore
+from rbm_cli.study.sweep import run_sweep
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -266,12 +266,12 @@ def _no_result(folder: Path) -> None:
 def test_case06_a_plot_failure_publishes_nothing(small, tmp_path, straight, monkeypatch):
     """Defect: domain.csv, boundary.csv and meta.json were written before the PNG: a plot
     failure left files that looked finished."""
-    import rbm_cli.sweep
+    import rbm_cli.study.sweep
 
     def broken(*args, **kwargs):
         raise ValueError("the figure cannot be drawn")
 
-    monkeypatch.setattr(rbm_cli.sweep, "domain_figure", broken)
+    monkeypatch.setattr(rbm_cli.study.sweep, "domain_figure", broken)
     res = invoke("sweep", small, "-o", tmp_path / "out", "--jobs", "1", "--quiet")
     one_line_error(res, "cannot draw domain.png", "--resume")
     folder = tmp_path / "out" / "small"
@@ -284,12 +284,12 @@ def test_case06_a_plot_failure_publishes_nothing(small, tmp_path, straight, monk
 
 
 def test_case06_ctrl_c_while_drawing_publishes_nothing(small, tmp_path, monkeypatch):
-    import rbm_cli.sweep
+    import rbm_cli.study.sweep
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(rbm_cli.sweep, "domain_figure", interrupted)
+    monkeypatch.setattr(rbm_cli.study.sweep, "domain_figure", interrupted)
     res = invoke("sweep", small, "-o", tmp_path / "out", "--jobs", "1", "--quiet")
     one_line_error(res, f"{N_CELLS} of {N_CELLS} cells are kept", "--resume", code=130)
     _no_result(tmp_path / "out" / "small")
@@ -319,11 +319,11 @@ def test_case06_a_full_disk_publishes_nothing(small, tmp_path, straight):
 # ----------------------------------------------------------------- hangs
 NAN_KERNEL = """
 import numpy as np
-from rbm_cli.column import build_column
-from rbm_cli.config_types import ColumnConfig, InterfaceConfig, SolverConfig
-from rbm_cli.excitation import GroundMotion
-from rbm_cli.kernel import integrate_compiled
-from rbm_cli.model import build_model
+from rbm_cli.physics.column import build_column
+from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
+from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.models.rbm.kernel import integrate_compiled
+from rbm_cli.physics.equations import build_model
 with np.errstate(all="ignore"):
     geometry = ColumnConfig(height=4.0, base_width=1.0, top_width=1.0, depth=1.0,
                             density=1e308, drum_heights=(4.0,))
@@ -364,7 +364,7 @@ solver: {max_steps: 1e9, max_events: 1e9}
 @pytest.fixture(scope="module")
 def compiled():
     """The kernel compiled (or loaded) once, so a subprocess only loads it."""
-    from rbm_cli.kernel import warm_up
+    from rbm_cli.models.rbm.kernel import warm_up
 
     warm_up()
 
@@ -450,9 +450,9 @@ def test_case09_a_scheduler_that_is_not_dask_is_refused_in_bounded_time(
     """Defect: --scheduler tcp://host:<an HTTP port> blocked forever (the 10 s timeout
     covered only the connection)."""
     pytest.importorskip("dask.distributed")
-    import rbm_cli.parallel
+    import rbm_cli.study.parallel
 
-    monkeypatch.setattr(rbm_cli.parallel, "DASK_PROBE_TIMEOUT_S", 2.0)
+    monkeypatch.setattr(rbm_cli.study.parallel, "DASK_PROBE_TIMEOUT_S", 2.0)
     server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), _Http)
     threading.Thread(target=server.serve_forever, daemon=True).start()
     try:
@@ -491,8 +491,8 @@ def test_case10_the_same_column_at_a_stone_density_collapses(tmp_path):
 
 def test_case10_every_derived_quantity_is_checked_before_a_run():
     """A column whose masses overflow is refused by model_from_config, not run."""
-    from rbm_cli.config import parse_config
-    from rbm_cli.simulate import model_from_config
+    from rbm_cli.config.load import parse_config
+    from rbm_cli.study.simulate import model_from_config
 
     cfg = parse_config({"name": "c", "column": {"height": 4.0, "base_width": 1.0}})
     huge = dataclasses.replace(cfg, column=dataclasses.replace(cfg.column, density=1e308))
@@ -632,7 +632,7 @@ def test_case15_the_eta_counts_only_this_sessions_cells(monkeypatch):
     compile left in): 100 resumed of 200, then 10 cells in 2 s -> 5 cells/s, 18 s left."""
     import io
 
-    import rbm_cli.progress as progress
+    import rbm_cli.cli.progress as progress
 
     clock = iter([1000.0, 1002.0, 1002.0])
     monkeypatch.setattr(progress.time, "monotonic", lambda: next(clock))

@@ -22,13 +22,13 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from rbm_cli.config import parse_config
-from rbm_cli.excitation import make_ground_motion
-from rbm_cli.info import describe
-from rbm_cli.integrate import integrate
-from rbm_cli.result import STATUSES
-from rbm_cli.simulate import model_from_config, simulate
-from rbm_cli.sweep import run_sweep
+from rbm_cli.config.load import parse_config
+from rbm_cli.models.rbm.python import integrate
+from rbm_cli.models.result import STATUSES
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.report.info import describe
+from rbm_cli.study.simulate import model_from_config, simulate
+from rbm_cli.study.sweep import run_sweep
 
 from .stress_strategies import (
     _round,
@@ -279,7 +279,7 @@ def test_impact_energy_reproducer(formulation):
 def test_energy_jump_reproducer():
     """Guards against a missed first event when another row crosses later in the step
     (energy jump 5e-4 before the fix; the limit is 1e-6). Runs the Python reference
-    integrator (rbm_cli.integrate) directly, where the step sequence of the failure
+    integrator (rbm_cli.models.rbm.python) directly, where the step sequence of the failure
     was found."""
     config = parse_config(
         {

@@ -1,0 +1,1 @@
+"""Below everything: errors, deterministic arithmetic, atomic files. Imports nothing of rbm."""

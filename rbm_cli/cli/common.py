@@ -1,0 +1,110 @@
+"""The CLI's shared pieces: the `rbm` group, one-line errors, config loading, options.
+
+Command modules (run, domain, bench) import from here; nothing here imports them.
+
+Each command loads a config, calls one library function and writes or prints
+the result. Errors a user can cause (:class:`rbm_cli.base.errors.RbmError`, bad
+options) end in one line ``Error: ...`` on stderr and exit status 2.
+"""
+
+from __future__ import annotations
+
+import click
+
+from rbm_cli import __version__
+from rbm_cli.base.errors import RbmError
+
+#: Exit status of a user error (bad input, unwritable output).
+EXIT_USER_ERROR = 2
+#: Exit status of a run whose integration failed (files are still written).
+EXIT_RUN_FAILED = 1
+#: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
+EXIT_INTERRUPTED = 130
+#: Most samples `rbm run --dt` may record (a history of 10^7 rows is ~2 GB of CSV).
+MAX_SAMPLES = 10_000_000
+
+
+class UserError(click.ClickException):
+    """A one-line error for the user, exit status 2."""
+
+    exit_code = EXIT_USER_ERROR
+
+
+class Interrupted(click.ClickException):
+    """Ctrl-C: one line saying what was kept, exit status 130."""
+
+    exit_code = EXIT_INTERRUPTED
+
+
+class RbmGroup(click.Group):
+    """A click group whose usage errors are one line, like every other error, and
+    whose Ctrl-C is one line too (click's own says only 'Aborted!')."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except click.UsageError as exc:
+            hint = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+            message = " ".join(exc.format_message().split())
+            raise UserError(message + hint) from None
+        except KeyboardInterrupt:
+            raise Interrupted("interrupted (Ctrl-C)") from None
+
+
+def load(config_path: str):
+    """Load a config, turning every library error into a one-line CLI error."""
+    from rbm_cli.config.load import load_config
+
+    try:
+        return load_config(config_path)
+    except RbmError as exc:
+        raise UserError(one_line(exc)) from None
+
+
+def compile_notice(cfg) -> None:
+    """One line on stderr before a run that will compile the kernel (first use)."""
+    if cfg.model == "rbm" and cfg.solver.implementation == "compiled":
+        from rbm_cli.models.rbm.kernel import needs_compile
+
+        if needs_compile():
+            click.echo("note: compiling the integrator (first use only, about 20 s)", err=True)
+
+
+def one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+# --------------------------------------------------------------------------- shared options
+
+config_argument = click.argument("config", metavar="CONFIG.yaml", type=str)
+
+
+def check_output(ctx, param, value: str) -> str:
+    """--output: a folder name, not empty (-o '' once wrote into the current folder)."""
+    if value is not None and not value.strip():
+        raise UserError(f"--output must name a folder (e.g. out), got {value!r}")
+    return value
+
+
+output_option = click.option(
+    "-o",
+    "--output",
+    "output",
+    default="out",
+    show_default=True,
+    type=str,
+    callback=check_output,
+    help="Output root folder; results go to OUTPUT/<name>/.",
+)
+
+
+@click.group(cls=RbmGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="rbm")
+def cli() -> None:
+    """Seismic rocking of freestanding stone columns with the Rigid Beam Model.
+
+    \b
+    Example:
+        rbm info configs/spanos_koh_slender.yaml
+        rbm run configs/spanos_koh_slender.yaml --amplitude 0.5 --frequency 1
+    """

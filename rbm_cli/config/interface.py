@@ -1,0 +1,117 @@
+"""The ``interface`` section of a config: joint stiffness, xi, restitution, formulation.
+
+The stiffness is written with its unit explicit: ``rigid``, ``{rotational: K_M}``
+(a joint bending stiffness [N m/rad], one value or one per interface) or
+``{normal: k_n}`` (a joint normal stiffness [Pa/m], from which K_M,i follows). A bare
+number or list is refused: 5e9 read as K_M is a column 20x stiffer than 5e9 read as k_n
+(issue 14), and the file cannot say which the user meant.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.types import FORMULATIONS, InterfaceConfig, StiffnessConfig
+from rbm_cli.config.validate import choice, describe, fmt, is_number, mapping, number, number_list
+
+INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation", "friction")
+STIFFNESS_KEYS = ("rotational", "normal")
+#: Stiffnesses the tool accepts [assumption]: far beyond any stone joint on either side,
+#: and inside the range where K_M theta^2, K_M / I and their products stay finite.
+ROTATIONAL_RANGE = (1e-3, 1e30)  # K_M [N m/rad]
+NORMAL_RANGE = (1e-3, 1e20)  # k_n [Pa/m]
+FRICTION_MAX = 100.0
+BOTH_FORMS = "{rotational: K_M} [N m/rad] or {normal: k_n} [Pa/m]"
+
+
+def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
+    """Validate the ``interface`` mapping of a column of n drums for a model."""
+    i = mapping(raw, "interface", INTERFACE_KEYS)
+    if "friction" in i and model != "bullet":
+        raise ConfigError(
+            f"interface.friction applies only to model bullet (model is {model}, which does"
+            " not slide): delete it"
+        )
+    friction = number(i.get("friction", 1.0), "interface.friction", "", 0.0)
+    if friction > FRICTION_MAX:
+        raise ConfigError(
+            f"interface.friction must be at most {fmt(FRICTION_MAX)}, got {fmt(friction)}"
+        )
+    stiffness = i.get("stiffness", "rigid")
+    if model == "bullet" and isinstance(stiffness, str) and stiffness == "rigid":
+        n = 1  # the engine's drums are rigid; the RBM's joint law is not used
+    restitution = i.get("restitution", 1.0)
+    if isinstance(restitution, str) and restitution == "housner":
+        if n != 1:
+            raise ConfigError(
+                f"interface.restitution: housner needs a monolithic column (drums: 1), got {n}"
+                " drums; give a number in (0, 1]"
+            )
+    elif is_number(restitution):
+        restitution = number(restitution, "interface.restitution", "", 0.0, 1.0)
+    else:
+        raise ConfigError(
+            f"interface.restitution must be a number in (0, 1] or housner, got"
+            f" {describe(restitution)}"
+        )
+    return InterfaceConfig(
+        stiffness=stiffness_value(i.get("stiffness", "rigid"), n, given="stiffness" in i),
+        xi=number(i.get("xi", 1.0), "interface.xi", "", 0.0, 1.0),
+        restitution=restitution,
+        formulation=choice(i.get("formulation", "relative"), "interface.formulation", FORMULATIONS),
+        friction=friction,
+    )
+
+
+def _in_range(x: float, path: str, unit: str, bounds: tuple[float, float]) -> float:
+    if not bounds[0] <= x <= bounds[1]:
+        raise ConfigError(
+            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
+            f" the arithmetic is sound), got {fmt(x)}"
+        )
+    return x
+
+
+def stiffness_value(value: Any, n: int, *, given: bool = True) -> StiffnessConfig:
+    """``rigid``, ``{rotational: K_M or [K_M,i]}`` or ``{normal: k_n}``."""
+    path = "interface.stiffness"
+    if isinstance(value, str) and value == "rigid":
+        if n > 1:
+            raise ConfigError(
+                f"{path}: rigid{'' if given else ' (the default)'} needs a monolithic column"
+                f" (drums: 1); give {BOTH_FORMS} for multi-drum columns"
+            )
+        return StiffnessConfig("rigid", ())
+    if is_number(value) or isinstance(value, list | tuple):
+        what = "number" if is_number(value) else "list"
+        raise ConfigError(
+            f"{path}: a bare {what} does not say its unit: write {BOTH_FORMS},"
+            f" got {describe(value)}"
+        )
+    if isinstance(value, Mapping):
+        m = mapping(value, path, STIFFNESS_KEYS)
+        if len(m) != 1:
+            raise ConfigError(f"{path} needs exactly one of rotational and normal: {BOTH_FORMS}")
+        if "rotational" in m:
+            return _rotational(m["rotational"], n)
+        sub = f"{path}.normal"
+        k_n = number(m["normal"], sub, "Pa/m", 0.0, inf_hint="use rigid for an infinite stiffness")
+        return StiffnessConfig("normal", (_in_range(k_n, sub, "Pa/m", NORMAL_RANGE),))
+    raise ConfigError(
+        f"{path} must be rigid, {BOTH_FORMS} (K_M one value or a list with one per interface),"
+        f" got {describe(value)}"
+    )
+
+
+def _rotational(value: Any, n: int) -> StiffnessConfig:
+    path = "interface.stiffness.rotational"
+    if isinstance(value, list | tuple):
+        per = f"one K_M per interface ({n} for {n} drum{'s' if n > 1 else ''})"
+        values = number_list(value, path, "N m/rad", 0.0, length=n, length_text=per)
+        for i, k in enumerate(values):
+            _in_range(k, f"{path}[{i}]", "N m/rad", ROTATIONAL_RANGE)
+        return StiffnessConfig("moment", values)
+    k_m = number(value, path, "N m/rad", 0.0, inf_hint="use rigid for an infinite stiffness")
+    return StiffnessConfig("moment", (_in_range(k_m, path, "N m/rad", ROTATIONAL_RANGE),))

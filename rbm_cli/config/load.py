@@ -1,0 +1,396 @@
+"""Read a YAML config into the validated, frozen dataclasses of :mod:`rbm_cli.config.types`.
+
+Every user error raises :class:`rbm_cli.base.errors.ConfigError` with one line that names
+the YAML key path and the allowed range or values, e.g.
+``cfg.yaml: column.height must be a number > 0 [m], got -1``.
+
+The schema is SPEC section 4, plus ``excitation.initial`` (SPEC section 3) and a
+``solver`` section (our extension: integrator settings). Lengths are in m,
+stiffnesses in N m/rad (K_M) or Pa/m (k_n), times in s, angles in rad; the grid
+keeps amplitudes in g and frequencies in Hz, the edge units.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.interface import interface_section
+from rbm_cli.config.types import (
+    EXCITATIONS,
+    IMPLEMENTATIONS,
+    METHODS,
+    MODELS,
+    SECTIONS,
+    CollapseConfig,
+    ColumnConfig,
+    Config,
+    ExcitationConfig,
+    GridConfig,
+    InitialConfig,
+    SolverConfig,
+)
+from rbm_cli.config.validate import (
+    choice,
+    describe,
+    fmt,
+    grid_axis,
+    integer,
+    join,
+    mapping,
+    number,
+    number_list,
+    one_line,
+    read_yaml,
+)
+
+__all__ = ["load_config", "parse_config"]
+
+TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
+COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
+EXCITATION_KEYS = ("type", "duration", "phase", "initial")
+INITIAL_KEYS = ("rotations", "velocities")
+GRID_KEYS = ("amplitudes", "frequencies")
+COLLAPSE_KEYS = ("ratio",)
+SOLVER_KEYS = (
+    "method",
+    "rtol",
+    "atol",
+    "max_steps",
+    "max_events",
+    "time_step",
+    "implementation",
+    "max_wall_time",
+)
+
+#: Models of SPEC section 2 that this version does not implement yet.
+PLANNED_MODELS: tuple[str, ...] = ()
+#: Models that accept any number of drums (the reference blocks are monolithic).
+MULTI_DRUM_MODELS = ("rbm", "bullet")
+#: Range of solver.time_step, the contact engine's fixed step [s].
+TIME_STEP_RANGE = (1e-6, 1e-2)
+#: Default ``excitation.duration`` per type [s] (SPEC section 3).
+DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
+MAX_DURATION = 1e4  # [s]
+MAX_DRUMS = 200
+MAX_TOP_TAPER = 3.0  # top_width <= MAX_TOP_TAPER * base_width (and <= height)
+#: Heights of a column or block the tool accepts [m] [assumption]: a laboratory
+#: block to a tower; far outside, masses and inertias overflow or underflow.
+HEIGHT_RANGE = (1e-3, 1e3)
+#: Widths, depth and drum heights [m] and density [kg/m^3] the tool accepts [assumption]:
+#: wide enough for any stone column or laboratory model, narrow enough that masses,
+#: inertias and moments stay far inside floating point (density 1e307 overflowed them
+#: and reported a collapsing column as survived: issue 14).
+LENGTH_RANGE = (1e-4, 1e3)
+DENSITY_RANGE = (1.0, 1e5)
+#: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
+INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
+PHASE_MAX = 1e3
+#: Grid and command-line excitation ranges [assumption]: g and Hz at the edges.
+AMPLITUDE_RANGE_G = (0.0, 1e3)
+FREQUENCY_RANGE_HZ = (1e-3, 1e3)
+#: Largest step and event budgets (a 64-bit count; 1e300 failed in the compiled kernel).
+MAX_BUDGET = 1_000_000_000
+#: Range of solver.max_wall_time, the wall-clock budget of one run [s].
+WALL_TIME_RANGE = (0.0, 1e6)
+MAX_FILE_BYTES = 1_000_000
+DRUM_SUM_RTOL = 1e-9
+NAME_RE = re.compile(r"[A-Za-z0-9_.\-]{1,100}")
+
+
+def load_config(path: str | os.PathLike[str]) -> Config:
+    """Read and validate a YAML config file.
+
+    Parameters
+    ----------
+    path : str or path-like  The YAML file
+
+    Returns
+    -------
+    Config  Validated, SI units (the grid in g and Hz)
+
+    Raises
+    ------
+    ConfigError  File missing or unreadable, malformed YAML, or any key missing,
+        unknown, of the wrong type or out of range; one line naming the key path.
+    """
+    source = os.fspath(path)
+    file = Path(source)
+    try:
+        if file.is_dir():
+            raise ConfigError(f"{source} is a directory, not a config file")
+        if file.exists() and not file.is_file():
+            raise ConfigError(f"{source} is not a regular file")
+        with file.open("rb") as handle:
+            raw = handle.read(MAX_FILE_BYTES + 1)
+    except FileNotFoundError:
+        raise ConfigError(f"config file not found: {source}") from None
+    except PermissionError:
+        raise ConfigError(f"cannot read {source}: permission denied") from None
+    except (OSError, ValueError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise ConfigError(f"cannot read {source}: {one_line(str(reason))}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ConfigError(f"{source} is larger than {MAX_FILE_BYTES} bytes: not a config file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"cannot parse {source}: not UTF-8 text (bad byte at offset {exc.start})"
+        ) from None
+    return parse_config(read_yaml(text, source), source)
+
+
+# ------------------------------------------------------------------------ sections
+
+
+def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
+    """Validate the mapping a YAML config holds and build a :class:`Config`.
+
+    Parameters
+    ----------
+    data : mapping  Parsed YAML (keys of SPEC section 4)
+    source : str  Where ``data`` came from, prefixed to error messages
+
+    Returns
+    -------
+    Config  Validated, SI units (the grid in g and Hz)
+
+    Raises
+    ------
+    ConfigError  One line: ``<source>: <key path> must be <allowed>, got <value>``.
+    """
+    try:
+        return _config(data)
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
+
+
+def _config(data: Any) -> Config:
+    if data is None:
+        raise ConfigError("the config is empty (it needs at least name and column)")
+    if isinstance(data, Mapping) and "initial" in data:
+        raise ConfigError("unknown key 'initial' at top level: it goes under excitation")
+    top = mapping(data, "", TOP_KEYS)
+    if "name" not in top:
+        raise ConfigError("name is required (the output folder name)")
+    if "column" not in top:
+        raise ConfigError("column is required (a mapping with height and base_width [m])")
+    name = _name(top["name"])
+    model = top.get("model", "rbm")
+    if isinstance(model, str) and model in PLANNED_MODELS and model not in MODELS:
+        raise ConfigError(
+            f"model {model!r} is not available in this version (allowed: {', '.join(MODELS)})"
+        )
+    model = choice(model, "model", MODELS)
+    column = _column(top["column"])
+    n = column.n_drums
+    if model not in MULTI_DRUM_MODELS and n != 1:
+        raise ConfigError(f"model {model!r} needs a monolithic column (drums: 1), got {n} drums")
+    return Config(
+        name=name,
+        column=column,
+        model=model,
+        interface=interface_section(top.get("interface"), n, model),
+        excitation=_excitation(top.get("excitation"), n),
+        grid=_grid(top.get("grid")),
+        collapse=CollapseConfig(
+            ratio=number(
+                mapping(top.get("collapse"), "collapse", COLLAPSE_KEYS).get("ratio", 1.0),
+                "collapse.ratio",
+                "",
+                0.0,
+                1.0,
+            )
+        ),
+        solver=_solver(top.get("solver")),
+    )
+
+
+def _name(value: Any) -> str:
+    if not isinstance(value, str):
+        raise ConfigError(f"name must be a string (quote it), got {describe(value)}")
+    if not NAME_RE.fullmatch(value) or set(value) == {"."}:
+        raise ConfigError(
+            "name must be a folder name of 1-100 letters A-Z a-z, digits and _ - . "
+            f"(no spaces or slashes), got {describe(value)}"
+        )
+    return value
+
+
+def _column(raw: Any) -> ColumnConfig:
+    c = mapping(raw, "column", COLUMN_KEYS)
+    for key in ("height", "base_width"):
+        if key not in c:
+            raise ConfigError(f"column.{key} is required (a number > 0 [m])")
+    height = number(c["height"], "column.height", "m", 0.0)
+    if not HEIGHT_RANGE[0] <= height <= HEIGHT_RANGE[1]:
+        raise ConfigError(
+            f"column.height must be in [{fmt(HEIGHT_RANGE[0])}, {fmt(HEIGHT_RANGE[1])}] [m]"
+            f" (a laboratory block to a tower), got {fmt(height)}"
+        )
+    base = _bounded(number(c["base_width"], "column.base_width", "m", 0.0), "column.base_width")
+    if base > height:
+        raise ConfigError(
+            f"column.base_width must be <= column.height ({fmt(height)} m), got {fmt(base)}"
+            " (a block wider than tall is outside the model's intent)"
+        )
+    top = number(
+        c.get("top_width", base),
+        "column.top_width",
+        "m",
+        0.0,
+        min(MAX_TOP_TAPER * base, height),
+        hint=f"at most {fmt(MAX_TOP_TAPER)} x column.base_width and at most column.height",
+    )
+    top = _bounded(top, "column.top_width")
+    section = choice(c.get("section", "rectangular"), "column.section", SECTIONS)
+    depth = None
+    if "depth" in c:
+        if section != "rectangular":
+            raise ConfigError(
+                f"column.depth applies only to section: rectangular (section is {section};"
+                " a circle's diameter is the width): delete it"
+            )
+        depth = _bounded(number(c["depth"], "column.depth", "m", 0.0), "column.depth")
+    return ColumnConfig(
+        height=height,
+        base_width=base,
+        top_width=top,
+        section=section,
+        depth=depth,
+        density=_bounded(
+            number(c.get("density", 2700.0), "column.density", "kg/m^3", 0.0),
+            "column.density",
+            "kg/m^3",
+            DENSITY_RANGE,
+        ),
+        drum_heights=_drums(c.get("drums", 1), height),
+    )
+
+
+def _bounded(
+    x: float, path: str, unit: str = "m", bounds: tuple[float, float] = LENGTH_RANGE
+) -> float:
+    """x within bounds [assumption: the range where the arithmetic is sound]."""
+    if not bounds[0] <= x <= bounds[1]:
+        raise ConfigError(
+            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
+            f" masses, inertias and moments stay finite), got {fmt(x)}"
+        )
+    return x
+
+
+def _drums(value: Any, height: float) -> tuple[float, ...]:
+    path = "column.drums"
+    if not isinstance(value, list | tuple):
+        count = integer(
+            value, path, 1, MAX_DRUMS, " (count of equal drums) or a list of drum heights [m]"
+        )
+        return (height / count,) * count
+    if not 1 <= len(value) <= MAX_DRUMS:
+        got = f"{len(value)} heights" if value else "an empty list"
+        raise ConfigError(f"{path} must list 1..{MAX_DRUMS} drum heights [m], got {got}")
+    heights = number_list(value, path, "m", 0.0)
+    for i, h in enumerate(heights):
+        _bounded(h, join(path, i), "m", (1e-6, LENGTH_RANGE[1]))
+    total = math.fsum(heights)
+    if abs(total - height) > DRUM_SUM_RTOL * height:
+        raise ConfigError(
+            f"{path} heights sum to {fmt(total)} m but column.height is {fmt(height)} m"
+            " (they must agree within 1e-9 relative)"
+        )
+    return heights
+
+
+def _excitation(raw: Any, n: int) -> ExcitationConfig:
+    e = mapping(raw, "excitation", EXCITATION_KEYS)
+    kind = choice(e.get("type", "harmonic"), "excitation.type", EXCITATIONS)
+    duration = number(
+        e.get("duration", DEFAULT_DURATION.get(kind, 10.0)),
+        "excitation.duration",
+        "s",
+        0.0,
+        MAX_DURATION,
+    )
+    phase = number(e.get("phase", 0.0), "excitation.phase", "rad")
+    phase = _bounded(phase, "excitation.phase", "rad", (-PHASE_MAX, PHASE_MAX))
+    if phase != 0.0 and kind != "harmonic":
+        raise ConfigError(
+            f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"
+        )
+    path = "excitation.initial"
+    init = mapping(e.get("initial"), path, INITIAL_KEYS)
+    per = f"one value per drum ({n})"
+    values = {
+        key: tuple(
+            _bounded(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
+            for i, x in enumerate(
+                number_list(init[key], join(path, key), unit, length=n, length_text=per)
+            )
+        )
+        if key in init
+        else ()
+        for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
+    }
+    if kind == "free" and not any(values["rotations"]) and not any(values["velocities"]):
+        raise ConfigError(
+            f"{path}: excitation type free needs a non-zero initial rotation or velocity"
+            f" ({path}.rotations or .velocities); with none the column stays at rest"
+        )
+    return ExcitationConfig(
+        type=kind, duration=duration, phase=phase, initial=InitialConfig(**values)
+    )
+
+
+def _grid(raw: Any) -> GridConfig:
+    g = mapping(raw, "grid", GRID_KEYS)
+    amplitudes, frequencies = (
+        grid_axis(g[key], join("grid", key), unit, lo_open=lo_open, bounds=bounds)
+        if key in g
+        else ()
+        for key, unit, lo_open, bounds in (
+            ("amplitudes", "g", False, AMPLITUDE_RANGE_G),
+            ("frequencies", "Hz", True, FREQUENCY_RANGE_HZ),
+        )
+    )
+    return GridConfig(amplitudes_g=amplitudes, frequencies_hz=frequencies)
+
+
+def _solver(raw: Any) -> SolverConfig:
+    s = mapping(raw, "solver", SOLVER_KEYS)
+    default = SolverConfig()
+    return SolverConfig(
+        method=choice(s.get("method", default.method), "solver.method", METHODS),
+        rtol=number(s.get("rtol", default.rtol), "solver.rtol", "", 1e-13, 1e-3, lo_open=False),
+        atol=number(s.get("atol", default.atol), "solver.atol", "", 0.0, 1e-3),
+        max_steps=integer(
+            s.get("max_steps", default.max_steps), "solver.max_steps", 1000, MAX_BUDGET
+        ),
+        max_events=integer(
+            s.get("max_events", default.max_events), "solver.max_events", 100, MAX_BUDGET
+        ),
+        time_step=number(
+            s.get("time_step", default.time_step),
+            "solver.time_step",
+            "s",
+            *TIME_STEP_RANGE,
+            lo_open=False,
+        ),
+        implementation=choice(
+            s.get("implementation", default.implementation),
+            "solver.implementation",
+            IMPLEMENTATIONS,
+        ),
+        max_wall_time=number(
+            s.get("max_wall_time", default.max_wall_time),
+            "solver.max_wall_time",
+            "s",
+            *WALL_TIME_RANGE,
+        ),
+    )

@@ -1,0 +1,158 @@
+"""Validated configuration: frozen dataclasses in SI units.
+
+The YAML loader (:mod:`rbm_cli.config.load`) builds these; everything downstream
+(column, law, model, integrator, sweep) reads only these objects, never YAML.
+Amplitudes stay in g and frequencies in Hz only in :class:`GridConfig`, the
+edge of the program; physics code converts with :data:`G`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+#: Acceleration of gravity [m/s^2] (SPEC: g = 9.81).
+G = 9.81
+
+#: rbm: the Rigid Beam Model; housner: Housner's nonlinear rigid block (large
+#: rotations, true geometry); housner-linear: the piecewise-linear block of
+#: Spanos and Koh (closed form, true geometry). The last two: monolithic only.
+#: bullet: stacked rigid drums in Bullet's contact dynamics (PyBullet), any drums.
+MODELS = ("rbm", "housner", "housner-linear", "bullet")
+SECTIONS = ("rectangular", "circular")
+FORMULATIONS = ("relative", "absolute", "geometric")
+EXCITATIONS = ("harmonic", "half-sine", "free")
+METHODS = ("DOP853", "RK45", "RK23")
+IMPLEMENTATIONS = ("compiled", "python")
+
+
+@dataclass(frozen=True)
+class ColumnConfig:
+    """Geometry and material of the column.
+
+    height : float  Total height H [m]
+    base_width : float  Width B_1 at z = 0 [m]
+    top_width : float  Width at z = H [m]
+    section : str  'rectangular' or 'circular'
+    depth : float or None  Out-of-plane depth [m] (rectangular only); None = local width
+    density : float  Mass density [kg/m^3]
+    drum_heights : tuple of float  Heights h_i of the drums, bottom first [m]
+    """
+
+    height: float
+    base_width: float
+    top_width: float
+    section: str = "rectangular"
+    depth: float | None = None
+    density: float = 2700.0
+    drum_heights: tuple[float, ...] = ()
+
+    @property
+    def n_drums(self) -> int:
+        return len(self.drum_heights)
+
+
+@dataclass(frozen=True)
+class StiffnessConfig:
+    """Interface bending stiffness.
+
+    kind : str  'rigid' (K_M = infinity), 'moment' (K_M given [N m/rad]) or
+        'normal' (joint normal stiffness k_n [Pa/m])
+    values : tuple of float  For 'moment': one value, or one per interface
+        [N m/rad]; for 'normal': (k_n,) [Pa/m]; for 'rigid': ()
+    """
+
+    kind: str = "rigid"
+    values: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class InterfaceConfig:
+    """Moment-rotation law of the interfaces.
+
+    restitution : float or str  Angular-velocity ratio in (0, 1], or 'housner'
+    friction : float  Coulomb friction coefficient of the joints and the base
+        (model bullet only; the RBM and the reference models do not slide) [-]
+    """
+
+    stiffness: StiffnessConfig = field(default_factory=StiffnessConfig)
+    xi: float = 1.0
+    restitution: float | str = 1.0
+    formulation: str = "relative"
+    friction: float = 1.0
+
+
+@dataclass(frozen=True)
+class InitialConfig:
+    """Initial absolute drum rotations [rad] and rates [rad/s], bottom first.
+
+    Empty tuples mean zero.
+    """
+
+    rotations: tuple[float, ...] = ()
+    velocities: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class ExcitationConfig:
+    """Ground motion shape; amplitude and frequency come from the grid or the CLI.
+
+    type : str  'harmonic', 'half-sine' or 'free'
+    duration : float  Harmonic: length of the excitation; half-sine: maximum
+        simulated time; free: simulated time [s]
+    phase : float  Phase of the harmonic [rad]
+    """
+
+    type: str = "harmonic"
+    duration: float = 10.0
+    phase: float = 0.0
+    initial: InitialConfig = field(default_factory=InitialConfig)
+
+
+@dataclass(frozen=True)
+class GridConfig:
+    """Sweep grid, at the edge of the program: amplitudes in g, frequencies in Hz."""
+
+    amplitudes_g: tuple[float, ...] = ()
+    frequencies_hz: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class CollapseConfig:
+    ratio: float = 1.0
+
+
+@dataclass(frozen=True)
+class SolverConfig:
+    """Integrator settings.
+
+    method : str  Runge-Kutta pair of scipy.integrate.solve_ivp
+    rtol, atol : float  Tolerances (atol relative to the rotation scale theta_u)
+    max_steps : int  Step budget of one run; beyond it the run is 'failed'
+    max_events : int  Budget of events (kinks, impacts) of one run
+    time_step : float  Fixed time step of the contact engine (model bullet) [s]
+    implementation : str  'compiled' (the numba kernel, rbm_cli.models.rbm.kernel) or
+        'python' (the reference loop, rbm_cli.models.rbm.python); same algorithm
+    max_wall_time : float  Wall-clock budget of one run [s]; beyond it the run is
+        'failed' (a guard against a run that would not end, not a tolerance)
+    """
+
+    method: str = "DOP853"
+    rtol: float = 1e-10
+    atol: float = 1e-12
+    max_steps: int = 2_000_000
+    max_events: int = 200_000
+    time_step: float = 1e-4
+    implementation: str = "compiled"
+    max_wall_time: float = 3600.0
+
+
+@dataclass(frozen=True)
+class Config:
+    name: str
+    column: ColumnConfig
+    model: str = "rbm"
+    interface: InterfaceConfig = field(default_factory=InterfaceConfig)
+    excitation: ExcitationConfig = field(default_factory=ExcitationConfig)
+    grid: GridConfig = field(default_factory=GridConfig)
+    collapse: CollapseConfig = field(default_factory=CollapseConfig)
+    solver: SolverConfig = field(default_factory=SolverConfig)

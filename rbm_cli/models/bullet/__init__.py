@@ -1,0 +1,1 @@
+"""`bullet`: stacked rigid drums in Bullet's contact dynamics (PyBullet)."""

@@ -1,0 +1,127 @@
+"""The benchmark's baseline: the RBM as a researcher would first write it.
+
+scipy's ``solve_ivp`` (RK45, rtol 1e-6) called once per smooth piece, with
+terminal events for the law's kinks, the impacts and collapse (one Python
+function per event surface), restarted after each event. The physics is the
+same as rbm_cli.models.rbm.python's (same pieces, same impact rule, same rest of a
+rigid block), so the benchmark compares integrators, not models. Only the
+outcome is kept: status, collapse time and peak rotation ratio (from the
+solver's steps and the event states).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from rbm_cli.models.events import Pieces
+from rbm_cli.models.rbm.python import REST_RATE
+from rbm_cli.physics.equations import Model
+from rbm_cli.physics.excitation import GroundMotion
+
+#: Tolerances of the baseline (the issue's: RK45, rtol 1e-6); atol in units of
+#: theta_u for rotations and 10 theta_u for rates, as rbm's own solver.
+BASELINE_RTOL = 1e-6
+BASELINE_ATOL = 1e-9
+
+
+def _event(row, offset):
+    def ev(t, y):
+        return float(row @ y[: row.size]) + offset
+
+    ev.terminal = True
+    ev.direction = -1
+    return ev
+
+
+def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) -> dict:
+    """One run of the baseline; returns status, t_collapse_s, max_rotation_ratio, wall_time_s.
+    A run longer than budget_s [s] of wall time stops as 'failed' (its time still counts)."""
+    start = time.perf_counter()
+    n = model.n
+    tu = model.column.rotation_capacity
+    pieces = Pieces(model)
+    argmap = model.arg_map
+    arg_inv = model.arg_inverse
+    cmap = model.collapse_map / model.collapse_limit[:, None]
+    c = model.collapse_ratio
+    atol = BASELINE_ATOL * np.concatenate([np.full(n, tu.min()), np.full(n, 10 * tu.min())])
+    uplift = model.uplift_level
+    rest_rate = REST_RATE * model.rocking_p * tu.min()
+    y = np.zeros(2 * n)
+    t = 0.0
+    at_rest = uplift is not None
+    peak = 0.0
+    pieces.locate(np.zeros(n), np.zeros(n))
+    status, t_col = "survived", math.nan
+    for seg_start, seg_end in motion.segments():
+        forced = motion.forced(seg_start)
+        amp = motion.amplitude if forced else 0.0
+        while t < seg_end:
+            if at_rest:
+                kind, t = motion.rest_end(t, seg_end, uplift, forced)
+                if kind != "uplift":
+                    break
+                y = np.zeros(2 * n)
+                pieces.side[0], pieces.k[0] = motion.uplift_side(t), 0
+                at_rest = False
+            if time.perf_counter() - start > budget_s:
+                return {"status": "failed", "t_collapse_s": math.nan, "max_rotation_ratio": peak,
+                        "wall_time_s": time.perf_counter() - start}  # fmt: skip
+            A, cvec, evec = pieces.system()
+            lo, hi = pieces.bounds()
+            events = []
+            for i in range(n):
+                row = argmap[i]
+                events.append(_event(row, -lo[i]) if np.isfinite(lo[i]) else None)
+                events.append(_event(-row, hi[i]) if np.isfinite(hi[i]) else None)
+                events.append(_event(-cmap[i], c))
+                events.append(_event(cmap[i], c))
+            live = [e for e in events if e is not None]
+            n_terminal = len(live)
+            for i in range(n):  # peaks: zero crossings of the collapse quantities' rates
+
+                def peak_event(tt, yy, row=cmap[i]):
+                    return float(row @ yy[n:])
+
+                live.append(peak_event)
+
+            def fun(tt, yy, A=A, cvec=cvec, evec=evec, amp=amp):
+                g = amp * math.sin(motion.omega * tt + motion.phase) if amp else 0.0
+                return np.concatenate([yy[n:], A @ yy[:n] + cvec + evec * g])
+
+            sol = solve_ivp(
+                fun, (t, seg_end), y, method="RK45", rtol=BASELINE_RTOL, atol=atol, events=live
+            )
+            peak = max(peak, float(np.max(np.abs(cmap @ sol.y[:n]))))
+            for ye in sol.y_events[n_terminal:]:
+                if ye.size:
+                    peak = max(peak, float(np.max(np.abs(ye[:, :n] @ cmap.T))))
+            if sol.status != 1:
+                if sol.status < 0:
+                    return {"status": "failed", "t_collapse_s": math.nan,
+                            "max_rotation_ratio": peak,
+                            "wall_time_s": time.perf_counter() - start}  # fmt: skip
+                t, y = seg_end, sol.y[:, -1]
+                break
+            hit = next(j for j, te in enumerate(sol.t_events[:n_terminal]) if te.size)
+            t, y = float(sol.t_events[hit][0]), sol.y_events[hit][0].copy()
+            kind_i = events.index(live[hit])
+            i, which = divmod(kind_i, 4)
+            if which >= 2:
+                status, t_col, peak = "collapsed", t, max(peak, c)
+                return {"status": status, "t_collapse_s": t_col, "max_rotation_ratio": peak,
+                        "wall_time_s": time.perf_counter() - start}  # fmt: skip
+            going_up = which == 1
+            bound = hi[i] if going_up else lo[i]
+            y[:n] += arg_inv[:, i] * (bound - float(argmap[i] @ y[:n]))
+            if pieces.cross(i, going_up) == "impact":
+                if model.restitution < 1.0:
+                    y[n:] = model.impact_rates(y[n:], i)
+                if uplift is not None and abs(y[n]) < rest_rate:
+                    y, at_rest = np.zeros(2 * n), True
+    return {"status": status, "t_collapse_s": t_col, "max_rotation_ratio": peak,
+            "wall_time_s": time.perf_counter() - start}  # fmt: skip

@@ -1,0 +1,362 @@
+"""Event search and law bookkeeping for the compiled kernel (numba): the
+transcriptions of rbm_cli.models.events (earliest crossing on the dense output,
+cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces), plus the exact
+uplift time of a rigid block at rest and time-history sampling."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rbm_cli.base.detmath import asin as dasin
+from rbm_cli.base.detmath import dot, matvec
+from rbm_cli.base.detmath import sin as dsin
+from rbm_cli.models.rbm.kernel_rk import TAB_NP, _dense_eval
+
+
+@njit(cache=True)
+def _affine(G, y, off, h0, out):
+    """out = G @ y[off:off + cols] (+ h0 if given): no allocation."""
+    for r in range(G.shape[0]):
+        d = 0.0 if h0.size == 0 else h0[r]
+        for j in range(G.shape[1]):
+            d += G[r, j] * y[off + j]
+        out[r] = d
+
+
+@njit(cache=True)
+def _row_poly(mc, F, y_old, G, row, h0, n, rate, coef):
+    """One row of the step's interpolant, projected: the distance G[row] theta +
+    h0[row] (or, rate, the rate G[row] theta') as a polynomial in the step's
+    fraction, with _dense_eval's form. Fills coef, returns the constant term;
+    _poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
+    off = n if rate else 0
+    for q in range(TAB_NP[mc]):
+        v = 0.0
+        for j in range(n):
+            v += G[row, j] * F[q, off + j]
+        coef[q] = v
+    base = 0.0 if rate else h0[row]
+    for j in range(n):
+        base += G[row, j] * y_old[off + j]
+    return base
+
+
+@njit(cache=True)
+def _poly_val(mc, t, t_old, h, coef, base):
+    """A projected row (_row_poly) at time t: _dense_eval for one row."""
+    x = (t - t_old) / h
+    v = 0.0
+    nq = TAB_NP[mc]
+    if mc == 2:  # DOP853's nested form (_dense_eval)
+        for q in range(nq):
+            v += coef[nq - 1 - q]
+            v *= x if q % 2 == 0 else 1.0 - x
+        return v + base
+    p = 1.0
+    for r in range(nq):
+        p *= x
+        v += coef[r] * p
+    return base + v
+
+
+#: Tolerances of the root finding: scipy brentq's rtol (4 eps) and our xtol [s].
+XTOL, RTOL, MAXITER = 1e-14, 8.881784197001252e-16, 100
+
+
+@njit(cache=True)
+def _brentq(mc, xa, xb, t_old, h, coef, base):
+    """scipy's brentq (zeros.c) along a projected row of the step's interpolant."""
+    xpre, xcur = xa, xb
+    xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
+    fpre = _poly_val(mc, xpre, t_old, h, coef, base)
+    fcur = _poly_val(mc, xcur, t_old, h, coef, base)
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    for _ in range(MAXITER):
+        if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = (XTOL + RTOL * abs(xcur)) / 2.0
+        sbis = (xblk - xcur) / 2.0
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre, scur = sbis, sbis
+        else:
+            spre, scur = sbis, sbis
+        xpre, fpre = xcur, fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0 else -delta
+        fcur = _poly_val(mc, xcur, t_old, h, coef, base)
+    return xcur
+
+
+@njit(cache=True)
+def _quad_roots(qa, qb, qc):
+    """Real roots of qa s^2 + qb s + qc (as np.roots: leading zeros dropped)."""
+    r = np.full(2, np.nan)
+    if qa == 0.0:
+        if qb != 0.0:
+            r[0] = -qc / qb
+        return r
+    disc = qb * qb - 4.0 * qa * qc
+    if disc < 0.0:
+        return r
+    sq = math.sqrt(disc)
+    q = -0.5 * (qb + sq if qb >= 0.0 else qb - sq)
+    if q != 0.0:
+        r[0] = q / qa
+        r[1] = qc / q
+    else:
+        r[0] = 0.0
+        r[1] = 0.0
+    return r
+
+
+@njit(cache=True)
+def _lowest_dip(d0, d1, r0, r1, dt):
+    """events._lowest_dip: (time from the start, row) of the lowest interior minimum
+    below zero of the cubic Hermite interpolants, or (-1, -1)."""
+    best, t_best, row = 0.0, -1.0, -1
+    for r in range(d0.size):
+        if not (r0[r] < 0.0 and r1[r] > 0.0):
+            continue
+        p0, m0, p1, m1 = d0[r], dt * r0[r], d1[r], dt * r1[r]
+        if min(p0, p1) > 0.5 * (abs(m0) + abs(m1)):
+            continue
+        a = 2 * p0 + m0 - 2 * p1 + m1
+        b = -3 * p0 - 2 * m0 + 3 * p1 - m1
+        if abs(a) + abs(b) == 0.0:
+            continue
+        roots = _quad_roots(3 * a, 2 * b, m0)
+        for s in roots:
+            if 0.0 < s < 1.0:
+                val = ((a * s + b) * s + m0) * s + p0
+                if val < best:
+                    best, t_best, row = val, s * dt, r
+    return t_best, row
+
+
+#: Sub-intervals of a step checked on the dense output (events.CHECK_INTERVALS).
+CHECK_INTERVALS = 8
+
+
+@njit(cache=True)
+def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
+    """events.within_reach, row by row: mask[r] marks the rows within reach (only
+    they are searched in _first_crossing; the others cannot cross by the same
+    criterion that lets a step with no row within reach go unchecked)."""
+    anyrow = False
+    for r in range(d0.size):
+        reach = dt * (abs(r0[r]) + abs(r1[r])) + dt * dt * (abs(a0[r]) + abs(a1[r]))
+        mask[r] = min(d0[r], d1[r]) <= reach
+        anyrow = anyrow or mask[r]
+    return anyrow
+
+
+@njit(cache=True)
+def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
+                    CP, BP, CR, BR):  # fmt: skip
+    """events.first_crossing on the step's dense output, over the rows in `mask`:
+    (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
+    The masked rows' interpolants are projected once (CP, BP: distances; CR, BR:
+    rates) and evaluated as scalars."""
+    nseg = CHECK_INTERVALS
+    h = t1 - t0
+    nrow = G.shape[0]
+    for r in range(nrow):
+        if mask[r]:
+            BP[r] = _row_poly(mc, F, y_old, G, r, h0, n, False, CP[r])
+            BR[r] = _row_poly(mc, F, y_old, G, r, h0, n, True, CR[r])
+    for q in range(nseg + 1):
+        tq = t0 + h * q / nseg if q < nseg else t1
+        for r in range(nrow):
+            if not mask[r]:
+                D[r, q], R[r, q] = np.inf, 0.0  # inert: never below zero, never turning
+                continue
+            D[r, q] = _poly_val(mc, tq, t0, h, CP[r], BP[r])
+            R[r, q] = _poly_val(mc, tq, t0, h, CR[r], BR[r])
+    best, brow = np.inf, -1
+    for r in range(nrow):
+        if D[r, 0] < best:
+            best, brow = D[r, 0], r
+    if best <= 0.0:
+        return t0, brow
+    ds = h / nseg
+    for q in range(nseg):
+        a = t0 + h * q / nseg
+        b = t0 + h * (q + 1) / nseg if q + 1 < nseg else t1
+        look = False
+        for r in range(nrow):
+            if D[r, q + 1] < 0.0:
+                look = True
+            elif R[r, q] < 0.0 and R[r, q + 1] > 0.0:
+                if min(D[r, q], D[r, q + 1]) <= 0.5 * ds * (abs(R[r, q]) + abs(R[r, q + 1])):
+                    look = True
+        if not look:
+            continue
+        t_first, r_first = np.inf, -1
+        for r in range(nrow):
+            dcol0[r], dcol1[r] = D[r, q], D[r, q + 1]
+            rcol0[r], rcol1[r] = R[r, q], R[r, q + 1]
+        for r in range(nrow):
+            if D[r, q + 1] < 0.0:
+                tr = _brentq(mc, a, b, t0, h, CP[r], BP[r])
+                if tr < t_first:
+                    t_first, r_first = tr, r
+        s_dip, r_dip = _lowest_dip(dcol0, dcol1, rcol0, rcol1, b - a)
+        if r_dip >= 0:
+            if _poly_val(mc, a + s_dip, t0, h, CP[r_dip], BP[r_dip]) < 0.0:
+                tr = _brentq(mc, a, a + s_dip, t0, h, CP[r_dip], BP[r_dip])
+                if tr < t_first:
+                    t_first, r_first = tr, r_dip
+        if r_first >= 0:
+            return t_first, r_first
+    return -1.0, -1
+
+
+# ---------------------------------------------------------------- laws, pieces
+@njit(cache=True)
+def _n_below(edges, ne, x):
+    k = 0
+    while k < ne and edges[k] <= x:
+        k += 1
+    return k
+
+
+@njit(cache=True)
+def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
+    ne = nedges[i]
+    start = 0.0 if k[i] == 0 else edges[i, k[i] - 1]
+    end = edges[i, k[i]] if k[i] < ne else np.inf
+    if k[i] == 0 and not (rigid[i] or pending[i]):
+        start = -end
+    if side[i] > 0:
+        lo[i], hi[i] = start, end
+    else:
+        lo[i], hi[i] = -end, -start
+
+
+@njit(cache=True)
+def _system(side, k, intercepts, slopes, md, mg, argmap, As, cs):
+    """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place:
+    A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :], c = -(M^-1 D^T) a,
+    with md = M^-1 D^T and mg = M^-1 K_g assembled once (Model.linear_system)."""
+    n = side.size
+    for p in range(n):
+        cs[p] = 0.0
+        for q in range(n):
+            As[p, q] = mg[p, q]
+    for i in range(n):
+        a = side[i] * intercepts[i, k[i]]
+        b = slopes[i, k[i]]
+        for p in range(n):
+            w = md[p, i]
+            if w == 0.0:
+                continue
+            cs[p] -= w * a
+            for q in range(n):
+                if argmap[i, q] != 0.0:
+                    As[p, q] -= w * b * argmap[i, q]
+
+
+@njit(cache=True)
+def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
+    """The event rows G v[off:off + n] (+ h0) of the kernel, from their two
+    distinct blocks: G = [gx; -gx; -gc; gc] (gx = argmap / theta_u, gc the
+    normalised collapse map; `same` when gc == gx, as for `relative`)."""
+    n = gx.shape[0]
+    for i in range(n):
+        a = 0.0
+        for j in range(n):
+            a += gx[i, j] * v[off + j]
+        c = a
+        if not same:
+            c = 0.0
+            for j in range(n):
+                c += gc[i, j] * v[off + j]
+        if with_h0:
+            out[i], out[n + i] = a + h0[i], h0[n + i] - a
+            out[2 * n + i], out[3 * n + i] = h0[2 * n + i] - c, c + h0[3 * n + i]
+        else:
+            out[i], out[n + i], out[2 * n + i], out[3 * n + i] = a, -a, -c, c
+
+
+@njit(cache=True)
+def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
+    """Model.energy for one state."""
+    n = theta.size
+    e = 0.5 * dot(rate, matvec(mass, rate, np.empty(n))) - 0.5 * dot(
+        theta, matvec(gravity, theta, np.empty(n))
+    )
+    x = matvec(argmap, theta, np.empty(n))
+    for i in range(n):
+        ax = abs(x[i])
+        ne = nedges[i]
+        cum, x0 = 0.0, 0.0
+        kk = _n_below(edges[i], ne, ax)
+        for q in range(kk):
+            x1 = edges[i, q]
+            cum += intercepts[i, q] * (x1 - x0) + 0.5 * slopes[i, q] * (x1 * x1 - x0 * x0)
+            x0 = x1
+        e += cum + intercepts[i, kk] * (ax - x0) + 0.5 * slopes[i, kk] * (ax * ax - x0 * x0)
+    return e
+
+
+@njit(cache=True)
+def _next_exceedance(t0, level, amp, om, ph, last):
+    """GroundMotion.next_exceedance; -1 for none before `last`."""
+    if amp <= level or t0 >= last:
+        return -1.0
+    s = level / amp
+    psi0 = om * t0 + ph
+    if abs(dsin(psi0)) > s:
+        return t0
+    lo = dasin(s)
+    kk = math.ceil((psi0 - lo) / math.pi)
+    psi = lo + kk * math.pi
+    if psi < psi0:
+        psi += math.pi
+    t = (psi - ph) / om
+    if t >= last:
+        return -1.0
+    return t
+
+
+@njit(cache=True)
+def _emit_rest(t_stop, samples, n_out, next_out, dt):
+    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
+        samples[n_out, 0] = next_out
+        samples[n_out, 1:] = 0.0
+        n_out += 1
+        next_out += dt
+    return n_out, next_out
+
+
+@njit(cache=True)
+def _emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
+    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
+        samples[n_out, 0] = next_out
+        _dense_eval(mc, next_out, t_old, h, y_old, F, samples[n_out, 1:])
+        n_out += 1
+        next_out += dt
+    return n_out, next_out

@@ -1,0 +1,231 @@
+"""Runge-Kutta steps for the compiled kernel (numba): scipy's DOP853, RK45 and
+RK23 tableaux, initial step, error norm and dense output, transcribed so the
+kernel's step sequence is scipy's (rbm_cli.models.rbm.python drives scipy's steppers)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.integrate._ivp import dop853_coefficients as _dop
+from scipy.integrate._ivp.rk import RK23 as _RK23
+from scipy.integrate._ivp.rk import RK45 as _RK45
+
+from rbm_cli.base.detmath import pow_pos
+from rbm_cli.base.detmath import sin as dsin
+
+#: method name -> code in the kernel
+METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
+
+# ---- Butcher tableaux, padded to one shape: (A, B, C, E, P, n_stages, est_order)
+_NS_MAX = _dop.N_STAGES_EXTENDED
+
+
+def _tableau(method: str):
+    A = np.zeros((_NS_MAX, _NS_MAX))
+    C = np.zeros(_NS_MAX)
+    B = np.zeros(_NS_MAX)
+    E = np.zeros(_NS_MAX)
+    E3 = np.zeros(_NS_MAX)
+    P = np.zeros((_NS_MAX, 8))
+    if method == "DOP853":
+        ns = _dop.N_STAGES
+        A[:, :] = _dop.A
+        C[:] = _dop.C
+        B[:ns] = _dop.B
+        E[: ns + 1] = _dop.E5
+        E3[: ns + 1] = _dop.E3
+        # dense output: D (4 x 16) stored transposed in P[:, :4]
+        P[:, :4] = _dop.D.T
+        return A, B, C, E, E3, P, ns, 7
+    cls = _RK45 if method == "RK45" else _RK23
+    ns = cls.n_stages
+    A[: cls.A.shape[0], : cls.A.shape[1]] = cls.A
+    C[:ns] = cls.C
+    B[:ns] = cls.B
+    E[: ns + 1] = cls.E
+    P[: ns + 1, : cls.P.shape[1]] = cls.P
+    return A, B, C, E, E3, P, ns, cls.error_estimator_order
+
+
+_TAB = [_tableau(m) for m in ("RK23", "RK45", "DOP853")]
+TAB_A = np.stack([t[0] for t in _TAB])
+TAB_B = np.stack([t[1] for t in _TAB])
+TAB_C = np.stack([t[2] for t in _TAB])
+TAB_E = np.stack([t[3] for t in _TAB])
+TAB_E3 = np.stack([t[4] for t in _TAB])
+TAB_P = np.stack([t[5] for t in _TAB])
+TAB_NS = np.array([t[6] for t in _TAB], dtype=np.int64)
+TAB_EST = np.array([t[7] for t in _TAB], dtype=np.int64)
+TAB_NP = np.array([3, 4, 7], dtype=np.int64)  # interpolant order of RK23 / RK45 / DOP853
+
+# status codes of the kernel
+SURVIVED, STOPPED_EARLY, COLLAPSED, FAILED_STEP, FAILED_STEPS, FAILED_EVENTS = range(6)
+# a run past its wall-clock budget, stopped by Ctrl-C, or whose state became NaN or inf
+FAILED_WALL, INTERRUPTED, FAILED_NONFINITE = 6, 7, 8
+_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+
+
+# ---------------------------------------------------------------- small pieces
+@njit(cache=True, inline="always")
+def _ground(t, amp, om, ph):
+    if amp == 0.0:
+        return 0.0
+    return amp * dsin(om * t + ph)
+
+
+@njit(cache=True, inline="always")
+def _rhs(t, y, n, As, cs, es, amp, om, ph, out):
+    g = _ground(t, amp, om, ph)
+    for i in range(n):
+        out[i] = y[n + i]
+        s = cs[i] + es[i] * g
+        for j in range(n):
+            s += As[i, j] * y[j]
+        out[n + i] = s
+
+
+@njit(cache=True)
+def _rms(v):
+    s = 0.0
+    for x in v:
+        s += x * x
+    return math.sqrt(s / v.size)
+
+
+@njit(cache=True)
+def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, amp, om, ph, work):
+    """scipy.integrate._ivp.common.select_initial_step (max_step = inf)."""
+    interval = abs(t_bound - t0)
+    if interval == 0.0:
+        return 0.0
+    m = y0.size
+    scale = atol + np.abs(y0) * rtol
+    d0 = _rms(y0 / scale)
+    d1 = _rms(f0 / scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, interval)
+    y1 = np.empty(m)
+    for i in range(m):
+        y1[i] = y0[i] + h0 * f0[i]
+    _rhs(t0 + h0, y1, n, As, cs, es, amp, om, ph, work)
+    d2 = _rms((work - f0) / scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = pow_pos(0.01 / max(d1, d2), 1.0 / (order + 1))
+    return min(100.0 * h0, h1, interval)
+
+
+@njit(cache=True)
+def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, amp, om, ph):
+    """Stage s from the stages before it: K[s] = f(t + c_s h, y + h sum_j a_sj K_j)."""
+    A = TAB_A[mc]
+    for i in range(y.size):
+        acc = 0.0
+        for j in range(s):
+            acc += A[s, j] * K[j, i]
+        tmp[i] = y[i] + h * acc
+    _rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, amp, om, ph, K[s])
+
+
+@njit(cache=True)
+def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, amp, om, ph):
+    """One Runge-Kutta step of size h; stages in K (row ns = f(t + h, y_new))."""
+    B = TAB_B[mc]
+    ns = TAB_NS[mc]
+    m = y.size
+    K[0, :] = f
+    for s in range(1, ns):
+        _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, amp, om, ph)
+    for i in range(m):
+        acc = 0.0
+        for j in range(ns):
+            acc += B[j] * K[j, i]
+        ynew[i] = y[i] + h * acc
+    _rhs(t + h, ynew, n, As, cs, es, amp, om, ph, K[ns])
+
+
+@njit(cache=True)
+def _error_norm(mc, K, h, y, ynew, atol, rtol, scale):
+    ns = TAB_NS[mc]
+    E = TAB_E[mc]
+    m = scale.size
+    for i in range(m):
+        scale[i] = atol[i] + max(abs(y[i]), abs(ynew[i])) * rtol
+    if mc == 2:
+        E3 = TAB_E3[mc]
+        e5, e3 = 0.0, 0.0
+        for i in range(m):
+            a5, a3 = 0.0, 0.0
+            for j in range(ns + 1):
+                a5 += E[j] * K[j, i]
+                a3 += E3[j] * K[j, i]
+            a5 /= scale[i]
+            a3 /= scale[i]
+            e5 += a5 * a5
+            e3 += a3 * a3
+        if e5 == 0.0 and e3 == 0.0:
+            return 0.0
+        return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * m)
+    s = 0.0
+    for i in range(m):
+        a = 0.0
+        for j in range(ns + 1):
+            a += E[j] * K[j, i]
+        a = a * h / scale[i]
+        s += a * a
+    return math.sqrt(s / m)
+
+
+@njit(cache=True)
+def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, amp, om, ph):
+    """Coefficients F of the step's interpolant (DOP853: extra stages)."""
+    m = y_old.size
+    ns = TAB_NS[mc]
+    P = TAB_P[mc]
+    if mc == 2:
+        for s in range(ns + 1, _NS_MAX):
+            _stage(mc, s, t_old, y_old, h, K, tmp, n, As, cs, es, amp, om, ph)
+        for i in range(m):
+            dy = y_new[i] - y_old[i]
+            F[0, i] = dy
+            F[1, i] = h * K[0, i] - dy
+            F[2, i] = 2.0 * dy - h * (K[ns, i] + K[0, i])
+            for r in range(4):
+                acc = 0.0
+                for j in range(_NS_MAX):
+                    acc += P[j, r] * K[j, i]
+                F[3 + r, i] = h * acc
+        return _NS_MAX - ns - 1
+    order = TAB_NP[mc]
+    for i in range(m):
+        for r in range(order):
+            acc = 0.0
+            for j in range(ns + 1):
+                acc += K[j, i] * P[j, r]
+            F[r, i] = h * acc
+    return 0
+
+
+@njit(cache=True)
+def _dense_eval(mc, t, t_old, h, y_old, F, out):
+    x = (t - t_old) / h
+    m = y_old.size
+    if mc == 2:
+        for i in range(m):
+            v = 0.0
+            for k in range(7):
+                v += F[6 - k, i]
+                v *= x if k % 2 == 0 else 1.0 - x
+            out[i] = v + y_old[i]
+        return
+    order = TAB_NP[mc]
+    for i in range(m):
+        v = 0.0
+        p = 1.0
+        for r in range(order):
+            p *= x
+            v += F[r, i] * p
+        out[i] = y_old[i] + v

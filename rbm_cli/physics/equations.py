@@ -1,0 +1,256 @@
+"""The Rigid Beam Model equations (paper eqs. 1-5), assembled once per column.
+
+Generalised coordinates are the absolute drum rotations theta_i; the nodal
+displacements relative to the ground are u_{k+1} = sum_{j<=k} h_j theta_j. In
+these coordinates the paper's system (5) reads
+
+    M theta'' = D^T m(x) + K_g theta - r a_g(t)
+
+with M = L^T diag(m) L + diag(I_G) the (constant, symmetric) mass matrix,
+L the map from theta to the drums' centre displacements (weight at mid-height:
+L_ij = h_j for j < i, h_i / 2 for j = i), r = L^T m the ground load vector,
+D the difference matrix (D^T M gives M_i - M_{i+1}: interface moments acting
+on the drums above and below), m(x) = -f(x) the interface moments, x the
+argument the law reads (phi = D theta, or theta for `absolute`), and K_g the
+gravity term of the `geometric` formulation. Eliminating the shears T of
+eq. (1) gives the same system; for n = 1 it is
+(I_G + m h^2 / 4) theta'' = -f(theta) - m (h / 2) a_g.
+
+Inside one set of active law pieces the right-hand side is linear:
+theta'' = A theta + c + e a_g(t).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from scipy.linalg import eig
+
+from rbm_cli.base.detmath import inverse, product
+from rbm_cli.physics.column import Column
+from rbm_cli.physics.law import Law, make_law
+
+
+@dataclass(frozen=True)
+class Model:
+    """Assembled equations of one column (SI units).
+
+    mass : (n, n) Mass matrix M [kg m^2]
+    mass_inv : (n, n) M^-1
+    ground_load : (n,) r = L^T m [kg m]
+    centre_map : (n, n) L, theta -> drum-centre displacements [m]
+    node_map : (n+1, n) theta -> node displacements relative to the ground [m]
+    arg_map : (n, n) theta -> law arguments x (D, or I for `absolute`)
+    diff : (n, n) D
+    gravity : (n, n) K_g [N m/rad] (zero unless `geometric`)
+    laws : tuple of Law, one per interface
+    collapse_map : (n, n) theta -> collapse quantities (law arguments, or
+        overturning moments of the stacks above each joint for `geometric`)
+    collapse_limit : (n,) their limits (theta_u [rad] or M_u [N m])
+    collapse_ratio : float  c, collapse when |quantity| >= c * limit
+    restitution : float  e, angular-velocity ratio at an impact
+    formulation : str
+    """
+
+    column: Column
+    mass: np.ndarray
+    mass_inv: np.ndarray
+    ground_load: np.ndarray
+    centre_map: np.ndarray
+    node_map: np.ndarray
+    arg_map: np.ndarray
+    diff: np.ndarray
+    gravity: np.ndarray
+    laws: tuple[Law, ...]
+    collapse_map: np.ndarray
+    collapse_limit: np.ndarray
+    collapse_ratio: float
+    restitution: float
+    formulation: str
+
+    @property
+    def n(self) -> int:
+        return self.mass.shape[0]
+
+    @property
+    def rigid(self) -> bool:
+        return any(law.rigid for law in self.laws)
+
+    def arguments(self, theta: np.ndarray) -> np.ndarray:
+        """Law arguments x (..., n) of rotations theta (..., n) [rad]."""
+        return theta @ self.arg_map.T
+
+    def collapse_ratios(self, theta: np.ndarray) -> np.ndarray:
+        """|collapse quantity| / limit (..., n); collapse at collapse_ratio."""
+        return np.abs(theta @ self.collapse_map.T) / self.collapse_limit
+
+    def energy(self, theta: np.ndarray, rate: np.ndarray) -> np.ndarray:
+        """Energy relative to the ground [J]: kinetic + the laws' potential
+        (+ gravity's for `geometric`). Conserved in free motion with e = 1
+        for `relative` and `geometric`."""
+        theta, rate = np.atleast_2d(theta), np.atleast_2d(rate)
+        kin = 0.5 * np.einsum("ki,ij,kj->k", rate, self.mass, rate)
+        x = self.arguments(theta)
+        pot = sum(law.potential(x[:, i]) for i, law in enumerate(self.laws))
+        grav = -0.5 * np.einsum("ki,ij,kj->k", theta, self.gravity, theta)
+        return kin + pot + grav
+
+    @property
+    def rocking_p(self) -> float:
+        """p of the column rocking as one rigid stack on its base [rad/s]:
+        p^2 = N_1 zbar_1 / (1^T M 1); for n = 1, m g (H/2) / (I_G + m H^2/4)."""
+        col = self.column
+        ones = np.ones(self.n)
+        return math.sqrt(
+            col.normal_forces[0] * col.lever_arms[0] / product(ones, product(self.mass, ones))
+        )
+
+    @property
+    def uplift_level(self) -> float | None:
+        """Ground acceleration at which a rigid monolith starts rocking [m/s^2]:
+        f(0+) / (m h / 2) = xi M_u / (m h / 2); None unless n = 1 with a rigid law."""
+        if self.n != 1 or not self.laws[0].rigid:
+            return None
+        return float(self.laws[0].intercepts[0] / abs(self.ground_load[0]))
+
+    @cached_property
+    def arg_inverse(self) -> np.ndarray:
+        """(n, n) inverse of the argument map: law arguments -> drum rotations."""
+        return inverse(self.arg_map)
+
+    @cached_property
+    def silent_impacts(self) -> np.ndarray:
+        """(n,) bool: interfaces whose impact changes nothing (e = 1 and a law linear
+        through zero on its first piece), so a zero crossing after an excursion need
+        not stop the integrator (events.Pieces.settle and the kernel count it)."""
+        return np.array(
+            [
+                self.restitution == 1.0 and not law.rigid
+                and len(law.edges) > 0 and law.intercepts[0] == 0.0
+                for law in self.laws
+            ],
+            dtype=bool,
+        )  # fmt: skip
+
+    def elastic_frequencies_hz(self) -> list[float]:
+        """Natural frequencies [Hz] of the column on the elastic branches of its laws,
+        ascending (none for a rigid law)."""
+        if self.rigid:
+            return []
+        slopes = np.array([law.slopes[0] for law in self.laws])
+        w2 = np.real(eig(self.stiffness(slopes), self.mass, right=False))
+        return sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
+
+    @cached_property
+    def impulse_directions(self) -> tuple[np.ndarray, np.ndarray]:
+        """(D, w) of an impact at joint i: the impulsive moment acts along P^T e_i, so
+        the rates change along column i of D = M^-1 P^T; w_i = e_i^T P M^-1 P^T e_i."""
+        directions = product(self.mass_inv, self.arg_map.T)
+        w = np.array([product(self.arg_map[i], directions[:, i]) for i in range(self.n)])
+        return directions, w
+
+    def impact_rates(self, rate: np.ndarray, i: int) -> np.ndarray:
+        """Drum rates [rad/s] after an impact at joint i (its argument's rate times e).
+
+        Momentum-consistent: an impulsive moment along the joint's direction, so the
+        kinetic energy changes by -(1 - e^2) xdot_i^2 / (2 w_i) <= 0 (identical to the
+        paper's rule for n = 1). `absolute` keeps the paper's wording: only the
+        joint's own rate is scaled, the others unchanged."""
+        xdot = float(self.arg_map[i] @ rate)
+        if self.formulation == "absolute":
+            return rate + self.arg_inverse[:, i] * (self.restitution - 1.0) * xdot
+        directions, w = self.impulse_directions
+        return rate + directions[:, i] * ((self.restitution - 1.0) * xdot / w[i])
+
+    def stiffness(self, slopes: np.ndarray) -> np.ndarray:
+        """Stiffness matrix [N m/rad] of active law pieces of the given slopes,
+        gravity of the `geometric` formulation included."""
+        return product(self.diff.T, slopes[:, None] * self.arg_map) - self.gravity
+
+    def linear_system(self, intercepts: np.ndarray, slopes: np.ndarray):
+        """(A, c, e) of theta'' = A theta + c + e a_g for active pieces
+        f_i(x) = intercepts_i + slopes_i x."""
+        minv = self.mass_inv
+        stiff = self.stiffness(slopes)
+        c = product(self.diff.T, intercepts)
+        return -product(minv, stiff), -product(minv, c), -product(minv, self.ground_load)
+
+    def shear_ratios(self, accel: np.ndarray, ground_accel: np.ndarray) -> np.ndarray:
+        """|T_i / N_i| (k, n) from drum angular accelerations (k, n) and a_g (k,).
+
+        T_i = -sum_{j>=i} m_j (absolute horizontal acceleration of drum j's centre).
+        """
+        col = self.column
+        abs_acc = accel @ self.centre_map.T + np.asarray(ground_accel)[:, None]
+        forces = abs_acc * col.masses
+        shear = np.cumsum(forces[:, ::-1], axis=1)[:, ::-1]
+        return np.abs(shear) / col.normal_forces
+
+
+def build_model(
+    column: Column,
+    xi: float = 1.0,
+    restitution: float = 1.0,
+    formulation: str = "relative",
+    collapse_ratio: float = 1.0,
+) -> Model:
+    """Assemble the equations of a column.
+
+    Parameters
+    ----------
+    column : Column  Derived properties (rbm_cli.physics.column.build_column)
+    xi : float  Smoothing parameter of the law, 0 < xi <= 1
+    restitution : float  e in (0, 1]
+    formulation : str  'relative', 'absolute' or 'geometric' (SPEC section 1)
+    collapse_ratio : float  c in (0, 1]
+    """
+    n = column.n
+    h = column.heights
+    lower = np.tril(np.ones((n, n)), -1) * h[None, :]
+    centre = lower + np.diag(h / 2.0)
+    mass = product(centre.T, column.masses[:, None] * centre) + np.diag(column.inertias)
+    node = np.vstack([np.zeros(n), np.tril(np.ones((n, n))) * h[None, :]])
+    diff = np.eye(n) - np.eye(n, k=-1)
+    arg_map = np.eye(n) if formulation == "absolute" else diff.copy()
+
+    mu, tu = column.moment_capacity, column.rotation_capacity
+    if formulation == "geometric":
+        n_above = np.concatenate([column.normal_forces[1:], [0.0]])
+        gravity = np.diag((column.normal_forces + n_above) * h / 2.0)
+        extra = mu / tu
+        # overturning moment of the drums above joint i about the joint:
+        # sum_{j>=i} P_j (x_j - u_i), x_j the centre, u_i the joint's node
+        over = np.zeros((n, n))
+        for i in range(n):
+            for j in range(i, n):
+                over[i] += column.weights[j] * (centre[j] - node[i])
+        collapse_map, collapse_limit = over, mu.copy()
+    else:
+        gravity = np.zeros((n, n))
+        extra = np.zeros(n)
+        collapse_map, collapse_limit = arg_map.copy(), tu.copy()
+
+    laws = tuple(
+        make_law(mu[i], tu[i], column.stiffness[i], xi, extra_slope=float(extra[i]))
+        for i in range(n)
+    )
+    return Model(
+        column=column,
+        mass=mass,
+        mass_inv=inverse(mass),
+        ground_load=product(centre.T, column.masses),
+        centre_map=centre,
+        node_map=node,
+        arg_map=arg_map,
+        diff=diff,
+        gravity=gravity,
+        laws=laws,
+        collapse_map=collapse_map,
+        collapse_limit=collapse_limit,
+        collapse_ratio=float(collapse_ratio),
+        restitution=float(restitution),
+        formulation=formulation,
+    )

@@ -1,0 +1,335 @@
+"""Ground-motion records: PEER NGA ``.AT2`` and CSV accelerograms, read, checked and written.
+
+A :class:`Record` holds the horizontal ground acceleration a_g(t) [m/s^2] (SI inside) at
+strictly increasing sample times t [s]. Its conventions, which the integrator relies on:
+
+- **Sign.** A positive value is a ground acceleration in the +x direction of the model, the
+  same a_g as the harmonic and half-sine excitations (SPEC section 1).
+- **Clock.** The simulation starts at t = 0. An ``.AT2`` record's k-th value (k = 0, 1, ...)
+  is at t = k DT, so its first sample is at t = 0. A CSV record keeps the times of its file
+  (no shift); a first time > 0 means the ground is at rest before it: :meth:`Record.at`
+  is 0 before the first sample and after the last one, and linear in between. So a record
+  whose first or last value is not 0 starts or ends with a jump of the acceleration (the
+  integrator must restart there). Negative times are refused.
+- **Duration.** :attr:`Record.duration` is the time of the last sample, measured from
+  t = 0 (not from the first sample).
+
+Reading is strict: every malformed file is refused with an :class:`~rbm_cli.base.errors.RbmError`
+whose one-line message names the file and, where there is one, the line. Files are parsed
+in blocks of lines with numpy (:mod:`rbm_cli.physics.record_parsers`), so memory stays bounded;
+files of more than 10^7 samples or 512 MiB are refused before they are read.
+
+References
+----------
+.. [1] PEER NGA strong motion database: file format of the ``.AT2`` acceleration time
+   series (four header lines, then the values in g). Pacific Earthquake Engineering
+   Research Center, https://ngawest2.berkeley.edu.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.physics import record_parsers
+
+#: Standard gravity used to convert g to m/s^2 [m/s^2] (SPEC: g = 9.81 m/s^2).
+G = 9.81
+
+_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0}
+
+
+@dataclass(frozen=True, eq=False)
+class Record:
+    """A horizontal ground-acceleration record, SI units.
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times [s], strictly increasing, t[0] >= 0, at least two samples
+    acceleration : array_like
+        Ground acceleration at the sample times [m/s^2], finite; positive in +x
+    name : str
+        Short name (the file stem for a record read from a file)
+    source : str
+        Where it comes from (a file path, or a description)
+    title : str
+        Free text (line 2 of an ``.AT2`` header: event, station, component)
+
+    Notes
+    -----
+    Between samples the acceleration is linear; before the first and after the last
+    sample it is 0 (see the module docstring for the clock):
+
+    .. math:: a_g(t) = a_k + (a_{k+1} - a_k) (t - t_k) / (t_{k+1} - t_k),
+              \\quad t_k \\le t \\le t_{k+1}
+
+    Examples
+    --------
+    >>> rec = Record.from_samples([0.0, 1.0, 0.0], dt=0.5, name="tri")
+    >>> rec.at(0.25), rec.pga, rec.duration
+    (0.5, 1.0, 1.0)
+    """
+
+    t: np.ndarray
+    acceleration: np.ndarray
+    name: str = "record"
+    source: str = ""
+    title: str = field(default="")
+
+    def __post_init__(self) -> None:
+        t = np.array(self.t, dtype=float, copy=True).ravel()
+        a = np.array(self.acceleration, dtype=float, copy=True).ravel()
+        where = f"record {self.name!r}"
+        if t.size != a.size:
+            raise RbmError(f"{where}: {t.size} times but {a.size} accelerations")
+        if t.size < 2:
+            raise RbmError(f"{where}: needs at least 2 samples, has {t.size}")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(a))):
+            raise RbmError(f"{where}: times and accelerations must be finite")
+        if t[0] < 0.0:
+            raise RbmError(f"{where}: times must be >= 0 [s], got {t[0]!r}")
+        steps = np.diff(t)
+        if np.any(steps <= 0.0):
+            k = int(np.argmax(steps <= 0.0))
+            raise RbmError(f"{where}: times must increase, t[{k + 1}] <= t[{k}]")
+        t.setflags(write=False)
+        a.setflags(write=False)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "acceleration", a)
+
+    @classmethod
+    def from_samples(
+        cls, acceleration, dt: float, name: str = "record", source: str = "", title: str = ""
+    ) -> Record:
+        """A record sampled every ``dt`` [s] from t = 0; ``acceleration`` in [m/s^2]."""
+        if not (np.isfinite(dt) and dt > 0.0):
+            raise RbmError(f"record {name!r}: dt must be > 0 [s], got {dt!r}")
+        a = np.asarray(acceleration, dtype=float).ravel()
+        return cls(np.arange(a.size) * float(dt), a, name, source, title)
+
+    @property
+    def pga(self) -> float:
+        """Peak ground acceleration max |a_g| [m/s^2]."""
+        return float(np.max(np.abs(self.acceleration)))
+
+    @property
+    def duration(self) -> float:
+        """Time of the last sample, from t = 0 [s]."""
+        return float(self.t[-1])
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def at(self, t):
+        """Ground acceleration a_g(t) [m/s^2]: linear between samples, 0 outside them.
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times [s]
+
+        Returns
+        -------
+        float or numpy.ndarray
+            a_g at ``t`` [m/s^2] (a float for a scalar ``t``)
+        """
+        out = np.interp(t, self.t, self.acceleration, left=0.0, right=0.0)
+        return float(out) if np.ndim(out) == 0 else out
+
+    def scaled(self, factor: float) -> Record:
+        """The record with its acceleration multiplied by ``factor`` [-]."""
+        if not np.isfinite(factor):
+            raise RbmError(f"record {self.name!r}: scale factor must be finite, got {factor!r}")
+        return Record(self.t, self.acceleration * factor, self.name, self.source, self.title)
+
+
+# --------------------------------------------------------------------------- reading
+
+
+def read_record(path: str | os.PathLike, units: str = "g", fmt: str | None = None) -> Record:
+    """Read a ground-motion record from a PEER NGA ``.AT2`` or a CSV file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file; its suffix (``.at2`` or ``.csv``, any case) gives the format unless
+        ``fmt`` is given
+    units : str
+        Units of a CSV's acceleration column: ``"g"`` (default) or ``"m/s2"``. An
+        ``.AT2`` file is in g by definition; ``"m/s2"`` with one is refused.
+    fmt : str, optional
+        ``"at2"`` or ``"csv"``, to override the suffix
+
+    Returns
+    -------
+    Record
+        Times [s] and acceleration [m/s^2]; ``name`` is the file stem
+
+    Raises
+    ------
+    RbmError
+        On any malformed file, in one line naming the file and line: missing file,
+        empty file, bad or missing header, NPTS not matching the number of values,
+        DT <= 0, non-numeric or non-finite values, non-increasing or negative times,
+        a CSV with fewer than 2 columns or 2 rows, unknown units, a file too large.
+
+    Notes
+    -----
+    ``.AT2`` (PEER NGA): four header lines; the fourth gives the number of points and
+    the time step, in either style in use::
+
+        NPTS=  5000, DT=   .0050 SEC        (also NPTS= 5000 DT= 0.005)
+        4096    0.0100    NPTS, DT          (older files)
+
+    then the NPTS values in g, any number per line, Fortran exponents (``-.123E-02``,
+    ``1.0D-02``) accepted. Sample k is at t = k DT.
+
+    CSV: a header row of column names, then rows whose first column is the time [s] and
+    second the acceleration (further columns ignored); time steps may be uneven. Blank
+    lines and lines starting with ``#`` are skipped.
+
+    Examples
+    --------
+    >>> rec = read_record("configs/records/synthetic/rdk_01.AT2")  # doctest: +SKIP
+    >>> rec.pga / G  # doctest: +SKIP
+    0.31
+    """
+    path = Path(path)
+    kind = (fmt or path.suffix.lstrip(".")).lower()
+    if kind not in ("at2", "csv"):
+        raise RbmError(f"{path}: unknown record format {kind!r} (expected .AT2 or .csv)")
+    if units not in _UNITS:
+        raise RbmError(f"{path}: units must be 'g' or 'm/s2', got {units!r}")
+    record_parsers.check_file(path)
+    if kind == "at2":
+        if _UNITS[units] != G:
+            raise RbmError(f"{path}: an .AT2 file is in g; units {units!r} do not apply")
+        t, values_g, title = record_parsers.read_at2(path)
+        return Record(t, values_g * G, path.stem, str(path), title)
+    t, values = record_parsers.read_csv(path)
+    return Record(t, values * _UNITS[units], path.stem, str(path))
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def _uniform_dt(record: Record) -> float:
+    n = len(record)
+    dt = float(record.t[1] - record.t[0])
+    expected = np.arange(n) * dt
+    if record.t[0] != 0.0 or not np.allclose(record.t, expected, rtol=1e-9, atol=1e-12 * dt):
+        raise RbmError(f"record {record.name!r}: an .AT2 file needs samples at t = k DT from t = 0")
+    return dt
+
+
+def write_at2(
+    path: str | os.PathLike,
+    record: Record | np.ndarray,
+    *,
+    dt: float | None = None,
+    title: str | None = None,
+    header_style: str = "new",
+    values_per_line: int = 5,
+) -> Path:
+    """Write a record as a PEER NGA ``.AT2`` file (values in g, 8 significant digits).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write (overwritten)
+    record : Record or array_like
+        A :class:`Record` sampled at t = k DT from 0, or the accelerations [m/s^2]
+        (then ``dt`` is required)
+    dt : float, optional
+        Time step [s] for an array ``record``
+    title : str, optional
+        Header line 2 (default: the record's title or name)
+    header_style : str
+        ``"new"`` (``NPTS= n, DT= dt SEC``) or ``"old"`` (``n dt NPTS, DT``)
+    values_per_line : int
+        Values on each data line, >= 1
+
+    Returns
+    -------
+    pathlib.Path
+        The path written
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> a = 0.3 * G * np.sin(2 * np.pi * np.arange(101) * 0.01)
+    >>> write_at2(tmp / "sine.AT2", a, dt=0.01)  # doctest: +SKIP
+    """
+    if not isinstance(record, Record):
+        if dt is None:
+            raise RbmError("write_at2: dt [s] is required with an array of accelerations")
+        record = Record.from_samples(record, dt, name=Path(path).stem)
+    step = _uniform_dt(record)
+    if header_style not in ("new", "old"):
+        raise RbmError(f"write_at2: header_style must be 'new' or 'old', got {header_style!r}")
+    if values_per_line < 1:
+        raise RbmError(f"write_at2: values_per_line must be >= 1, got {values_per_line}")
+    n = len(record)
+    head = title if title is not None else (record.title or record.name)
+    if header_style == "new":
+        line4 = f"NPTS= {n:7d}, DT= {step!r} SEC"
+    else:
+        line4 = f"{n:8d}   {step!r}   NPTS, DT"
+    g_values = record.acceleration / G
+    rows = [
+        "".join(f"{v:15.7E}" for v in g_values[i : i + values_per_line])
+        for i in range(0, n, values_per_line)
+    ]
+    lines = [
+        "rbm ground-motion record (PEER NGA .AT2 format)",
+        head.replace("\n", " "),
+        "ACCELERATION TIME SERIES IN UNITS OF G",
+        line4,
+        *rows,
+    ]
+    path = Path(path)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8", newline="\n")
+    return path
+
+
+def write_csv(
+    path: str | os.PathLike,
+    record: Record | tuple[np.ndarray, np.ndarray],
+    *,
+    units: str = "g",
+) -> Path:
+    """Write a record as CSV: a header row, then time [s] and acceleration (17 digits).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write (overwritten)
+    record : Record or (t, acceleration)
+        A :class:`Record`, or times [s] and accelerations [m/s^2]
+    units : str
+        Units of the written acceleration column: ``"g"`` or ``"m/s2"``
+
+    Returns
+    -------
+    pathlib.Path
+        The path written; :func:`read_record` with the same ``units`` reads it back
+        exactly
+    """
+    if units not in _UNITS:
+        raise RbmError(f"write_csv: units must be 'g' or 'm/s2', got {units!r}")
+    if not isinstance(record, Record):
+        t, a = record
+        record = Record(t, a, name=Path(path).stem)
+    column = "acceleration_g" if _UNITS[units] == G else "acceleration_m_s2"
+    values = record.acceleration / _UNITS[units]
+    body = "\n".join(
+        f"{t!r},{v!r}" for t, v in zip(record.t.tolist(), values.tolist(), strict=True)
+    )
+    path = Path(path)
+    path.write_text(f"time_s,{column}\n{body}\n", encoding="utf-8", newline="\n")
+    return path

@@ -1,0 +1,362 @@
+"""Files written by the CLI: atomic writers and the folder of one run.
+
+Every file is written to a temporary name in its destination folder and moved
+into place with :func:`os.replace`, so a reader never sees half a file and an
+interrupted run leaves no partial output. The folder of a run is created only
+once the simulation has succeeded and all its files are written.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import math
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rbm_cli import __version__
+from rbm_cli.base.errors import RbmError
+from rbm_cli.models.result import History, RunResult
+
+#: Significant digits of every float written to CSV (SPEC section 5).
+FLOAT_FORMAT = "%.12g"
+
+#: Number of deformed shapes drawn in shapes.png.
+N_SHAPES = 6
+
+
+class OutputError(RbmError):
+    """An output folder or file cannot be created or written."""
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+# --------------------------------------------------------------------------- atomic writers
+
+
+@contextlib.contextmanager
+def _atomic_target(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; move it onto ``path`` on success.
+
+    On any exception the temporary file is removed and the exception re-raised.
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        os.chmod(tmp_path, 0o666 & ~_umask())  # mkstemp makes 0o600 files
+        yield tmp_path
+        os.replace(tmp_path, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp_path.unlink()
+        raise
+
+
+def write_csv_atomic(
+    path: str | os.PathLike, frame: pd.DataFrame, float_format: str = FLOAT_FORMAT
+) -> Path:
+    """Write a table as CSV (no index, floats with 12 significant digits), atomically."""
+    with _atomic_target(path) as tmp:
+        frame.to_csv(tmp, index=False, float_format=float_format, lineterminator="\n")
+    return Path(path)
+
+
+def json_ready(obj: Any) -> Any:
+    """Convert numpy scalars/arrays, tuples and dataclasses to JSON types.
+
+    Non-finite floats (nan, inf) become ``None`` so the file is strict JSON.
+    """
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return json_ready(dataclasses.asdict(obj))
+    if isinstance(obj, dict):
+        return {str(k): json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [json_ready(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [json_ready(v) for v in obj.tolist()]
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, float | np.floating):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, os.PathLike):
+        return os.fspath(obj)
+    return obj
+
+
+def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
+    """Write text (UTF-8), atomically."""
+    with _atomic_target(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def write_json_atomic(path: str | os.PathLike, obj: Any) -> Path:
+    """Write ``obj`` as indented, strict JSON (nan/inf as null), atomically."""
+    return write_text_atomic(path, json.dumps(json_ready(obj), indent=2, allow_nan=False) + "\n")
+
+
+def save_figure_atomic(fig, path: str | os.PathLike, dpi: int = 150) -> Path:
+    """Save a matplotlib figure (format from the suffix of ``path``), atomically."""
+    path = Path(path)
+    fmt = path.suffix.lstrip(".") or "png"
+    with _atomic_target(path) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=dpi, bbox_inches="tight")
+    return path
+
+
+# --------------------------------------------------------------------------- folders
+
+
+def format_number(x: float) -> str:
+    """Compact form of a number for folder names: 0.5 -> '0.5', 1.0 -> '1'."""
+    text = f"{float(x):.6g}"
+    return "0" if text == "-0" else text
+
+
+def run_folder_name(amplitude_g: float, frequency_hz: float, excitation_type: str) -> str:
+    """``run_A<A>_f<F>`` (e.g. ``run_A0.5_f1``); ``run_free`` for free motion."""
+    if excitation_type == "free":
+        return "run_free"
+    return f"run_A{format_number(amplitude_g)}_f{format_number(frequency_hz)}"
+
+
+def check_writable_dir(path: str | os.PathLike) -> Path:
+    """Check, without creating anything, that ``path`` is or can become a writable folder.
+
+    Raises
+    ------
+    OutputError
+        If ``path`` or one of its existing ancestors is not a folder, or the
+        nearest existing ancestor is not writable.
+    """
+    path = Path(path)
+    probe = path
+    while not probe.exists():
+        if probe.is_symlink():  # dangling link
+            raise OutputError(f"output folder {path}: {probe} is a broken link")
+        parent = probe.parent
+        if parent == probe:
+            break
+        probe = parent
+    if probe.exists() and not probe.is_dir():
+        raise OutputError(f"cannot create output folder {path}: {probe} is not a folder")
+    if probe.exists() and not os.access(probe, os.W_OK | os.X_OK):
+        raise OutputError(f"cannot write output folder {path}: {probe} is not writable")
+    return path
+
+
+def _make_dirs(path: Path) -> None:
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        raise OutputError(f"cannot create output folder {path}: {reason}") from None
+
+
+# --------------------------------------------------------------------------- one run
+
+
+def history_frame(history: History) -> pd.DataFrame:
+    """history.csv as a table: t_s, ag_m_s2, ug_m, u1_m..u{n+1}_m, theta1_rad..thetan_rad.
+
+    The u columns are node displacements relative to the ground [m]; the theta
+    columns absolute drum rotations [rad].
+    """
+    u = np.atleast_2d(np.asarray(history.node_displacements, dtype=float))
+    theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
+    data: dict[str, np.ndarray] = {
+        "t_s": np.asarray(history.t, dtype=float),
+        "ag_m_s2": np.asarray(history.ground_acceleration, dtype=float),
+        "ug_m": np.asarray(history.ground_displacement, dtype=float),
+    }
+    for i in range(u.shape[1]):
+        data[f"u{i + 1}_m"] = u[:, i]
+    for i in range(theta.shape[1]):
+        data[f"theta{i + 1}_rad"] = theta[:, i]
+    # + 0.0 turns -0.0 into 0.0, so the file never shows "-0"
+    return pd.DataFrame({k: v + 0.0 for k, v in data.items()})
+
+
+def shape_instants(t: Sequence[float], count: int = N_SHAPES) -> list[int]:
+    """Indices of ``count`` instants evenly spaced up to the last sample, which is included.
+
+    The first instant is one step (t_end / count) after the start, since at
+    t = 0 a column starting from rest shows nothing.
+    """
+    t = np.asarray(t, dtype=float)
+    if t.size == 0:
+        return []
+    targets = np.linspace(t[0], t[-1], count + 1)[1:]
+    idx = sorted({int(np.argmin(np.abs(t - target))) for target in targets})
+    if idx[-1] != t.size - 1:
+        idx.append(t.size - 1)
+    return idx
+
+
+def run_summary(
+    result: RunResult,
+    config,
+    *,
+    config_path: str | os.PathLike | None,
+    amplitude_g: float,
+    frequency_hz: float,
+    output_dt: float | None,
+) -> dict:
+    """summary.json: RunResult.summary() plus the resolved inputs and the version."""
+    summary = dict(result.summary())
+    summary["inputs"] = {
+        "config_file": os.fspath(config_path) if config_path is not None else None,
+        "amplitude_g": amplitude_g,
+        "frequency_hz": frequency_hz,
+        "output_dt_s": output_dt,
+    }
+    summary["config"] = json_ready(config)
+    summary["rbm_version"] = __version__
+    return json_ready(summary)
+
+
+def _history_figure(history: History, t_collapse: float | None):
+    from matplotlib.figure import Figure
+
+    from rbm_cli.report.plots import plot_history, plot_top_relative
+
+    fig = Figure(figsize=(8.0, 6.0))
+    ax_abs, ax_rel = fig.subplots(2, 1, sharex=True)
+    plot_history(history, ax=ax_abs, t_collapse=t_collapse)
+    plot_top_relative(history, ax=ax_rel, t_collapse=t_collapse)
+    ax_abs.set_xlabel("")
+    fig.tight_layout()
+    return fig
+
+
+def _shapes_figure(history: History, widths, elevations, t_collapse: float | None):
+    from matplotlib.figure import Figure
+
+    from rbm_cli.report.plots import plot_shapes
+
+    fig = Figure(figsize=(10.0, 5.0))
+    ax = fig.subplots()
+    plot_shapes(
+        history,
+        widths,
+        shape_instants(history.t),
+        ax=ax,
+        elevations=elevations,
+        t_collapse=t_collapse,
+    )
+    fig.tight_layout()
+    return fig
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_staging(parent: Path, folder: str) -> int:
+    """Remove the staging folders ``.<folder>.<pid>.*`` that a killed ``rbm run`` left
+    behind (their process is gone); a live run's staging is left alone. Returns how
+    many were removed."""
+    removed = 0
+    for item in parent.glob(f".{folder}.*"):
+        parts = item.name[len(folder) + 2 :].split(".", 1)
+        if not (item.is_dir() and not item.is_symlink() and parts[0].isdigit()):
+            continue
+        if int(parts[0]) != os.getpid() and not _alive(int(parts[0])):
+            shutil.rmtree(item, ignore_errors=True)
+            removed += 1
+    return removed
+
+
+def write_run(
+    out_dir: str | os.PathLike,
+    name: str,
+    folder: str,
+    result: RunResult,
+    summary: dict,
+    *,
+    widths,
+    elevations,
+) -> Path:
+    """Write history.csv, history.png, shapes.png and summary.json of one run.
+
+    The files are written into a hidden staging folder beside the destination
+    ``out_dir/name/folder``, which then replaces its files (or is renamed into
+    place). Nothing is left behind if writing fails.
+
+    Parameters
+    ----------
+    out_dir : path  Output root (``-o``) [folder]
+    name : str  Config name (second level of the output tree)
+    folder : str  Run folder name, see :func:`run_folder_name`
+    result : RunResult  A run with its history recorded
+    summary : dict  Contents of summary.json
+    widths : (n+1,) Column widths at the nodes [m]
+    elevations : (n+1,) Node elevations [m]
+
+    Returns
+    -------
+    Path of the run folder.
+
+    Raises
+    ------
+    OutputError
+        If a folder or file cannot be created or written.
+    """
+    if result.history is None:
+        raise ValueError("write_run needs a result recorded with record=True")
+    parent = Path(out_dir) / name
+    target = parent / folder
+    check_writable_dir(parent)
+    _make_dirs(parent)
+    if target.exists() and not target.is_dir():
+        raise OutputError(f"cannot create run folder {target}: a file of that name exists")
+    t_collapse = result.t_collapse_s if result.collapsed else None
+    remove_stale_staging(parent, folder)
+    try:
+        staging = Path(tempfile.mkdtemp(prefix=f".{folder}.{os.getpid()}.", dir=parent))
+        os.chmod(staging, 0o777 & ~_umask())  # mkdtemp makes 0o700 folders
+    except OSError as exc:
+        raise OutputError(f"cannot write in output folder {parent}: {exc.strerror}") from None
+    try:
+        write_csv_atomic(staging / "history.csv", history_frame(result.history))
+        save_figure_atomic(_history_figure(result.history, t_collapse), staging / "history.png")
+        save_figure_atomic(
+            _shapes_figure(result.history, widths, elevations, t_collapse),
+            staging / "shapes.png",
+        )
+        write_json_atomic(staging / "summary.json", summary)
+        if target.is_dir():
+            for item in staging.iterdir():
+                os.replace(item, target / item.name)
+            staging.rmdir()
+        else:
+            os.replace(staging, target)
+    except OSError as exc:
+        raise OutputError(f"cannot write run folder {target}: {exc.strerror or exc}") from None
+    finally:
+        if staging.exists():
+            shutil.rmtree(staging, ignore_errors=True)
+    return target

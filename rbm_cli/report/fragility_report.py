@@ -1,0 +1,273 @@
+"""Files and figures of a fragility analysis (:mod:`rbm_cli.study.fragility`).
+
+:func:`write_fragility` writes ``fragility.csv`` (per intensity), ``fragility_curve.csv``
+(the fitted curve and its band on a grid) and ``fragility.json`` (median, dispersion,
+intervals, method, counts, seed). :func:`plot_fragility` and :func:`plot_ida` draw on a
+given matplotlib axes, or on a new figure's (no pyplot state), and return the axes; saving
+is the caller's business.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.study.fragility import METHOD, FragilityResult
+from rbm_cli.study.outcomes import intensity_column as find_intensity_column
+
+#: Float format of the CSV files (12 significant digits, as domain.csv).
+FLOAT_FORMAT = "%.12g"
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _number(x: float) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def fragility_summary(result: FragilityResult) -> dict:
+    """The contents of ``fragility.json``: strict JSON (no NaN; null where undefined)."""
+    fit = result.fit
+    return {
+        "method": METHOD,
+        "fitted": fit is not None,
+        "note": result.note,
+        "median_g": _number(fit.median_g) if fit else None,
+        "beta": _number(fit.beta) if fit else None,
+        "log_likelihood": _number(fit.log_likelihood) if fit else None,
+        "median_ci_g": [_number(v) for v in result.median_ci_g],
+        "beta_ci": [_number(v) for v in result.beta_ci],
+        "ci_percentiles": list(result.ci_percentiles),
+        "n_records": result.n_records,
+        "n_runs": result.n_runs,
+        "n_failed": result.n_failed,
+        "n_levels": len(result.table),
+        "n_resamples": result.n_resamples,
+        "n_resamples_used": result.n_resamples_used,
+        "seed": result.seed,
+        "intensity_column": result.intensity_column,
+    }
+
+
+def write_fragility(result: FragilityResult, folder: str | os.PathLike) -> list[Path]:
+    """Write ``fragility.csv``, ``fragility_curve.csv`` and ``fragility.json`` into ``folder``.
+
+    Parameters
+    ----------
+    result : FragilityResult
+        From :func:`rbm_cli.study.fragility.fragility`
+    folder : str or os.PathLike
+        Created if missing; files are replaced atomically
+
+    Returns
+    -------
+    list of pathlib.Path
+        The three files
+
+    Notes
+    -----
+    ``fragility.csv``: intensity_g, n_records, n_failed, n_collapsed, fraction, fitted
+    (the fitted probability), band_lower, band_upper (the bootstrap band), one row per
+    intensity. Undefined values (no fit, no runs at a level) are empty cells.
+    """
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise RbmError(f"{folder}: cannot create the output folder ({exc.strerror})") from None
+    paths = [folder / "fragility.csv", folder / "fragility_curve.csv", folder / "fragility.json"]
+    try:
+        _write_atomic(paths[0], result.table.to_csv(index=False, float_format=FLOAT_FORMAT))
+        _write_atomic(paths[1], result.curve.to_csv(index=False, float_format=FLOAT_FORMAT))
+        text = json.dumps(fragility_summary(result), indent=2, allow_nan=False)
+        _write_atomic(paths[2], text + "\n")
+    except OSError as exc:
+        raise RbmError(f"{folder}: cannot write the fragility files ({exc.strerror})") from None
+    return paths
+
+
+# --------------------------------------------------------------------------- figures
+
+
+def _new_axes():
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(7, 5)).subplots()
+
+
+def plot_fragility(
+    result: FragilityResult,
+    ax=None,
+    *,
+    label: str | None = None,
+    color: str | None = None,
+    counts: bool = True,
+    xlabel: str = "intensity: peak ground acceleration [g]",
+):
+    """Observed collapse fractions, the fitted lognormal curve and its bootstrap band.
+
+    Parameters
+    ----------
+    result : FragilityResult
+        From :func:`rbm_cli.study.fragility.fragility`
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure's when None)
+    label : str, optional
+        Prefix of the legend entries (e.g. the column's name, to overlay several results)
+    color : str, optional
+        Colour of all three marks
+    counts : bool
+        Write "collapsed/records" beside each point
+    xlabel : str
+        Label of the intensity axis
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes: points (marker "o", gid "observed"), fitted curve (gid "fitted"), band
+        (a PolyCollection, gid "band"); the legend says which is which
+    """
+    ax = ax if ax is not None else _new_axes()
+    prefix = f"{label}: " if label else ""
+    table = result.table
+    (points,) = ax.plot(
+        table["intensity_g"],
+        table["fraction"],
+        "o",
+        color=color,
+        label=f"{prefix}observed fraction collapsed (collapsed/records)",
+    )
+    points.set_gid("observed")
+    color = points.get_color()
+    if counts:
+        for x, y, k, n in zip(
+            table["intensity_g"],
+            table["fraction"],
+            table["n_collapsed"],
+            table["n_records"],
+            strict=True,
+        ):
+            if n > 0:
+                ax.annotate(
+                    f"{k}/{n}",
+                    (x, y),
+                    textcoords="offset points",
+                    xytext=(4, 4),
+                    fontsize=7,
+                    color=color,
+                )
+    curve = result.curve
+    if result.fit is not None:
+        lo, hi = result.ci_percentiles
+        if result.n_resamples_used > 0:
+            band = ax.fill_between(
+                curve["intensity_g"],
+                curve["lower"],
+                curve["upper"],
+                color=color,
+                alpha=0.2,
+                linewidth=0,
+                label=f"{prefix}bootstrap {lo:g}-{hi:g} % band "
+                f"({result.n_resamples_used} resamples of the records)",
+            )
+            band.set_gid("band")
+        (fitted,) = ax.plot(
+            curve["intensity_g"],
+            curve["probability"],
+            "-",
+            color=color,
+            label=f"{prefix}lognormal MLE: median {result.fit.median_g:.3g} g, "
+            f"beta {result.fit.beta:.2f}",
+        )
+        fitted.set_gid("fitted")
+    else:
+        ax.text(
+            0.02,
+            0.95,
+            f"{prefix}no fit: {result.note}",
+            transform=ax.transAxes,
+            fontsize=7,
+            va="top",
+            wrap=True,
+        )
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("probability of collapse [-]")
+    ax.set_ylim(-0.03, 1.03)
+    ax.set_xlim(left=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="lower right")
+    return ax
+
+
+def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):
+    """Incremental dynamic analysis: peak rotation ratio against intensity, a line per record.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        Rows with ``record``, an intensity column [g] (``intensity_g``, ``amplitude_g`` or
+        ``intensity``), ``max_rotation_ratio``, ``collapsed``; optional ``status``
+        (failed rows are left out)
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure's when None)
+    intensity_column : str, optional
+        Name of the intensity column
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        One line per record (gid ``record:<name>``, points sorted by intensity), collapsed
+        runs marked "x" in the record's colour (gid ``collapse:<name>``), the collapse
+        limit (ratio 1) dashed
+    """
+    column = find_intensity_column(df, intensity_column)
+    needed = ["record", column or "intensity_g", "max_rotation_ratio", "collapsed"]
+    missing = [c for c in needed if c not in df.columns]
+    if missing:
+        raise RbmError(f"IDA plot: missing column {missing[0]!r}")
+    rows = df if "status" not in df.columns else df[df["status"].astype(str) != "failed"]
+    ax = ax if ax is not None else _new_axes()
+    first = True
+    for name, group in sorted(rows.groupby(rows["record"].astype(str)), key=lambda g: g[0]):
+        group = group.sort_values(column)
+        x = group[column].to_numpy(float)
+        y = group["max_rotation_ratio"].to_numpy(float)
+        (line,) = ax.plot(
+            x, y, "-", lw=1.0, alpha=0.8, label="a record (one line each)" if first else None
+        )
+        line.set_gid(f"record:{name}")
+        hit = group["collapsed"].to_numpy(float) == 1.0
+        if hit.any():
+            (marks,) = ax.plot(
+                x[hit],
+                y[hit],
+                "x",
+                color=line.get_color(),
+                ms=6,
+                label="collapsed run" if first else None,
+            )
+            marks.set_gid(f"collapse:{name}")
+        first = False
+    ax.axhline(1.0, color="k", ls="--", lw=0.8, label="collapse limit (ratio 1)")
+    ax.set_xlabel("intensity: peak ground acceleration [g]")
+    ax.set_ylabel("peak rotation ratio (collapse quantity / limit) [-]")
+    ax.set_xlim(left=0.0)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    return ax

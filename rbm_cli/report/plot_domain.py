@@ -1,0 +1,277 @@
+"""Safe-unsafe domain plot in the frequency [Hz] x amplitude [g] plane (paper figs. 5, 8, 9, 12).
+
+A pure plot function: it takes ``ax=None`` (a new figure is made if omitted)
+and returns the axes; it never saves or shows (the CLI and the sweep do).
+Every artist it draws carries a ``gid`` ('safe', 'unsafe', 'failed',
+'boundary', 'compare-<k>', 'static', 'housner', 'linear'), so callers and
+tests can find them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from rbm_cli.physics.closed_forms import halfsine_threshold_curves
+from rbm_cli.physics.column import Column
+from rbm_cli.study.domain import boundary
+
+__all__ = ["boundary", "plot_domain"]
+
+#: Colours of compared domains' boundaries (the main boundary is black).
+COMPARE_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")
+#: Colour map of the collapse fraction of ensemble sweeps.
+FRACTION_CMAP = "viridis"
+#: Points of the closed-form curves over the frequency range.
+CURVE_POINTS = 300
+
+
+def _new_axes(ax):
+    if ax is not None:
+        return ax
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(7, 5)).subplots()
+
+
+def _masks(df: pd.DataFrame):
+    """Boolean masks of the safe, unsafe and failed cells."""
+    status = df["status"].astype(str)
+    unsafe = (status == "collapsed").to_numpy()
+    failed = (status == "failed").to_numpy()
+    return ~unsafe & ~failed, unsafe, failed
+
+
+def _plot_cells(ax, df: pd.DataFrame) -> None:
+    """Safe cells as open circles, unsafe as crosses, failed as grey squares."""
+    f = df["frequency_hz"].to_numpy(float)
+    a = df["amplitude_g"].to_numpy(float)
+    safe, unsafe, failed = _masks(df)
+    style = dict(linestyle="none", markersize=5)
+    ax.plot(
+        f[safe],
+        a[safe],
+        marker="o",
+        markerfacecolor="none",
+        color="tab:green",
+        label="safe (survived)",
+        gid="safe",
+        **style,
+    )
+    ax.plot(
+        f[unsafe],
+        a[unsafe],
+        marker="x",
+        color="tab:red",
+        label="unsafe (collapsed)",
+        gid="unsafe",
+        **style,
+    )
+    if failed.any():
+        ax.plot(
+            f[failed],
+            a[failed],
+            marker="s",
+            color="0.55",
+            label="failed run",
+            gid="failed",
+            **style,
+        )
+
+
+def _plot_fraction_cells(ax, df: pd.DataFrame) -> list:
+    """Cells coloured by the ensemble's collapse fraction, with a colour bar.
+
+    Returns grey legend proxies of the markers (the points' colours vary).
+    """
+    from matplotlib import colormaps
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
+
+    cmap, norm = colormaps[FRACTION_CMAP], Normalize(0.0, 1.0)
+    f = df["frequency_hz"].to_numpy(float)
+    a = df["amplitude_g"].to_numpy(float)
+    frac = df["collapse_fraction"].to_numpy(float)
+    safe, unsafe, failed = _masks(df)
+    colours = cmap(norm(np.nan_to_num(frac, nan=0.0)))
+    ax.scatter(
+        f[safe],
+        a[safe],
+        marker="o",
+        facecolors="none",
+        edgecolors=colours[safe],
+        s=28,
+        linewidths=1.2,
+        gid="safe",
+    )
+    ax.scatter(
+        f[unsafe], a[unsafe], marker="x", c=colours[unsafe], s=28, linewidths=1.2, gid="unsafe"
+    )
+    proxy = dict(linestyle="none", color="0.3", markersize=5)
+    handles = [
+        Line2D([], [], marker="o", markerfacecolor="none", label="safe (survived)", **proxy),
+        Line2D([], [], marker="x", label="unsafe (collapsed)", **proxy),
+    ]
+    if failed.any():
+        ax.scatter(f[failed], a[failed], marker="s", c="0.55", s=22, gid="failed")
+        handles.append(Line2D([], [], marker="s", label="failed run", **{**proxy, "color": "0.55"}))
+    # below the axes: the legend sits beside them
+    ax.figure.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, label="collapse fraction [-]",
+                       location="bottom", pad=0.16, fraction=0.06, aspect=40)  # fmt: skip
+    return handles
+
+
+def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str) -> None:
+    bnd = boundary(df)
+    ax.plot(
+        bnd["frequency_hz"].to_numpy(float),
+        bnd["lowest_unsafe_g"].to_numpy(float),
+        color=colour,
+        marker=".",
+        linewidth=1.4,
+        markersize=6,
+        label=label,
+        gid=gid,
+    )
+
+
+def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
+    lo, hi = float(np.min(frequencies_hz)), float(np.max(frequencies_hz))
+    f = np.linspace(lo, hi, CURVE_POINTS) if hi > lo else np.array([lo])
+    curves = halfsine_threshold_curves(column, f)
+    ax.plot(
+        f,
+        curves["housner"],
+        color="tab:purple",
+        linestyle="-.",
+        linewidth=1.3,
+        label=r"Housner (1963), $A/\alpha=\sqrt{1+(\omega/p)^2}$",
+        gid="housner",
+    )
+    ax.plot(
+        f,
+        curves["linear"],
+        color="tab:cyan",
+        linestyle="-",
+        linewidth=1.5,
+        label="exact, linear model (rigid RBM)",
+        gid="linear",
+    )
+
+
+def plot_domain(
+    df: pd.DataFrame,
+    ax=None,
+    compare: Sequence[pd.DataFrame] = (),
+    labels: Sequence[str] | None = None,
+    column: Column | None = None,
+    excitation_type: str | None = None,
+    static_multiplier: float | None = None,
+    static_label: str = "static multiplier",
+):
+    """Plot a safe-unsafe domain: cells, boundary, static multiplier, closed forms.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        A domain table (domain.csv): amplitude_g [g], frequency_hz [Hz],
+        status ('collapsed', 'survived' or 'failed'); optionally
+        collapse_fraction [-] in [0, 1] (ensemble sweeps), which colours the
+        cells and adds a colour bar
+    ax : matplotlib Axes, optional
+        Axes to draw on; a new figure is made if omitted
+    compare : sequence of pandas.DataFrame, optional
+        Other domains whose boundaries are drawn in other colours
+    labels : sequence of str, optional
+        Legend labels of the boundaries: labels[0] for ``df``, then one per
+        ``compare`` entry
+    column : rbm_cli.physics.column.Column, optional
+        The column of ``df``; with n = 1, a rigid law and a half-sine
+        excitation, the closed-form half-sine thresholds are drawn
+    excitation_type : str, optional
+        'harmonic', 'half-sine' or 'free'
+    static_multiplier : float, optional
+        Uplift acceleration [g], drawn as a dashed horizontal line; defaults
+        to ``column.static_multiplier`` when a column is given
+    static_label : str, optional
+        Legend name of that line (the contact engine's is its 'uplift level')
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Notes
+    -----
+    Safe cells are open circles, unsafe (collapsed) cells crosses, failed runs
+    grey squares (in the legend only if there are any). The boundary is the
+    lowest collapsed amplitude per frequency (:func:`rbm_cli.study.domain.boundary`;
+    gaps where nothing collapses). The closed forms use the mapping of SPEC
+    section 2 (:func:`rbm_cli.physics.closed_forms.linear_rocking_parameters`): the
+    rigid RBM monolith is the piecewise-linear block with alpha = B_1/H.
+    The amplitude axis starts at 0 and stops just above the largest amplitude
+    of the grids, so a steep closed-form curve does not squash the domain.
+    """
+    compare = list(compare)
+    if labels is None:
+        labels = ["boundary"] + [f"boundary, domain {k + 2}" for k in range(len(compare))]
+    labels = list(labels)
+    if len(labels) != 1 + len(compare):
+        raise ValueError(
+            f"labels needs {1 + len(compare)} entries (the domain, then one per compared "
+            f"domain), got {len(labels)}"
+        )
+    ax = _new_axes(ax)
+
+    proxies = []
+    if "collapse_fraction" in df.columns:
+        proxies = _plot_fraction_cells(ax, df)
+    else:
+        _plot_cells(ax, df)
+    _plot_boundary(ax, df, "black", labels[0], "boundary")
+    for k, (other, label) in enumerate(zip(compare, labels[1:], strict=True)):
+        colour = COMPARE_COLOURS[k % len(COMPARE_COLOURS)]
+        _plot_boundary(ax, other, colour, label, f"compare-{k}")
+
+    if static_multiplier is None and column is not None:
+        static_multiplier = column.static_multiplier
+    if static_multiplier is not None:
+        ax.axhline(
+            static_multiplier,
+            color="0.3",
+            linestyle="--",
+            linewidth=1.0,
+            label=f"{static_label} {static_multiplier:.3g} g",
+            gid="static",
+        )
+
+    frequencies = np.concatenate([d["frequency_hz"].to_numpy(float) for d in [df, *compare]])
+    if (
+        column is not None
+        and column.n == 1
+        and column.rigid
+        and excitation_type == "half-sine"
+        and len(frequencies)
+    ):
+        _plot_closed_forms(ax, column, frequencies)
+
+    amplitudes = np.concatenate([d["amplitude_g"].to_numpy(float) for d in [df, *compare]])
+    top = max([float(np.nanmax(amplitudes))] if len(amplitudes) else [1.0])
+    if static_multiplier is not None:
+        top = max(top, float(static_multiplier))
+    ax.set_ylim(0.0, 1.06 * top)
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("amplitude [g]")
+    ax.grid(True, alpha=0.3)
+    handles, texts = ax.get_legend_handles_labels()
+    ax.legend(
+        handles=proxies + handles,
+        labels=[h.get_label() for h in proxies] + texts,
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),  # beside the axes: never over the cells
+        borderaxespad=0.0,
+        fontsize="small",
+    )
+    return ax

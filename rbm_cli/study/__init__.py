@@ -1,0 +1,2 @@
+"""Studies of runs: simulate through the registry, sweep, ensembles, domains, fragility,
+the benchmark. No physics and no plotting. Imports models, physics, config and base."""

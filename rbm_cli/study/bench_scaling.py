@@ -1,0 +1,133 @@
+"""Scaling figures of `rbm bench --scaling`: time per run against the number of
+drums, the joint stiffness (elastic frequency) and the duration, and the
+speed-up of 2 workers over 1 on whole domains (all measured in one run)."""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from rbm_cli.config.load import parse_config
+
+#: The paper's tapered column (5 m, 0.96 -> 0.66 m), one cell that stays elastic
+#: for all drum counts (0.05 g, 2 Hz; at 0.15 g joints of 32-50 thin drums chatter), 10 s.
+COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "section": "rectangular",
+          "density": 2700}  # fmt: skip
+CELL = (0.05, 2.0)
+DRUMS = (1, 2, 4, 8, 16, 32, 50)
+STIFFNESS = (5e7, 1.5e8, 5e8, 1.5e9, 5e9, 1.5e10, 5e10)  # k_n [Pa/m]
+DURATIONS = (2.5, 5.0, 10.0, 20.0, 40.0)  # s
+
+
+def _config(drums: int = 8, k_n: float = 5e9, duration: float = 10.0):
+    return parse_config(
+        {
+            "name": "scaling",
+            "column": dict(COLUMN, drums=drums),
+            "interface": {"stiffness": {"normal": k_n}},
+            "excitation": {"type": "harmonic", "duration": duration},
+        }
+    )
+
+
+def _elastic_hz(cfg) -> float:
+    from rbm_cli.study.simulate import model_from_config
+
+    return max(model_from_config(cfg).elastic_frequencies_hz())
+
+
+def _time(cfg, repeats: int = 3) -> dict:
+    from rbm_cli.study.simulate import model_from_config, simulate
+
+    model = model_from_config(cfg)
+    walls, res = [], None
+    for _ in range(repeats):
+        res = simulate(cfg, *CELL, model=model)
+        walls.append(res.wall_time_s)
+    return {"time_per_run_s": float(np.median(walls)), "n_steps": res.n_steps,
+            "n_rhs": res.n_rhs, "status": res.status}  # fmt: skip
+
+
+def run_scaling(output: str | os.PathLike = "bench", log=print) -> pd.DataFrame:
+    from rbm_cli.report.files import write_text_atomic
+    from rbm_cli.study.bench import PROBLEMS, _cells, problem_config, run_cells
+
+    rows = []
+    for n in DRUMS:
+        cfg = _config(drums=n)
+        rows.append({"series": "drums", "x": n, "elastic_hz": _elastic_hz(cfg), **_time(cfg)})
+        log(f"scaling: {n} drums: {rows[-1]['time_per_run_s'] * 1e3:.1f} ms/run")
+    for k in STIFFNESS:
+        cfg = _config(drums=4, k_n=k)
+        rows.append({"series": "k_n", "x": k, "elastic_hz": _elastic_hz(cfg), **_time(cfg)})
+        log(f"scaling: k_n {k:.2g} Pa/m: {rows[-1]['time_per_run_s'] * 1e3:.1f} ms/run")
+    for d in DURATIONS:
+        cfg = _config(duration=d)
+        rows.append({"series": "duration", "x": d, "elastic_hz": _elastic_hz(cfg), **_time(cfg)})
+        log(f"scaling: {d:g} s: {rows[-1]['time_per_run_s'] * 1e3:.1f} ms/run")
+    for prob in PROBLEMS:
+        if prob.name not in ("slender", "multidrum"):
+            continue
+        cfg = problem_config(prob, stride=1 if prob.name == "slender" else 4)
+        cells = _cells(cfg)
+        walls = {}
+        for jobs in (1, 2):
+            start = time.perf_counter()
+            run_cells("rbm", cfg, cells, jobs)
+            walls[jobs] = time.perf_counter() - start
+        rows.append({"series": "workers", "x": prob.name, "time_per_run_s": walls[2] / len(cells),
+                     "wall_1_s": walls[1], "wall_2_s": walls[2],
+                     "speedup_2_over_1": walls[1] / walls[2], "cells": len(cells)})  # fmt: skip
+        log(f"scaling: {prob.name} {len(cells)} cells: 1 worker {walls[1]:.2f} s, "
+            f"2 workers {walls[2]:.2f} s, speed-up {walls[1] / walls[2]:.2f}")  # fmt: skip
+    table = pd.DataFrame(rows)
+    out = Path(output)
+    out.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(out / "scaling.csv", table.to_csv(index=False, float_format="%.6g"))
+    _figure(table, out / "scaling.png")
+    return table
+
+
+def _figure(table: pd.DataFrame, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    from rbm_cli.report.files import save_figure_atomic
+
+    fig, axes = plt.subplots(1, 4, figsize=(16, 3.8))
+    for ax, (series, xlabel) in zip(
+        axes[:3],
+        [
+            ("drums", "drums"),
+            ("k_n", "joint normal stiffness k_n [Pa/m] (4 drums)"),
+            ("duration", "duration [s] (8 drums)"),
+        ],  # fmt: skip
+        strict=True,
+    ):
+        sub = table[table["series"] == series]
+        xs = sub["x"].astype(float)
+        ax.loglog(xs, sub["time_per_run_s"], "o-")
+        if series != "k_n":  # label the points themselves (the log axis's minor labels overlap)
+            ax.set_xticks(xs, [f"{x:g}" for x in xs])
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("time per run [s]")
+        ax.grid(True, which="both", alpha=0.3)
+    sub = table[table["series"] == "workers"]
+    axes[3].bar(sub["x"].astype(str), sub["speedup_2_over_1"])
+    axes[3].axhline(2.0, color="0.5", ls="--", lw=0.8)
+    axes[3].set_ylabel("speed-up, 2 workers over 1")
+    fig.suptitle(f"rbm scaling, one cell {CELL[0]} g {CELL[1]} Hz (stays elastic)")
+    fig.tight_layout()
+    save_figure_atomic(fig, path)
+    plt.close(fig)
+
+
+__all__ = ["run_scaling"]

@@ -1,0 +1,237 @@
+"""Safe-unsafe domains as tables: rows, CSV text, boundary, comparison.
+
+A domain is a pandas DataFrame with the columns of SPEC section 5
+(:data:`rbm_cli.models.result.CSV_FIELDS`), one row per (amplitude, frequency) cell.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.models.result import CSV_FIELDS, STATUSES
+
+#: Columns a domain CSV must have for plotting and comparing.
+REQUIRED = ("amplitude_g", "frequency_hz", "status")
+
+
+def format_value(value) -> str:
+    """CSV text of one value: floats with 12 significant digits, empty for None/NaN."""
+    if value is None:
+        return ""
+    if isinstance(value, float | np.floating):
+        if not math.isfinite(value):
+            return ""
+        return f"{float(value):.12g}"
+    if isinstance(value, int | np.integer):
+        return str(int(value))
+    text = str(value)
+    if any(c in text for c in ',"\n'):
+        text = '"' + text.replace('"', '""').replace("\n", " ") + '"'
+    return text
+
+
+def format_row(row: dict, fields=CSV_FIELDS) -> str:
+    return ",".join(format_value(row.get(k)) for k in fields)
+
+
+def csv_text(rows: list[dict], fields=CSV_FIELDS) -> str:
+    return ",".join(fields) + "\n" + "".join(format_row(r, fields) + "\n" for r in rows)
+
+
+def cell_key(amplitude_g: float, frequency_hz: float) -> tuple[str, str]:
+    """Identity of a grid cell, stable through a CSV round trip."""
+    return (f"{float(amplitude_g):.12g}", f"{float(frequency_hz):.12g}")
+
+
+def read_domain(path: str | Path) -> pd.DataFrame:
+    """Read a domain CSV; a missing file or missing columns is an RbmError."""
+    path = Path(path)
+    if not path.is_file():
+        raise RbmError(f"domain file not found: {path}")
+    try:
+        df = pd.read_csv(path, keep_default_na=True)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        reason = " ".join(str(exc).split())
+        raise RbmError(f"cannot read {path} as a domain CSV: {reason}") from None
+    except OSError as exc:  # unreadable (permissions), I/O error
+        raise RbmError(f"cannot read {path}: {exc.strerror or exc}") from None
+    missing = [c for c in REQUIRED if c not in df.columns]
+    if missing:
+        raise RbmError(f"{path} is not a domain CSV: missing column(s) {', '.join(missing)}")
+    if not isinstance(df.index, pd.RangeIndex):
+        raise RbmError(
+            f"{path} is not a domain CSV: some rows have more fields than its header"
+            f" ({len(df.columns)})"
+        )
+    if df.empty:
+        raise RbmError(f"{path} has no rows")
+    _check_cells(df, path)
+    if "collapsed" not in df.columns:
+        df["collapsed"] = (df["status"] == "collapsed").astype(int)
+    return df
+
+
+def _check_cells(df: pd.DataFrame, path: Path) -> None:
+    """Values of the required columns: amplitude_g finite >= 0 [g], frequency_hz
+    finite > 0 [Hz], status one of STATUSES, and each cell once. Raises an
+    RbmError naming the first bad line (the header is line 1); converts the two
+    numeric columns to float in place."""
+
+    def got(value) -> str:
+        return "an empty field" if pd.isna(value) else repr(str(value))
+
+    for col, unit, positive in (("amplitude_g", "g", False), ("frequency_hz", "Hz", True)):
+        raw = df[col]
+        x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isfinite(x) | ((x <= 0.0) if positive else (x < 0.0))
+        if bad.any():
+            i = int(np.argmax(bad))
+            rng = "> 0" if positive else ">= 0"
+            raise RbmError(
+                f"{path}: line {i + 2}: {col} must be a finite number {rng} [{unit}],"
+                f" got {got(raw.iloc[i])}"
+            )
+        df[col] = x
+    bad = ~df["status"].isin(STATUSES).to_numpy()
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RbmError(
+            f"{path}: line {i + 2}: status must be one of {', '.join(STATUSES)},"
+            f" got {got(df['status'].iloc[i])}"
+        )
+    if "collapsed" in df.columns:
+        _check_collapsed(df, path, got)
+    keys = [cell_key(a, f) for a, f in zip(df["amplitude_g"], df["frequency_hz"], strict=True)]
+    seen: dict[tuple[str, str], int] = {}
+    for i, key in enumerate(keys):
+        if key in seen:
+            raise RbmError(
+                f"{path}: line {i + 2} repeats the cell of line {seen[key] + 2}"
+                f" (amplitude {key[0]} g, frequency {key[1]} Hz)"
+            )
+        seen[key] = i
+
+
+def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
+    """collapsed is 0 or 1 on every row and says what status says (collapsed <=> 1):
+    compare counts cells from collapsed and draws boundaries from status, so a row where
+    they disagree would make the two disagree quietly (issue 14). Converts it to int."""
+    raw = df["collapsed"]
+    x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
+    bad = ~np.isin(x, (0.0, 1.0))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RbmError(f"{path}: line {i + 2}: collapsed must be 0 or 1, got {got(raw.iloc[i])}")
+    flags = x.astype(int)
+    disagree = flags != (df["status"] == "collapsed").to_numpy(int)
+    if disagree.any():
+        i = int(np.argmax(disagree))
+        raise RbmError(
+            f"{path}: line {i + 2}: status {df['status'].iloc[i]!r} but collapsed {flags[i]}:"
+            " the two columns disagree (collapsed is 1 exactly when status is collapsed)"
+        )
+    df["collapsed"] = flags
+
+
+def boundary(df: pd.DataFrame) -> pd.DataFrame:
+    """Lowest unsafe (collapsed) amplitude per frequency, and the highest safe one below it.
+
+    Returns a DataFrame sorted by frequency with columns frequency_hz,
+    lowest_unsafe_g (NaN where nothing collapses) and highest_safe_g (largest
+    survived amplitude below lowest_unsafe_g; NaN if none).
+    """
+    rows = []
+    for f, grp in df.groupby("frequency_hz", sort=True):
+        unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
+        low = float(unsafe.min()) if len(unsafe) else math.nan
+        safe = grp.loc[grp["status"] == "survived", "amplitude_g"]
+        if math.isfinite(low):
+            safe = safe[safe < low]
+        high = float(safe.max()) if len(safe) else math.nan
+        rows.append({"frequency_hz": float(f), "lowest_unsafe_g": low, "highest_safe_g": high})
+    return pd.DataFrame(rows, columns=["frequency_hz", "lowest_unsafe_g", "highest_safe_g"])
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """How two domains differ.
+
+    n_common : cells present in both (matched on amplitude and frequency)
+    n_differ : common cells whose collapsed flag differs
+    fraction : n_differ / n_common
+    max_shift_g : largest |boundary shift| over frequencies [g]
+    shifts : per frequency: frequency_hz, boundary_a_g, boundary_b_g, shift_g
+    only_a, only_b : cells present in one domain only
+    first_missing : (amplitude, frequency) text of the first such cell, in grid order
+    """
+
+    n_common: int
+    n_differ: int
+    fraction: float
+    max_shift_g: float
+    shifts: pd.DataFrame
+    only_a: int
+    only_b: int
+    first_missing: tuple[str, str] | None = None
+
+
+def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
+    """Compare two domains cell by cell and boundary by boundary.
+
+    Where one domain has no collapsed cell at a frequency, its boundary is
+    taken as one grid step above its highest amplitude there (just above the
+    grid), so a boundary that leaves the grid counts as a finite shift.
+    """
+
+    def flags(df):
+        cols = (df.amplitude_g, df.frequency_hz, df.collapsed)
+        return {cell_key(x, y): int(c) for x, y, c in zip(*cols, strict=True)}
+
+    ka, kb = flags(a), flags(b)
+    common = ka.keys() & kb.keys()
+    differ = sum(ka[k] != kb[k] for k in common)
+
+    def edge(df):
+        out = {}
+        for f, grp in df.groupby("frequency_hz"):
+            amps = np.sort(grp["amplitude_g"].to_numpy(float))
+            unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
+            if len(unsafe):
+                out[f"{float(f):.12g}"] = float(unsafe.min())
+            else:
+                step = float(np.min(np.diff(amps))) if len(amps) > 1 else 0.0
+                out[f"{float(f):.12g}"] = float(amps[-1]) + step
+        return out
+
+    ea, eb = edge(a), edge(b)
+    rows = []
+    for f in sorted(ea.keys() & eb.keys(), key=float):
+        rows.append(
+            {
+                "frequency_hz": float(f),
+                "boundary_a_g": ea[f],
+                "boundary_b_g": eb[f],
+                "shift_g": eb[f] - ea[f],
+            }
+        )
+    shifts = pd.DataFrame(rows, columns=["frequency_hz", "boundary_a_g", "boundary_b_g", "shift_g"])
+    max_shift = float(shifts["shift_g"].abs().max()) if len(shifts) else 0.0
+    return Comparison(
+        n_common=len(common),
+        n_differ=int(differ),
+        fraction=differ / len(common) if common else math.nan,
+        max_shift_g=max_shift,
+        shifts=shifts,
+        only_a=len(ka.keys() - kb.keys()),
+        only_b=len(kb.keys() - ka.keys()),
+        first_missing=min(
+            ka.keys() ^ kb.keys(), key=lambda k: (float(k[1]), float(k[0])), default=None
+        ),
+    )

@@ -1,0 +1,95 @@
+"""What a row of a sweep's journal must be to be trusted (rbm_cli.study.store reads them).
+
+A row is a finished cell of one config: the config's hash, a cell of the grid, a status
+of STATUSES with collapsed agreeing, and every other domain.csv field of its type and
+range. A hand-made or damaged row fails here and its cell is run again (issue 14).
+"""
+
+from __future__ import annotations
+
+import math
+
+from rbm_cli.models.result import STATUSES
+from rbm_cli.study.domain import cell_key
+
+COUNT_FIELDS = ("n_uplifts", "n_impacts", "n_steps", "n_rhs")
+
+
+def _is_number(x) -> bool:
+    return isinstance(x, int | float) and not isinstance(x, bool)
+
+
+def _nan_or_none(x) -> bool:
+    return x is None or (isinstance(x, float) and math.isnan(x))
+
+
+def validate_row(
+    row, digest: str, grid: set[tuple[str, str]], n_interfaces: int, ensemble: int
+) -> str:
+    """'' if a journal row is a finished cell of this config, else what is wrong.
+
+    The row must be a mapping with the config's hash (rows of journals made before the
+    hash was written carry none: the caller allows that only with a matching state
+    file), a cell of the grid, a status of STATUSES, collapsed 0/1 agreeing with it, and
+    every other domain.csv field of the right type and range (a failed run may leave
+    them out or NaN)."""
+    if not isinstance(row, dict):
+        return "not a JSON object"
+    if "config_hash" in row and row["config_hash"] != digest:
+        return f"made by another config (hash {str(row['config_hash'])[:24]!r})"
+    a, f = row.get("amplitude_g"), row.get("frequency_hz")
+    if not (_is_number(a) and math.isfinite(a) and a >= 0):
+        return f"amplitude_g must be a finite number >= 0, got {a!r}"
+    if not (_is_number(f) and math.isfinite(f) and f > 0):
+        return f"frequency_hz must be a finite number > 0, got {f!r}"
+    if cell_key(a, f) not in grid:
+        return f"the cell ({a} g, {f} Hz) is not in the config's grid"
+    status = row.get("status")
+    if status not in STATUSES:
+        return f"status must be one of {', '.join(STATUSES)}, got {str(status)[:40]!r}"
+    collapsed = row.get("collapsed")
+    if collapsed not in (0, 1) or isinstance(collapsed, bool):
+        return f"collapsed must be 0 or 1, got {collapsed!r}"
+    if collapsed != (status == "collapsed"):
+        return f"status {status!r} but collapsed {collapsed}: they disagree"
+    if not isinstance(row.get("message"), str):
+        return "message must be a string"
+    failed = status == "failed"
+    problem = _check_numbers(row, failed, status == "collapsed", n_interfaces)
+    if problem:
+        return problem
+    if ensemble > 1:
+        cf = row.get("collapse_fraction")
+        if not (_is_number(cf) and (math.isnan(cf) or 0.0 <= cf <= 1.0)):
+            return f"collapse_fraction must be in [0, 1] or NaN, got {cf!r}"
+        robust = row.get("robust")
+        if robust not in (0, 1) or isinstance(robust, bool):
+            return f"robust must be 0 or 1, got {robust!r}"
+        if robust == 1 and cf not in (0.0, 1.0):
+            return f"robust 1 but collapse_fraction {cf!r}: they disagree"
+    return ""
+
+
+def _check_numbers(row: dict, failed: bool, collapsed: bool, n_interfaces: int) -> str:
+    for key in COUNT_FIELDS:
+        v = row.get(key)
+        if v is None and failed:
+            continue
+        if not (isinstance(v, int) and not isinstance(v, bool) and v >= 0):
+            return f"{key} must be an integer >= 0, got {v!r}"
+    for key in ("max_rotation_ratio", "max_top_displacement_m"):
+        v = row.get(key)
+        if failed and (v is None or _nan_or_none(v)):
+            continue
+        if not (_is_number(v) and math.isfinite(v) and v >= 0):
+            return f"{key} must be a finite number >= 0, got {v!r}"
+    t, where = row.get("t_collapse_s"), row.get("collapse_interface")
+    if collapsed:
+        if not (_is_number(t) and math.isfinite(t) and t >= 0):
+            return f"t_collapse_s of a collapsed cell must be a finite time >= 0, got {t!r}"
+        ok = isinstance(where, int) and not isinstance(where, bool)
+        if not (ok and 1 <= where <= n_interfaces):
+            return f"collapse_interface must be in 1..{n_interfaces}, got {where!r}"
+    elif not (_nan_or_none(t) and where is None):
+        return "t_collapse_s and collapse_interface must be empty unless collapsed"
+    return ""

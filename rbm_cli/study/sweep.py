@@ -1,0 +1,391 @@
+"""Sweeps: run a grid of amplitude x frequency cells in parallel, resumably.
+
+The sweep knows runs, not physics. Cells are run in chunks by workers
+(rbm_cli.study.parallel; each worker assembles the model once per chunk and returns its rows;
+nothing accumulates in globals). The output folder is a transactional store
+(rbm_cli.study.store): locked for one sweep, finished chunks appended to a validated journal,
+``domain.partial.jsonl``, so an interrupted, killed or doubled sweep keeps every finished
+cell and leaves no file that looks complete, and ``resume=True`` finishes it without
+redoing finished cells. The result is published in one step at the end, in grid order,
+so the same config gives the same ``domain.csv`` whatever the number of workers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import joblib
+import numpy as np
+import pandas as pd
+
+from rbm_cli import __version__
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import Config
+from rbm_cli.models.result import CSV_FIELDS
+from rbm_cli.study.domain import cell_key
+from rbm_cli.study.parallel import run_chunks
+from rbm_cli.study.provenance import provenance
+from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
+from rbm_cli.study.robustness import Member, member_config, members, summarise
+from rbm_cli.study.store import JOURNAL, SweepStore
+from rbm_cli.study.sweep_folder import prepare_folder, publish_result
+
+#: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s).
+MAX_CELLS = 100_000
+BACKENDS = ("loky", "threading", "sequential", "dask")
+#: Columns an ensemble sweep adds to domain.csv (rbm_cli.study.robustness).
+ENSEMBLE_FIELDS = ("collapse_fraction", "robust")
+
+
+@dataclass(frozen=True)
+class SweepSummary:
+    folder: Path
+    n_cells: int
+    n_run: int
+    n_resumed: int
+    n_collapsed: int
+    n_survived: int
+    n_failed: int
+    wall_time_s: float
+    compile_s: float = 0.0  # compiling (or loading) the kernel, left out of wall_time_s
+    already_finished: bool = False  # resume on a folder that holds this config's result
+
+
+def grid_cells(config: Config) -> list[tuple[float, float]]:
+    """The cells of a config's grid, frequency-major: [(amplitude_g, frequency_hz), ...]."""
+    return [(a, f) for f in config.grid.frequencies_hz for a in config.grid.amplitudes_g]
+
+
+def config_hash(config: Config) -> str:
+    """Fingerprint of everything that changes a domain (the resolved config).
+
+    solver.max_wall_time is left out: a guard against a run that would not end, not a
+    setting of the domain (and hashes of domains made before it existed stay valid)."""
+    resolved = dataclasses.asdict(config)
+    resolved["solver"].pop("max_wall_time", None)
+    text = json.dumps(resolved, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def ensemble_member(config: Config, a: float, member: Member) -> tuple[Config, float]:
+    """(config, amplitude [g]) of an ensemble member (rbm_cli.study.robustness.members)
+    of the cell at amplitude a [g]."""
+    return member_config(config, a, member)
+
+
+def _run_cell(config: Config, a: float, f: float, model) -> dict:
+    from rbm_cli.study.simulate import simulate
+
+    try:
+        return simulate(config, a, f, model=model).row()
+    except Exception as exc:  # a sweep goes on past one bad cell
+        return {
+            "amplitude_g": a,
+            "frequency_hz": f,
+            "status": "failed",
+            "collapsed": 0,
+            "message": f"{type(exc).__name__}: {' '.join(str(exc).split())}",
+        }
+
+
+def run_chunk(config: Config, cells: list[tuple[float, float]], ensemble: int = 1) -> list[dict]:
+    """Run cells of one config in this process; a cell that raises is 'failed'.
+
+    With ensemble K > 1 each cell is run K times (rbm_cli.study.robustness.members) and
+    its row is member 0's, plus collapse_fraction (the fraction of the members
+    that did not fail which collapsed; NaN if all failed) and robust (1 when all
+    members agree and none failed: the robustness rule)."""
+    from rbm_cli.study.simulate import model_from_config
+
+    model = model_from_config(config) if config.model == "rbm" else None
+    rows = []
+    others = members(ensemble)[1:]
+    for a, f in cells:
+        row = _run_cell(config, a, f, model)
+        if ensemble > 1:
+            runs = [row] + [_run_cell(*ensemble_member(config, a, m), f, model) for m in others]
+            flags = [r["collapsed"] for r in runs if r["status"] != "failed"]
+            fraction, robust = summarise(flags, len(runs) - len(flags))
+            row["collapse_fraction"], row["robust"] = fraction, robust
+        rows.append(row)
+    return rows
+
+
+def _chunks(cells: list, jobs: int) -> list[list]:
+    size = int(np.clip(len(cells) // max(1, 16 * jobs), 1, 32))
+    return [cells[i : i + size] for i in range(0, len(cells), size)]
+
+
+def _versions() -> dict:
+    import matplotlib
+    import scipy
+
+    return {
+        "rbm": __version__,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "pandas": pd.__version__,
+        "joblib": joblib.__version__,
+        "matplotlib": matplotlib.__version__,
+    }
+
+
+def _check_request(
+    config: Config, jobs: int, ensemble: int, backend: str, scheduler: str | None, force: bool
+) -> int:
+    """The number of cells, once every argument is checked (before any folder exists)."""
+    # counted before the cells are listed: a 10^8-cell grid is refused at once
+    n_cells = len(config.grid.amplitudes_g) * len(config.grid.frequencies_hz)
+    if not n_cells:
+        raise RbmError("the config has no grid: give grid.amplitudes and grid.frequencies")
+    if n_cells > MAX_CELLS and not force:
+        raise RbmError(
+            f"the grid has {n_cells:,} cells (more than {MAX_CELLS:,}); use --force to run it"
+        )
+    if jobs < 1:
+        raise RbmError(f"--jobs must be >= 1, got {jobs}")
+    if ensemble < 1:
+        raise RbmError(f"--ensemble must be >= 1, got {ensemble}")
+    if backend not in BACKENDS:
+        raise RbmError(f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
+    if backend == "dask" and scheduler:
+        from rbm_cli.study.parallel import probe_dask
+
+        probe_dask(scheduler)  # an address that is not a Dask scheduler: one line, bounded
+    if config.model == "rbm":
+        from rbm_cli.study.simulate import model_from_config
+
+        model_from_config(config)  # every derived quantity finite, or one line now
+    return n_cells
+
+
+def run_sweep(
+    config: Config,
+    output: str | os.PathLike = "out",
+    jobs: int = 2,
+    backend: str = "loky",
+    scheduler: str | None = None,
+    resume: bool = False,
+    force: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+    stop_after: int | None = None,
+    ensemble: int = 1,
+    notify: Callable[[str], None] | None = None,
+    resume_command: str | None = None,
+) -> SweepSummary:
+    """Run the grid of a config and write OUTPUT/<name>/domain.csv and friends.
+
+    The folder is locked for the sweep (a second sweep into it is refused), finished
+    cells go to a validated journal as they finish, and the result is published in one
+    step once every file of it is written (rbm_cli.study.store). Nothing finished is deleted:
+    an unfinished journal needs resume=True (or force=True, which moves it to
+    superseded/); a finished result of the same config is replaced only by a complete
+    new one; one of another config needs force=True (moved to superseded/ first).
+
+    Parameters
+    ----------
+    config : Config  Validated config with a non-empty grid
+    output : path  Output root; files go to output/<name>/
+    jobs : int  Worker processes (joblib); 1 runs in this process
+    backend : str  joblib backend: loky (default), threading, sequential or
+        dask (a Dask distributed cluster at `scheduler`)
+    resume : bool  Finish an interrupted sweep of the same config; on a finished
+        folder of the same config, do nothing (the summary says already_finished)
+    force : bool  Allow grids of more than MAX_CELLS cells; set aside (never delete)
+        an unfinished journal, or a finished result of another config, and start again
+    progress : callable(done, total)  Called once before the first cell runs (after the
+        compile; done = the resumed cells), as chunks finish, and now and then between
+    stop_after : int  Stop after this many chunks (tests of interruption)
+    ensemble : int  Runs per cell (>1 adds the collapse_fraction column; see
+        rbm_cli.study.robustness for the perturbations)
+    notify : callable(str)  One-line notes (a journal recovered, lines not trusted...)
+    resume_command : str  The command that resumes this sweep (stored in the state
+        file and quoted in messages); default: a generic one
+
+    Raises
+    ------
+    RbmError  Bad arguments, a busy or unusable folder, a full disk (finished cells kept)
+    SweepInterrupted  Ctrl-C (a KeyboardInterrupt): finished cells kept, see its message
+    """
+    n_cells = _check_request(config, jobs, ensemble, backend, scheduler, force)
+    cells = grid_cells(config)
+    folder = Path(output) / config.name
+    digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
+    fields = CSV_FIELDS + (ENSEMBLE_FIELDS if ensemble > 1 else ())
+    resume_command = resume_command or f"rbm sweep CONFIG.yaml -o {output} --resume"
+    note = notify or (lambda text: None)
+    with SweepStore(folder) as store:
+        done = prepare_folder(store, config, cells, digest, ensemble, resume, force, note,
+                              resume_command)  # fmt: skip
+        if done is None:
+            return _finished_summary(folder, n_cells)
+        todo = [c for c in cells if cell_key(*c) not in done]
+        try:
+            compile_s = _warm_up(config, todo)
+            start = time.perf_counter()
+            chunks = _chunks(todo, jobs)
+            if stop_after is not None:
+                chunks = chunks[:stop_after]
+            tasks = [(config, c, ensemble) for c in chunks]
+            _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
+                       resume_command)  # fmt: skip
+        except KeyboardInterrupt:
+            # counted from the journal: Ctrl-C may land between a chunk's write and its count
+            read = store.read_journal(digest, {cell_key(*c) for c in cells},
+                                      config.column.n_drums, ensemble)  # fmt: skip
+            kept = max(len(done), len(read.rows))
+            raise SweepInterrupted(folder, kept, n_cells, resume_command) from None
+        if stop_after is not None and len(done) < n_cells:
+            raise RbmError(
+                f"sweep stopped after {stop_after} chunks (journal kept in {store.journal})"
+            )
+        wall = time.perf_counter() - start
+
+        rows = [done[cell_key(*c)] for c in cells]
+        df = pd.DataFrame(rows, columns=list(fields))
+        counts = df["status"].value_counts().to_dict()
+        meta = {
+            "name": config.name,
+            "config": dataclasses.asdict(config),
+            "config_hash": digest,
+            "versions": _versions(),
+            "wall_time_s": wall,
+            "jobs": jobs,
+            "backend": backend,
+            "scheduler": scheduler,
+            "n_cells": len(cells),
+            "n_run": len(todo),
+            "n_resumed": len(cells) - len(todo),
+            "status_counts": counts,
+            "ensemble": {"members": ensemble, "rule": ROBUSTNESS_RULE if ensemble > 1 else None},
+            "provenance": provenance(),
+            "cpu_count": os.cpu_count(),
+        }
+        meta["compile_time_s"] = compile_s
+        try:
+            publish_result(
+                store, lambda: domain_figure(df, config), rows, df, fields, meta, resume_command
+            )
+        except KeyboardInterrupt:
+            raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
+    return SweepSummary(
+        folder=folder,
+        n_cells=len(cells),
+        n_run=len(todo),
+        n_resumed=len(cells) - len(todo),
+        n_collapsed=int(counts.get("collapsed", 0)),
+        n_survived=int(counts.get("survived", 0)),
+        n_failed=int(counts.get("failed", 0)),
+        wall_time_s=wall,
+        compile_s=compile_s,
+    )
+
+
+def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
+               resume_command) -> None:  # fmt: skip
+    """Run the chunks; each one's rows go to the journal (fsync'ed), then into done."""
+    n_done = len(done)
+    if progress:
+        progress(n_done, n_cells)
+    store.open_journal()
+    try:
+        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler):
+            if rows is not None:
+                store.append(rows, digest)
+                for row in rows:
+                    done[cell_key(row["amplitude_g"], row["frequency_hz"])] = row
+                n_done += len(rows)
+            if progress:
+                progress(n_done, n_cells)
+    except OSError as exc:
+        raise RbmError(
+            f"cannot write the journal {store.journal}: {exc.strerror or exc}; the"
+            f" {len(done)} finished cells are kept: make room, then run {resume_command}"
+        ) from None
+    finally:
+        store.close_journal()
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep: the finished cells are kept in the journal."""
+
+    def __init__(self, folder: Path, n_kept: int, n_cells: int, resume_command: str):
+        self.folder, self.n_kept, self.n_cells = folder, n_kept, n_cells
+        self.resume_command = resume_command
+        super().__init__(
+            f"interrupted: {n_kept} of {n_cells} cells are kept in {folder / JOURNAL};"
+            f" resume with: {resume_command}"
+        )
+
+
+def _finished_summary(folder: Path, n_cells: int) -> SweepSummary:
+    """The summary of a folder that already holds this config's result."""
+    counts: dict = {}
+    try:
+        counts = json.loads((folder / "meta.json").read_text()).get("status_counts", {})
+    except (OSError, ValueError, AttributeError):
+        pass
+    return SweepSummary(
+        folder=folder,
+        n_cells=n_cells,
+        n_run=0,
+        n_resumed=n_cells,
+        n_collapsed=int(counts.get("collapsed", 0)),
+        n_survived=int(counts.get("survived", 0)),
+        n_failed=int(counts.get("failed", 0)),
+        wall_time_s=0.0,
+        already_finished=True,
+    )
+
+
+def _warm_up(config: Config, todo: list) -> float:
+    """Compile (or load) the kernel once here, so the workers load it from numba's
+    cache; its time [s], which the sweep's wall time and ETA leave out."""
+    if not (todo and config.model == "rbm" and config.solver.implementation == "compiled"):
+        return 0.0
+    from rbm_cli.models.rbm.kernel import warm_up
+
+    start = time.perf_counter()
+    warm_up()
+    return time.perf_counter() - start
+
+
+def domain_figure(df: pd.DataFrame, config: Config, compare=(), labels=None):
+    """The domain PNG's figure (the CLI and run_sweep save it)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from rbm_cli.physics.column import build_column
+    from rbm_cli.report.plot_domain import plot_domain
+
+    column = build_column(config.column, config.interface)
+    level, level_label = column.static_multiplier, "static multiplier"
+    if config.model == "bullet":  # the engine's true solids: its own uplift level
+        from rbm_cli.models.bullet.run import engine_uplift_g
+
+        level, level_label = engine_uplift_g(config), "engine uplift level"
+    fig, ax = plt.subplots(figsize=(9.5, 5))
+    plot_domain(
+        df,
+        ax=ax,
+        compare=compare,
+        labels=labels,
+        column=column,
+        excitation_type=config.excitation.type,
+        static_multiplier=level,
+        static_label=level_label,
+    )
+    ax.set_title(f"{config.name}: safe (o) / unsafe (x) domain")
+    fig.tight_layout()
+    return fig

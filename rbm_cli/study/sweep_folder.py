@@ -1,0 +1,156 @@
+"""The folder of a sweep before and after its cells run (over rbm_cli.study.store).
+
+prepare_folder decides, from what the folder holds, what a new sweep may do with it:
+finish the journal (resume), start one, or refuse; it never deletes a finished cell.
+publish_result writes the result files and publishes them in one step.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable
+from pathlib import Path
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.study.domain import boundary, cell_key, csv_text
+from rbm_cli.study.store import FINALS, JOURNAL, STATE
+
+
+def prepare_folder(store, config, cells, digest, ensemble, resume, force, note, command):
+    """The finished rows to keep (resume), {} for a new sweep, None if the folder
+    already holds this config's finished result and resume is asked. Refuses (RbmError)
+    whatever would lose finished work."""
+    folder = store.folder
+    if store.journal.exists():
+        grid = {cell_key(*c) for c in cells}
+        read = store.read_journal(digest, grid, config.column.n_drums, ensemble)
+        ours = digest in read.hashes or store.state_hash() == digest
+        n = len(read.rows) if ours else read.rejected  # rows of the other config
+        if not read.rows and not read.rejected and (ours or not read.hashes):
+            store.start_journal(digest, len(cells), command)  # it held no cell: start over
+            return {}
+        whose = "of this config" if ours else "of another config"
+        if not resume and not force:
+            hint = "add --resume to finish it" if ours else "use another -o folder"
+            raise RbmError(
+                f"{folder} holds an unfinished sweep {whose} ({n} finished cells): {hint},"
+                " or --force to set its journal aside (to superseded/) and start again"
+            )
+        if not resume or (not ours and read.hashes):
+            if resume:
+                raise RbmError(
+                    f"{store.journal} was made with a different config: use another -o folder,"
+                    " or run without --resume and with --force to set it aside"
+                )
+            where = store.set_aside([JOURNAL, STATE])
+            note(f"the unfinished journal ({n} finished cells) was moved to {where}")
+        elif not ours:  # no hash anywhere: nothing in it can be trusted
+            where = store.set_aside([JOURNAL, STATE])
+            note(f"the journal held no row of this config; it was moved to {where}")
+        else:
+            if read.rejected:
+                note(
+                    f"{read.rejected} journal line(s) were not trusted and their cells run"
+                    f" again (first: {read.first_problem})"
+                )
+            if store.state_hash() != digest:
+                note("the state file was missing or unreadable: recovered from the journal")
+                store.write_state(digest, len(cells), command)
+            return dict(read.rows)
+    else:
+        finished = store.finished_hash()
+        if finished not in (None, digest) and _same_settings(folder, config, ensemble):
+            finished = digest  # made before a setting with a default was added to configs
+        if finished == digest and resume:
+            return None
+        if finished is not None and finished != digest:
+            if not force:
+                act = "nothing to resume" if resume else "it is kept"
+                raise RbmError(
+                    f"{folder} holds the finished domain of another config ({act}): use"
+                    " another -o folder, or --force (without --resume) to set it aside"
+                    " (to superseded/) and run this config"
+                )
+            if resume:
+                raise RbmError(
+                    f"{folder} holds the finished domain of another config: nothing to resume"
+                )
+            where = store.set_aside(FINALS)
+            note(f"the finished domain of another config was moved to {where}")
+    store.start_journal(digest, len(cells), command)
+    return {}
+
+
+def publish_result(store, figure, rows, df, fields, meta, resume_command) -> None:
+    """domain.png (``figure()`` draws it), boundary.csv, domain.csv and meta.json (with
+    the others' SHA-256), published in one step; a failure keeps the journal and says
+    how to finish."""
+    bnd = boundary(df)
+    texts = {
+        "domain.csv": csv_text(rows, fields),
+        "boundary.csv": csv_text(bnd.to_dict("records"), tuple(bnd.columns)),
+    }
+
+    def png(path: Path) -> None:
+        import matplotlib.pyplot as plt
+
+        fig = figure()
+        try:
+            fig.savefig(path, format="png", dpi=150, bbox_inches="tight")
+        finally:
+            plt.close(fig)  # pyplot holds every figure it made until closed
+
+    def text(name: str) -> Callable[[Path], None]:
+        return lambda path: path.write_text(texts[name], encoding="utf-8")
+
+    def meta_json(path: Path) -> None:
+        from rbm_cli.report.files import json_ready
+
+        meta["files"] = {
+            name: hashlib.sha256((path.parent / name).read_bytes()).hexdigest()
+            for name in FINALS
+            if name != "meta.json"
+        }
+        path.write_text(json.dumps(json_ready(meta), indent=2, allow_nan=False) + "\n")
+
+    writers = [("domain.png", png), ("boundary.csv", text("boundary.csv")),
+               ("domain.csv", text("domain.csv")), ("meta.json", meta_json)]  # fmt: skip
+    kept = f"every finished cell is kept in {store.journal}"
+    try:
+        store.publish(writers)
+    except OSError as exc:
+        raise RbmError(
+            f"cannot write the result into {store.folder}: {exc.strerror or exc}; {kept}:"
+            f" make room, then run {resume_command}"
+        ) from None
+    except (RbmError, KeyboardInterrupt):
+        raise
+    except Exception as exc:  # a plot that fails: the result is not published half
+        reason = " ".join(str(exc).split())[:200]
+        raise RbmError(
+            f"cannot draw domain.png ({type(exc).__name__}: {reason}); {kept}, and {resume_command}"
+            " publishes it once the cause is fixed"
+        ) from None
+
+
+def _same_settings(folder: Path, config, ensemble: int) -> bool:
+    """Whether meta.json's resolved config equals this config on every key both have
+    (a finished domain made before a config key with a default existed has another hash
+    but the same settings)."""
+    import dataclasses
+
+    try:
+        meta = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
+        members = meta.get("ensemble", {}).get("members", 1)
+        stored = meta["config"]
+    except (OSError, ValueError, KeyError, AttributeError, TypeError):
+        return False
+    current = json.loads(json.dumps(dataclasses.asdict(config), default=str))
+    return members == ensemble and isinstance(stored, dict) and _common_equal(stored, current)
+
+
+def _common_equal(a, b) -> bool:
+    if isinstance(a, dict) and isinstance(b, dict):
+        return all(_common_equal(a[k], b[k]) for k in a.keys() & b.keys())
+    return a == b

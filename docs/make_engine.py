@@ -44,7 +44,8 @@ from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import GridConfig  # noqa: E402
 from rbm_cli.models.bullet.run import impact_rate_ratios, measure_restitution  # noqa: E402
 from rbm_cli.models.bullet.scene import EngineSettings  # noqa: E402
-from rbm_cli.models.housner import block_geometry, housner_restitution  # noqa: E402
+from rbm_cli.physics.block import block_geometry  # noqa: E402
+from rbm_cli.physics.restitution import block_restitution  # noqa: E402
 from rbm_cli.study.domain import read_domain  # noqa: E402
 from rbm_cli.study.simulate import simulate  # noqa: E402
 from rbm_cli.study.sweep import run_sweep  # noqa: E402
@@ -111,7 +112,7 @@ def part_impact() -> None:
     rows = []
     for name, column in COLUMNS.items():
         cfg = column_config(column)
-        e_h = housner_restitution(block_geometry(cfg.column))
+        e_h = block_restitution(block_geometry(cfg.column))
         for erp in (0.2, 0.05):
             s = EngineSettings(erp=erp)
             for frac in (0.2, 0.5, 0.8):

@@ -36,8 +36,9 @@ from rbm_cli.models.bullet.scene import (
     keep_in_plane,
     read_frame,
 )
-from rbm_cli.models.housner import block_geometry, housner_restitution
+from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.restitution import block_restitution
 from rbm_cli.study.simulate import simulate
 
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}  # Spanos-Koh slender, H/B = 4
@@ -125,7 +126,7 @@ def test_rate_reading_of_the_impact_is_biased_by_erp():
     (erp; no split impulse for multibody contacts), so on the tapered column it
     reads below Housner's e and moves with erp; the peaks' energy does not."""
     cfg = config(TAPER)
-    e_h = housner_restitution(block_geometry(cfg.column))
+    e_h = block_restitution(block_geometry(cfg.column))
     rates = impact_rate_ratios(cfg, impacts=4)
     assert np.min(rates) < e_h - 0.005, rates
     for erp in (0.2, 0.05):

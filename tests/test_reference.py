@@ -18,9 +18,11 @@ from scipy.integrate import quad, tplquad
 from scipy.optimize import brentq
 
 from rbm_cli.config.types import ColumnConfig, SolverConfig
-from rbm_cli.models.housner import block_geometry, housner_restitution, housner_run
+from rbm_cli.models.housner import housner_run
 from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.restitution import block_restitution
 
 G = 9.81
 ALPHA = 0.2  # slenderness of the linear test block [rad]
@@ -67,7 +69,7 @@ def test_uniform_rectangle_geometry(depth):
     assert geo.corner_inertia == pytest.approx(4.0 * m * R * R / 3.0, rel=1e-13)
     assert geo.frequency_parameter == pytest.approx(math.sqrt(3 * G / (4 * R)), rel=1e-13)
     alpha = math.atan(B / H)
-    assert housner_restitution(geo) == pytest.approx(1 - 1.5 * math.sin(alpha) ** 2, rel=1e-13)
+    assert block_restitution(geo) == pytest.approx(1 - 1.5 * math.sin(alpha) ** 2, rel=1e-13)
 
 
 def test_uniform_cylinder_inertia():

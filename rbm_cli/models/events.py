@@ -9,6 +9,17 @@ from scipy.optimize import brentq
 
 from rbm_cli.physics.equations import Model
 
+#: Relative offset of event surfaces, so that a restart exactly on a surface
+#: is not taken for a new crossing [fraction of theta_u].
+EVENT_EPS = 1e-12
+#: A rigid block whose post-impact rate is below REST_RATE * p * theta_u is
+#: put to rest [assumption]: its next excursion would stay below
+#: (REST_RATE^2 / 2) theta_u = 5e-7 theta_u. This ends Zeno impact sequences
+#: (e < 1) and micro-chatter (e = 1, demand just above uplift) in finite work.
+REST_RATE = 1e-3
+#: Stand-in for an infinite bound in the event distances.
+BIG = 1e30
+
 
 class Pieces:
     """Which piece of its law each interface is on: side s = +-1 and index k."""

@@ -29,7 +29,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from rbm_cli.config.types import G
-from rbm_cli.models.rbm.python import EVENT_EPS, REST_RATE, Outcome
+from rbm_cli.models.events import EVENT_EPS, REST_RATE
+from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.excitation import GroundMotion
 
 #: Samples per scanning chunk of a closed-form piece.

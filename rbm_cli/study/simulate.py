@@ -11,23 +11,11 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.models.rbm.python import integrate
 from rbm_cli.models.result import History, RunResult
+from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.column import Column, build_column
 from rbm_cli.physics.equations import Model, build_model
 from rbm_cli.physics.excitation import make_ground_motion
-
-
-def housner_restitution(column: Column) -> float:
-    """Housner's coefficient e = 1 - 2 m R^2 sin^2(alpha) / I_O of a monolithic
-    column (angular-velocity ratio), with the RBM's centre (mid-height) and
-    inertia: I_O = I_G + m (H^2 + B^2) / 4, R^2 sin^2(alpha) = (B / 2)^2.
-
-    For a rectangle of uniform width this is Housner's 1 - 1.5 sin^2(alpha).
-    """
-    m = column.total_mass
-    half_b = column.widths[0] / 2.0
-    half_h = column.height / 2.0
-    i_o = float(column.inertias[0]) + m * (half_h**2 + half_b**2)
-    return 1.0 - 2.0 * m * half_b**2 / i_o
+from rbm_cli.physics.restitution import block_restitution, column_restitution, resolve
 
 
 def model_from_config(config: Config, column: Column | None = None) -> Model:
@@ -38,9 +26,7 @@ def model_from_config(config: Config, column: Column | None = None) -> Model:
     with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
         if column is None:
             column = build_column(config.column, config.interface)
-        e = config.interface.restitution
-        if e == "housner":
-            e = housner_restitution(column)
+        e = resolve(config.interface.restitution, lambda: column_restitution(column))
         try:
             model = build_model(
                 column,
@@ -165,7 +151,7 @@ def simulate(
             early_stop=not record,
         )
     except (FloatingPointError, np.linalg.LinAlgError, ValueError, ZeroDivisionError) as exc:
-        from rbm_cli.models.rbm.python import Outcome
+        from rbm_cli.models.outcome import Outcome
 
         out = Outcome(status="failed", message=f"numerical failure: {exc}")
         out.max_ratio = np.full(n, np.nan)
@@ -213,8 +199,7 @@ def _engine_run(config, amplitude_g, frequency_hz, record, output_dt, start) -> 
 
 def _reference_run(config, amplitude_g, frequency_hz, record, output_dt, start) -> RunResult:
     """`housner` and `housner-linear`: single rigid blocks with their true geometry."""
-    from rbm_cli.models.housner import block_geometry, housner_run
-    from rbm_cli.models.housner import housner_restitution as block_restitution
+    from rbm_cli.models.housner import housner_run
     from rbm_cli.models.housner_linear import housner_linear_run
 
     geometry = block_geometry(config.column)
@@ -224,8 +209,7 @@ def _reference_run(config, amplitude_g, frequency_hz, record, output_dt, start) 
         float(init.rotations[0]) if init.rotations else 0.0,
         float(init.velocities[0]) if init.velocities else 0.0,
     )
-    e = config.interface.restitution
-    e = block_restitution(geometry) if e == "housner" else float(e)
+    e = resolve(config.interface.restitution, lambda: block_restitution(geometry))
     dt = output_dt if output_dt is not None else 0.002
     common = dict(
         restitution=e,

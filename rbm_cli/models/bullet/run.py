@@ -51,7 +51,7 @@ from rbm_cli.models.bullet.scene import (
     keep_in_plane,
     read_frame,
 )
-from rbm_cli.models.rbm.python import Outcome
+from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.result import History
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -77,7 +77,7 @@ OPEN_FRACTION = 1e-3
 DROP_FRACTION = 0.5
 #: Half-sine/free early stop: every rate below this [rad/s] and every joint
 #: closed for REST_TIME [s] after the pulse.
-REST_RATE = 1e-4
+REST_ANGULAR_RATE = 1e-4
 REST_TIME = 0.2
 #: A drum faster than this [m/s or rad/s] means the engine blew up.
 BLOWUP = 1e3
@@ -240,7 +240,7 @@ def bullet_run(
             break
         prev_ratio, prev_t = float(joints.ratio[worst]), t
         if early_stop and motion.kind != "harmonic" and t >= motion.pulse_end:
-            still = np.max(np.abs(frame.rates)) < REST_RATE and not np.any(is_open)
+            still = np.max(np.abs(frame.rates)) < REST_ANGULAR_RATE and not np.any(is_open)
             quiet_since = (quiet_since if quiet_since is not None else t) if still else None
             if quiet_since is not None and t - quiet_since >= REST_TIME:
                 out.n_steps = out.n_rhs = k

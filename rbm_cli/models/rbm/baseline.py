@@ -17,8 +17,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from rbm_cli.models.events import Pieces
-from rbm_cli.models.rbm.python import REST_RATE
+from rbm_cli.models.events import REST_RATE, Pieces
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
@@ -37,7 +36,16 @@ from scipy.integrate import DOP853, RK23, RK45
 
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.config.types import SolverConfig
-from rbm_cli.models.events import Pieces, first_crossing, hermite_peaks, within_reach
+from rbm_cli.models.events import (
+    BIG,
+    EVENT_EPS,
+    REST_RATE,
+    Pieces,
+    first_crossing,
+    hermite_peaks,
+    within_reach,
+)
+from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -86,44 +94,6 @@ def initial_step(rhs, t0: float, y0, f0, t_bound: float, order: int, rtol, atol)
     else:
         h1 = pow_pos(0.01 / max(d1, d2), 1.0 / (order + 1))
     return min(100.0 * h0, h1, interval)
-
-
-#: Relative offset of event surfaces, so that a restart exactly on a surface
-#: is not taken for a new crossing [fraction of theta_u].
-EVENT_EPS = 1e-12
-#: A rigid block whose post-impact rate is below REST_RATE * p * theta_u is
-#: put to rest [assumption]: its next excursion would stay below
-#: (REST_RATE^2 / 2) theta_u = 5e-7 theta_u. This ends Zeno impact sequences
-#: (e < 1) and micro-chatter (e = 1, demand just above uplift) in finite work.
-REST_RATE = 1e-3
-#: Stand-in for an infinite bound in the event distances.
-BIG = 1e30
-
-
-@dataclass
-class Outcome:
-    """Raw outcome of an integration (simulate() turns it into a RunResult)."""
-
-    status: str = "survived"
-    message: str = ""
-    t_end: float = 0.0
-    t_collapse: float = math.nan
-    collapse_interface: int | None = None
-    max_ratio: np.ndarray | None = None
-    max_top: float = 0.0
-    friction: np.ndarray | None = None
-    n_uplifts: int = 0
-    n_impacts: int = 0
-    n_steps: int = 0
-    n_rhs: int = 0
-    n_events: int = 0
-    samples: list = field(default_factory=list)  # (t, theta, rate) when recording
-
-    def stop(self, status: str, message: str, t: float) -> Outcome:
-        """End the run at time t with a status and a reason."""
-        self.status, self.t_end = status, t
-        self.message = message if status != "failed" else f"{message} at t={t:.6g} s"
-        return self
 
 
 def integrate(

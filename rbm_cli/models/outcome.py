@@ -1,0 +1,41 @@
+"""The raw outcome of one run, the one type every model's runner returns.
+
+study.simulate adds the cell (amplitude, frequency) and the wall time and turns it into a
+rbm_cli.models.result.RunResult, the row of a domain.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rbm_cli.models.result import History
+
+
+@dataclass
+class Outcome:
+    """Raw outcome of an integration (simulate() turns it into a RunResult)."""
+
+    status: str = "survived"
+    message: str = ""
+    t_end: float = 0.0
+    t_collapse: float = math.nan
+    collapse_interface: int | None = None
+    max_ratio: np.ndarray | None = None
+    max_top: float = 0.0
+    friction: np.ndarray | None = None
+    n_uplifts: int = 0
+    n_impacts: int = 0
+    n_steps: int = 0
+    n_rhs: int = 0
+    n_events: int = 0
+    samples: list = field(default_factory=list)  # (t, theta, rate) when recording
+    history: History | None = None  # the sampled history, made by the runner when recording
+
+    def stop(self, status: str, message: str, t: float) -> Outcome:
+        """End the run at time t with a status and a reason."""
+        self.status, self.t_end = status, t
+        self.message = message if status != "failed" else f"{message} at t={t:.6g} s"
+        return self

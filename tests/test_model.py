@@ -18,6 +18,7 @@ from rbm_cli.config.types import (
     StiffnessConfig,
 )
 from rbm_cli.physics.column import build_column
+from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.study.simulate import model_from_config, simulate
 
 from .closed_form import LinearRocking
@@ -202,7 +203,7 @@ def test_strong_upper_joints_behave_as_monolith(formulation, amplitude, frequenc
     ref = simulate(mono, amplitude, frequency)
     assert ref.collapsed
     model = model_from_config(stack, column=_stiff_upper_joints(stack))
-    res = simulate(stack, amplitude, frequency, model=model)
+    res = simulate(stack, amplitude, frequency, runner=RbmRunner(stack, model=model))
     assert res.collapsed and res.collapse_interface == 1
     assert res.t_collapse_s == pytest.approx(ref.t_collapse_s, rel=0.01)
 

@@ -71,7 +71,7 @@ SOLVER_KEYS = (
 #: Models of SPEC section 2 that this version does not implement yet.
 PLANNED_MODELS: tuple[str, ...] = ()
 #: Models that accept any number of drums (the reference blocks are monolithic).
-MULTI_DRUM_MODELS = ("rbm", "bullet")
+MULTI_DRUM_MODELS = tuple(name for name, entry in MODELS.items() if entry.multi_drum)
 #: Range of solver.time_step, the contact engine's fixed step [s].
 TIME_STEP_RANGE = (1e-6, 1e-2)
 #: Default ``excitation.duration`` per type [s] (SPEC section 3).

@@ -13,16 +13,35 @@ from dataclasses import dataclass, field
 #: Acceleration of gravity [m/s^2] (SPEC: g = 9.81).
 G = 9.81
 
-#: rbm: the Rigid Beam Model; housner: Housner's nonlinear rigid block (large
-#: rotations, true geometry); housner-linear: the piecewise-linear block of
-#: Spanos and Koh (closed form, true geometry). The last two: monolithic only.
-#: bullet: stacked rigid drums in Bullet's contact dynamics (PyBullet), any drums.
-MODELS = ("rbm", "housner", "housner-linear", "bullet")
 SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
 EXCITATIONS = ("harmonic", "half-sine", "free")
 METHODS = ("DOP853", "RK45", "RK23")
 IMPLEMENTATIONS = ("compiled", "python")
+
+
+@dataclass(frozen=True)
+class ModelEntry:
+    """A registered model: its runner ("module:class", rbm_cli.models.contract.Runner)
+    and whether it takes more than one drum."""
+
+    runner: str
+    multi_drum: bool
+
+
+#: The model registry, name -> runner (rbm_cli.models.registry resolves it). rbm: the
+#: Rigid Beam Model; housner: Housner's nonlinear rigid block (large rotations, true
+#: geometry); housner-linear: the piecewise-linear block of Spanos and Koh (closed form,
+#: true geometry); the last two monolithic only. bullet: stacked rigid drums in Bullet's
+#: contact dynamics (PyBullet), any drums. A new model is one module and one line here.
+MODELS = {
+    "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True),
+    "housner": ModelEntry("rbm_cli.models.housner:HousnerRunner", multi_drum=False),
+    "housner-linear": ModelEntry(
+        "rbm_cli.models.housner_linear:HousnerLinearRunner", multi_drum=False
+    ),
+    "bullet": ModelEntry("rbm_cli.models.bullet.run:BulletRunner", multi_drum=True),
+}
 
 
 @dataclass(frozen=True)

@@ -108,3 +108,23 @@ class RunResult:
             if isinstance(v, float) and not np.isfinite(v):
                 out[k] = None
         return out
+
+
+def history_from_samples(node_map: np.ndarray, motion, samples) -> History:
+    """The History of a run from its samples [(t, theta, rate), ...], the map of
+    rotations to node displacements (n+1, n) and its ground motion."""
+    n = node_map.shape[1]
+    if samples:
+        t = np.array([s[0] for s in samples])
+        theta = np.array([s[1] for s in samples])
+        rates = np.array([s[2] for s in samples])
+    else:
+        t, theta, rates = np.zeros(0), np.zeros((0, n)), np.zeros((0, n))
+    return History(
+        t=t,
+        ground_acceleration=np.asarray(motion.accel(t), dtype=float),
+        ground_displacement=motion.displacement(t),
+        node_displacements=theta @ node_map.T,
+        rotations=theta,
+        rates=rates,
+    )

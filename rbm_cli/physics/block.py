@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.polynomial import Polynomial
 
-from rbm_cli.config.types import ColumnConfig, G
+from rbm_cli.config.types import ColumnConfig, Config, G
 
 
 @dataclass(frozen=True)
@@ -116,3 +116,12 @@ def housner_energy(theta, rate, alpha: float, p: float):
     E = theta'^2 / 2 + p^2 (cos(alpha - |theta|) - cos(alpha)), zero at rest.
     """
     return 0.5 * rate * rate + p * p * (np.cos(alpha - np.abs(theta)) - math.cos(alpha))
+
+
+def block_initial(config: Config) -> tuple[float, float]:
+    """(theta0 [rad], rate0 [rad/s]) of a block from the config's initial state."""
+    init = config.excitation.initial
+    return (
+        float(init.rotations[0]) if init.rotations else 0.0,
+        float(init.velocities[0]) if init.velocities else 0.0,
+    )

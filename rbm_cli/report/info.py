@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from rbm_cli.config.types import Config, G
-from rbm_cli.study.simulate import model_from_config
+from rbm_cli.models.rbm.runner import model_from_config
 
 
 def normal_stiffness(col, i: int) -> float:

@@ -81,11 +81,11 @@ def ensemble_member(config: Config, a: float, member: Member) -> tuple[Config, f
     return member_config(config, a, member)
 
 
-def _run_cell(config: Config, a: float, f: float, model) -> dict:
+def _run_cell(config: Config, a: float, f: float, runner) -> dict:
     from rbm_cli.study.simulate import simulate
 
     try:
-        return simulate(config, a, f, model=model).row()
+        return simulate(config, a, f, runner=runner).row()
     except Exception as exc:  # a sweep goes on past one bad cell
         return {
             "amplitude_g": a,
@@ -103,15 +103,15 @@ def run_chunk(config: Config, cells: list[tuple[float, float]], ensemble: int = 
     its row is member 0's, plus collapse_fraction (the fraction of the members
     that did not fail which collapsed; NaN if all failed) and robust (1 when all
     members agree and none failed: the robustness rule)."""
-    from rbm_cli.study.simulate import model_from_config
+    from rbm_cli.models.registry import make_runner
 
-    model = model_from_config(config) if config.model == "rbm" else None
+    runner = make_runner(config)  # the column assembled once for every cell and member
     rows = []
     others = members(ensemble)[1:]
     for a, f in cells:
-        row = _run_cell(config, a, f, model)
+        row = _run_cell(config, a, f, runner)
         if ensemble > 1:
-            runs = [row] + [_run_cell(*ensemble_member(config, a, m), f, model) for m in others]
+            runs = [row] + [_run_cell(*ensemble_member(config, a, m), f, runner) for m in others]
             flags = [r["collapsed"] for r in runs if r["status"] != "failed"]
             fraction, robust = summarise(flags, len(runs) - len(flags))
             row["collapse_fraction"], row["robust"] = fraction, robust
@@ -162,7 +162,7 @@ def _check_request(
 
         probe_dask(scheduler)  # an address that is not a Dask scheduler: one line, bounded
     if config.model == "rbm":
-        from rbm_cli.study.simulate import model_from_config
+        from rbm_cli.models.rbm.runner import model_from_config
 
         model_from_config(config)  # every derived quantity finite, or one line now
     return n_cells

@@ -34,10 +34,12 @@ References
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import Config, G
+from rbm_cli.config.types import Config, G, SolverConfig
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.impact import impact_rate_ratios, measure_restitution
 from rbm_cli.models.bullet.scene import (
@@ -51,6 +53,7 @@ from rbm_cli.models.bullet.scene import (
     keep_in_plane,
     read_frame,
 )
+from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.result import History
 from rbm_cli.physics.excitation import GroundMotion
@@ -289,3 +292,31 @@ def _history(samples, motion: GroundMotion) -> History:
         rotations=np.array([s[1] for s in samples]),
         rates=np.array([s[2] for s in samples]),
     )
+
+
+class BulletRunner:
+    """`bullet` (rbm_cli.models.contract.Runner): the config's drums in Bullet's contact
+    dynamics; the engine's own history (from the drums' poses) when recording."""
+
+    def __init__(self, config: Config) -> None:
+        self.config = config
+        self.n_interfaces = config.column.n_drums
+
+    def run(
+        self,
+        motion: GroundMotion,
+        solver: SolverConfig,
+        *,
+        record: bool = False,
+        output_dt: float = DEFAULT_OUTPUT_DT,
+        early_stop: bool = True,
+    ) -> Outcome:
+        """One run (rbm_cli.models.contract.Runner.run): the engine steps at solver.time_step."""
+        config = self.config
+        if solver != config.solver:
+            config = dataclasses.replace(config, solver=solver)
+        out, history = bullet_run(
+            config, motion, record=record, output_dt=output_dt, early_stop=early_stop
+        )
+        out.history = history
+        return out

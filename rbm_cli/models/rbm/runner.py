@@ -1,0 +1,151 @@
+"""The Rigid Beam Model's runner: the column's equations assembled once, run by the compiled
+kernel (default) or the readable Python loop, two implementations of the same integrator
+(`solver.implementation`); tests/test_kernel.py holds them to the same steps."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import Config, SolverConfig
+from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
+from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.result import history_from_samples
+from rbm_cli.physics.column import Column, build_column
+from rbm_cli.physics.equations import Model, build_model
+from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.restitution import column_restitution, resolve
+
+#: What a numerical failure of the integrator raises; the run ends `failed`, with the reason.
+NUMERICAL_FAILURES = (FloatingPointError, np.linalg.LinAlgError, ValueError, ZeroDivisionError)
+
+
+def model_from_config(config: Config, column: Column | None = None) -> Model:
+    """Assemble the model of a config (column may be overridden, e.g. in tests).
+
+    Raises RbmError if a derived quantity (mass, inertia, capacity, stiffness, the
+    mass matrix or its inverse, a law's pieces, p) is not finite: see check_derived."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+        if column is None:
+            column = build_column(config.column, config.interface)
+        e = resolve(config.interface.restitution, lambda: column_restitution(column))
+        try:
+            model = build_model(
+                column,
+                xi=config.interface.xi,
+                restitution=float(e),
+                formulation=config.interface.formulation,
+                collapse_ratio=config.collapse.ratio,
+            )
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+            raise RbmError(
+                f"the column's model cannot be assembled ({type(exc).__name__}: {exc}): its"
+                " inputs are outside the range where the arithmetic is sound"
+            ) from None
+        check_derived(model)
+    return model
+
+
+def check_derived(model: Model) -> None:
+    """Every derived quantity of a model finite (and positive where it must be), before a
+    run starts: a density of 1e307 once made masses overflow and a collapsing column
+    report 'survived' (issue 14). Raises RbmError naming the first bad quantity."""
+    col = model.column
+    positive = {
+        "drum masses": col.masses,
+        "drum inertias": col.inertias,
+        "normal forces N_i": col.normal_forces,
+        "moment capacities M_u,i": col.moment_capacity,
+        "rotation capacities theta_u,i": col.rotation_capacity,
+        "lever arms": col.lever_arms,
+    }
+    finite = {
+        "mass matrix": model.mass,
+        "inverse mass matrix": model.mass_inv,
+        "gravity matrix": model.gravity,
+        "ground load": model.ground_load,
+        "collapse limits": model.collapse_limit,
+    }
+    for i, law in enumerate(model.laws):
+        finite[f"law of interface {i + 1}"] = np.concatenate(
+            [law.edges, law.intercepts, law.slopes]
+        )
+    stiff = col.stiffness
+    bad_stiffness = not np.all(np.isinf(stiff) | (np.isfinite(stiff) & (stiff > 0)))
+    for name, values in positive.items():
+        v = np.asarray(values, dtype=float)
+        if not (np.all(np.isfinite(v)) and np.all(v > 0)):
+            _derived_error(name, v)
+    for name, values in finite.items():
+        v = np.asarray(values, dtype=float)
+        if not np.all(np.isfinite(v)):
+            _derived_error(name, v)
+    if bad_stiffness:
+        _derived_error("joint stiffnesses K_M,i", stiff)
+    p = model.rocking_p
+    if not (math.isfinite(p) and p > 0):
+        _derived_error("rocking parameter p", np.array([p]))
+
+
+def _derived_error(name: str, values: np.ndarray) -> None:
+    shown = ", ".join(f"{x:.4g}" for x in values.ravel()[:3])
+    raise RbmError(
+        f"the column's {name} are not finite and positive ({shown}...): the inputs are"
+        " outside the range where the arithmetic is sound (check column sizes, density"
+        " and interface.stiffness)"
+    )
+
+
+class RbmRunner:
+    """The Rigid Beam Model of a config's column (rbm_cli.models.contract.Runner).
+
+    Parameters
+    ----------
+    config : Config  Validated configuration
+    model : Model  Pre-assembled equations (tests that alter a column); default: the config's
+    """
+
+    def __init__(self, config: Config, model: Model | None = None) -> None:
+        self.config = config
+        self.model = model if model is not None else model_from_config(config)
+        self.n_interfaces = self.model.n
+        init = config.excitation.initial
+        n = self.model.n
+        self.theta0 = np.zeros(n) if not init.rotations else np.asarray(init.rotations, float)
+        self.rate0 = np.zeros(n) if not init.velocities else np.asarray(init.velocities, float)
+
+    def run(
+        self,
+        motion: GroundMotion,
+        solver: SolverConfig,
+        *,
+        record: bool = False,
+        output_dt: float = DEFAULT_OUTPUT_DT,
+        early_stop: bool = True,
+    ) -> Outcome:
+        """One run (rbm_cli.models.contract.Runner.run)."""
+        if solver.implementation == "compiled":
+            from rbm_cli.models.rbm.kernel import integrate_compiled as integrator
+        else:
+            from rbm_cli.models.rbm.python import integrate as integrator
+        n = self.model.n
+        try:
+            out = integrator(
+                self.model,
+                motion,
+                self.theta0,
+                self.rate0,
+                solver,
+                record=record,
+                output_dt=output_dt,
+                early_stop=early_stop,
+            )
+        except NUMERICAL_FAILURES as exc:
+            out = Outcome(status="failed", message=f"numerical failure: {exc}")
+            out.max_ratio = np.full(n, np.nan)
+            out.friction = np.full(n, np.nan)
+        if record:
+            out.history = history_from_samples(self.model.node_map, motion, out.samples)
+        return out

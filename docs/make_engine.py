@@ -40,6 +40,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import GridConfig  # noqa: E402
 from rbm_cli.models.bullet.run import impact_rate_ratios, measure_restitution  # noqa: E402
@@ -48,7 +49,6 @@ from rbm_cli.physics.block import block_geometry  # noqa: E402
 from rbm_cli.physics.restitution import block_restitution  # noqa: E402
 from rbm_cli.study.domain import read_domain  # noqa: E402
 from rbm_cli.study.simulate import simulate  # noqa: E402
-from rbm_cli.study.sweep import run_sweep  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "engine_data"

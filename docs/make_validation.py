@@ -32,6 +32,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
+from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import ExcitationConfig, GridConfig, InitialConfig  # noqa: E402
 from rbm_cli.models.housner import block_geometry  # noqa: E402
@@ -46,7 +47,6 @@ from rbm_cli.physics.excitation import make_ground_motion  # noqa: E402
 from rbm_cli.report.plot_domain import plot_domain  # noqa: E402
 from rbm_cli.study.domain import boundary, compare, read_domain  # noqa: E402
 from rbm_cli.study.simulate import housner_restitution, model_from_config, simulate  # noqa: E402
-from rbm_cli.study.sweep import run_sweep  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIGS = ROOT / "configs"

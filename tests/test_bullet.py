@@ -315,7 +315,7 @@ def test_engine_domain_plot_marks_the_engine_uplift_level():
     import matplotlib.pyplot as plt
     import pandas as pd
 
-    from rbm_cli.study.sweep import domain_figure
+    from rbm_cli.report.domain_figure import domain_figure
 
     cfg = config(TAPER)
     df = pd.DataFrame(

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from rbm_cli.api import run_sweep
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import GridConfig
@@ -20,7 +21,6 @@ from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.study.domain import read_domain
 from rbm_cli.study.robustness import LARGEST, RULE, SMALLEST, member_config, members, tight_rtol
 from rbm_cli.study.simulate import model_from_config, simulate
-from rbm_cli.study.sweep import run_sweep
 
 from .paths import CONFIGS
 

@@ -46,9 +46,10 @@ from pathlib import Path
 
 import pytest
 
+from rbm_cli.api import run_sweep
 from rbm_cli.config.load import load_config
 from rbm_cli.study.store import JOURNAL, STATE, SweepStore
-from rbm_cli.study.sweep import config_hash, grid_cells, run_sweep
+from rbm_cli.study.sweep import config_hash, grid_cells
 
 CONFIG = """\
 name: faults

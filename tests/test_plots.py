@@ -11,20 +11,16 @@ import pytest
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
+from rbm_cli.base.files import (
+    OutputError,
+    check_writable_dir,
+    save_figure_atomic,
+    write_csv_atomic,
+    write_json_atomic,
+)
 from rbm_cli.config.load import load_config
 from rbm_cli.models.result import History
 from rbm_cli.physics.column import build_column
-from rbm_cli.report.files import (
-    OutputError,
-    check_writable_dir,
-    history_frame,
-    run_folder_name,
-    save_figure_atomic,
-    shape_instants,
-    write_csv_atomic,
-    write_json_atomic,
-    write_run,
-)
 from rbm_cli.report.plots import (
     exaggeration_factor,
     infer_elevations,
@@ -33,6 +29,7 @@ from rbm_cli.report.plots import (
     plot_top_relative,
     top_relative_displacement,
 )
+from rbm_cli.report.run_folder import history_frame, run_folder_name, shape_instants, write_run
 from rbm_cli.study.simulate import simulate
 
 THREE_DRUMS = """\

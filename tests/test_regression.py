@@ -24,11 +24,11 @@ import json
 
 import pytest
 
+from rbm_cli.api import run_sweep
 from rbm_cli.config.load import load_config
 from rbm_cli.study.domain import compare, read_domain
 from rbm_cli.study.regression import check
 from rbm_cli.study.robustness import MEMBERS, RULE
-from rbm_cli.study.sweep import run_sweep
 
 from .paths import CONFIGS, RESULTS
 

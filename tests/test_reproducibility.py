@@ -29,11 +29,11 @@ import pandas as pd
 import pytest
 from numba import njit
 
+from rbm_cli.api import run_sweep
 from rbm_cli.base import detmath
 from rbm_cli.config.load import load_config
 from rbm_cli.study.domain import read_domain
 from rbm_cli.study.regression import check, sensitive_bound
-from rbm_cli.study.sweep import run_sweep
 
 from .paths import CONFIGS, RESULTS, ROOT
 

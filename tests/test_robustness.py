@@ -23,11 +23,11 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from rbm_cli.api import run_sweep
 from rbm_cli.base.errors import RbmError
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import load_config
 from rbm_cli.study.store import JOURNAL, STATE, SweepStore
-from rbm_cli.study.sweep import run_sweep
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -266,12 +266,12 @@ def _no_result(folder: Path) -> None:
 def test_case06_a_plot_failure_publishes_nothing(small, tmp_path, straight, monkeypatch):
     """Defect: domain.csv, boundary.csv and meta.json were written before the PNG: a plot
     failure left files that looked finished."""
-    import rbm_cli.study.sweep
+    import rbm_cli.api
 
     def broken(*args, **kwargs):
         raise ValueError("the figure cannot be drawn")
 
-    monkeypatch.setattr(rbm_cli.study.sweep, "domain_figure", broken)
+    monkeypatch.setattr(rbm_cli.api, "domain_figure", broken)
     res = invoke("sweep", small, "-o", tmp_path / "out", "--jobs", "1", "--quiet")
     one_line_error(res, "cannot draw domain.png", "--resume")
     folder = tmp_path / "out" / "small"
@@ -284,12 +284,12 @@ def test_case06_a_plot_failure_publishes_nothing(small, tmp_path, straight, monk
 
 
 def test_case06_ctrl_c_while_drawing_publishes_nothing(small, tmp_path, monkeypatch):
-    import rbm_cli.study.sweep
+    import rbm_cli.api
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(rbm_cli.study.sweep, "domain_figure", interrupted)
+    monkeypatch.setattr(rbm_cli.api, "domain_figure", interrupted)
     res = invoke("sweep", small, "-o", tmp_path / "out", "--jobs", "1", "--quiet")
     one_line_error(res, f"{N_CELLS} of {N_CELLS} cells are kept", "--resume", code=130)
     _no_result(tmp_path / "out" / "small")

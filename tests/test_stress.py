@@ -22,13 +22,13 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
+from rbm_cli.api import run_sweep
 from rbm_cli.config.load import parse_config
 from rbm_cli.models.rbm.python import integrate
 from rbm_cli.models.result import STATUSES
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.report.info import describe
 from rbm_cli.study.simulate import model_from_config, simulate
-from rbm_cli.study.sweep import run_sweep
 
 from .stress_strategies import (
     _round,

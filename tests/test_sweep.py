@@ -8,11 +8,12 @@ import json
 import pandas as pd
 import pytest
 
+from rbm_cli.api import run_sweep
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import GridConfig
 from rbm_cli.study.domain import boundary, compare, read_domain
-from rbm_cli.study.sweep import JOURNAL, grid_cells, run_sweep
+from rbm_cli.study.sweep import JOURNAL, grid_cells
 
 from .paths import CONFIGS
 

@@ -92,8 +92,8 @@ def sweep(
         rbm sweep configs/harmonic_multidrum.yaml -o out --jobs 2 --resume
         rbm sweep configs/harmonic_multidrum.yaml --backend dask --scheduler tcp://10.0.0.5:8786
     """
+    from rbm_cli.api import SweepInterrupted, run_sweep
     from rbm_cli.cli.progress import Progress, duration
-    from rbm_cli.study.sweep import SweepInterrupted, run_sweep
 
     cfg = load(config)
     if scheduler and backend != "dask":
@@ -210,7 +210,7 @@ def plot_domain_cmd(
     import matplotlib.pyplot as plt
     from matplotlib.backend_bases import FigureCanvasBase
 
-    from rbm_cli.report.files import save_figure_atomic
+    from rbm_cli.base.files import save_figure_atomic
     from rbm_cli.report.plot_domain import plot_domain
     from rbm_cli.study.domain import read_domain
 
@@ -229,7 +229,7 @@ def plot_domain_cmd(
             )
         labels = [Path(domain_csv).parent.name or "domain"] + [Path(p).parent.name for p in others]
         if cfg is not None:
-            from rbm_cli.study.sweep import domain_figure
+            from rbm_cli.report.domain_figure import domain_figure
 
             fig = domain_figure(df, cfg, compare=dfs, labels=labels)
         else:

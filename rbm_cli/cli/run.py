@@ -119,8 +119,9 @@ def run(
         rbm run configs/spanos_koh_slender.yaml --amplitude 0.5 --frequency 1
         rbm run configs/harmonic_multidrum.yaml -a 0.3 -f 2 -o /tmp/rbm-out
     """
+    from rbm_cli.base.files import check_writable_dir
     from rbm_cli.physics.column import build_column
-    from rbm_cli.report.files import check_writable_dir, run_folder_name, run_summary, write_run
+    from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
     from rbm_cli.study.simulate import simulate
 
     cfg = load(config)
@@ -278,7 +279,7 @@ def info(config: str, as_json: bool) -> None:
     if as_json:
         import json
 
-        from rbm_cli.report.files import json_ready
+        from rbm_cli.base.files import json_ready
 
         click.echo(json.dumps(json_ready(figures), indent=2))
     else:

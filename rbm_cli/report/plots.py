@@ -1,7 +1,7 @@
 """Plots of one run: displacement histories (paper fig. 4) and deformed shapes (fig. 3).
 
 Pure functions: each takes ``ax=None`` (a new figure is made if omitted) and
-returns the axes. Nothing here saves a file; :mod:`rbm_cli.report.files` does.
+returns the axes. Nothing here saves a file; :mod:`rbm_cli.report.run_folder` does.
 """
 
 from __future__ import annotations

@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import joblib
 import numpy as np
@@ -37,6 +38,9 @@ from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
 from rbm_cli.study.robustness import Member, member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
 from rbm_cli.study.sweep_folder import prepare_folder, publish_result
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s).
 MAX_CELLS = 100_000
@@ -181,6 +185,8 @@ def run_sweep(
     ensemble: int = 1,
     notify: Callable[[str], None] | None = None,
     resume_command: str | None = None,
+    *,
+    figure: Callable[[pd.DataFrame, Config], Figure],
 ) -> SweepSummary:
     """Run the grid of a config and write OUTPUT/<name>/domain.csv and friends.
 
@@ -210,6 +216,9 @@ def run_sweep(
     notify : callable(str)  One-line notes (a journal recovered, lines not trusted...)
     resume_command : str  The command that resumes this sweep (stored in the state
         file and quoted in messages); default: a generic one
+    figure : callable(domain DataFrame, Config) -> matplotlib Figure  Draws domain.png
+        (the report layer's rbm_cli.report.domain_figure.domain_figure; rbm_cli.api.run_sweep
+        passes it): the sweep knows runs, not plotting
 
     Raises
     ------
@@ -273,7 +282,7 @@ def run_sweep(
         meta["compile_time_s"] = compile_s
         try:
             publish_result(
-                store, lambda: domain_figure(df, config), rows, df, fields, meta, resume_command
+                store, lambda: figure(df, config), rows, df, fields, meta, resume_command
             )
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
@@ -357,35 +366,3 @@ def _warm_up(config: Config, todo: list) -> float:
     start = time.perf_counter()
     warm_up()
     return time.perf_counter() - start
-
-
-def domain_figure(df: pd.DataFrame, config: Config, compare=(), labels=None):
-    """The domain PNG's figure (the CLI and run_sweep save it)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from rbm_cli.physics.column import build_column
-    from rbm_cli.report.plot_domain import plot_domain
-
-    column = build_column(config.column, config.interface)
-    level, level_label = column.static_multiplier, "static multiplier"
-    if config.model == "bullet":  # the engine's true solids: its own uplift level
-        from rbm_cli.models.bullet.run import engine_uplift_g
-
-        level, level_label = engine_uplift_g(config), "engine uplift level"
-    fig, ax = plt.subplots(figsize=(9.5, 5))
-    plot_domain(
-        df,
-        ax=ax,
-        compare=compare,
-        labels=labels,
-        column=column,
-        excitation_type=config.excitation.type,
-        static_multiplier=level,
-        static_label=level_label,
-    )
-    ax.set_title(f"{config.name}: safe (o) / unsafe (x) domain")
-    fig.tight_layout()
-    return fig

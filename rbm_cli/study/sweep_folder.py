@@ -93,19 +93,13 @@ def publish_result(store, figure, rows, df, fields, meta, resume_command) -> Non
     }
 
     def png(path: Path) -> None:
-        import matplotlib.pyplot as plt
-
-        fig = figure()
-        try:
-            fig.savefig(path, format="png", dpi=150, bbox_inches="tight")
-        finally:
-            plt.close(fig)  # pyplot holds every figure it made until closed
+        figure().savefig(path, format="png", dpi=150, bbox_inches="tight")
 
     def text(name: str) -> Callable[[Path], None]:
         return lambda path: path.write_text(texts[name], encoding="utf-8")
 
     def meta_json(path: Path) -> None:
-        from rbm_cli.report.files import json_ready
+        from rbm_cli.base.files import json_ready
 
         meta["files"] = {
             name: hashlib.sha256((path.parent / name).read_bytes()).hexdigest()

@@ -246,60 +246,17 @@ def plot_domain_cmd(
 
 
 def _config_for(domain_csv: str, config_path: str | None):
-    """The config of a domain: given, or resolved from meta.json beside it."""
+    """The config of a domain: given, or the one stored in meta.json beside it (as the
+    user wrote it); None when neither is there (the plot then lacks the curves that
+    need the column)."""
+    from rbm_cli.study.domain import domain_config
+
     if config_path:
         return load(config_path)
-    meta = Path(domain_csv).with_name("meta.json")
-    if not meta.is_file():
-        return None
-    import json
-
-    from rbm_cli.config.load import parse_config
-
     try:
-        resolved = json.loads(meta.read_text())["config"]
-        return parse_config(_unresolve(resolved), source=str(meta))
-    except (ValueError, KeyError, TypeError, RbmError):
-        return None  # plot without the config-dependent curves
-
-
-def _unresolve(c: dict) -> dict:
-    """meta.json's resolved config (dataclass fields) back into YAML keys."""
-    col, itf, exc = c["column"], c["interface"], c["excitation"]
-    stiff = itf["stiffness"]
-    if stiff["kind"] == "rigid":
-        stiffness = "rigid"
-    elif stiff["kind"] == "normal":
-        stiffness = {"normal": stiff["values"][0]}
-    else:
-        vals = stiff["values"]
-        stiffness = {"rotational": vals[0] if len(vals) == 1 else list(vals)}
-    column = {
-        "height": col["height"],
-        "base_width": col["base_width"],
-        "top_width": col["top_width"],
-        "section": col["section"],
-        "density": col["density"],
-        "drums": list(col["drum_heights"]),
-    }
-    if col.get("depth") is not None:
-        column["depth"] = col["depth"]
-    excitation = {"type": exc["type"], "duration": exc["duration"]}
-    if exc["type"] == "harmonic":
-        excitation["phase"] = exc["phase"]
-    return {
-        "name": c["name"],
-        "model": c["model"],
-        "column": column,
-        "interface": {
-            "stiffness": stiffness,
-            "xi": itf["xi"],
-            "restitution": itf["restitution"],
-            "formulation": itf["formulation"],
-        },
-        "excitation": excitation,
-        "collapse": {"ratio": c["collapse"]["ratio"]},
-    }
+        return domain_config(domain_csv)
+    except RbmError as exc:
+        raise UserError(f"the config stored beside {domain_csv}: {one_line(exc)}") from None
 
 
 @cli.command()

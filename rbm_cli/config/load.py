@@ -12,6 +12,7 @@ keeps amplitudes in g and frequencies in Hz, the edge units.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import re
@@ -48,6 +49,7 @@ from rbm_cli.config.validate import (
     one_line,
     read_yaml,
 )
+from rbm_cli.config.written import plain_copy
 
 __all__ = ["load_config", "parse_config"]
 
@@ -166,9 +168,10 @@ def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
     ConfigError  One line: ``<source>: <key path> must be <allowed>, got <value>``.
     """
     try:
-        return _config(data)
+        config = _config(data)
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
+    return dataclasses.replace(config, written=plain_copy(data))
 
 
 def _config(data: Any) -> Config:

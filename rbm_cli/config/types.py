@@ -8,7 +8,7 @@ edge of the program; physics code converts with :data:`G`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 #: Acceleration of gravity [m/s^2] (SPEC: g = 9.81).
 G = 9.81
@@ -167,6 +167,14 @@ class SolverConfig:
 
 @dataclass(frozen=True)
 class Config:
+    """A validated config.
+
+    The sections are typed and in SI (the grid in g and Hz); ``written`` is the mapping the
+    user wrote (YAML or a dict), kept as given once it validated, so that a stored result
+    (meta.json) can be re-read exactly as it was configured, never rebuilt from derived
+    values. It takes no part in equality, in the config's hash or in :meth:`resolved`.
+    """
+
     name: str
     column: ColumnConfig
     model: str = "rbm"
@@ -175,3 +183,10 @@ class Config:
     grid: GridConfig = field(default_factory=GridConfig)
     collapse: CollapseConfig = field(default_factory=CollapseConfig)
     solver: SolverConfig = field(default_factory=SolverConfig)
+    written: dict | None = field(default=None, compare=False, repr=False)
+
+    def resolved(self) -> dict:
+        """Every resolved setting as plain data (dataclasses.asdict without ``written``)."""
+        out = asdict(self)
+        out.pop("written", None)
+        return out

@@ -106,7 +106,8 @@ def run_summary(
         "frequency_hz": frequency_hz,
         "output_dt_s": output_dt,
     }
-    summary["config"] = json_ready(config)
+    summary["config"] = json_ready(config.resolved())
+    summary["config_written"] = json_ready(config.written)
     summary["rbm_version"] = __version__
     return json_ready(summary)
 

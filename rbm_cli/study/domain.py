@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import Config
 from rbm_cli.models.result import CSV_FIELDS, STATUSES
 
 #: Columns a domain CSV must have for plotting and comparing.
@@ -235,3 +236,25 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
             ka.keys() ^ kb.keys(), key=lambda k: (float(k[1]), float(k[0])), default=None
         ),
     )
+
+
+def domain_config(domain_csv: str | Path) -> Config | None:
+    """The config a domain was swept with, from the meta.json beside its domain.csv.
+
+    It is the config as the user wrote it (meta.json's ``config_written``), validated
+    again: every setting the sweep had (a bullet domain's friction, the solver's
+    settings), none rebuilt from derived values. None when there is no meta.json or it
+    predates ``config_written``; RbmError when the stored config no longer validates.
+    """
+    import json
+
+    from rbm_cli.config.load import parse_config
+
+    meta = Path(domain_csv).with_name("meta.json")
+    try:
+        written = json.loads(meta.read_text(encoding="utf-8")).get("config_written")
+    except (OSError, ValueError, AttributeError):
+        return None
+    if not isinstance(written, dict):
+        return None
+    return parse_config(written, source=str(meta))

@@ -13,10 +13,12 @@ import subprocess
 from functools import lru_cache
 from pathlib import Path
 
+import rbm_cli
 from rbm_cli import __version__
 from rbm_cli.study.robustness import RULE
 
-_ROOT = Path(__file__).resolve().parent.parent
+#: The checkout holding the package (the folder above rbm_cli/), where .git would be.
+_ROOT = Path(rbm_cli.__file__).resolve().parents[1]
 
 
 def _git_commit() -> str | None:

@@ -12,7 +12,6 @@ so the same config gives the same ``domain.csv`` whatever the number of workers.
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 import os
@@ -73,7 +72,7 @@ def config_hash(config: Config) -> str:
 
     solver.max_wall_time is left out: a guard against a run that would not end, not a
     setting of the domain (and hashes of domains made before it existed stay valid)."""
-    resolved = dataclasses.asdict(config)
+    resolved = config.resolved()
     resolved["solver"].pop("max_wall_time", None)
     text = json.dumps(resolved, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -264,7 +263,8 @@ def run_sweep(
         counts = df["status"].value_counts().to_dict()
         meta = {
             "name": config.name,
-            "config": dataclasses.asdict(config),
+            "config": config.resolved(),
+            "config_written": config.written,
             "config_hash": digest,
             "versions": _versions(),
             "wall_time_s": wall,

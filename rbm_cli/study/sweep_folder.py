@@ -132,15 +132,13 @@ def _same_settings(folder: Path, config, ensemble: int) -> bool:
     """Whether meta.json's resolved config equals this config on every key both have
     (a finished domain made before a config key with a default existed has another hash
     but the same settings)."""
-    import dataclasses
-
     try:
         meta = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
         members = meta.get("ensemble", {}).get("members", 1)
         stored = meta["config"]
     except (OSError, ValueError, KeyError, AttributeError, TypeError):
         return False
-    current = json.loads(json.dumps(dataclasses.asdict(config), default=str))
+    current = json.loads(json.dumps(config.resolved(), default=str))
     return members == ensemble and isinstance(stored, dict) and _common_equal(stored, current)
 
 

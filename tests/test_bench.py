@@ -78,6 +78,7 @@ def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
     (every member agrees); a peak is scored only if it is converged, 1e-11, 1e-12
     and the nudge agree to 1e-6, and those three count the same uplifts and impacts."""
     import rbm_cli.study.bench as bench
+    from rbm_cli.study.bench_runs import _row
 
     cells = [(0.1, 1.0), (0.2, 1.0), (0.3, 1.0), (0.4, 1.0), (0.5, 1.0), (0.6, 1.0)]
     # per cell: (collapsed, peak, uplifts) at 1e-10, 1e-11, 1e-12 and nudged
@@ -102,7 +103,7 @@ def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
                 c = 1 - c if (k - 4 == flipping_member and round(a, 4) == 0.6) else c
             else:
                 c, p, u = plan[(round(a, 6), f)][k]
-            row = bench._row(a, f, "collapsed" if c else "survived", float("nan"), p, 0.0)
+            row = _row(a, f, "collapsed" if c else "survived", float("nan"), p, 0.0)
             rows.append(dict(row, n_uplifts=u, n_impacts=u))
         return pd.DataFrame(rows), 0.0
 

@@ -21,7 +21,7 @@ from rbm_cli.config.types import (
     SolverConfig,
     StiffnessConfig,
 )
-from rbm_cli.config.validate import read_yaml
+from rbm_cli.config.yaml_reader import read_yaml
 
 FULL = """\
 name: paper_column-8.drums

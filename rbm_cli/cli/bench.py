@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import click
 
@@ -42,6 +43,8 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references) 
         rbm bench --quick
         rbm bench -o bench --scaling
     """
+    from rbm_cli.base.files import save_figure_atomic
+    from rbm_cli.report.bench_figures import scaling_figure, work_precision_figure
     from rbm_cli.study.bench import check_targets, run_bench
 
     def log(line: str) -> None:
@@ -52,10 +55,12 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references) 
         table = run_bench(quick=quick, jobs=jobs, output=output, reference_dir=references,
                           problems=tuple(problems) or None, reuse_references=reuse_references,
                           log=log)  # fmt: skip
+        save_figure_atomic(work_precision_figure(table), Path(output) / "bench.png")
         if scaling:
             from rbm_cli.study.bench_scaling import run_scaling
 
-            run_scaling(output=output, log=log)
+            scaling_table = run_scaling(output=output, log=log)
+            save_figure_atomic(scaling_figure(scaling_table), Path(output) / "scaling.png")
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     click.echo(f"output: {output}/bench.csv, {output}/bench.png")

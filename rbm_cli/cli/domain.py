@@ -204,14 +204,10 @@ def plot_domain_cmd(
         rbm plot-domain out/spanos_koh_slender/domain.csv -o slender.png
         rbm plot-domain out/a/domain.csv --compare results/a/domain.csv
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.backend_bases import FigureCanvasBase
 
     from rbm_cli.base.files import save_figure_atomic
-    from rbm_cli.report.plot_domain import plot_domain
+    from rbm_cli.report.domain_figure import domain_figure
     from rbm_cli.study.domain import read_domain
 
     if png is not None and not png.strip():
@@ -228,16 +224,7 @@ def plot_domain_cmd(
                 f" (allowed: {', '.join(sorted(kinds))})"
             )
         labels = [Path(domain_csv).parent.name or "domain"] + [Path(p).parent.name for p in others]
-        if cfg is not None:
-            from rbm_cli.report.domain_figure import domain_figure
-
-            fig = domain_figure(df, cfg, compare=dfs, labels=labels)
-        else:
-            fig, ax = plt.subplots(figsize=(9.5, 5))
-            plot_domain(df, ax=ax, compare=dfs, labels=labels)
-            fig.tight_layout()
-        save_figure_atomic(fig, target)
-        plt.close(fig)
+        save_figure_atomic(domain_figure(df, cfg, compare=dfs, labels=labels), target)
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except OSError as exc:

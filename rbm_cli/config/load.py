@@ -47,9 +47,9 @@ from rbm_cli.config.validate import (
     number,
     number_list,
     one_line,
-    read_yaml,
 )
 from rbm_cli.config.written import plain_copy
+from rbm_cli.config.yaml_reader import read_yaml
 
 __all__ = ["load_config", "parse_config"]
 

@@ -74,6 +74,54 @@ def _frustum_area_integral(w_a: float, w_b: float, h: float) -> float:
     return h * (w_a * w_a + w_a * w_b + w_b * w_b) / 3.0
 
 
+def _volumes_and_depths(
+    column: ColumnConfig, widths: np.ndarray, h: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Drum volumes [m^3] (exact for the tapered drum) and the depth or diameter at the
+    interfaces and the top [m] (square drums: the width; circular: the diameter)."""
+    w_a, w_b = widths[:-1], widths[1:]
+    if column.section == "circular":
+        volumes = (
+            np.pi
+            / 4.0
+            * np.array(
+                [_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h, strict=True)]
+            )
+        )
+        depths = widths.copy()
+    elif column.depth is None:  # square drums
+        volumes = np.array(
+            [_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h, strict=True)]
+        )
+        depths = widths.copy()
+    else:
+        mean_w = 0.5 * (w_a + w_b)
+        volumes = column.depth * h * mean_w
+        depths = np.full(len(h) + 1, float(column.depth))
+    return volumes, depths
+
+
+def _moment_stiffness(
+    interface: InterfaceConfig, section: str, widths: np.ndarray, depths: np.ndarray, n: int
+) -> np.ndarray:
+    """K_M,i [N m/rad] of the n interfaces: inf (rigid), given, or from the joint normal
+    stiffness k_n [Pa/m] over the interface section (k_n I of the contact area)."""
+    stiff = interface.stiffness
+    if stiff.kind == "rigid":
+        k_m = np.full(n, np.inf)
+    elif stiff.kind == "moment":
+        vals = np.asarray(stiff.values, dtype=float)
+        k_m = np.full(n, vals[0]) if len(vals) == 1 else vals.copy()
+    else:  # joint normal stiffness k_n [Pa/m]
+        k_n = float(stiff.values[0])
+        b_i = widths[:-1]
+        if section == "circular":
+            k_m = k_n * np.pi * b_i**4 / 64.0
+        else:
+            k_m = k_n * depths[:-1] * b_i**3 / 12.0
+    return k_m
+
+
 def build_column(column: ColumnConfig, interface: InterfaceConfig) -> Column:
     """Derive masses, inertias and interface strengths from the geometry.
 
@@ -102,24 +150,7 @@ def build_column(column: ColumnConfig, interface: InterfaceConfig) -> Column:
     w_a, w_b = widths[:-1], widths[1:]
     mean_w = 0.5 * (w_a + w_b)
 
-    if column.section == "circular":
-        volumes = (
-            np.pi
-            / 4.0
-            * np.array(
-                [_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h, strict=True)]
-            )
-        )
-        depths = widths.copy()
-    elif column.depth is None:  # square drums
-        volumes = np.array(
-            [_frustum_area_integral(a, b, hh) for a, b, hh in zip(w_a, w_b, h, strict=True)]
-        )
-        depths = widths.copy()
-    else:
-        volumes = column.depth * h * mean_w
-        depths = np.full(n + 1, float(column.depth))
-
+    volumes, depths = _volumes_and_depths(column, widths, h)
     masses = column.density * volumes
     if column.section == "circular":
         inertias = masses * (h**2 / 12.0 + mean_w**2 / 16.0)
@@ -133,19 +164,7 @@ def build_column(column: ColumnConfig, interface: InterfaceConfig) -> Column:
     mu = widths[:-1] / 2.0 * normal
     theta_u = (widths[:-1] / 2.0) / lever
 
-    stiff = interface.stiffness
-    if stiff.kind == "rigid":
-        k_m = np.full(n, np.inf)
-    elif stiff.kind == "moment":
-        vals = np.asarray(stiff.values, dtype=float)
-        k_m = np.full(n, vals[0]) if len(vals) == 1 else vals.copy()
-    else:  # joint normal stiffness k_n [Pa/m]
-        k_n = float(stiff.values[0])
-        b_i = widths[:-1]
-        if column.section == "circular":
-            k_m = k_n * np.pi * b_i**4 / 64.0
-        else:
-            k_m = k_n * depths[:-1] * b_i**3 / 12.0
+    k_m = _moment_stiffness(interface, column.section, widths, depths, n)
 
     return Column(
         heights=h,

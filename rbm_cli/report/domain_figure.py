@@ -27,7 +27,7 @@ def uplift_level(config: Config) -> tuple[float, str]:
 
 def domain_figure(
     df: pd.DataFrame,
-    config: Config,
+    config: Config | None,
     compare: Sequence[pd.DataFrame] = (),
     labels: Sequence[str] | None = None,
 ) -> Figure:
@@ -36,14 +36,18 @@ def domain_figure(
     Parameters
     ----------
     df : DataFrame  The domain (domain.csv's rows)
-    config : Config  The config it was swept with
+    config : Config or None  The config it was swept with (None: the cells and boundaries only)
     compare : sequence of DataFrame  Other domains whose boundaries are drawn over it
     labels : sequence of str  Their legend labels
     """
-    column = build_column(config.column, config.interface)
-    level, level_label = uplift_level(config)
     fig = Figure(figsize=(9.5, 5))
     ax = fig.add_subplot()
+    if config is None:  # a domain without its config: no column, no curves of it
+        plot_domain(df, ax=ax, compare=compare, labels=labels)
+        fig.tight_layout()
+        return fig
+    column = build_column(config.column, config.interface)
+    level, level_label = uplift_level(config)
     plot_domain(
         df,
         ax=ax,

@@ -144,7 +144,31 @@ def plot_fragility(
     """
     ax = ax if ax is not None else _new_axes()
     prefix = f"{label}: " if label else ""
-    table = result.table
+    color = _plot_observed(ax, result.table, prefix, color, counts)
+    if result.fit is not None:
+        _plot_fit(ax, result, prefix, color)
+    else:
+        ax.text(
+            0.02,
+            0.95,
+            f"{prefix}no fit: {result.note}",
+            transform=ax.transAxes,
+            fontsize=7,
+            va="top",
+            wrap=True,
+        )
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("probability of collapse [-]")
+    ax.set_ylim(-0.03, 1.03)
+    ax.set_xlim(left=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="lower right")
+    return ax
+
+
+def _plot_observed(ax, table: pd.DataFrame, prefix: str, color, counts: bool):
+    """The observed fractions (gid "observed"), with "collapsed/records" beside each point
+    when `counts`; returns the colour used."""
     (points,) = ax.plot(
         table["intensity_g"],
         table["fraction"],
@@ -171,47 +195,35 @@ def plot_fragility(
                     fontsize=7,
                     color=color,
                 )
+    return color
+
+
+def _plot_fit(ax, result: FragilityResult, prefix: str, color) -> None:
+    """The bootstrap band (gid "band", when resamples fitted) and the fitted curve (gid
+    "fitted") of a result with a fit."""
     curve = result.curve
-    if result.fit is not None:
-        lo, hi = result.ci_percentiles
-        if result.n_resamples_used > 0:
-            band = ax.fill_between(
-                curve["intensity_g"],
-                curve["lower"],
-                curve["upper"],
-                color=color,
-                alpha=0.2,
-                linewidth=0,
-                label=f"{prefix}bootstrap {lo:g}-{hi:g} % band "
-                f"({result.n_resamples_used} resamples of the records)",
-            )
-            band.set_gid("band")
-        (fitted,) = ax.plot(
+    lo, hi = result.ci_percentiles
+    if result.n_resamples_used > 0:
+        band = ax.fill_between(
             curve["intensity_g"],
-            curve["probability"],
-            "-",
+            curve["lower"],
+            curve["upper"],
             color=color,
-            label=f"{prefix}lognormal MLE: median {result.fit.median_g:.3g} g, "
-            f"beta {result.fit.beta:.2f}",
+            alpha=0.2,
+            linewidth=0,
+            label=f"{prefix}bootstrap {lo:g}-{hi:g} % band "
+            f"({result.n_resamples_used} resamples of the records)",
         )
-        fitted.set_gid("fitted")
-    else:
-        ax.text(
-            0.02,
-            0.95,
-            f"{prefix}no fit: {result.note}",
-            transform=ax.transAxes,
-            fontsize=7,
-            va="top",
-            wrap=True,
-        )
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("probability of collapse [-]")
-    ax.set_ylim(-0.03, 1.03)
-    ax.set_xlim(left=0.0)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="lower right")
-    return ax
+        band.set_gid("band")
+    (fitted,) = ax.plot(
+        curve["intensity_g"],
+        curve["probability"],
+        "-",
+        color=color,
+        label=f"{prefix}lognormal MLE: median {result.fit.median_g:.3g} g, "
+        f"beta {result.fit.beta:.2f}",
+    )
+    fitted.set_gid("fitted")
 
 
 def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):

@@ -47,20 +47,19 @@ import math
 import os
 import time
 from dataclasses import dataclass
-from functools import partial
 from pathlib import Path
 
-import joblib
 import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import Config, GridConfig, SolverConfig
-from rbm_cli.study.domain import compare
+from rbm_cli.study.bench_runs import run_cells
+from rbm_cli.study.bench_scoring import _key, errors
 from rbm_cli.study.robustness import MEMBERS, member_config, members
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]  # the repository (rbm_cli/study/bench.py)
 
 
 @dataclass(frozen=True)
@@ -123,79 +122,6 @@ def _with_solver(cfg: Config, implementation: str, method: str, rtol: float) -> 
     solver = dataclasses.replace(cfg.solver, implementation=implementation, method=method,
                                  rtol=rtol)  # fmt: skip
     return dataclasses.replace(cfg, solver=solver)
-
-
-# ---------------------------------------------------------------- running cells
-def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: float) -> dict:
-    """One cell's outcome, as every runner of the benchmark reports it."""
-    return {"amplitude_g": a, "frequency_hz": f, "status": status,
-            "collapsed": int(status == "collapsed"), "t_collapse_s": t_collapse,
-            "max_rotation_ratio": peak, "wall_time_s": wall}  # fmt: skip
-
-
-def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
-    from rbm_cli.models.rbm.kernel import warm_up
-    from rbm_cli.study.simulate import model_from_config, simulate
-
-    warm_up()  # load the compiled kernel in this worker before timing runs
-    model = model_from_config(cfg)
-    rows = []
-    for a, f in cells:
-        r = simulate(cfg, a, f, model=model)
-        row = _row(a, f, r.status, r.t_collapse_s, r.max_rotation_ratio, r.wall_time_s)
-        rows.append(dict(row, n_uplifts=r.n_uplifts, n_impacts=r.n_impacts))
-    return rows
-
-
-def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dict]:
-    from rbm_cli.models.rbm.baseline import baseline_run
-    from rbm_cli.physics.excitation import make_ground_motion
-    from rbm_cli.study.simulate import model_from_config
-
-    model = model_from_config(cfg)
-    rows = []
-    for a, f in cells:
-        out = baseline_run(model, make_ground_motion(cfg.excitation, a, f), budget_s=budget_s)
-        rows.append(_row(a, f, out["status"], out["t_collapse_s"], out["max_rotation_ratio"],
-                         out["wall_time_s"]))  # fmt: skip
-    return rows
-
-
-def _run_closed_form_chunk(cfg: Config, cells) -> list[dict]:
-    from rbm_cli.models.housner_linear import housner_linear_run
-    from rbm_cli.physics.closed_forms import linear_rocking_parameters
-    from rbm_cli.physics.excitation import make_ground_motion
-    from rbm_cli.study.simulate import model_from_config
-
-    model = model_from_config(cfg)
-    alpha, p = linear_rocking_parameters(model.column)
-    rows = []
-    for a, f in cells:
-        start = time.perf_counter()
-        out = housner_linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f),
-                                 restitution=model.restitution,
-                                 collapse_ratio=cfg.collapse.ratio)  # fmt: skip
-        rows.append(_row(a, f, out.status, out.t_collapse, float(np.max(out.max_ratio)),
-                         time.perf_counter() - start))  # fmt: skip
-    return rows
-
-
-def run_cells(
-    kind: str, cfg: Config, cells, jobs: int, budget_s: float = 120.0
-) -> tuple[pd.DataFrame, float]:
-    """Rows of `cells` and the wall time [s] on `jobs` workers (budget_s: per
-    baseline run, which has no step budget of its own)."""
-    fn = {"rbm": _run_rbm_chunk, "baseline": partial(_run_baseline_chunk, budget_s=budget_s),
-          "closed-form": _run_closed_form_chunk}[kind]  # fmt: skip
-    size = max(1, min(32, len(cells) // max(1, 8 * jobs)))
-    chunks = [cells[i : i + size] for i in range(0, len(cells), size)]
-    start = time.perf_counter()
-    if jobs == 1:
-        parts = [fn(cfg, c) for c in chunks]
-    else:
-        parts = joblib.Parallel(n_jobs=jobs)(joblib.delayed(fn)(cfg, c) for c in chunks)
-    wall = time.perf_counter() - start
-    return pd.DataFrame([r for p in parts for r in p]), wall
 
 
 # ---------------------------------------------------------------- references
@@ -267,51 +193,6 @@ _REF_COLUMNS = ["amplitude_g", "frequency_hz", "status", "collapsed", "t_collaps
                 "max_rotation_ratio", "robust", "converged", "peak_converged"]  # fmt: skip
 
 
-def _key(df: pd.DataFrame) -> pd.Series:
-    return df["amplitude_g"].round(9).astype(str) + "|" + df["frequency_hz"].round(9).astype(str)
-
-
-def errors(run: pd.DataFrame, ref: pd.DataFrame) -> dict:
-    """Errors of a run's rows against the reference rows of the same cells."""
-    m = run.assign(key=_key(run)).merge(ref.assign(key=_key(ref)), on="key",
-                                        suffixes=("", "_ref"))  # fmt: skip
-    n_failed = int((m["status"] == "failed").sum())
-    conv = m[(m["converged"] == 1) & (m["status"] != "failed")]
-    differ = int((conv["collapsed"] != conv["collapsed_ref"]).sum())
-    both_surv = m[(m["peak_converged"] == 1) & (m["collapsed"] == 0) & (m["collapsed_ref"] == 0)]
-    both_surv = both_surv[both_surv["max_rotation_ratio_ref"] > 0]
-    peak = (both_surv["max_rotation_ratio"] - both_surv["max_rotation_ratio_ref"]).abs()
-    peak = (peak / both_surv["max_rotation_ratio_ref"]).to_numpy()
-    both_col = conv[(conv["collapsed"] == 1) & (conv["collapsed_ref"] == 1)]
-    tcol = ((both_col["t_collapse_s"] - both_col["t_collapse_s_ref"]).abs()
-            / both_col["t_collapse_s_ref"]).to_numpy()  # fmt: skip
-    shift = math.nan
-    if len(conv) and conv["frequency_hz"].nunique() > 0:
-        a = conv[["amplitude_g", "frequency_hz", "collapsed"]].assign(
-            status=np.where(conv["collapsed"] == 1, "collapsed", "survived")
-        )
-        b = conv[["amplitude_g", "frequency_hz", "collapsed_ref"]].rename(
-            columns={"collapsed_ref": "collapsed"}
-        )
-        b = b.assign(status=np.where(b["collapsed"] == 1, "collapsed", "survived"))
-        shift = compare(a, b).max_shift_g
-    return {
-        "n_cells": len(m),
-        "n_failed": n_failed,
-        "n_converged": len(conv),
-        "n_sensitive": len(m) - len(conv),
-        "cells_differ": differ,
-        "fraction_differ": differ / len(conv) if len(conv) else math.nan,
-        "boundary_err_g": shift,
-        "n_peak": len(peak),
-        "peak_err_median": float(np.median(peak)) if len(peak) else math.nan,
-        "peak_err_max": float(np.max(peak)) if len(peak) else math.nan,
-        "n_tcol": len(tcol),
-        "tcol_err_median": float(np.median(tcol)) if len(tcol) else math.nan,
-        "tcol_err_max": float(np.max(tcol)) if len(tcol) else math.nan,
-    }
-
-
 # ---------------------------------------------------------------- the benchmark
 def _sample(cells, k: int, seed: int = 5) -> list:
     rng = np.random.default_rng(seed)
@@ -328,9 +209,12 @@ def run_bench(
     log=print,
     reuse_references: bool = False,
 ) -> pd.DataFrame:
-    """Run the benchmark; write bench.csv and bench.png (and, full, the references)."""
+    """Run the benchmark; write bench.csv (and, full, the references).
+
+    The figure (bench.png) is drawn by the caller from the returned table
+    (:func:`rbm_cli.report.bench_figures.work_precision_figure`)."""
+    from rbm_cli.base.files import write_text_atomic
     from rbm_cli.models.rbm.kernel import warm_up
-    from rbm_cli.report.files import write_text_atomic
 
     ref_dir = Path(reference_dir) if reference_dir else REFERENCE_DIR
     out_dir = Path(output)
@@ -344,66 +228,101 @@ def run_bench(
     for prob in chosen:
         cfg = problem_config(prob, stride=4 if quick else 1)
         cells = _cells(cfg)
-        ref_path = ref_dir / f"{prob.name}_reference.csv"
-        if quick or (reuse_references and ref_path.is_file()):
-            if not ref_path.is_file():
-                raise RbmError(f"no stored reference {ref_path}: run the full `rbm bench` first")
-            ref = pd.read_csv(ref_path)
-            if not quick and len(ref) != len(cells):
-                raise RbmError(
-                    f"{ref_path} does not match the grid; run without --reuse-references"
-                )
-        else:
-            start = time.perf_counter()
-            ref = make_reference(prob, cfg, jobs)
-            ref_dir.mkdir(parents=True, exist_ok=True)
-            write_text_atomic(ref_path, ref.to_csv(index=False, float_format="%.12g"))
-            log(f"{prob.name}: reference ({prob.reference}) in {time.perf_counter() - start:.1f} s")
-        default = ("compiled", SolverConfig().method, SolverConfig().rtol)
-        methods = [default] if quick else list(METHODS)
+        ref = _reference(prob, cfg, cells, ref_dir, quick, reuse_references, jobs, log)
         sample = _sample(cells, QUICK_SAMPLE if quick else SAMPLE[prob.name])
-        results = []  # (method triple, rows, wall time [s], on the sample only)
-        for impl, method, rtol in methods:
-            part = sample if impl == "python" else cells
-            df, wall = run_cells("rbm", _with_solver(cfg, impl, method, rtol), part, jobs)
-            results.append(((impl, method, rtol), df, wall, part is sample))
-        df, wall = run_cells("baseline", cfg, sample, jobs, budget_s=20.0 if quick else 60.0)
-        results.append((("baseline", "solve_ivp RK45", 1e-6), df, wall, True))
-
-        # paired times: each method's run times summed over the sample's cells
-        on_sample = set(_key(pd.DataFrame(sample, columns=["amplitude_g", "frequency_hz"])))
-        paired = [
-            float(d.loc[_key(d).isin(on_sample), "wall_time_s"].sum()) for _, d, _, _ in results
-        ]
-        base_sum = paired[-1]
-        k_default = next(k for k, r in enumerate(results) if r[0] == default)
-        for (triple, df, wall, sampled), own in zip(results, paired, strict=True):
-            impl, method, rtol = triple
-            row = {
-                "problem": prob.name,
-                "implementation": impl,
-                "method": method,
-                "rtol": rtol,
-                "default": int(triple == default),
-                "cells_run": len(df),
-                "time_per_run_ms_median": 1e3 * float(df["wall_time_s"].median()),
-                "time_per_run_ms_mean": 1e3 * float(df["wall_time_s"].mean()),
-                "sample_time_s": own,
-                # a sampled method's whole domain: the default's wall time x the paired ratio
-                "domain_wall_s": results[k_default][2] * own / paired[k_default]
-                if sampled and paired[k_default] > 0
-                else (math.nan if sampled else wall),
-                "domain_estimated": int(sampled),
-                "jobs": jobs,
-                "speedup_vs_baseline": base_sum / own if own > 0 else math.nan,
-            }
-            row.update(errors(df, ref))
+        results = _run_methods(cfg, cells, sample, quick, jobs)
+        for row in _method_rows(prob, results, sample, ref, jobs):
             rows.append(row)
             log(_line(row))
     table = pd.DataFrame(rows)
     write_text_atomic(out_dir / "bench.csv", table.to_csv(index=False, float_format="%.6g"))
-    figure(table, out_dir / "bench.png")
     return table
+
+
+def _reference(
+    prob: Problem,
+    cfg: Config,
+    cells: list,
+    ref_dir: Path,
+    quick: bool,
+    reuse_references: bool,
+    jobs: int,
+    log,
+) -> pd.DataFrame:
+    """The stored reference of a problem (quick, or full with reuse), or a new one, stored."""
+    from rbm_cli.base.files import write_text_atomic
+
+    ref_path = ref_dir / f"{prob.name}_reference.csv"
+    if quick or (reuse_references and ref_path.is_file()):
+        if not ref_path.is_file():
+            raise RbmError(f"no stored reference {ref_path}: run the full `rbm bench` first")
+        ref = pd.read_csv(ref_path)
+        if not quick and len(ref) != len(cells):
+            raise RbmError(f"{ref_path} does not match the grid; run without --reuse-references")
+        return ref
+    start = time.perf_counter()
+    ref = make_reference(prob, cfg, jobs)
+    ref_dir.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(ref_path, ref.to_csv(index=False, float_format="%.12g"))
+    log(f"{prob.name}: reference ({prob.reference}) in {time.perf_counter() - start:.1f} s")
+    return ref
+
+
+def _default_method() -> tuple[str, str, float]:
+    """(implementation, method, rtol) of rbm's default solver."""
+    return ("compiled", SolverConfig().method, SolverConfig().rtol)
+
+
+def _run_methods(cfg: Config, cells: list, sample: list, quick: bool, jobs: int) -> list:
+    """Run every method (quick: the default) and the baseline.
+
+    Returns (method triple, rows, wall time [s], whether on the sample only) per
+    method, the baseline last; the Python loop and the baseline run the sample."""
+    methods = [_default_method()] if quick else list(METHODS)
+    results = []
+    for impl, method, rtol in methods:
+        part = sample if impl == "python" else cells
+        df, wall = run_cells("rbm", _with_solver(cfg, impl, method, rtol), part, jobs)
+        results.append(((impl, method, rtol), df, wall, part is sample))
+    df, wall = run_cells("baseline", cfg, sample, jobs, budget_s=20.0 if quick else 60.0)
+    results.append((("baseline", "solve_ivp RK45", 1e-6), df, wall, True))
+    return results
+
+
+def _method_rows(
+    prob: Problem, results: list, sample: list, ref: pd.DataFrame, jobs: int
+) -> list[dict]:
+    """One table row per method of `results` (from :func:`_run_methods`): times and errors."""
+    default = _default_method()
+    # paired times: each method's run times summed over the sample's cells
+    on_sample = set(_key(pd.DataFrame(sample, columns=["amplitude_g", "frequency_hz"])))
+    paired = [float(d.loc[_key(d).isin(on_sample), "wall_time_s"].sum()) for _, d, _, _ in results]
+    base_sum = paired[-1]
+    k_default = next(k for k, r in enumerate(results) if r[0] == default)
+    rows = []
+    for (triple, df, wall, sampled), own in zip(results, paired, strict=True):
+        impl, method, rtol = triple
+        row = {
+            "problem": prob.name,
+            "implementation": impl,
+            "method": method,
+            "rtol": rtol,
+            "default": int(triple == default),
+            "cells_run": len(df),
+            "time_per_run_ms_median": 1e3 * float(df["wall_time_s"].median()),
+            "time_per_run_ms_mean": 1e3 * float(df["wall_time_s"].mean()),
+            "sample_time_s": own,
+            # a sampled method's whole domain: the default's wall time x the paired ratio
+            "domain_wall_s": results[k_default][2] * own / paired[k_default]
+            if sampled and paired[k_default] > 0
+            else (math.nan if sampled else wall),
+            "domain_estimated": int(sampled),
+            "jobs": jobs,
+            "speedup_vs_baseline": base_sum / own if own > 0 else math.nan,
+        }
+        row.update(errors(df, ref))
+        rows.append(row)
+    return rows
 
 
 def _line(r: dict) -> str:
@@ -432,35 +351,3 @@ def check_targets(table: pd.DataFrame) -> list[str]:
             fails.append(f"{prob.name}: peak rotation error {r['peak_err_max']:.2g} "
                          f"(target < {PEAK_TARGET:g})")  # fmt: skip
     return fails
-
-
-def figure(table: pd.DataFrame, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from rbm_cli.report.files import save_figure_atomic
-
-    probs = list(dict.fromkeys(table["problem"]))
-    fig, axes = plt.subplots(2, len(probs), figsize=(4.2 * len(probs), 7.5), squeeze=False)
-    for j, name in enumerate(probs):
-        sub = table[table["problem"] == name]
-        for (impl, method), grp in sub.groupby(["implementation", "method"], sort=False):
-            grp = grp.sort_values("rtol")
-            x = grp["domain_wall_s"].to_numpy()
-            label = f"{method} ({impl})" if impl != "baseline" else "baseline: solve_ivp RK45"
-            y1 = np.maximum(grp["peak_err_median"].to_numpy(float), 1e-16)
-            y2 = np.maximum(grp["fraction_differ"].to_numpy(float), 1e-4)
-            style = "o-" if impl == "compiled" else "s"
-            axes[0, j].loglog(x, y1, style, label=label)
-            axes[1, j].loglog(x, y2, style, label=label)
-        axes[0, j].set_title(name)
-        axes[1, j].set_xlabel("domain wall time [s] (2 workers)")
-        axes[0, j].axhline(PEAK_TARGET, color="0.6", lw=0.8, ls="--")
-    axes[0, 0].set_ylabel("peak rotation error, median (relative)")
-    axes[1, 0].set_ylabel("fraction of converged cells differing\n(1e-4 = none)")
-    axes[0, -1].legend(fontsize=7)
-    fig.tight_layout()
-    save_figure_atomic(fig, path)
-    plt.close(fig)

@@ -1,6 +1,7 @@
-"""Scaling figures of `rbm bench --scaling`: time per run against the number of
+"""Scaling measurements of `rbm bench --scaling`: time per run against the number of
 drums, the joint stiffness (elastic frequency) and the duration, and the
-speed-up of 2 workers over 1 on whole domains (all measured in one run)."""
+speed-up of 2 workers over 1 on whole domains (all measured in one run).
+The figure is drawn by rbm_cli.report.bench_figures."""
 
 from __future__ import annotations
 
@@ -35,25 +36,30 @@ def _config(drums: int = 8, k_n: float = 5e9, duration: float = 10.0):
 
 
 def _elastic_hz(cfg) -> float:
-    from rbm_cli.study.simulate import model_from_config
+    from rbm_cli.models.rbm.runner import model_from_config
 
     return max(model_from_config(cfg).elastic_frequencies_hz())
 
 
 def _time(cfg, repeats: int = 3) -> dict:
-    from rbm_cli.study.simulate import model_from_config, simulate
+    from rbm_cli.models.registry import make_runner
+    from rbm_cli.study.simulate import simulate
 
-    model = model_from_config(cfg)
+    runner = make_runner(cfg)
     walls, res = [], None
     for _ in range(repeats):
-        res = simulate(cfg, *CELL, model=model)
+        res = simulate(cfg, *CELL, runner=runner)
         walls.append(res.wall_time_s)
     return {"time_per_run_s": float(np.median(walls)), "n_steps": res.n_steps,
             "n_rhs": res.n_rhs, "status": res.status}  # fmt: skip
 
 
 def run_scaling(output: str | os.PathLike = "bench", log=print) -> pd.DataFrame:
-    from rbm_cli.report.files import write_text_atomic
+    """Measure the scaling series and write scaling.csv to `output`.
+
+    The figure (scaling.png) is drawn by the caller from the returned table
+    (:func:`rbm_cli.report.bench_figures.scaling_figure`)."""
+    from rbm_cli.base.files import write_text_atomic
     from rbm_cli.study.bench import PROBLEMS, _cells, problem_config, run_cells
 
     rows = []
@@ -88,46 +94,7 @@ def run_scaling(output: str | os.PathLike = "bench", log=print) -> pd.DataFrame:
     out = Path(output)
     out.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out / "scaling.csv", table.to_csv(index=False, float_format="%.6g"))
-    _figure(table, out / "scaling.png")
     return table
-
-
-def _figure(table: pd.DataFrame, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.ticker
-
-    from rbm_cli.report.files import save_figure_atomic
-
-    fig, axes = plt.subplots(1, 4, figsize=(16, 3.8))
-    for ax, (series, xlabel) in zip(
-        axes[:3],
-        [
-            ("drums", "drums"),
-            ("k_n", "joint normal stiffness k_n [Pa/m] (4 drums)"),
-            ("duration", "duration [s] (8 drums)"),
-        ],  # fmt: skip
-        strict=True,
-    ):
-        sub = table[table["series"] == series]
-        xs = sub["x"].astype(float)
-        ax.loglog(xs, sub["time_per_run_s"], "o-")
-        if series != "k_n":  # label the points themselves (the log axis's minor labels overlap)
-            ax.set_xticks(xs, [f"{x:g}" for x in xs])
-            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel("time per run [s]")
-        ax.grid(True, which="both", alpha=0.3)
-    sub = table[table["series"] == "workers"]
-    axes[3].bar(sub["x"].astype(str), sub["speedup_2_over_1"])
-    axes[3].axhline(2.0, color="0.5", ls="--", lw=0.8)
-    axes[3].set_ylabel("speed-up, 2 workers over 1")
-    fig.suptitle(f"rbm scaling, one cell {CELL[0]} g {CELL[1]} Hz (stays elastic)")
-    fig.tight_layout()
-    save_figure_atomic(fig, path)
-    plt.close(fig)
 
 
 __all__ = ["run_scaling"]

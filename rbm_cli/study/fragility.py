@@ -7,9 +7,18 @@ collapses and the fraction; the lognormal fragility
     P(collapse | IM = x) = Phi( ln(x / theta) / beta )
 
 fitted by maximum likelihood (Baker 2015, multiple-stripe form: every non-failed run is a
-Bernoulli trial with that probability); and a bootstrap over records for confidence
-intervals of theta and beta and a band of the curve. Files and figures are in
-:mod:`rbm_cli.report.fragility_report`.
+Bernoulli trial with that probability; :mod:`rbm_cli.study.fragility_fit`); and a bootstrap
+over records for confidence intervals of theta and beta and a band of the curve. Files and
+figures are in :mod:`rbm_cli.report.fragility_report`.
+
+The bootstrap draws whole records with replacement (a record's runs at all intensities
+stay together, so the correlation between its outcomes is kept), refits, and takes
+percentiles of theta, beta and P(x) at each grid intensity (Efron and Tibshirani's
+percentile interval). Resamples with no fit (e.g. no collapse drawn) are skipped and
+counted. Percentile intervals of a dispersion are somewhat narrow at small samples: on 80
+simulated suites of 40 records (capacities lognormal, theta 0.4 g, beta 0.35, 20 levels)
+the 5-95 % intervals covered theta in 89 % and beta in 83 % of the suites (nominal 90 %);
+the MLE of beta was 2 % low on average, as the sample standard deviation of 40 values is.
 
 References
 ----------
@@ -26,30 +35,20 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import minimize
-from scipy.special import log_ndtr, ndtr, ndtri
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.study.fragility_fit import (
+    LognormalFit,
+    _fit_counts,
+    collapse_probability,
+    fit_lognormal,
+)
 from rbm_cli.study.outcomes import level_table, prepare_outcomes
 
 METHOD = (
     "lognormal fragility, maximum likelihood on per-record outcomes "
     "(Bernoulli per record and intensity; Baker 2015); percentile bootstrap over records"
 )
-
-
-@dataclass(frozen=True)
-class LognormalFit:
-    """A fitted lognormal fragility.
-
-    median_g : float  Median theta [g] (intensity of 50 % collapse probability)
-    beta : float  Dispersion, the standard deviation of ln(capacity) [-]
-    log_likelihood : float  Maximised log-likelihood [-]
-    """
-
-    median_g: float
-    beta: float
-    log_likelihood: float
 
 
 @dataclass(frozen=True)
@@ -82,144 +81,6 @@ class FragilityResult:
     @property
     def fitted(self) -> bool:
         return self.fit is not None
-
-
-def collapse_probability(intensity_g, median_g: float, beta: float):
-    """Lognormal fragility Phi(ln(x / theta) / beta) [-] at intensities x [g] (0 at x <= 0)."""
-    x = np.asarray(intensity_g, dtype=float)
-    with np.errstate(divide="ignore"):
-        z = (np.log(np.maximum(x, 0.0)) - math.log(median_g)) / beta
-    out = ndtr(z)
-    return float(out) if out.ndim == 0 else out
-
-
-# --------------------------------------------------------------------------- the fit
-
-
-def _neg_log_likelihood(params, log_x, n, k):
-    """-ln L and its gradient in (ln theta, ln beta), binomial counts per level."""
-    log_theta, log_beta = params
-    beta = math.exp(log_beta)
-    z = (log_x - log_theta) / beta
-    lp, lq = log_ndtr(z), log_ndtr(-z)
-    value = -float(np.sum(k * lp + (n - k) * lq))
-    log_pdf = -0.5 * z * z - 0.5 * math.log(2.0 * math.pi)
-    dz = k * np.exp(log_pdf - lp) - (n - k) * np.exp(log_pdf - lq)  # d lnL / dz
-    grad = np.array([np.sum(dz) / beta, np.sum(dz * z)])
-    return value, grad
-
-
-def _start(log_x, n, k) -> np.ndarray:
-    """Starting (ln theta, ln beta): least squares of probit(fraction) on ln x."""
-    p = np.clip((k + 0.5) / (n + 1.0), 0.02, 0.98)
-    z = ndtri(p)
-    w = n / np.sum(n)
-    mx, mz = np.sum(w * log_x), np.sum(w * z)
-    sxx = np.sum(w * (log_x - mx) ** 2)
-    slope = np.sum(w * (log_x - mx) * (z - mz)) / sxx if sxx > 0 else 0.0
-    if slope <= 0.05:
-        return np.array([mx, math.log(0.5)])
-    return np.array([mx - mz / slope, -math.log(slope)])
-
-
-def _fit_counts(log_x, n, k, start=None) -> LognormalFit:
-    """MLE from counts per level; RbmError when no finite, increasing fit exists."""
-    total_k, total_n = float(np.sum(k)), float(np.sum(n))
-    if total_n == 0:
-        raise RbmError("fragility: no runs to fit")
-    if total_k == 0:
-        raise RbmError(
-            "fragility: no record collapsed at any intensity: the median lies above them"
-        )
-    if total_k == total_n:
-        raise RbmError(
-            "fragility: every record collapsed at every intensity: the median lies below them"
-        )
-    survived, collapsed = n - k > 0, k > 0
-    if np.max(log_x[survived]) <= np.min(log_x[collapsed]):
-        raise RbmError(
-            f"fragility: outcomes are separated (all runs survive up to "
-            f"{math.exp(np.max(log_x[survived])):.6g} g and collapse from "
-            f"{math.exp(np.min(log_x[collapsed])):.6g} g): the dispersion has no finite estimate"
-        )
-    x0 = _start(log_x, n, k) if start is None else np.asarray(start, dtype=float)
-    res = minimize(
-        _neg_log_likelihood,
-        x0,
-        args=(log_x, n, k),
-        jac=True,
-        method="BFGS",
-        options={"gtol": 1e-9, "maxiter": 500},
-    )
-    log_theta, log_beta = res.x
-    spread = np.max(log_x) - np.min(log_x)
-    if (
-        not np.all(np.isfinite(res.x))
-        or abs(log_theta - np.mean(log_x)) > 10.0 * max(spread, 1.0)
-        or log_beta > math.log(50.0)
-        or np.max(np.abs(res.jac)) > 1e-4 * max(total_n, 1.0)
-    ):
-        raise RbmError(
-            "fragility: no increasing lognormal curve fits these outcomes "
-            "(collapse does not become more frequent with intensity)"
-        )
-    return LognormalFit(math.exp(log_theta), math.exp(log_beta), -float(res.fun))
-
-
-def fit_lognormal(intensity_g, collapsed) -> LognormalFit:
-    """Maximum-likelihood lognormal fragility from individual outcomes.
-
-    Parameters
-    ----------
-    intensity_g : array_like
-        Intensity of each run [g], > 0
-    collapsed : array_like
-        1 (or True) where the run collapsed, 0 where it survived
-
-    Returns
-    -------
-    LognormalFit
-        Median theta [g], dispersion beta [-], log-likelihood
-
-    Raises
-    ------
-    RbmError
-        No collapse, only collapses, or outcomes separated by intensity (the likelihood
-        then has no maximum: beta -> 0 or theta -> 0 or infinity), or collapse not
-        increasing with intensity.
-
-    Notes
-    -----
-    Each run is a Bernoulli trial with probability p(x) = Phi(ln(x / theta) / beta); the
-    likelihood is, with n_j runs and k_j collapses at intensity x_j (Baker 2015),
-
-    .. math:: L(\\theta, \\beta) = \\prod_j \\binom{n_j}{k_j} p(x_j)^{k_j}
-              (1 - p(x_j))^{n_j - k_j}
-
-    maximised over (ln theta, ln beta) with BFGS and the analytic gradient, from a probit
-    least-squares start.
-
-    Examples
-    --------
-    Two levels, 1 of 4 and 3 of 4 collapsed: the curve passes through both fractions, so
-    theta = sqrt(0.2 x 0.4) and beta = ln 2 / (2 Phi^-1(0.75)):
-
-    >>> fit = fit_lognormal([0.2] * 4 + [0.4] * 4, [1, 0, 0, 0, 1, 1, 1, 0])
-    >>> round(fit.median_g, 4), round(fit.beta, 4)
-    (0.2828, 0.5138)
-    """
-    x = np.asarray(intensity_g, dtype=float).ravel()
-    c = np.asarray(collapsed, dtype=float).ravel()
-    if x.size != c.size:
-        raise RbmError(f"fragility: {x.size} intensities but {c.size} outcomes")
-    if np.any(~np.isfinite(x)) or np.any(x <= 0.0):
-        raise RbmError("fragility: intensities must be finite and > 0 [g]")
-    if np.any((c != 0.0) & (c != 1.0)):
-        raise RbmError("fragility: collapsed must be 0 or 1")
-    levels, inverse = np.unique(x, return_inverse=True)
-    n = np.bincount(inverse, minlength=levels.size).astype(float)
-    k = np.bincount(inverse, weights=c, minlength=levels.size)
-    return _fit_counts(np.log(levels), n, k)
 
 
 # --------------------------------------------------------------------------- bootstrap
@@ -302,22 +163,47 @@ def fragility(
 
     Notes
     -----
-    The curve P(x) = Phi(ln(x / theta) / beta) is fitted as in :func:`fit_lognormal`. The
-    bootstrap draws whole records with replacement (a record's runs at all intensities
-    stay together, so the correlation between its outcomes is kept), refits, and takes
-    percentiles of theta, beta and P(x) at each grid intensity (Efron and Tibshirani's
-    percentile interval). Resamples with no fit (e.g. no collapse drawn) are skipped and
-    counted: ``n_resamples_used``. Percentile intervals of a dispersion are somewhat
-    narrow at small samples: on 80 simulated suites of 40 records (capacities lognormal,
-    theta 0.4 g, beta 0.35, 20 levels) the 5-95 % intervals covered theta in 89 % and beta
-    in 83 % of the suites (nominal 90 %); the MLE of beta was 2 % low on average, as the
-    sample standard deviation of 40 values is.
+    The curve P(x) = Phi(ln(x / theta) / beta) is fitted as in :func:`fit_lognormal`; the
+    intervals and the band are percentiles of a bootstrap over whole records (module
+    docstring: method and measured coverage). Resamples with no fit are skipped and
+    counted: ``n_resamples_used``.
 
     Examples
     --------
     >>> res = fragility(pd.read_csv("domain.csv"), n_resamples=500, seed=1)  # doctest: +SKIP
     >>> res.fit.median_g, res.median_ci_g  # doctest: +SKIP
     """
+    lo_pct, hi_pct = _check_options(n_resamples, ci_percentiles)
+    rows, column = prepare_outcomes(df, intensity_column)
+    table = level_table(rows)
+    levels = table["intensity_g"].to_numpy()
+    grid = (
+        np.linspace(0.0, 1.1 * levels.max(), 201) if grid_g is None else np.asarray(grid_g, float)
+    )
+    fit, note = _fit_table(table)
+    band = _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, [lo_pct, hi_pct])
+    curve = _curve(grid, fit, band)
+    _add_fitted(table, grid, fit, band)
+    return FragilityResult(
+        table=table,
+        curve=curve,
+        fit=fit,
+        note=note,
+        median_ci_g=band.median_ci_g,
+        beta_ci=band.beta_ci,
+        ci_percentiles=(float(lo_pct), float(hi_pct)),
+        n_records=int(rows["record"].nunique()),
+        n_runs=int((~rows["failed"]).sum()),
+        n_failed=int(rows["failed"].sum()),
+        n_resamples=int(n_resamples) if fit is not None else 0,
+        n_resamples_used=band.n_used,
+        seed=int(seed),
+        intensity_column=column,
+    )
+
+
+def _check_options(n_resamples: int, ci_percentiles: tuple[float, float]) -> tuple[float, float]:
+    """The (low, high) percentiles of :func:`fragility`, after checking its options."""
     if n_resamples < 0:
         raise RbmError(f"fragility: n_resamples must be >= 0, got {n_resamples}")
     lo_pct, hi_pct = ci_percentiles
@@ -325,15 +211,13 @@ def fragility(
         raise RbmError(
             f"fragility: ci_percentiles must be 0 <= low < high <= 100, got {ci_percentiles}"
         )
-    rows, column = prepare_outcomes(df, intensity_column)
-    table = level_table(rows)
+    return lo_pct, hi_pct
+
+
+def _fit_table(table: pd.DataFrame) -> tuple[LognormalFit | None, str]:
+    """The lognormal fit of the per-level counts, or None and why there is none (one line)."""
     levels = table["intensity_g"].to_numpy()
-    grid = (
-        np.linspace(0.0, 1.1 * levels.max(), 201) if grid_g is None else np.asarray(grid_g, float)
-    )
-    nan_pair = (math.nan, math.nan)
     used = table["n_records"].to_numpy() > 0
-    fit, note = None, ""
     try:
         fit = _fit_counts(
             np.log(levels[used]),
@@ -341,7 +225,24 @@ def fragility(
             table["n_collapsed"].to_numpy(float)[used],
         )
     except RbmError as exc:
-        note = str(exc).removeprefix("fragility: ")
+        return None, str(exc).removeprefix("fragility: ")
+    return fit, ""
+
+
+@dataclass(frozen=True)
+class _Band:
+    """Bootstrap result: percentile band of the curve on the grid (lower, upper [-], nan
+    without resamples), intervals of theta [g] and beta [-], resamples with a fit."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    median_ci_g: tuple[float, float]
+    beta_ci: tuple[float, float]
+    n_used: int
+
+
+def _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, pct) -> _Band:
+    """The bootstrap over records around `fit` (none without a fit or resamples)."""
     thetas = betas = np.array([])
     curves = np.empty((0, grid.size))
     if fit is not None and n_resamples > 0:
@@ -350,33 +251,43 @@ def fragility(
         thetas, betas, curves = _bootstrap(
             runs, hits, np.log(levels), start, n_resamples, seed, grid
         )
-    pct = [lo_pct, hi_pct]
-    have_band = curves.shape[0] > 0
+    if curves.shape[0] == 0:
+        nan_pair = (math.nan, math.nan)
+        lower, upper = np.full((2, grid.size), np.nan)
+        return _Band(lower, upper, nan_pair, nan_pair, int(thetas.size))
+    lower, upper = np.percentile(curves, pct, axis=0)
+    return _Band(
+        lower,
+        upper,
+        tuple(np.percentile(thetas, pct)),
+        tuple(np.percentile(betas, pct)),
+        int(thetas.size),
+    )
+
+
+def _curve(grid: np.ndarray, fit: LognormalFit | None, band: _Band) -> pd.DataFrame:
+    """The fitted curve at intensities `grid` [g] and its band (nan where there is none)."""
     probability = (
         collapse_probability(grid, fit.median_g, fit.beta) if fit else np.full(grid.size, np.nan)
     )
-    lower, upper = (
-        np.percentile(curves, pct, axis=0) if have_band else np.full((2, grid.size), np.nan)
+    return pd.DataFrame(
+        {"intensity_g": grid, "probability": probability, "lower": band.lower, "upper": band.upper}
     )
-    curve = pd.DataFrame(
-        {"intensity_g": grid, "probability": probability, "lower": lower, "upper": upper}
-    )
+
+
+def _add_fitted(table: pd.DataFrame, grid: np.ndarray, fit: LognormalFit | None, band: _Band):
+    """Add to the per-level table the fitted probability and the band at each level."""
+    levels = table["intensity_g"].to_numpy()
     table["fitted"] = collapse_probability(levels, fit.median_g, fit.beta) if fit else np.nan
-    table["band_lower"] = np.interp(levels, grid, lower) if have_band else np.nan
-    table["band_upper"] = np.interp(levels, grid, upper) if have_band else np.nan
-    return FragilityResult(
-        table=table,
-        curve=curve,
-        fit=fit,
-        note=note,
-        median_ci_g=tuple(np.percentile(thetas, pct)) if have_band else nan_pair,
-        beta_ci=tuple(np.percentile(betas, pct)) if have_band else nan_pair,
-        ci_percentiles=(float(lo_pct), float(hi_pct)),
-        n_records=int(rows["record"].nunique()),
-        n_runs=int((~rows["failed"]).sum()),
-        n_failed=int(rows["failed"].sum()),
-        n_resamples=int(n_resamples) if fit is not None else 0,
-        n_resamples_used=int(thetas.size),
-        seed=int(seed),
-        intensity_column=column,
-    )
+    table["band_lower"] = np.interp(levels, grid, band.lower) if band.n_used else np.nan
+    table["band_upper"] = np.interp(levels, grid, band.upper) if band.n_used else np.nan
+
+
+__all__ = [
+    "METHOD",
+    "FragilityResult",
+    "LognormalFit",
+    "collapse_probability",
+    "fit_lognormal",
+    "fragility",
+]

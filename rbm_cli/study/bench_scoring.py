@@ -1,0 +1,62 @@
+"""Scoring a run of `rbm bench` against its reference, cell by cell.
+
+Errors: (a) cells whose outcome differs from the reference (converged cells
+only), (b) the largest boundary shift [g], (c) relative errors of the peak
+rotation ratio (cells with a well-conditioned reference peak that survive in
+both) and of the collapse time (converged cells that collapse in both), median
+and max.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from rbm_cli.study.domain import compare
+
+
+def _key(df: pd.DataFrame) -> pd.Series:
+    return df["amplitude_g"].round(9).astype(str) + "|" + df["frequency_hz"].round(9).astype(str)
+
+
+def errors(run: pd.DataFrame, ref: pd.DataFrame) -> dict:
+    """Errors of a run's rows against the reference rows of the same cells."""
+    m = run.assign(key=_key(run)).merge(ref.assign(key=_key(ref)), on="key",
+                                        suffixes=("", "_ref"))  # fmt: skip
+    n_failed = int((m["status"] == "failed").sum())
+    conv = m[(m["converged"] == 1) & (m["status"] != "failed")]
+    differ = int((conv["collapsed"] != conv["collapsed_ref"]).sum())
+    both_surv = m[(m["peak_converged"] == 1) & (m["collapsed"] == 0) & (m["collapsed_ref"] == 0)]
+    both_surv = both_surv[both_surv["max_rotation_ratio_ref"] > 0]
+    peak = (both_surv["max_rotation_ratio"] - both_surv["max_rotation_ratio_ref"]).abs()
+    peak = (peak / both_surv["max_rotation_ratio_ref"]).to_numpy()
+    both_col = conv[(conv["collapsed"] == 1) & (conv["collapsed_ref"] == 1)]
+    tcol = ((both_col["t_collapse_s"] - both_col["t_collapse_s_ref"]).abs()
+            / both_col["t_collapse_s_ref"]).to_numpy()  # fmt: skip
+    shift = math.nan
+    if len(conv) and conv["frequency_hz"].nunique() > 0:
+        a = conv[["amplitude_g", "frequency_hz", "collapsed"]].assign(
+            status=np.where(conv["collapsed"] == 1, "collapsed", "survived")
+        )
+        b = conv[["amplitude_g", "frequency_hz", "collapsed_ref"]].rename(
+            columns={"collapsed_ref": "collapsed"}
+        )
+        b = b.assign(status=np.where(b["collapsed"] == 1, "collapsed", "survived"))
+        shift = compare(a, b).max_shift_g
+    return {
+        "n_cells": len(m),
+        "n_failed": n_failed,
+        "n_converged": len(conv),
+        "n_sensitive": len(m) - len(conv),
+        "cells_differ": differ,
+        "fraction_differ": differ / len(conv) if len(conv) else math.nan,
+        "boundary_err_g": shift,
+        "n_peak": len(peak),
+        "peak_err_median": float(np.median(peak)) if len(peak) else math.nan,
+        "peak_err_max": float(np.max(peak)) if len(peak) else math.nan,
+        "n_tcol": len(tcol),
+        "tcol_err_median": float(np.median(tcol)) if len(tcol) else math.nan,
+        "tcol_err_max": float(np.max(tcol)) if len(tcol) else math.nan,
+    }

@@ -93,7 +93,7 @@ def sweep(
         rbm sweep configs/harmonic_multidrum.yaml --backend dask --scheduler tcp://10.0.0.5:8786
     """
     from rbm_cli.api import SweepInterrupted, run_sweep
-    from rbm_cli.cli.progress import Progress, duration
+    from rbm_cli.cli.progress import Progress
 
     cfg = load(config)
     if scheduler and backend != "dask":
@@ -129,6 +129,13 @@ def sweep(
     finally:
         if reporter is not None:
             reporter.close()
+    _print_sweep_summary(summary, jobs)
+
+
+def _print_sweep_summary(summary, jobs: int) -> None:
+    """What a finished `rbm sweep` says on stdout (failed cells: a warning on stderr)."""
+    from rbm_cli.cli.progress import duration
+
     if summary.already_finished:
         click.echo(
             f"{summary.folder} is already finished ({summary.n_cells} cells: domain.csv,"

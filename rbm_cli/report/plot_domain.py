@@ -162,6 +162,68 @@ def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
     )
 
 
+def _labels(labels: Sequence[str] | None, n_compare: int) -> list[str]:
+    """The legend labels of the boundaries: the domain's, then one per compared domain."""
+    if labels is None:
+        return ["boundary"] + [f"boundary, domain {k + 2}" for k in range(n_compare)]
+    labels = list(labels)
+    if len(labels) != 1 + n_compare:
+        raise ValueError(
+            f"labels needs {1 + n_compare} entries (the domain, then one per compared "
+            f"domain), got {len(labels)}"
+        )
+    return labels
+
+
+def _finish_axes(ax, domains: list, static_multiplier: float | None, proxies: list) -> None:
+    """Amplitude range, axis labels, grid and the legend beside the axes."""
+    amplitudes = np.concatenate([d["amplitude_g"].to_numpy(float) for d in domains])
+    top = max([float(np.nanmax(amplitudes))] if len(amplitudes) else [1.0])
+    if static_multiplier is not None:
+        top = max(top, float(static_multiplier))
+    ax.set_ylim(0.0, 1.06 * top)
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("amplitude [g]")
+    ax.grid(True, alpha=0.3)
+    handles, texts = ax.get_legend_handles_labels()
+    ax.legend(
+        handles=proxies + handles,
+        labels=[h.get_label() for h in proxies] + texts,
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),  # beside the axes: never over the cells
+        borderaxespad=0.0,
+        fontsize="small",
+    )
+
+
+def _plot_levels(ax, domains, column, excitation_type, static_multiplier, static_label):
+    """The static multiplier (or the level given) and, for a rigid monolith under a
+    half-sine, the closed-form thresholds; returns the level drawn [g] (or None)."""
+    if static_multiplier is None and column is not None:
+        static_multiplier = column.static_multiplier
+    if static_multiplier is not None:
+        ax.axhline(
+            static_multiplier,
+            color="0.3",
+            linestyle="--",
+            linewidth=1.0,
+            label=f"{static_label} {static_multiplier:.3g} g",
+            gid="static",
+        )
+
+    frequencies = np.concatenate([d["frequency_hz"].to_numpy(float) for d in domains])
+    if (
+        column is not None
+        and column.n == 1
+        and column.rigid
+        and excitation_type == "half-sine"
+        and len(frequencies)
+    ):
+        _plot_closed_forms(ax, column, frequencies)
+
+    return static_multiplier
+
+
 def plot_domain(
     df: pd.DataFrame,
     ax=None,
@@ -215,14 +277,7 @@ def plot_domain(
     of the grids, so a steep closed-form curve does not squash the domain.
     """
     compare = list(compare)
-    if labels is None:
-        labels = ["boundary"] + [f"boundary, domain {k + 2}" for k in range(len(compare))]
-    labels = list(labels)
-    if len(labels) != 1 + len(compare):
-        raise ValueError(
-            f"labels needs {1 + len(compare)} entries (the domain, then one per compared "
-            f"domain), got {len(labels)}"
-        )
+    labels = _labels(labels, len(compare))
     ax = _new_axes(ax)
 
     proxies = []
@@ -235,43 +290,8 @@ def plot_domain(
         colour = COMPARE_COLOURS[k % len(COMPARE_COLOURS)]
         _plot_boundary(ax, other, colour, label, f"compare-{k}")
 
-    if static_multiplier is None and column is not None:
-        static_multiplier = column.static_multiplier
-    if static_multiplier is not None:
-        ax.axhline(
-            static_multiplier,
-            color="0.3",
-            linestyle="--",
-            linewidth=1.0,
-            label=f"{static_label} {static_multiplier:.3g} g",
-            gid="static",
-        )
-
-    frequencies = np.concatenate([d["frequency_hz"].to_numpy(float) for d in [df, *compare]])
-    if (
-        column is not None
-        and column.n == 1
-        and column.rigid
-        and excitation_type == "half-sine"
-        and len(frequencies)
-    ):
-        _plot_closed_forms(ax, column, frequencies)
-
-    amplitudes = np.concatenate([d["amplitude_g"].to_numpy(float) for d in [df, *compare]])
-    top = max([float(np.nanmax(amplitudes))] if len(amplitudes) else [1.0])
-    if static_multiplier is not None:
-        top = max(top, float(static_multiplier))
-    ax.set_ylim(0.0, 1.06 * top)
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("amplitude [g]")
-    ax.grid(True, alpha=0.3)
-    handles, texts = ax.get_legend_handles_labels()
-    ax.legend(
-        handles=proxies + handles,
-        labels=[h.get_label() for h in proxies] + texts,
-        loc="upper left",
-        bbox_to_anchor=(1.01, 1.0),  # beside the axes: never over the cells
-        borderaxespad=0.0,
-        fontsize="small",
+    static_multiplier = _plot_levels(
+        ax, [df, *compare], column, excitation_type, static_multiplier, static_label
     )
+    _finish_axes(ax, [df, *compare], static_multiplier, proxies)
     return ax

@@ -12,6 +12,7 @@ so the same config gives the same ``domain.csv`` whatever the number of workers.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -237,48 +238,13 @@ def run_sweep(
         if done is None:
             return _finished_summary(folder, n_cells)
         todo = [c for c in cells if cell_key(*c) not in done]
-        try:
-            compile_s = _warm_up(config, todo)
-            start = time.perf_counter()
-            chunks = _chunks(todo, jobs)
-            if stop_after is not None:
-                chunks = chunks[:stop_after]
-            tasks = [(config, c, ensemble) for c in chunks]
-            _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
-                       resume_command)  # fmt: skip
-        except KeyboardInterrupt:
-            # counted from the journal: Ctrl-C may land between a chunk's write and its count
-            read = store.read_journal(digest, {cell_key(*c) for c in cells},
-                                      config.column.n_drums, ensemble)  # fmt: skip
-            kept = max(len(done), len(read.rows))
-            raise SweepInterrupted(folder, kept, n_cells, resume_command) from None
-        if stop_after is not None and len(done) < n_cells:
-            raise RbmError(
-                f"sweep stopped after {stop_after} chunks (journal kept in {store.journal})"
-            )
-        wall = time.perf_counter() - start
-
+        run = _Run(store, config, cells, digest, ensemble, resume_command, done)
+        compile_s, wall = run.run(todo, jobs, backend, scheduler, progress, stop_after)
         rows = [done[cell_key(*c)] for c in cells]
         df = pd.DataFrame(rows, columns=list(fields))
         counts = df["status"].value_counts().to_dict()
-        meta = {
-            "name": config.name,
-            "config": config.resolved(),
-            "config_written": config.written,
-            "config_hash": digest,
-            "versions": _versions(),
-            "wall_time_s": wall,
-            "jobs": jobs,
-            "backend": backend,
-            "scheduler": scheduler,
-            "n_cells": len(cells),
-            "n_run": len(todo),
-            "n_resumed": len(cells) - len(todo),
-            "status_counts": counts,
-            "ensemble": {"members": ensemble, "rule": ROBUSTNESS_RULE if ensemble > 1 else None},
-            "provenance": provenance(),
-            "cpu_count": os.cpu_count(),
-        }
+        meta = _meta(config, digest, len(cells), len(todo), counts, ensemble)
+        meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler)
         meta["compile_time_s"] = compile_s
         try:
             publish_result(
@@ -286,17 +252,85 @@ def run_sweep(
             )
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
+    return _summary(folder, len(cells), len(todo), counts, wall, compile_s)
+
+
+def _summary(folder, n_cells, n_run, counts, wall, compile_s) -> SweepSummary:
     return SweepSummary(
         folder=folder,
-        n_cells=len(cells),
-        n_run=len(todo),
-        n_resumed=len(cells) - len(todo),
+        n_cells=n_cells,
+        n_run=n_run,
+        n_resumed=n_cells - n_run,
         n_collapsed=int(counts.get("collapsed", 0)),
         n_survived=int(counts.get("survived", 0)),
         n_failed=int(counts.get("failed", 0)),
         wall_time_s=wall,
         compile_s=compile_s,
     )
+
+
+def _meta(config: Config, digest: str, n_cells: int, n_run: int, counts: dict, ensemble: int):
+    """meta.json's record of a sweep (wall time, workers and compile time added after)."""
+    return {
+        "name": config.name,
+        "config": config.resolved(),
+        "config_written": config.written,
+        "config_hash": digest,
+        "versions": _versions(),
+        "wall_time_s": None,
+        "jobs": None,
+        "backend": None,
+        "scheduler": None,
+        "n_cells": n_cells,
+        "n_run": n_run,
+        "n_resumed": n_cells - n_run,
+        "status_counts": counts,
+        "ensemble": {"members": ensemble, "rule": ROBUSTNESS_RULE if ensemble > 1 else None},
+        "provenance": provenance(),
+        "cpu_count": os.cpu_count(),
+    }
+
+
+@dataclass
+class _Run:
+    """The cells of one sweep being run into its store (journal rows land in `done`)."""
+
+    store: SweepStore
+    config: Config
+    cells: list
+    digest: str
+    ensemble: int
+    resume_command: str
+    done: dict
+
+    def cells_kept(self) -> int:
+        """Cells kept after a Ctrl-C, counted from the journal: Ctrl-C may land between a
+        chunk's write and its count."""
+        keys = {cell_key(*c) for c in self.cells}
+        read = self.store.read_journal(self.digest, keys, self.config.column.n_drums,
+                                       self.ensemble)  # fmt: skip
+        return max(len(self.done), len(read.rows))
+
+    def run(self, todo, jobs, backend, scheduler, progress, stop_after) -> tuple[float, float]:
+        """Run the cells still to do; (compile time, wall time) [s]."""
+        n_cells = len(self.cells)
+        try:
+            compile_s = _warm_up(self.config, todo)
+            start = time.perf_counter()
+            chunks = _chunks(todo, jobs)
+            if stop_after is not None:
+                chunks = chunks[:stop_after]
+            tasks = [(self.config, c, self.ensemble) for c in chunks]
+            _run_tasks(self.store, tasks, jobs, backend, scheduler, self.digest, self.done,
+                       n_cells, progress, self.resume_command)  # fmt: skip
+        except KeyboardInterrupt:
+            raise SweepInterrupted(self.store.folder, self.cells_kept(), n_cells,
+                                   self.resume_command) from None  # fmt: skip
+        if stop_after is not None and len(self.done) < n_cells:
+            raise RbmError(
+                f"sweep stopped after {stop_after} chunks (journal kept in {self.store.journal})"
+            )
+        return compile_s, time.perf_counter() - start
 
 
 def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
@@ -343,16 +377,8 @@ def _finished_summary(folder: Path, n_cells: int) -> SweepSummary:
         counts = json.loads((folder / "meta.json").read_text()).get("status_counts", {})
     except (OSError, ValueError, AttributeError):
         pass
-    return SweepSummary(
-        folder=folder,
-        n_cells=n_cells,
-        n_run=0,
-        n_resumed=n_cells,
-        n_collapsed=int(counts.get("collapsed", 0)),
-        n_survived=int(counts.get("survived", 0)),
-        n_failed=int(counts.get("failed", 0)),
-        wall_time_s=0.0,
-        already_finished=True,
+    return dataclasses.replace(
+        _summary(folder, n_cells, 0, counts, 0.0, 0.0), already_finished=True
     )
 
 

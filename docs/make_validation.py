@@ -30,7 +30,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
-from scipy.optimize import brentq  # noqa: E402
 
 from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
@@ -46,7 +45,13 @@ from rbm_cli.physics.column import build_column  # noqa: E402
 from rbm_cli.physics.excitation import make_ground_motion  # noqa: E402
 from rbm_cli.report.plot_domain import plot_domain  # noqa: E402
 from rbm_cli.study.domain import boundary, compare, read_domain  # noqa: E402
-from rbm_cli.study.simulate import housner_restitution, model_from_config, simulate  # noqa: E402
+from rbm_cli.study.simulate import model_from_config, simulate  # noqa: E402
+from rbm_cli.study.validation import (  # noqa: E402
+    differing_cells,
+    linear_domain,
+    period_from_crossings,
+    zero_crossings,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIGS = ROOT / "configs"
@@ -87,66 +92,10 @@ def save(fig, out: Path, name: str) -> str:
     return f"figures/{path.name}"
 
 
-def restitution_of(cfg, column) -> float:
-    e = cfg.interface.restitution
-    return housner_restitution(column) if e == "housner" else float(e)
-
-
 def sweep_domain(cfg, tmp: Path, jobs: int) -> tuple[pd.DataFrame, float]:
     """run_sweep into a temporary folder; the domain and the sweep's wall time [s]."""
     summary = run_sweep(cfg, tmp, jobs=jobs)
     return read_domain(summary.folder / "domain.csv"), summary.wall_time_s
-
-
-def linear_domain(cfg, alpha: float, p: float, e: float) -> pd.DataFrame:
-    """housner_linear_run over the grid of cfg with the given (alpha, p)."""
-    rows = []
-    for f in cfg.grid.frequencies_hz:
-        for a in cfg.grid.amplitudes_g:
-            motion = make_ground_motion(cfg.excitation, a, f)
-            out = housner_linear_run(
-                alpha, p, motion, restitution=e, collapse_ratio=cfg.collapse.ratio
-            )
-            rows.append(
-                {
-                    "amplitude_g": float(a),
-                    "frequency_hz": float(f),
-                    "status": out.status,
-                    "collapsed": int(out.status == "collapsed"),
-                }
-            )
-    return pd.DataFrame(rows)
-
-
-def differing_cells(a: pd.DataFrame, b: pd.DataFrame) -> list[dict]:
-    """Cells whose collapsed flag differs; 'near' when an amplitude neighbour at the
-    same frequency has the other status in either domain."""
-
-    def table(df):
-        return {
-            (round(x, 9), round(f, 9)): int(c)
-            for x, f, c in zip(df.amplitude_g, df.frequency_hz, df.collapsed, strict=True)
-        }
-
-    ta, tb = table(a), table(b)
-    amps = sorted({k[0] for k in ta})
-    out = []
-    for key in sorted(ta.keys() & tb.keys(), key=lambda k: (k[1], k[0])):
-        if ta[key] == tb[key]:
-            continue
-        i = amps.index(key[0])
-        neigh = [amps[j] for j in (i - 1, i + 1) if 0 <= j < len(amps)]
-        near = any((n, key[1]) in t and t[(n, key[1])] != t[key] for t in (ta, tb) for n in neigh)
-        out.append(
-            {
-                "amplitude_g": key[0],
-                "frequency_hz": key[1],
-                "a": ta[key],
-                "b": tb[key],
-                "near": near,
-            }
-        )
-    return out
 
 
 def mark_cells(ax, cells: list[dict], label: str) -> None:
@@ -173,41 +122,20 @@ def legend_below(ax) -> None:
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize="small")
 
 
-def zero_crossings(t, theta, rate) -> np.ndarray:
-    """Times where theta changes sign, refined on the cubic Hermite interpolant."""
-    out = []
-    for k in np.nonzero(np.sign(theta[:-1]) * np.sign(theta[1:]) < 0)[0]:
-        t0, t1 = t[k], t[k + 1]
-        h = t1 - t0
-        y0, y1, d0, d1 = theta[k], theta[k + 1], rate[k] * h, rate[k + 1] * h
-
-        def herm(s, y0=y0, y1=y1, d0=d0, d1=d1):
-            return (
-                (2 * s**3 - 3 * s**2 + 1) * y0
-                + (s**3 - 2 * s**2 + s) * d0
-                + (-2 * s**3 + 3 * s**2) * y1
-                + (s**3 - s**2) * d1
-            )
-
-        out.append(t0 + h * brentq(herm, 0.0, 1.0, xtol=1e-15))
-    return np.array(out)
+# ----------------------------------------------------------------------------- section 1
 
 
-def period_from_crossings(times) -> float:
-    times = np.asarray(times, float)
-    if len(times) < 2:
-        return math.nan
-    return 2.0 * (times[-1] - times[0]) / (len(times) - 1)
-
-
-# ----------------------------------------------------------------------------- sections
-
-
-def section1(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
+def slender_mapping():
+    """The slender study's config, column, mapped (alpha, p) and the RBM's restitution."""
     cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
     column = build_column(cfg.column, cfg.interface)
     alpha, p = linear_rocking_parameters(column)
-    e = restitution_of(cfg, column)
+    e = model_from_config(cfg, column).restitution  # the rule the RBM runs with
+    return cfg, column, alpha, p, e
+
+
+def section1(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
+    cfg, column, alpha, p, e = slender_mapping()
     rep(
         "Column: `configs/spanos_koh_slender.yaml` (rectangle H 4 m x B 1 m, rigid law, xi 1, "
         f"e {e:g}). Mapping of SPEC section 2: alpha = B/H = {alpha:.6g} rad, "
@@ -219,54 +147,68 @@ def section1(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     rep()
     rep("### 1a. Time histories")
     rep()
+    worst = section1a(rep, out, cfg, alpha, p, e)
+    rep("### 1b. The whole domain")
+    rep()
+    section1b(rep, out, tmp, quick, jobs, (cfg, column, alpha, p, e), worst)
+
+
+def history_case(cfg, a, f, alpha, p, e, dt, axes) -> list:
+    """One time-history case of 1a: RBM and closed form drawn on axes (top, bottom);
+    the table row."""
+    res = simulate(cfg, a, f, record=True, output_dt=dt)
+    h = res.history
+    motion = make_ground_motion(cfg.excitation, a, f)
+    lin = housner_linear_run(
+        alpha, p, motion, restitution=e, record=True, output_dt=dt, early_stop=False
+    )
+    tl = np.array([s[0] for s in lin.samples])
+    thl = np.array([s[1][0] for s in lin.samples])
+    n = min(len(h.t), len(tl))
+    assert np.allclose(h.t[:n], tl[:n], atol=1e-9), "sample times differ"
+    th_r = h.rotations[:n, 0]
+    err = np.abs(th_r - thl[:n]) / alpha
+    peak_r = float(np.max(np.abs(h.rotations[:, 0])) / alpha)
+    peak_l = float(np.max(np.abs(thl)) / alpha)
+    row = [
+        f"{a:g} g, {f:g} Hz",
+        res.status,
+        lin.status,
+        fmt(res.t_collapse_s, 9),
+        fmt(lin.t_collapse, 9),
+        f"{res.n_impacts} / {lin.n_impacts}",
+        f"{peak_r:.6f} / {peak_l:.6f}",
+        f"{err.max():.2e}",
+    ]
+    ax, ax_err = axes
+    ax.plot(
+        tl, thl / alpha, color="C1", lw=2.5, alpha=0.6, label="closed form (housner_linear_run)"
+    )
+    ax.plot(h.t, h.rotations[:, 0] / alpha, color="C0", lw=1.0, label="RBM n = 1 (simulate)")
+    ax.axhline(1, color="0.5", ls=":", lw=0.8)
+    ax.axhline(-1, color="0.5", ls=":", lw=0.8)
+    ax.set_title(f"{a:g} g, {f:g} Hz: RBM {res.status}, closed form {lin.status}")
+    ax.set_ylabel("theta / alpha [-]")
+    ax.legend(fontsize="small", loc="lower left")
+    ax.grid(alpha=0.3)
+    ax_err.semilogy(tl[:n], np.maximum(err, 1e-16), color="C3", lw=0.8)
+    ax_err.set_ylabel("|RBM - closed| / alpha")
+    ax_err.set_xlabel("t [s]")
+    ax_err.grid(alpha=0.3)
+    return row
+
+
+def section1a(rep: Report, out: Path, cfg, alpha: float, p: float, e: float) -> str:
+    """Time histories; returns the worst max |error| / alpha (text)."""
     dt = 0.002
     cases = [(0.5, 1.0), (1.0, 2.0)]
     fig, axes = plt.subplots(
         2, len(cases), figsize=(11, 6), sharex="col", gridspec_kw={"height_ratios": [2, 1]}
     )
-    rows = []
-    for j, (a, f) in enumerate(cases):
-        res = simulate(cfg, a, f, record=True, output_dt=dt)
-        h = res.history
-        motion = make_ground_motion(cfg.excitation, a, f)
-        lin = housner_linear_run(
-            alpha, p, motion, restitution=e, record=True, output_dt=dt, early_stop=False
-        )
-        tl = np.array([s[0] for s in lin.samples])
-        thl = np.array([s[1][0] for s in lin.samples])
-        n = min(len(h.t), len(tl))
-        assert np.allclose(h.t[:n], tl[:n], atol=1e-9), "sample times differ"
-        th_r = h.rotations[:n, 0]
-        err = np.abs(th_r - thl[:n]) / alpha
-        peak_r = float(np.max(np.abs(h.rotations[:, 0])) / alpha)
-        peak_l = float(np.max(np.abs(thl)) / alpha)
-        rows.append(
-            [
-                f"{a:g} g, {f:g} Hz",
-                res.status,
-                lin.status,
-                fmt(res.t_collapse_s, 9),
-                fmt(lin.t_collapse, 9),
-                f"{res.n_impacts} / {lin.n_impacts}",
-                f"{peak_r:.6f} / {peak_l:.6f}",
-                f"{err.max():.2e}",
-            ]
-        )
-        ax = axes[0, j]
-        ax.plot(
-            tl, thl / alpha, color="C1", lw=2.5, alpha=0.6, label="closed form (housner_linear_run)"
-        )
-        ax.plot(h.t, h.rotations[:, 0] / alpha, color="C0", lw=1.0, label="RBM n = 1 (simulate)")
-        ax.axhline(1, color="0.5", ls=":", lw=0.8)
-        ax.axhline(-1, color="0.5", ls=":", lw=0.8)
-        ax.set_title(f"{a:g} g, {f:g} Hz: RBM {res.status}, closed form {lin.status}")
-        ax.set_ylabel("theta / alpha [-]")
-        ax.legend(fontsize="small", loc="lower left")
-        ax.grid(alpha=0.3)
-        axes[1, j].semilogy(tl[:n], np.maximum(err, 1e-16), color="C3", lw=0.8)
-        axes[1, j].set_ylabel("|RBM - closed| / alpha")
-        axes[1, j].set_xlabel("t [s]")
-        axes[1, j].grid(alpha=0.3)
+    rows = [
+        history_case(cfg, a, f, alpha, p, e, dt, (axes[0, j], axes[1, j]))
+        for j, (a, f) in enumerate(cases)
+    ]
     fig.suptitle(
         "Rigid RBM n = 1 vs the closed form of the linear rocking equation "
         f"(alpha {alpha:.4g}, p {p:.4g} rad/s)"
@@ -292,9 +234,12 @@ def section1(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         ],
         rows,
     )
+    return f"{max(float(r[-1]) for r in rows):.2e}"
 
-    rep("### 1b. The whole domain")
-    rep()
+
+def section1b(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int, mapped, worst: str):
+    """The whole domain of the slender block, RBM sweep vs the mapped closed form."""
+    cfg, column, alpha, p, e = mapped
     if quick:
         g = cfg.grid
         cfg = dc.replace(cfg, grid=GridConfig(g.amplitudes_g[::3], g.frequencies_hz[::3]))
@@ -326,6 +271,22 @@ def section1(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         f"took {wall:.1f} s on {jobs} workers."
     )
     rep()
+    report_differences(rep, cmp, diff, near)
+    rep(
+        f"**What it shows:** the rigid RBM with n = 1 integrates the piecewise-linear rocking "
+        f"equation to within {worst} of alpha along whole histories, and its domain "
+        + (
+            "is the closed form's, cell for cell."
+            if cmp.n_differ == 0
+            else f"differs from the closed form's in {cmp.n_differ} cell(s) "
+            f"({near} of them next to the boundary), i.e. where a run grazes the collapse limit."
+        )
+    )
+    rep()
+
+
+def report_differences(rep: Report, cmp, diff: list[dict], near: int) -> None:
+    """The cells that differ between the RBM and the closed form, one line each."""
     rep(
         f"- cells that differ: **{cmp.n_differ}** of {cmp.n_common} "
         f"({100 * cmp.fraction:.2f} %), of which {near} next to the boundary "
@@ -342,18 +303,46 @@ def section1(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
             f"{'collapsed' if c['b'] else 'survived'}, next to the boundary: {c['near']}"
         )
     rep()
-    worst = f"{max(float(r[-1]) for r in rows):.2e}"
-    rep(
-        f"**What it shows:** the rigid RBM with n = 1 integrates the piecewise-linear rocking "
-        f"equation to within {worst} of alpha along whole histories, and its domain "
-        + (
-            "is the closed form's, cell for cell."
-            if cmp.n_differ == 0
-            else f"differs from the closed form's in {cmp.n_differ} cell(s) "
-            f"({near} of them next to the boundary), i.e. where a run grazes the collapse limit."
-        )
+
+
+# ----------------------------------------------------------------------------- section 2
+
+
+def block_row(base, ratio: float, height: float, units, tmp: Path, jobs: int):
+    """housner vs housner-linear for one block H/B = ratio on a grid in its own units
+    (A/alpha, omega/p): the table row, the curve point (alpha, % differ, max shift /
+    alpha, mean |shift| / alpha) and whether every differing cell is next to the boundary."""
+    amp_units, freq_units = units
+    col = dc.replace(
+        base.column, base_width=height / ratio, top_width=height / ratio, height=height
     )
-    rep()
+    geo = block_geometry(col)
+    alpha, p = geo.slenderness, geo.frequency_parameter
+    grid = GridConfig(
+        tuple(float(x) for x in alpha * amp_units),
+        tuple(float(x) for x in p * freq_units / (2 * math.pi)),
+    )
+    doms = {}
+    for model in ("housner", "housner-linear"):
+        cfg = dc.replace(base, name=f"hb{ratio}_{model}", model=model, column=col, grid=grid)
+        doms[model], _ = sweep_domain(cfg, tmp / "s2", jobs)
+    cmp = compare(doms["housner"], doms["housner-linear"])
+    diff = differing_cells(doms["housner"], doms["housner-linear"])
+    near = sum(c["near"] for c in diff)
+    mean_shift = float(cmp.shifts["shift_g"].abs().mean()) / alpha
+    point = (alpha, 100 * cmp.fraction, cmp.max_shift_g / alpha, mean_shift)
+    row = [
+        f"{ratio:g}",
+        f"{alpha:.4f}",
+        f"{p:.4f}",
+        f"{cmp.n_differ} / {cmp.n_common}",
+        f"{100 * cmp.fraction:.1f}",
+        str(near),
+        f"{cmp.max_shift_g:.3g}",
+        f"{cmp.max_shift_g / alpha:.3g}",
+        f"{mean_shift:.3g}",
+    ]
+    return row, point, near == len(diff)
 
 
 def section2(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
@@ -377,36 +366,10 @@ def section2(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     rep()
     rows, curve, all_near = [], [], True
     for r in ratios:
-        col = dc.replace(base.column, base_width=H / r, top_width=H / r, height=H)
-        geo = block_geometry(col)
-        alpha, p = geo.slenderness, geo.frequency_parameter
-        grid = GridConfig(
-            tuple(float(x) for x in alpha * amp_units),
-            tuple(float(x) for x in p * freq_units / (2 * math.pi)),
-        )
-        doms = {}
-        for model in ("housner", "housner-linear"):
-            cfg = dc.replace(base, name=f"hb{r}_{model}", model=model, column=col, grid=grid)
-            doms[model], _ = sweep_domain(cfg, tmp / "s2", jobs)
-        cmp = compare(doms["housner"], doms["housner-linear"])
-        diff = differing_cells(doms["housner"], doms["housner-linear"])
-        near = sum(c["near"] for c in diff)
-        all_near = all_near and near == len(diff)
-        mean_shift = float(cmp.shifts["shift_g"].abs().mean()) / alpha
-        curve.append((alpha, 100 * cmp.fraction, cmp.max_shift_g / alpha, mean_shift))
-        rows.append(
-            [
-                f"{r:g}",
-                f"{alpha:.4f}",
-                f"{p:.4f}",
-                f"{cmp.n_differ} / {cmp.n_common}",
-                f"{100 * cmp.fraction:.1f}",
-                str(near),
-                f"{cmp.max_shift_g:.3g}",
-                f"{cmp.max_shift_g / alpha:.3g}",
-                f"{mean_shift:.3g}",
-            ]
-        )
+        row, point, every_near = block_row(base, r, H, (amp_units, freq_units), tmp, jobs)
+        rows.append(row)
+        curve.append(point)
+        all_near = all_near and every_near
     rep.table(
         [
             "H/B",
@@ -422,6 +385,30 @@ def section2(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         rows,
     )
     a_, pc, sh, msh = (np.array(v) for v in zip(*curve, strict=True))
+    fig = alpha_figure(a_, pc, sh, msh, ratios)
+    rep(f"![housner vs linear]({save(fig, out, 'housner_vs_linear')})")
+    rep()
+    monotone = bool(np.all(np.diff(pc) >= 0) and pc[-1] > pc[0])
+    trend = (
+        "the linearisation degrades as alpha grows"
+        if monotone
+        else "there is no monotonic trend with alpha on this grid: the cells that differ sit "
+        + ("next to the boundary at every alpha" if all_near else "mostly at the boundary")
+        + ", i.e. the sensitivity of undamped (e = 1) harmonic "
+        "rocking to small differences dominates the linearisation error at this resolution "
+        "(the time-history difference itself grows as alpha^2, README Validation)"
+    )
+    rep(
+        f"**What it shows:** the cells that differ go from {pc[0]:.1f} % at alpha "
+        f"{a_[0]:.3f} (H/B {ratios[0]}) to {pc[-1]:.1f} % at alpha {a_[-1]:.3f} "
+        f"(H/B {ratios[-1]}), with boundary shifts up to {sh.max():.2g} alpha; on a coarse grid "
+        f"single cells decide these numbers, so read the trend, not the digits: {trend}."
+    )
+    rep()
+
+
+def alpha_figure(a_, pc, sh, msh, ratios):
+    """% of cells that differ and boundary shifts against alpha (section 2)."""
     fig, ax = plt.subplots(figsize=(7, 4.2))
     ax.plot(a_, pc, "o-", color="C0", label="% cells that differ")
     ax.set_xlabel("alpha = atan(B/H) [rad]")
@@ -446,25 +433,34 @@ def section2(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
     ax.legend(h1 + h2, l1 + l2, loc="upper left", fontsize="small")
-    rep(f"![housner vs linear]({save(fig, out, 'housner_vs_linear')})")
-    rep()
-    monotone = bool(np.all(np.diff(pc) >= 0) and pc[-1] > pc[0])
-    trend = (
-        "the linearisation degrades as alpha grows"
-        if monotone
-        else "there is no monotonic trend with alpha on this grid: the cells that differ sit "
-        + ("next to the boundary at every alpha" if all_near else "mostly at the boundary")
-        + ", i.e. the sensitivity of undamped (e = 1) harmonic "
-        "rocking to small differences dominates the linearisation error at this resolution "
-        "(the time-history difference itself grows as alpha^2, README Validation)"
-    )
-    rep(
-        f"**What it shows:** the cells that differ go from {pc[0]:.1f} % at alpha "
-        f"{a_[0]:.3f} (H/B {ratios[0]}) to {pc[-1]:.1f} % at alpha {a_[-1]:.3f} "
-        f"(H/B {ratios[-1]}), with boundary shifts up to {sh.max():.2g} alpha; on a coarse grid "
-        f"single cells decide these numbers, so read the trend, not the digits: {trend}."
-    )
-    rep()
+    return fig
+
+
+# ----------------------------------------------------------------------------- section 3
+
+
+def halfsine_rows(bnd: pd.DataFrame, curves: dict, p: float) -> tuple[list, int]:
+    """Per frequency: the stored boundary, the exact linear and Housner thresholds, and
+    whether the exact one lies in (highest safe, lowest unsafe]; and how many do."""
+    rows, inside = [], 0
+    for k, fr in enumerate(bnd["frequency_hz"].to_numpy(float)):
+        lo, hi = bnd["highest_safe_g"].iloc[k], bnd["lowest_unsafe_g"].iloc[k]
+        ex, ho = curves["linear"][k], curves["housner"][k]
+        ok = (math.isnan(lo) or lo < ex + 1e-9) and (math.isnan(hi) or ex <= hi + 1e-9)
+        inside += ok
+        rows.append(
+            [
+                f"{fr:g}",
+                f"{2 * math.pi * fr / p:.3f}",
+                fmt(lo),
+                fmt(hi),
+                f"{ex:.4f}",
+                f"{ho:.4f}",
+                f"{100 * (ex / ho - 1):+.1f}",
+                "yes" if ok else "**no**",
+            ]
+        )
+    return rows, inside
 
 
 def section3(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
@@ -496,24 +492,7 @@ def section3(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     ax.set_title("Half-sine: stored RBM domain vs exact linear threshold and Housner")
     rep(f"![half-sine]({save(fig, out, 'halfsine')})")
     rep()
-    rows, inside = [], 0
-    for k, fr in enumerate(f):
-        lo, hi = bnd["highest_safe_g"].iloc[k], bnd["lowest_unsafe_g"].iloc[k]
-        ex, ho = curves["linear"][k], curves["housner"][k]
-        ok = (math.isnan(lo) or lo < ex + 1e-9) and (math.isnan(hi) or ex <= hi + 1e-9)
-        inside += ok
-        rows.append(
-            [
-                f"{fr:g}",
-                f"{2 * math.pi * fr / p:.3f}",
-                fmt(lo),
-                fmt(hi),
-                f"{ex:.4f}",
-                f"{ho:.4f}",
-                f"{100 * (ex / ho - 1):+.1f}",
-                "yes" if ok else "**no**",
-            ]
-        )
+    rows, inside = halfsine_rows(bnd, curves, p)
     rep.table(
         [
             "f [Hz]",
@@ -545,6 +524,43 @@ def section3(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     rep()
 
 
+# ----------------------------------------------------------------------------- section 4
+
+
+def free_rocking_case(cfg, alpha: float, p: float, r: float, dt: float, ax) -> list:
+    """Free rocking from theta0 = r alpha: the periods of the RBM (zero crossings of its
+    recorded history) and of the closed form (its impacts) against T; drawn on ax."""
+    T = float(free_rocking_period(p, r))
+    exc = ExcitationConfig(
+        type="free", duration=4.2 * T, initial=InitialConfig(rotations=(r * alpha,))
+    )
+    c = dc.replace(cfg, excitation=exc)
+    res = simulate(c, 0.0, 0.0, record=True, output_dt=dt)
+    h = res.history
+    t_rbm = period_from_crossings(zero_crossings(h.t, h.rotations[:, 0], h.rates[:, 0]))
+    ev: list = []
+    housner_linear_run(
+        alpha,
+        p,
+        make_ground_motion(exc, 0.0, 0.0),
+        restitution=1.0,
+        initial=(r * alpha, 0.0),
+        events=ev,
+    )
+    imp = [t for t, kind in ev if kind == "impact"]
+    t_lin = period_from_crossings(imp)
+    ax.plot(h.t / T, h.rotations[:, 0] / alpha, label=f"theta0/alpha = {r:g}")
+    return [
+        f"{r:g}",
+        f"{T:.9f}",
+        f"{t_rbm:.9f}",
+        f"{t_rbm / T - 1:.1e}",
+        f"{t_lin:.9f}",
+        f"{t_lin / T - 1:.1e}",
+        str(res.n_impacts),
+    ]
+
+
 def section4(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
     column = build_column(cfg.column, cfg.interface)
@@ -560,40 +576,8 @@ def section4(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         "Reference: T = (4/p) arccosh(1 / (1 - theta0/alpha))."
     )
     rep()
-    rows = []
     fig, ax = plt.subplots(figsize=(8, 4.2))
-    for r in (0.1, 0.5, 0.9):
-        T = float(free_rocking_period(p, r))
-        exc = ExcitationConfig(
-            type="free", duration=4.2 * T, initial=InitialConfig(rotations=(r * alpha,))
-        )
-        c = dc.replace(cfg, excitation=exc)
-        res = simulate(c, 0.0, 0.0, record=True, output_dt=dt)
-        h = res.history
-        t_rbm = period_from_crossings(zero_crossings(h.t, h.rotations[:, 0], h.rates[:, 0]))
-        ev: list = []
-        housner_linear_run(
-            alpha,
-            p,
-            make_ground_motion(exc, 0.0, 0.0),
-            restitution=1.0,
-            initial=(r * alpha, 0.0),
-            events=ev,
-        )
-        imp = [t for t, kind in ev if kind == "impact"]
-        t_lin = period_from_crossings(imp)
-        rows.append(
-            [
-                f"{r:g}",
-                f"{T:.9f}",
-                f"{t_rbm:.9f}",
-                f"{t_rbm / T - 1:.1e}",
-                f"{t_lin:.9f}",
-                f"{t_lin / T - 1:.1e}",
-                str(res.n_impacts),
-            ]
-        )
-        ax.plot(h.t / T, h.rotations[:, 0] / alpha, label=f"theta0/alpha = {r:g}")
+    rows = [free_rocking_case(cfg, alpha, p, r, dt, ax) for r in (0.1, 0.5, 0.9)]
     ax.set_xlabel("t / T (closed-form period)")
     ax.set_ylabel("theta / alpha [-]")
     ax.grid(alpha=0.3)
@@ -623,6 +607,9 @@ def section4(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     rep()
 
 
+# ----------------------------------------------------------------------------- section 5
+
+
 def energy_config(formulation: str, duration: float):
     return parse_config(
         {
@@ -645,6 +632,33 @@ FORMS = ("relative", "geometric", "absolute")
 def section5(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     rep("### 5a. Energy in free motion")
     rep()
+    section5a(rep, out, quick)
+    rep("### 5b. The paper's 8-drum column, three formulations")
+    rep()
+    section5b(rep, out, tmp, quick, jobs)
+
+
+def energy_case(form: str, duration: float, k: int, axes) -> list:
+    """One formulation of 5a: its energy history drawn on axes; the table row."""
+    cfg = energy_config(form, duration)
+    res = simulate(cfg, 0.0, 0.0, record=True, output_dt=0.01)
+    h = res.history
+    E = model_from_config(cfg).energy(h.rotations, h.rates)
+    rel = E / E[0] - 1.0
+    axes[0].plot(h.t, E / E[0], color=f"C{k}", label=form)
+    axes[1].semilogy(h.t, np.maximum(np.abs(rel), 1e-16), color=f"C{k}", lw=0.8, label=form)
+    return [
+        form,
+        f"{E[0]:.6g}",
+        f"{E[-1]:.6g}",
+        f"{np.max(E) / E[0]:.3g}",
+        f"{np.max(np.abs(rel)):.2e}",
+        res.status,
+        f"{res.wall_time_s:.1f}",
+    ]
+
+
+def section5a(rep: Report, out: Path, quick: bool) -> None:
     duration = 5.0 if quick else 20.0
     rep(
         f"4-drum elastic column (H 4 m, B 0.8 m, square, 2700 kg/m^3, k_n 1e8 Pa/m, xi 0.8, "
@@ -654,26 +668,7 @@ def section5(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     )
     rep()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    rows = []
-    for k, form in enumerate(FORMS):
-        cfg = energy_config(form, duration)
-        res = simulate(cfg, 0.0, 0.0, record=True, output_dt=0.01)
-        h = res.history
-        E = model_from_config(cfg).energy(h.rotations, h.rates)
-        rel = E / E[0] - 1.0
-        rows.append(
-            [
-                form,
-                f"{E[0]:.6g}",
-                f"{E[-1]:.6g}",
-                f"{np.max(E) / E[0]:.3g}",
-                f"{np.max(np.abs(rel)):.2e}",
-                res.status,
-                f"{res.wall_time_s:.1f}",
-            ]
-        )
-        axes[0].plot(h.t, E / E[0], color=f"C{k}", label=form)
-        axes[1].semilogy(h.t, np.maximum(np.abs(rel), 1e-16), color=f"C{k}", lw=0.8, label=form)
+    rows = [energy_case(form, duration, k, axes) for k, form in enumerate(FORMS)]
     axes[0].set_ylabel("E / E0 [-]")
     axes[1].set_ylabel("|E / E0 - 1| [-]")
     for ax in axes:
@@ -707,8 +702,10 @@ def section5(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     )
     rep()
 
-    rep("### 5b. The paper's 8-drum column, three formulations")
-    rep()
+
+def multidrum_config(rep: Report, quick: bool):
+    """The 8-drum study on a coarse grid (--quick: 3 x 3 cells, 1 s); config, amplitudes
+    and frequencies."""
     cfg = load_config(CONFIGS / "harmonic_multidrum.yaml")
     if quick:
         amps, freqs = (0.4, 0.7, 1.0), (1.0, 2.0, 3.0)
@@ -721,7 +718,11 @@ def section5(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     else:
         amps = tuple(round(0.1 + 0.15 * i, 10) for i in range(7))
         freqs = tuple(0.5 * i for i in range(1, 9))
-    cfg = dc.replace(cfg, grid=GridConfig(amps, freqs))
+    return dc.replace(cfg, grid=GridConfig(amps, freqs)), amps, freqs
+
+
+def section5b(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
+    cfg, amps, freqs = multidrum_config(rep, quick)
     column = build_column(cfg.column, cfg.interface)
     rep(
         f"`configs/harmonic_multidrum.yaml` (8 drums, k_n 5e9 Pa/m, xi 1, e 1, harmonic "
@@ -748,6 +749,11 @@ def section5(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
     fig.tight_layout()
     rep(f"![multidrum]({save(fig, out, 'multidrum_formulations')})")
     rep()
+    formulations_summary(rep, doms, column, amps, freqs)
+
+
+def formulations_summary(rep: Report, doms: dict, column, amps, freqs) -> None:
+    """5b's table of pairs of formulations and what it shows."""
     rows = []
     for a, b in (("relative", "geometric"), ("relative", "absolute"), ("geometric", "absolute")):
         cmp = compare(doms[a], doms[b])

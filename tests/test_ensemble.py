@@ -74,6 +74,11 @@ def test_rigid_block_fractions_match_the_closed_form(tmp_path):
                 zip(df["amplitude_g"], df["frequency_hz"], strict=True)]  # fmt: skip
     np.testing.assert_array_equal(df["collapse_fraction"].to_numpy(), expected)
     assert 0.0 < min(x for x in expected if x > 0) < 1.0  # one sensitive cell in this grid
+    # limits: below the uplift level (alpha g) no member moves; some cells always collapse
+    alpha, _ = linear_rocking_parameters(model_from_config(cfg).column)
+    below = df["amplitude_g"] < alpha
+    assert below.any() and (df.loc[below, "collapse_fraction"] == 0.0).all()
+    assert (df["collapse_fraction"] == 1.0).any()
     np.testing.assert_array_equal(df["robust"], np.isin(expected, [0.0, 1.0]).astype(int))
     meta = json.loads((ens.folder / "meta.json").read_text())
     assert meta["ensemble"] == {"members": 4, "rule": RULE}

@@ -236,3 +236,7 @@ def test_rendered_png_is_written_only_where_asked(tmp_path_factory):
 
     FigureCanvasAgg(fig).print_png(str(out))
     assert out.stat().st_size > 10_000
+    # read back: the figure's size in pixels, and not blank (many colours drawn)
+    image = plt.imread(str(out))
+    assert image.shape[:2] == (5 * fig.dpi, 7 * fig.dpi)
+    assert len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 10

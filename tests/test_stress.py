@@ -25,6 +25,7 @@ from hypothesis import strategies as st
 from rbm_cli.api import run_sweep
 from rbm_cli.config.load import parse_config
 from rbm_cli.models.rbm.python import integrate
+from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.models.result import STATUSES
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.report.info import describe
@@ -60,6 +61,45 @@ def stress(mult: int = 1):
     return settings(
         max_examples=max(1, mult * STRESS_EXAMPLES), suppress_health_check=HEALTH, phases=PHASES
     )
+
+
+# ------------------------------------------------------------------ failed runs in a property
+
+
+class FailedRuns:
+    """Tally of the runs a property could not judge because they failed.
+
+    A run beyond the example's solver budget ends 'failed' with "budget exceeded"
+    (acceptable, docs/stability.md), but it says nothing about the invariant: a
+    property that skipped it silently would pass if every run failed. So only a
+    budget failure is excused, and only while failures stay rare: at most
+    1 + RARE of the runs seen by this property (a tally per property and process).
+    """
+
+    RARE = 0.05
+
+    def __init__(self):
+        self.seen: dict[str, int] = {}
+        self.failed: dict[str, int] = {}
+
+    def excuse(self, prop: str, results, where: str, allowed: bool = True) -> bool:
+        """Whether to skip this example: True if a run in `results` failed (on its
+        budget, and rarely); raises AssertionError otherwise (and on any failed run
+        when not `allowed`, as in a reproducer)."""
+        self.seen[prop] = self.seen.get(prop, 0) + 1
+        bad = [r for r in results if r.status == "failed"]
+        if not bad:
+            return False
+        assert allowed, f"a run failed: {bad[0].message!r} in {where}"
+        self.failed[prop] = self.failed.get(prop, 0) + 1
+        for r in bad:
+            assert "budget exceeded" in r.message, f"a run failed: {r.message!r} in {where}"
+        n, k = self.seen[prop], self.failed[prop]
+        assert k <= 1 + self.RARE * n, f"{k} of {n} runs of {prop} failed; last: {where}"
+        return True
+
+
+FAILED = FailedRuns()
 
 
 # ------------------------------------------------------------------ 1. sanity of a result
@@ -125,7 +165,7 @@ def check_mirror(config, amplitude, frequency):
     flipped = with_phase(config, config.excitation.phase + math.pi)
     m = simulate(flipped, amplitude, frequency)
     where = f"{config} A={amplitude} f={frequency}: {r.status}/{m.status}"
-    if "failed" in (r.status, m.status):
+    if FAILED.excuse("mirror", (r, m), where):
         return
     assert m.status == r.status, where
     assert m.collapse_interface == r.collapse_interface, where
@@ -182,28 +222,30 @@ def test_rigid_rest_below_uplift_stress(config, fraction, frequency):
 
 
 def free_energy(config):
-    model = model_from_config(config)
-    r = simulate(config, 0.0, 0.0, record=True, output_dt=0.001, model=model)
+    runner = RbmRunner(config)
+    r = simulate(config, 0.0, 0.0, record=True, output_dt=0.001, runner=runner)
     h = r.history
-    energy = model.energy(h.rotations, h.rates)
+    energy = runner.model.energy(h.rotations, h.rates)
     return r, energy
 
 
 def check_energy_conserved(config):
     r, energy = free_energy(config)
     where = f"{config}: {r.status} {r.message}"
-    if r.status == "failed" or len(energy) < 2:
+    if FAILED.excuse("energy_conserved", (r,), where):
         return
+    assert len(energy) >= 2, f"no history to judge: {where}"
     e0 = energy[0]
     drift = np.max(np.abs(energy - e0)) / e0
     assert drift <= 1e-6, f"relative drift {drift:.3g} in {where}"
 
 
-def check_energy_not_growing(config):
+def check_energy_not_growing(config, allowed: bool = True):
     r, energy = free_energy(config)
     where = f"{config}: {r.status} {r.message}"
-    if r.status == "failed" or len(energy) < 2:
+    if FAILED.excuse("energy_not_growing", (r,), where, allowed):
         return
+    assert len(energy) >= 2, f"no history to judge: {where}"
     assert energy[-1] <= energy[0] * (1 + 1e-6), (
         f"energy {energy[0]:.9g} -> {energy[-1]:.9g} J in {where}"
     )
@@ -264,7 +306,7 @@ def test_impact_energy_reproducer(formulation):
             "solver": {"rtol": 1e-10},
         }
     )
-    check_energy_not_growing(config)
+    check_energy_not_growing(config, allowed=False)
 
 
 # Failure 2 of docs/stability.md (fixed, events.first_crossing): a 6-drum relative
@@ -364,9 +406,10 @@ def _outcome(config, amplitude, frequency):
 
 
 def check_convergence(config, amplitude, frequency):
-    coarse = _outcome(_with_rtol(config, 1e-8), amplitude, frequency)
-    fine = _outcome(_with_rtol(config, 1e-10), amplitude, frequency)
-    if "failed" in (coarse[0], fine[0]) or coarse == fine:
+    runs = [simulate(_with_rtol(config, rtol), amplitude, frequency) for rtol in (1e-8, 1e-10)]
+    coarse, fine = ((r.status, r.collapse_interface) for r in runs)
+    where = f"{config} A={amplitude} f={frequency}"
+    if FAILED.excuse("convergence", runs, where) or coarse == fine:
         return
     # a cell on the boundary: accept when a +-1% amplitude neighbour flips too
     fine_cfg = _with_rtol(config, 1e-10)

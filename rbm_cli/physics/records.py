@@ -35,10 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import G  # gravity [m/s^2], the one definition
 from rbm_cli.physics import record_parsers
-
-#: Standard gravity used to convert g to m/s^2 [m/s^2] (SPEC: g = 9.81 m/s^2).
-G = 9.81
 
 _UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0}
 

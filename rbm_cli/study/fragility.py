@@ -146,8 +146,7 @@ def fragility(
     grid_g : array_like, optional
         Intensities of the fitted curve and band [g]; default 201 points from 0 to 1.1 x
         the largest intensity
-    intensity_column : str, optional
-        Name of the intensity column
+    intensity_column : str, optional  Name of the intensity column
 
     Returns
     -------

@@ -208,17 +208,16 @@ def run_sweep(
         folder of the same config, do nothing (the summary says already_finished)
     force : bool  Allow grids of more than MAX_CELLS cells; set aside (never delete)
         an unfinished journal, or a finished result of another config, and start again
-    progress : callable(done, total)  Called once before the first cell runs (after the
-        compile; done = the resumed cells), as chunks finish, and now and then between
+    progress : callable(done, total)  Called before the first cell runs (after the compile;
+        done = the resumed cells), as chunks finish, and now and then between
     stop_after : int  Stop after this many chunks (tests of interruption)
     ensemble : int  Runs per cell (>1 adds the collapse_fraction column; see
         rbm_cli.study.robustness for the perturbations)
     notify : callable(str)  One-line notes (a journal recovered, lines not trusted...)
     resume_command : str  The command that resumes this sweep (stored in the state
         file and quoted in messages); default: a generic one
-    figure : callable(domain DataFrame, Config) -> matplotlib Figure  Draws domain.png
-        (the report layer's rbm_cli.report.domain_figure.domain_figure; rbm_cli.api.run_sweep
-        passes it): the sweep knows runs, not plotting
+    figure : callable(DataFrame, Config) -> Figure  Draws domain.png (rbm_cli.api.run_sweep
+        passes rbm_cli.report.domain_figure.domain_figure: the sweep does not plot)
 
     Raises
     ------

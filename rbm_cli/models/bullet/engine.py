@@ -1,9 +1,11 @@
-"""The process's PyBullet physics client (no GUI), imported and connected quietly.
+"""A PyBullet physics client (no GUI), imported and connected quietly.
 
-Bullet keeps its world in a C++ server; a process talks to it through one
-client. rbm opens one DIRECT client per process, on first use, and every run
-resets it (``resetSimulation``): this is the one piece of module state in
-rbm, and it holds no result. Sweep workers are processes, each with its own.
+Bullet keeps its world in a C++ server; Python talks to it through a client.
+A :class:`PhysicsClient` is one DIRECT client with a clear owner: whoever
+opens it closes it (``with PhysicsClient() as client: ...``). A run that is
+not handed one opens its own and closes it when it ends (connecting costs
+about 4 ms, against 0.5 ms for the ``resetSimulation`` every scene starts
+with); a caller that runs many scenes may open one and pass it to each.
 PyBullet prints its build time to the C-level stderr on import; that line is
 swallowed so that CLI output stays clean.
 """
@@ -16,21 +18,36 @@ import sys
 
 from rbm_cli.base.errors import RbmError
 
-_CLIENT: dict = {}
 
+class PhysicsClient:
+    """One connected PyBullet DIRECT client; close it when done (or use ``with``).
 
-def engine():
-    """(pybullet module, client id) of this process, connected on first call.
+    Attributes
+    ----------
+    module : the pybullet module (its functions take ``physicsClientId=id``)
+    id : int  This client's id
 
     Raises
     ------
     RbmError  PyBullet is not installed (``pip install pybullet``).
     """
-    pid = os.getpid()
-    if _CLIENT.get("pid") != pid:  # first use, or a forked child
+
+    def __init__(self) -> None:
         p = _quiet_import()
-        _CLIENT.update(pid=pid, module=p, client=_quiet(lambda: p.connect(p.DIRECT)))
-    return _CLIENT["module"], _CLIENT["client"]
+        self.module = p
+        self.id = _quiet(lambda: p.connect(p.DIRECT))
+
+    def close(self) -> None:
+        """Disconnect (the engine's world is freed); a second call does nothing."""
+        if self.id is not None:
+            self.module.disconnect(physicsClientId=self.id)
+            self.id = None
+
+    def __enter__(self) -> PhysicsClient:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
 
 def _quiet_import():

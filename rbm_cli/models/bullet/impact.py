@@ -124,14 +124,14 @@ def impact_rate_ratios(
 
 def _free_rocking(config, tilt_fraction, crossings, settings, tail=0.0):
     """Base drum's tilt [rad] and rate [rad/s] at every step of free rocking from
-    rest, until `crossings` sign changes of the tilt (then `tail` [s] more), in a
-    client of its own."""
+    rest, until `crossings` sign changes of the tilt (then `tail` [s] more), in the
+    process's client."""
     solids = drum_solids(config.column)
     settings = settings or settings_from_config(config)
     alpha = stack_slenderness(solids)
-    with PhysicsClient() as client:
-        bodies = build_scene(client, solids, settings, tilt_fraction * alpha[0], 0.0)
-        tilt, rate = _rock(client.module, client.id, bodies, settings.time_step, crossings, tail)
+    client = PhysicsClient.for_process()
+    bodies = build_scene(client, solids, settings, tilt_fraction * alpha[0], 0.0)
+    tilt, rate = _rock(client.module, client.id, bodies, settings.time_step, crossings, tail)
     return tilt, rate, settings.time_step
 
 

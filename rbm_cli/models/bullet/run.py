@@ -34,8 +34,6 @@ References
 
 from __future__ import annotations
 
-from contextlib import contextmanager
-
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
@@ -99,16 +97,6 @@ def engine_uplift_g(config: Config) -> float:
     return uplift_level(drum_solids(config.column), config.interface.friction) / G
 
 
-@contextmanager
-def _client_for(client: PhysicsClient | None):
-    """The caller's client (left open), or one of the run's own (closed at its end)."""
-    if client is not None:
-        yield client
-        return
-    with PhysicsClient() as own:
-        yield own
-
-
 def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, observe):
     """Step the engine from t = 0 to the motion's end or a stop, checking the stack
     every CHECK_DT (and at every sample); fills `out`. Returns (samples, watch)."""
@@ -169,8 +157,8 @@ def bullet_run(
         the stack has been at rest for REST_TIME
     settings : EngineSettings  Override the config's engine settings (tests)
     client : PhysicsClient  The engine client to build the scene in (its world is
-        reset; the caller keeps and closes it). By default the run opens one and
-        closes it at its end.
+        reset; the caller keeps and closes it). Default: the process's own
+        (:meth:`PhysicsClient.for_process`).
     observe : callable(pybullet, client id, body ids), optional  Called after
         every engine step, before the drums are held in the plane (a probe of the
         engine's own state, e.g. :class:`rbm_cli.models.bullet.normals.NormalCensus`);
@@ -204,20 +192,12 @@ def bullet_run(
     dt = settings.time_step
     sample = max(1, int(round(output_dt / dt))) if record else 0
     out.friction = np.full(n, np.nan)
-    with _client_for(client) as engine:
-        bodies = build_scene(engine, solids, settings, tilt, rate)
-        samples, watch = _drive(
-            engine,
-            bodies,
-            solids,
-            config.collapse.ratio,
-            dt,
-            motion,
-            out,
-            sample,
-            early_stop,
-            observe,
-        )
+    if client is None:
+        client = PhysicsClient.for_process()
+    bodies = build_scene(client, solids, settings, tilt, rate)
+    samples, watch = _drive(
+        client, bodies, solids, config.collapse.ratio, dt, motion, out, sample, early_stop, observe
+    )
     out.message += "; " + _slip_text(watch.max_slip)
     history = _history(samples, motion) if record else None
     return out, history

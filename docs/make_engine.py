@@ -43,11 +43,23 @@ import pandas as pd  # noqa: E402
 from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import GridConfig  # noqa: E402
-from rbm_cli.models.bullet.run import impact_rate_ratios, measure_restitution  # noqa: E402
-from rbm_cli.models.bullet.scene import EngineSettings  # noqa: E402
+from rbm_cli.models.bullet.convergence import (  # noqa: E402
+    ensemble_agreement,
+    outcome_marks,
+    step_agreement,
+)
+from rbm_cli.models.bullet.impact import (  # noqa: E402
+    engine_restitution,
+    impact_rate_ratios,
+    measure_restitution,
+)
+from rbm_cli.models.bullet.normals import NormalCensus  # noqa: E402
+from rbm_cli.models.bullet.run import bullet_run  # noqa: E402
+from rbm_cli.models.bullet.settings import EngineSettings  # noqa: E402
 from rbm_cli.physics.block import block_geometry  # noqa: E402
+from rbm_cli.physics.excitation import make_ground_motion  # noqa: E402
 from rbm_cli.physics.restitution import block_restitution  # noqa: E402
-from rbm_cli.study.domain import read_domain  # noqa: E402
+from rbm_cli.study.domain import boundary, read_domain  # noqa: E402
 from rbm_cli.study.simulate import simulate  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -144,55 +156,61 @@ def part_grid() -> None:
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
     cells = [(a, f) for f in GRID_FREQUENCIES for a in GRID_AMPLITUDES]
     for ax, name in zip(axes, ("block 4 x 1 m", "tapered 5 m column"), strict=True):
-        ratios = measure_restitution(column_config(COLUMNS[name]), impacts=4)
-        e = float(np.mean(ratios))
-        spread = np.linspace(ratios.min(), ratios.max(), 5)
-        e_rates = float(np.mean(impact_rate_ratios(column_config(COLUMNS[name]), impacts=4)))
-
-        def housner(e_, name=name):
-            ref = column_config(COLUMNS[name], model="housner", restitution=round(float(e_), 4))
-            return {c: simulate(ref, *c).status for c in cells}
-
-        ref = housner(e)
-        varied = [housner(x) for x in spread]
-        old = housner(e_rates)
-        res = {"e": e, "e_min": float(ratios.min()), "e_max": float(ratios.max())}
-        res["e_rates"] = e_rates
-        res["housner"] = {f"{a} {f}": s for (a, f), s in ref.items()}
-        for friction, dt in [(1.0, t) for t in TIME_STEPS] + [(2.0, TIME_STEPS[0])]:
-            cfg = with_step(column_config(COLUMNS[name], friction=friction), dt)
-            runs = [timed(simulate, cfg, a, f) for a, f in cells]
-            status = {c: r.status for c, (r, _) in zip(cells, runs, strict=True)}
-            differ = [c for c in cells if status[c] != ref[c]]
-            sensitive = [c for c in differ if len({v[c] for v in varied}) > 1]
-            slip = {
-                f"{a} {f}": r.message.split("max slip: ")[-1]
-                for (a, f), (r, _) in zip(cells, runs, strict=True)
-                if (a, f) in differ
-            }
-            cpu = sum(t for _, t in runs)
-            differ_rates = [c for c in cells if status[c] != old[c]]
-            res[f"mu {friction} dt {dt:g}"] = dict(
-                status={f"{a} {f}": s for (a, f), s in status.items()},
-                differ=differ,
-                differ_with_e_rates=differ_rates,
-                sensitive=sensitive,
-                slip_of_differing=slip,
-                cpu_s=cpu,
-            )
-            print(
-                f"{name}, e = {e:.3f} ({ratios.min():.3f}-{ratios.max():.3f}), friction"
-                f" {friction}, dt {dt:g}: {len(differ)} of {len(cells)} differ {differ}"
-                f" (sensitive to e: {sensitive}), slips {slip}, {cpu:.1f} s CPU; with e from"
-                f" rates ({e_rates:.4f}): {len(differ_rates)} differ {differ_rates}"
-            )
-            if friction == 1.0 and dt == TIME_STEPS[0]:
-                _grid_axes(ax, name, cells, ref, res[f"mu {friction} dt {dt:g}"]["status"], e)
-        out[name] = res
+        out[name] = _grid_column(name, cells, ax)
     axes[0].set_ylabel("amplitude [g]")
     fig.tight_layout()
     fig.savefig(FIGURES / "engine_monolithic_vs_housner.png", dpi=110, bbox_inches="tight")
     dump("grid", out)
+
+
+def _grid_column(name, cells, ax) -> dict:
+    """part_grid for one column: housner at the measured e (and across its spread,
+    and at the e read from the rates) against the engine at every setting."""
+    ratios = measure_restitution(column_config(COLUMNS[name]), impacts=4)
+    e = float(np.mean(ratios))
+    spread = np.linspace(ratios.min(), ratios.max(), 5)
+    e_rates = float(np.mean(impact_rate_ratios(column_config(COLUMNS[name]), impacts=4)))
+
+    def housner(e_):
+        ref = column_config(COLUMNS[name], model="housner", restitution=round(float(e_), 4))
+        return {c: simulate(ref, *c).status for c in cells}
+
+    ref = housner(e)
+    varied = [housner(x) for x in spread]
+    old = housner(e_rates)
+    res = {"e": e, "e_min": float(ratios.min()), "e_max": float(ratios.max())}
+    res["e_rates"] = e_rates
+    res["housner"] = {f"{a} {f}": s for (a, f), s in ref.items()}
+    for friction, dt in [(1.0, t) for t in TIME_STEPS] + [(2.0, TIME_STEPS[0])]:
+        cfg = with_step(column_config(COLUMNS[name], friction=friction), dt)
+        runs = [timed(simulate, cfg, a, f) for a, f in cells]
+        status = {c: r.status for c, (r, _) in zip(cells, runs, strict=True)}
+        differ = [c for c in cells if status[c] != ref[c]]
+        sensitive = [c for c in differ if len({v[c] for v in varied}) > 1]
+        slip = {
+            f"{a} {f}": r.message.split("max slip: ")[-1]
+            for (a, f), (r, _) in zip(cells, runs, strict=True)
+            if (a, f) in differ
+        }
+        cpu = sum(t for _, t in runs)
+        differ_rates = [c for c in cells if status[c] != old[c]]
+        res[f"mu {friction} dt {dt:g}"] = dict(
+            status={f"{a} {f}": s for (a, f), s in status.items()},
+            differ=differ,
+            differ_with_e_rates=differ_rates,
+            sensitive=sensitive,
+            slip_of_differing=slip,
+            cpu_s=cpu,
+        )
+        print(
+            f"{name}, e = {e:.3f} ({ratios.min():.3f}-{ratios.max():.3f}), friction"
+            f" {friction}, dt {dt:g}: {len(differ)} of {len(cells)} differ {differ}"
+            f" (sensitive to e: {sensitive}), slips {slip}, {cpu:.1f} s CPU; with e from"
+            f" rates ({e_rates:.4f}): {len(differ_rates)} differ {differ_rates}"
+        )
+        if friction == 1.0 and dt == TIME_STEPS[0]:
+            _grid_axes(ax, name, cells, ref, res[f"mu {friction} dt {dt:g}"]["status"], e)
+    return res
 
 
 def _grid_axes(ax, name, cells, housner, engine_status, e) -> None:
@@ -238,12 +256,10 @@ def part_timestep() -> None:
     _timestep_summary(rows)
 
 
-def _engine_cell(cfg, amplitude_g, frequency_hz, settings):
-    from rbm_cli.models.bullet.run import bullet_run
-    from rbm_cli.physics.excitation import make_ground_motion
-
+def _engine_cell(cfg, amplitude_g, frequency_hz, settings=None, observe=None):
+    """The engine's Outcome of one cell (bullet_run, as simulate runs it)."""
     motion = make_ground_motion(cfg.excitation, amplitude_g, frequency_hz)
-    out, _ = bullet_run(cfg, motion, settings=settings)
+    out, _ = bullet_run(cfg, motion, settings=settings, observe=observe)
     return out
 
 
@@ -256,26 +272,14 @@ def _timestep_summary(rows) -> dict:
     for label, _ in VARIANTS:
         cpu = [r["cpu_s"] for r in rows if r["variant"] == label]
         surv = [r["cpu_s"] for r in rows if r["variant"] == label and r["status"] == "survived"]
-        same = differ = chaotic = 0
-        for runs in table.values():
-            mine, base = set(runs[label]), set(runs[ref])
-            if len(mine) > 1 or len(base) > 1:
-                chaotic += 1
-            elif mine == base:
-                same += 1
-            else:
-                differ += 1
         summary[label] = dict(
             median_cpu_s=float(np.median(cpu)),
             median_cpu_survived_s=float(np.median(surv)) if surv else None,
             n_survived_runs=len(surv),
-            same_as_ref=same,
-            differ_from_ref=differ,
-            chaotic_here_or_ref=chaotic,
+            **step_agreement(table, label, ref),
         )
         print(label, summary[label])
-    for (a, f), runs in table.items():
-        marks = {k: "".join(sorted({s[0].upper() for s in v})) for k, v in runs.items()}
+    for (a, f), marks in outcome_marks(table).items():
         print(f"  {a:4.2f} g {f:3.1f} Hz: {marks}")
     return summary
 
@@ -323,7 +327,7 @@ def part_fine() -> None:
     out = {}
     for name in ("block 4 x 1 m", "tapered 5 m column"):
         cfg = column_config(COLUMNS[name])
-        e = round(float(np.mean(measure_restitution(cfg, impacts=4))), 4)
+        e = round(engine_restitution(cfg, impacts=4), 4)
         ref = column_config(COLUMNS[name], model="housner", restitution=e)
         runs = [timed(simulate, with_step(cfg, 5e-5), a, f) for a, f in cells]
         differ = [
@@ -361,10 +365,7 @@ def part_converge(jobs: int) -> None:
 
     cells = [(a, f) for f in GRID_FREQUENCIES for a in GRID_AMPLITUDES]
     names = ("block 4 x 1 m", "tapered 5 m column")
-    e = {
-        n: round(float(np.mean(measure_restitution(column_config(COLUMNS[n]), impacts=4))), 4)
-        for n in names
-    }
+    e = {n: round(engine_restitution(column_config(COLUMNS[n]), impacts=4), 4) for n in names}
     tasks = [
         (n, "housner", 0.0, e[n], a, f, j)
         for n in names
@@ -394,19 +395,8 @@ def _converge_summary(rows) -> dict:
         ref = {c: float(fraction[(name, "housner", 0.0, *c)]) for c in cells}
         for dt in CONVERGE_STEPS:
             eng = {c: float(fraction[(name, "bullet", dt, *c)]) for c in cells}
-            robust = [c for c in cells if eng[c] in (0.0, 1.0) and ref[c] in (0.0, 1.0)]
-            agree = [c for c in robust if eng[c] == ref[c]]
-            chaotic = {
-                f"{a} {f}": (eng[(a, f)], ref[(a, f)]) for a, f in cells if (a, f) not in robust
-            }
             cpu = sum(r["cpu_s"] for r in rows if r["column"] == name and r["dt"] == dt)
-            res = dict(
-                agree=len(agree),
-                of=len(cells),
-                differ=[c for c in robust if c not in agree],
-                chaotic_engine_housner=chaotic,
-                cpu_s=cpu,
-            )
+            res = dict(**ensemble_agreement(eng, ref), cpu_s=cpu)
             out[f"{name} dt {dt:g}"] = res
             print(f"{name}, dt {dt:g}: {res}")
     return out
@@ -420,51 +410,25 @@ NORMAL_OFF = 0.02
 
 
 def part_normals() -> None:
-    """Where the engine's friction demand (friction 1.0) reads above mu: at every 1 ms
-    check, the normal of each of Bullet's contact points at each joint against the
-    range between the joint's two faces' normals (the admissible ones,
+    """Where the engine's friction demand (friction 1.0) reads above mu: after every
+    engine step, the normal of each of Bullet's contact points at each joint against
+    the range between the joint's two faces' normals (the admissible ones,
     `joint_friction`); the share of the normal force on points more than NORMAL_OFF
-    off that range and the largest departure. Hooks the engine's per-check call."""
-    import math
-
-    import rbm_cli.models.bullet.run as engine_mod
-    from rbm_cli.models.bullet.scene import joint_normal_range, read_frame
-
-    hold = engine_mod.keep_in_plane
+    off that range and the largest departure (NormalCensus, bullet_run's observe)."""
     base = load_config(ROOT / "configs" / "harmonic_multidrum_bullet.yaml")
     rows = []
     for a, f, dt in NORMAL_CELLS:
-        census = dict(force=0.0, force_off=0.0, max_off=0.0)
-
-        def check(p, cid, bodies, pose=False, census=census):
-            tilts = read_frame(p, cid, bodies).tilts
-            lo, hi = joint_normal_range(tilts, tilts)
-            below = [0, *bodies[:-1]]  # the ground is body 0
-            for i, body in enumerate(bodies):
-                for c in p.getContactPoints(bodyA=body, bodyB=below[i], physicsClientId=cid):
-                    if c[9] <= 0.0:
-                        continue
-                    phi = math.atan2(c[7][0], c[7][2])  # the normal on the support, upwards
-                    off = max(0.0, lo[i] - phi, phi - hi[i])
-                    census["force"] += c[9]
-                    census["force_off"] += c[9] if off > NORMAL_OFF else 0.0
-                    census["max_off"] = max(census["max_off"], off)
-            return hold(p, cid, bodies, pose)
-
-        engine_mod.keep_in_plane = check
-        try:
-            r = simulate(with_step(base, dt), a, f)
-        finally:
-            engine_mod.keep_in_plane = hold
+        census = NormalCensus(NORMAL_OFF)
+        r = _engine_cell(with_step(base, dt), a, f, observe=census)
         rows.append(
             dict(
                 a=a,
                 f=f,
                 dt=dt,
                 status=r.status,
-                friction_demand=list(r.friction_demand),
-                share_off=census["force_off"] / census["force"],
-                max_off_rad=census["max_off"],
+                friction_demand=[float(v) for v in r.friction],
+                share_off=census.share_off,
+                max_off_rad=census.max_off,
                 message=r.message,
             )
         )
@@ -508,7 +472,7 @@ def part_monolithic(jobs: int) -> None:
     eng = read_domain(ROOT / "results" / "harmonic_monolithic_bullet" / "domain.csv")
     rbm = read_domain(ROOT / "results" / "harmonic_monolithic" / "domain.csv")
     engine_cfg = load_config(ROOT / "configs" / "harmonic_monolithic_bullet.yaml")
-    e_engine = round(float(np.mean(measure_restitution(engine_cfg, impacts=4))), 4)
+    e_engine = round(engine_restitution(engine_cfg, impacts=4), 4)
     ref = {}
     with tempfile.TemporaryDirectory() as tmp:
         for e in (1.0, e_engine, 0.929):
@@ -599,7 +563,7 @@ def part_rbm_e(jobs: int) -> None:
     eng = engine.set_index(["amplitude_g", "frequency_hz"])["collapse_fraction"]
     base = load_config(ROOT / "configs" / "harmonic_multidrum.yaml")
     mono = load_config(ROOT / "configs" / "harmonic_monolithic_bullet.yaml")
-    e_engine = round(float(np.mean(measure_restitution(mono, impacts=4))), 3)
+    e_engine = round(engine_restitution(mono, impacts=4), 3)
     grid = GridConfig(
         amplitudes_g=tuple(sorted({a for a, _ in eng.index})),
         frequencies_hz=tuple(sorted({f for _, f in eng.index})),
@@ -635,19 +599,18 @@ def part_rbm_e(jobs: int) -> None:
 
 
 def _boundary(df) -> dict:
-    out = {}
-    for f, g in df.groupby("frequency_hz"):
-        c = g[g["collapsed"] == 1]["amplitude_g"]
-        out[float(f)] = float(c.min()) if len(c) else None
-    return out
+    """Lowest collapsed amplitude per frequency [g] (None: none), from domain.boundary."""
+    b = boundary(df)
+    return {
+        float(f): None if np.isnan(a) else float(a)
+        for f, a in zip(b["frequency_hz"], b["lowest_unsafe_g"], strict=True)
+    }
 
 
 def _boundary_frac(df, col) -> dict:
-    out = {}
-    for f, g in df.groupby("frequency_hz"):
-        c = g[g[col] >= 0.5]["amplitude_g"]
-        out[float(f)] = float(c.min()) if len(c) else None
-    return out
+    """_boundary of an ensemble domain, a cell collapsed where its fraction is >= 0.5."""
+    majority = np.where(df[col] >= 0.5, "collapsed", "survived")
+    return _boundary(df.assign(status=majority))
 
 
 def main(argv=None) -> int:

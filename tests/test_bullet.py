@@ -21,6 +21,7 @@ from click.testing import CliRunner
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
+from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.run import (
     EngineSettings,
@@ -142,14 +143,16 @@ def test_split_impulse_does_not_reach_multibody_contacts():
     solids = drum_solids(config(TAPER).column)
     alpha = stack_slenderness(solids)[0]
     states = []
-    for split in (1, 0):
-        p, cid, bodies = build_scene(solids, EngineSettings(), 0.5 * alpha)
-        p.setPhysicsEngineParameter(useSplitImpulse=split, physicsClientId=cid)
-        p.setGravity(0.0, 0.0, -G, physicsClientId=cid)
-        for k in range(1, 15001):  # 1.5 s: two impacts
-            p.stepSimulation(physicsClientId=cid)
-            keep_in_plane(p, cid, bodies, pose=k % 10 == 0)
-        states.append(read_frame(p, cid, bodies))
+    with PhysicsClient() as client:
+        p, cid = client.module, client.id
+        for split in (1, 0):
+            bodies = build_scene(client, solids, EngineSettings(), 0.5 * alpha)
+            p.setPhysicsEngineParameter(useSplitImpulse=split, physicsClientId=cid)
+            p.setGravity(0.0, 0.0, -G, physicsClientId=cid)
+            for k in range(1, 15001):  # 1.5 s: two impacts
+                p.stepSimulation(physicsClientId=cid)
+                keep_in_plane(p, cid, bodies, pose=k % 10 == 0)
+            states.append(read_frame(p, cid, bodies))
     assert abs(states[0].tilts[0]) > 1e-3  # still rocking
     assert np.array_equal(states[0].centres, states[1].centres)
     assert np.array_equal(states[0].rates, states[1].rates)
@@ -160,12 +163,14 @@ def test_in_plane_reset_returns_what_the_engine_reads_back():
     skip a second round of engine calls; it must equal what read_frame reads
     (guards that shortcut)."""
     solids = drum_solids(config({**TAPER, "drums": 3}).column)
-    p, cid, bodies = build_scene(solids, EngineSettings(), 0.3 * stack_slenderness(solids)[0])
-    p.setGravity(-0.5 * G, 0.0, -G, physicsClientId=cid)
-    for _ in range(2000):
-        p.stepSimulation(physicsClientId=cid)
-    left = keep_in_plane(p, cid, bodies, pose=True)
-    back = read_frame(p, cid, bodies)
+    with PhysicsClient() as client:
+        p, cid = client.module, client.id
+        bodies = build_scene(client, solids, EngineSettings(), 0.3 * stack_slenderness(solids)[0])
+        p.setGravity(-0.5 * G, 0.0, -G, physicsClientId=cid)
+        for _ in range(2000):
+            p.stepSimulation(physicsClientId=cid)
+        left = keep_in_plane(p, cid, bodies, pose=True)
+        back = read_frame(p, cid, bodies)
     assert np.abs(left.rates).max() > 1e-3  # moving
     for name in ("centres", "rotations", "rates", "speeds"):
         assert np.array_equal(getattr(left, name), getattr(back, name)), name

@@ -75,63 +75,75 @@ def drum_solids(column: ColumnConfig, sides: int = CIRCLE_SIDES) -> tuple[DrumSo
     The collision shape of a circular drum is a regular polygonal frustum whose
     apothem is the true radius; its mass and inertia are the circle's.
     """
-    H = column.height
     z0 = np.concatenate([[0.0], np.cumsum(column.drum_heights)])
+    return tuple(_drum(column, z0, i, h, sides) for i, h in enumerate(column.drum_heights))
+
+
+def _drum(column: ColumnConfig, z0: np.ndarray, i: int, h: float, sides: int) -> DrumSolid:
+    """Drum i, of height h [m] from z0[i] to z0[i + 1] [m], as a true solid (notes of
+    :func:`drum_solids`)."""
+    H = column.height
     rho = column.density
-    solids = []
-    for i, h in enumerate(column.drum_heights):
-        wa = column.base_width + (column.top_width - column.base_width) * z0[i] / H
-        wb = column.base_width + (column.top_width - column.base_width) * z0[i + 1] / H
-        w = Polynomial([wa, (wb - wa) / h])
-        z = Polynomial([0.0, 1.0])
-        if column.section == "circular":
-            d = w
-            area = math.pi / 4.0 * w**2
-            j_x = j_y = math.pi / 64.0 * w**4
-            j_z = math.pi / 32.0 * w**4
-        else:
-            d = w if column.depth is None else Polynomial([column.depth])
-            area = w * d
-            j_y = d * w**3 / 12.0
-            j_x = w * d**3 / 12.0
-            j_z = w * d * (w**2 + d**2) / 12.0
+    wa = column.base_width + (column.top_width - column.base_width) * z0[i] / H
+    wb = column.base_width + (column.top_width - column.base_width) * z0[i + 1] / H
+    w = Polynomial([wa, (wb - wa) / h])
+    z = Polynomial([0.0, 1.0])
+    d, area, j_x, j_y, j_z = _section(column, w)
 
-        def integral(poly, h=h):
-            return float(poly.integ()(h))
+    def integral(poly, h=h):
+        return float(poly.integ()(h))
 
-        mass = rho * integral(area)
-        zc = rho * integral(area * z) / mass
-        arm = area * (z - zc) ** 2
-        inertia = (rho * integral(j_x + arm), rho * integral(j_y + arm), rho * integral(j_z))
-        box = column.section == "rectangular" and wa == wb
-        if column.section == "circular":
-            vertices = _polygon_frustum(wa / 2.0, wb / 2.0, h, zc, sides)
-        else:
-            da, db = float(d(0.0)), float(d(h))
-            vertices = np.array(
-                [
-                    (sx * ww / 2.0, sy * dd / 2.0, zz - zc)
-                    for ww, dd, zz in ((wa, da, 0.0), (wb, db, h))
-                    for sx in (-1.0, 1.0)
-                    for sy in (-1.0, 1.0)
-                ]
-            )
-        half = (wa / 2.0, float(d(0.0)) / 2.0, h / 2.0) if box else (0.0, 0.0, 0.0)
-        solids.append(
-            DrumSolid(
-                bottom=float(z0[i]),
-                height=float(h),
-                half_bottom=wa / 2.0,
-                half_top=wb / 2.0,
-                mass=mass,
-                centre=zc,
-                inertia=inertia,
-                vertices=vertices,
-                box=box,
-                half_extents=half,
-            )
-        )
-    return tuple(solids)
+    mass = rho * integral(area)
+    zc = rho * integral(area * z) / mass
+    arm = area * (z - zc) ** 2
+    inertia = (rho * integral(j_x + arm), rho * integral(j_y + arm), rho * integral(j_z))
+    box = column.section == "rectangular" and wa == wb
+    half = (wa / 2.0, float(d(0.0)) / 2.0, h / 2.0) if box else (0.0, 0.0, 0.0)
+    return DrumSolid(
+        bottom=float(z0[i]),
+        height=float(h),
+        half_bottom=wa / 2.0,
+        half_top=wb / 2.0,
+        mass=mass,
+        centre=zc,
+        inertia=inertia,
+        vertices=_hull(column, wa, wb, d, h, zc, sides),
+        box=box,
+        half_extents=half,
+    )
+
+
+def _section(column: ColumnConfig, w: Polynomial):
+    """Depth d, area a and second moments j_x, j_y, j_z of the section of width w,
+    as polynomials in the drum's local z [m, m^2, m^4]."""
+    if column.section == "circular":
+        d = w
+        area = math.pi / 4.0 * w**2
+        j_x = j_y = math.pi / 64.0 * w**4
+        j_z = math.pi / 32.0 * w**4
+    else:
+        d = w if column.depth is None else Polynomial([column.depth])
+        area = w * d
+        j_y = d * w**3 / 12.0
+        j_x = w * d**3 / 12.0
+        j_z = w * d * (w**2 + d**2) / 12.0
+    return d, area, j_x, j_y, j_z
+
+
+def _hull(column: ColumnConfig, wa, wb, d: Polynomial, h, zc, sides: int) -> np.ndarray:
+    """Vertices of the drum's collision hull relative to its centre of mass [m]:
+    widths wa (bottom), wb (top), depth d(z), height h, centre of mass at zc."""
+    if column.section == "circular":
+        return _polygon_frustum(wa / 2.0, wb / 2.0, h, zc, sides)
+    da, db = float(d(0.0)), float(d(h))
+    return np.array(
+        [
+            (sx * ww / 2.0, sy * dd / 2.0, zz - zc)
+            for ww, dd, zz in ((wa, da, 0.0), (wb, db, h))
+            for sx in (-1.0, 1.0)
+            for sy in (-1.0, 1.0)
+        ]
+    )
 
 
 def _polygon_frustum(ra: float, rb: float, h: float, zc: float, sides: int) -> np.ndarray:

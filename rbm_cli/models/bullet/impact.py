@@ -8,10 +8,11 @@ coefficient e (the ratio of angular velocities after / before an impact).
 
 Two readings are offered:
 
-- :func:`measure_restitution` (the one rbm uses): from the rocking energy at
-  successive peaks. Between impacts the block is a conservative pendulum, so
-  the energy just before impact k is that of the peak before it and the energy
-  just after it that of the peak after it; e_k = sqrt(E_after / E_before).
+- :func:`measure_restitution` (the one rbm uses; :func:`engine_restitution` is
+  its mean): from the rocking energy at successive peaks. Between impacts the
+  block is a conservative pendulum, so the energy just before impact k is that
+  of the peak before it and the energy just after it that of the peak after it;
+  e_k = sqrt(E_after / E_before).
 - :func:`impact_rate_ratios`: the angular velocity just before and just after
   the impact, each extrapolated to the crossing from 2 ms line fits. It reads
   the velocity in the few ms after the impact, where Bullet is still pushing
@@ -27,8 +28,10 @@ import math
 import numpy as np
 
 from rbm_cli.config.types import Config, G
+from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
-from rbm_cli.models.bullet.scene import EngineSettings, build_scene, keep_in_plane
+from rbm_cli.models.bullet.scene import build_scene, keep_in_plane
+from rbm_cli.models.bullet.settings import EngineSettings, settings_from_config
 
 #: Longest free rocking simulated to find the impacts [s] per impact.
 T_PER_IMPACT = 20.0
@@ -80,6 +83,16 @@ def measure_restitution(
     return np.sqrt(energy[1:] / energy[:-1])
 
 
+def engine_restitution(
+    config: Config, impacts: int = 4, settings: EngineSettings | None = None
+) -> float:
+    """The engine's impact loss of a column as one Housner e [-]: the mean of
+    :func:`measure_restitution` over the first `impacts` impacts (release at half
+    alpha_1). The e to give `housner` to compare it with the engine.
+    """
+    return float(np.mean(measure_restitution(config, impacts=impacts, settings=settings)))
+
+
 def impact_rate_ratios(
     config: Config,
     tilt_fraction: float = 0.5,
@@ -111,15 +124,20 @@ def impact_rate_ratios(
 
 def _free_rocking(config, tilt_fraction, crossings, settings, tail=0.0):
     """Base drum's tilt [rad] and rate [rad/s] at every step of free rocking from
-    rest, until `crossings` sign changes of the tilt (then `tail` [s] more)."""
-    from rbm_cli.models.bullet.run import settings_from_config
-
+    rest, until `crossings` sign changes of the tilt (then `tail` [s] more), in the
+    process's client."""
     solids = drum_solids(config.column)
     settings = settings or settings_from_config(config)
     alpha = stack_slenderness(solids)
-    p, cid, bodies = build_scene(solids, settings, tilt_fraction * alpha[0], 0.0)
+    client = PhysicsClient.for_process()
+    bodies = build_scene(client, solids, settings, tilt_fraction * alpha[0], 0.0)
+    tilt, rate = _rock(client.module, client.id, bodies, settings.time_step, crossings, tail)
+    return tilt, rate, settings.time_step
+
+
+def _rock(p, cid, bodies, dt, crossings, tail):
+    """Step the scene under gravity alone; the base drum's tilt and rate per step."""
     p.setGravity(0.0, 0.0, -G, physicsClientId=cid)
-    dt = settings.time_step
     base = bodies[0]
     t_max = T_PER_IMPACT * (crossings + 1)
     tilt, rate = [], []
@@ -137,4 +155,4 @@ def _free_rocking(config, tilt_fraction, crossings, settings, tail=0.0):
             found += 1
             if found == crossings:
                 k_stop = k + int(round(tail / dt))
-    return np.array(tilt), np.array(rate), dt
+    return np.array(tilt), np.array(rate)

@@ -40,18 +40,26 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config, G, SolverConfig
+from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.impact import impact_rate_ratios, measure_restitution
 from rbm_cli.models.bullet.scene import (
-    EngineSettings,
     Frame,
     Joints,
-    StackGeometry,
     build_scene,
-    joint_friction,
-    joint_state,
     keep_in_plane,
     read_frame,
+)
+from rbm_cli.models.bullet.settings import MAX_FRICTION, EngineSettings, settings_from_config
+from rbm_cli.models.bullet.watch import (
+    BLOWUP,
+    CHECK_DT,
+    DROP_FRACTION,
+    FRICTION_DT,
+    OPEN_FRACTION,
+    REST_ANGULAR_RATE,
+    REST_TIME,
+    RunWatch,
 )
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.outcome import Outcome
@@ -59,7 +67,16 @@ from rbm_cli.models.result import History
 from rbm_cli.physics.excitation import GroundMotion
 
 __all__ = [
+    "BLOWUP",
+    "CHECK_DT",
+    "DROP_FRACTION",
+    "FRICTION_DT",
+    "MAX_FRICTION",
+    "OPEN_FRACTION",
+    "REST_ANGULAR_RATE",
+    "REST_TIME",
     "EngineSettings",
+    "PhysicsClient",
     "bullet_run",
     "engine_uplift_g",
     "impact_rate_ratios",
@@ -67,37 +84,6 @@ __all__ = [
     "settings_from_config",
     "uplift_level",
 ]
-
-#: Interval of the collapse, sliding and contact checks [s].
-CHECK_DT = 1e-3
-#: Interval over which a joint's mean force gives its friction demand [s]: long
-#: enough to average out the contact's step-to-step chatter (measured: +-10 % of
-#: a_g / g on a block at rest over 1 ms, docs/engine.md), short against rocking.
-FRICTION_DT = 1e-2
-#: A joint is open when its relative rotation exceeds this fraction of alpha_i.
-OPEN_FRACTION = 1e-3
-#: Drop of a drum's centre of mass, as a fraction of its height, that is collapse.
-DROP_FRACTION = 0.5
-#: Half-sine/free early stop: every rate below this [rad/s] and every joint
-#: closed for REST_TIME [s] after the pulse.
-REST_ANGULAR_RATE = 1e-4
-REST_TIME = 0.2
-#: A drum faster than this [m/s or rad/s] means the engine blew up.
-BLOWUP = 1e3
-
-
-#: Bullet caps a contact's friction coefficient at this (btManifoldResult's MAX_FRICTION).
-MAX_FRICTION = 10.0
-
-
-def settings_from_config(config: Config) -> EngineSettings:
-    friction = config.interface.friction
-    if friction > MAX_FRICTION:
-        raise RbmError(
-            f"interface.friction must be <= {MAX_FRICTION:g} for model bullet (the engine caps"
-            f" a contact's friction there), got {friction:g}"
-        )
-    return EngineSettings(time_step=config.solver.time_step, friction=friction)
 
 
 # ------------------------------------------------------------------------- run
@@ -114,6 +100,42 @@ def engine_uplift_g(config: Config) -> float:
     return uplift_level(drum_solids(config.column), config.interface.friction) / G
 
 
+def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, observe):
+    """Step the engine from t = 0 to the motion's end or a stop, checking the stack
+    every CHECK_DT (and at every sample); fills `out`. Returns (samples, watch)."""
+    p, cid = client.module, client.id
+    alpha = stack_slenderness(solids)
+    n_steps = int(round(motion.t_end / dt))
+    check = max(1, int(round(CHECK_DT / dt)))
+    set_gravity, step = p.setGravity, p.stepSimulation
+    # a_g at every mid-step, at once (the same numbers as one call per step)
+    accel_array = np.asarray(motion.accel((np.arange(n_steps) + 0.5) * dt), dtype=float)
+    accel = accel_array.tolist()
+    frame = read_frame(p, cid, bodies)
+    watch = RunWatch(solids, alpha, limit, dt, accel_array, frame)
+    samples = [_sample(0.0, frame, watch.joints(frame))] if sample else []
+    k = 0
+    while k < n_steps:
+        set_gravity(-accel[k], 0.0, -G, physicsClientId=cid)
+        step(physicsClientId=cid)
+        k += 1
+        if observe is not None:
+            observe(p, cid, bodies)
+        checked = keep_in_plane(p, cid, bodies, pose=k % check == 0)
+        if checked is None and not (sample and k % sample == 0) and k != n_steps:
+            continue
+        frame = checked if checked is not None else read_frame(p, cid, bodies)
+        joints = watch.see(frame)
+        if sample and k % sample == 0:
+            samples.append(_sample(k * dt, frame, joints))
+        if watch.check(out, k, frame, joints, motion, early_stop):
+            break
+    else:
+        out.n_steps = out.n_rhs = k
+        out.stop("survived", "no joint passed over its edge", motion.t_end)
+    return samples, watch
+
+
 def bullet_run(
     config: Config,
     motion: GroundMotion,
@@ -122,6 +144,8 @@ def bullet_run(
     output_dt: float = 0.002,
     early_stop: bool = True,
     settings: EngineSettings | None = None,
+    client: PhysicsClient | None = None,
+    observe=None,
 ) -> tuple[Outcome, History | None]:
     """One run of the drum stack in the contact engine.
 
@@ -135,6 +159,13 @@ def bullet_run(
     early_stop : bool  After a half-sine pulse (or in free motion), stop once
         the stack has been at rest for REST_TIME
     settings : EngineSettings  Override the config's engine settings (tests)
+    client : PhysicsClient  The engine client to build the scene in (its world is
+        reset; the caller keeps and closes it). Default: the process's own
+        (:meth:`PhysicsClient.for_process`).
+    observe : callable(pybullet, client id, body ids), optional  Called after
+        every engine step, before the drums are held in the plane (a probe of the
+        engine's own state, e.g. :class:`rbm_cli.models.bullet.normals.NormalCensus`);
+        it must not change the scene.
 
     Returns
     -------
@@ -152,10 +183,8 @@ def bullet_run(
     n = len(solids)
     settings = settings or settings_from_config(config)
     tilt, rate = _initial(config)
-    alpha = stack_slenderness(solids)
     out = Outcome()
     out.max_ratio = np.zeros(n)
-    limit = config.collapse.ratio
     level = uplift_level(solids, settings.friction)
     if not record and tilt == 0.0 and rate == 0.0 and motion.amplitude < level * (1 - 1e-9):
         # the stack moves with the ground: every joint carries m_above a_g on m_above g
@@ -163,96 +192,16 @@ def bullet_run(
         out.message = "at rest: ground acceleration below the uplift and sliding levels"
         return out.stop("survived", out.message, motion.t_end), None
 
-    p, cid, bodies = build_scene(solids, settings, tilt, rate)
-    stack = StackGeometry.of(solids)
     dt = settings.time_step
-    n_steps = int(round(motion.t_end / dt))
-    check = max(1, int(round(CHECK_DT / dt)))
     sample = max(1, int(round(output_dt / dt))) if record else 0
-    rest_z = np.array([d.bottom + d.centre for d in solids])
-    drop = np.array([DROP_FRACTION * d.height for d in solids])
-    open_tol = OPEN_FRACTION * alpha
-    max_slip = np.zeros(n)
     out.friction = np.full(n, np.nan)
-    was_open = np.zeros(n, bool)
-    last_sign = np.zeros(n)
-    prev_ratio, prev_t, quiet_since = 0.0, 0.0, None
-    samples: list = []
-    set_gravity, step = p.setGravity, p.stepSimulation
-    # a_g at every mid-step, at once (the same numbers as one call per step)
-    accel_array = np.asarray(motion.accel((np.arange(n_steps) + 0.5) * dt), dtype=float)
-    accel = accel_array.tolist()
-    accel_sum = np.concatenate([[0.0], np.cumsum(accel_array)])  # for the mean over a check
-
-    frame = read_frame(p, cid, bodies)
-    joints = joint_state(frame, stack, alpha)
-    if record:
-        samples.append(_sample(0.0, frame, joints))
-    k = k_prev = 0
-    frame_prev = frame
-    tilt_lo = tilt_hi = frame.tilts
-    friction_steps = max(1, int(round(FRICTION_DT / dt)))
-    while k < n_steps:
-        set_gravity(-accel[k], 0.0, -G, physicsClientId=cid)
-        step(physicsClientId=cid)
-        k += 1
-        checked = keep_in_plane(p, cid, bodies, pose=k % check == 0)
-        if checked is None and not (sample and k % sample == 0) and k != n_steps:
-            continue
-        t = k * dt
-        frame = checked if checked is not None else read_frame(p, cid, bodies)
-        joints = joint_state(frame, stack, alpha)
-        tilts = frame.tilts
-        tilt_lo, tilt_hi = np.minimum(tilt_lo, tilts), np.maximum(tilt_hi, tilts)
-        if sample and k % sample == 0:
-            samples.append(_sample(t, frame, joints))
-        if not (np.all(np.isfinite(frame.centres)) and np.max(frame.speeds) < BLOWUP):
-            out.n_steps = out.n_rhs = k
-            out.stop("failed", "the engine diverged (non-finite or runaway drum)", t)
-            break
-        if k - k_prev >= friction_steps:
-            mean_accel = (accel_sum[k] - accel_sum[k_prev]) / (k - k_prev)
-            demand = joint_friction(
-                frame_prev, frame, stack, (k - k_prev) * dt, mean_accel, (tilt_lo, tilt_hi)
-            )
-            out.friction = np.fmax(out.friction, demand)
-            frame_prev, k_prev = frame, k
-            tilt_lo = tilt_hi = tilts
-        out.max_ratio = np.maximum(out.max_ratio, joints.ratio)
-        out.max_top = max(out.max_top, abs(joints.top[0] - joints.bottoms[0, 0]))
-        max_slip = np.maximum(max_slip, np.abs(joints.slip))
-        is_open = np.abs(joints.relative) > open_tol
-        sign = np.sign(joints.relative) * is_open
-        out.n_uplifts += int(np.sum(is_open & ~was_open))
-        out.n_impacts += int(np.sum(was_open & (~is_open | (sign * last_sign < 0))))
-        was_open, last_sign = is_open, np.where(is_open, sign, last_sign)
-        worst = int(np.argmax(joints.ratio))
-        dropped = np.nonzero(rest_z - frame.centres[:, 2] > drop)[0]
-        if joints.ratio[worst] >= limit or dropped.size:
-            out.n_steps = out.n_rhs = k
-            if joints.ratio[worst] >= limit:
-                frac = (limit - prev_ratio) / max(joints.ratio[worst] - prev_ratio, 1e-300)
-                out.t_collapse = prev_t + min(max(frac, 0.0), 1.0) * (t - prev_t)
-                out.collapse_interface = worst + 1
-                why = f"the drums above joint {worst + 1} passed over its edge"
-            else:
-                out.t_collapse = t
-                out.collapse_interface = int(dropped[0]) + 1
-                why = f"drum {dropped[0] + 1} dropped by half its height"
-            out.stop("collapsed", why, out.t_collapse)
-            break
-        prev_ratio, prev_t = float(joints.ratio[worst]), t
-        if early_stop and motion.kind != "harmonic" and t >= motion.pulse_end:
-            still = np.max(np.abs(frame.rates)) < REST_ANGULAR_RATE and not np.any(is_open)
-            quiet_since = (quiet_since if quiet_since is not None else t) if still else None
-            if quiet_since is not None and t - quiet_since >= REST_TIME:
-                out.n_steps = out.n_rhs = k
-                out.stop("survived", "at rest after the pulse", t)
-                break
-    else:
-        out.n_steps = out.n_rhs = k
-        out.stop("survived", "no joint passed over its edge", motion.t_end)
-    out.message += "; " + _slip_text(max_slip)
+    if client is None:
+        client = PhysicsClient.for_process()
+    bodies = build_scene(client, solids, settings, tilt, rate)
+    samples, watch = _drive(
+        client, bodies, solids, config.collapse.ratio, dt, motion, out, sample, early_stop, observe
+    )
+    out.message += "; " + _slip_text(watch.max_slip)
     history = _history(samples, motion) if record else None
     return out, history
 
@@ -301,6 +250,19 @@ class BulletRunner:
     def __init__(self, config: Config) -> None:
         self.config = config
         self.n_interfaces = config.column.n_drums
+        self._client: PhysicsClient | None = None  # the runner's own, opened on first run
+
+    def close(self) -> None:
+        """Disconnect the runner's engine client (a later run opens a new one)."""
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:  # at interpreter exit pybullet may be gone already
+            pass
 
     def run(
         self,
@@ -315,8 +277,15 @@ class BulletRunner:
         config = self.config
         if solver != config.solver:
             config = dataclasses.replace(config, solver=solver)
+        if self._client is None or self._client.id is None:
+            self._client = PhysicsClient()
         out, history = bullet_run(
-            config, motion, record=record, output_dt=output_dt, early_stop=early_stop
+            config,
+            motion,
+            record=record,
+            output_dt=output_dt,
+            early_stop=early_stop,
+            client=self._client,
         )
         out.history = history
         return out

@@ -1,7 +1,7 @@
 """The scene of `model: bullet`: ground and drums in the engine, and their kinematics.
 
-Builds the drums (:mod:`rbm_cli.models.bullet.geometry`) in the process's PyBullet
-client (:mod:`rbm_cli.models.bullet.engine`) with the engine settings of a run, and
+Builds the drums (:mod:`rbm_cli.models.bullet.geometry`) in a PyBullet client
+(:mod:`rbm_cli.models.bullet.engine`) with the engine settings of a run, and
 reads back the stack's state: drum positions and tilts, and per joint the
 relative rotation, the overturning ratio and the slip. Axes: x in the plane of
 motion, y out of plane, z up. SI units.
@@ -16,35 +16,43 @@ from functools import cached_property
 import numpy as np
 
 from rbm_cli.config.types import G
-from rbm_cli.models.bullet.engine import engine
+from rbm_cli.models.bullet.engine import PhysicsClient
+from rbm_cli.models.bullet.settings import EngineSettings
 
 
-@dataclass(frozen=True)
-class EngineSettings:
-    """Bullet settings of a run (SPEC: the issue's scoping values).
-
-    time_step : float  Fixed engine step [s]
-    solver_iterations : int  Sequential-impulse iterations per step
-    erp : float  Error reduction parameter of contacts and friction [-]
-    friction : float  Coulomb friction coefficient, drum-drum and drum-ground [-]
-    """
-
-    time_step: float = 1e-4
-    solver_iterations: int = 100
-    erp: float = 0.2
-    friction: float = 1.0
-
-
-# ----------------------------------------------------------------------- scene
-
-
-def build_scene(solids, settings: EngineSettings, tilt: float = 0.0, rate: float = 0.0):
-    """Reset the engine and build ground and drums; returns (pybullet, client, bodies).
+def build_scene(
+    client: PhysicsClient, solids, settings: EngineSettings, tilt: float = 0.0, rate: float = 0.0
+) -> list[int]:
+    """Reset the client's world and build ground and drums in it; returns the drums'
+    body ids (bottom first).
 
     tilt [rad], rate [rad/s]: the whole stack turned rigidly about the bottom
     corner of the base on the side of the tilt (positive: towards +x).
     """
-    p, cid = engine()
+    p, cid = client.module, client.id
+    _reset_world(p, cid, settings)
+    pivot = np.array([math.copysign(solids[0].half_bottom, tilt or 1.0), 0.0, 0.0])
+    c, s = math.cos(tilt), math.sin(tilt)
+    rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    quat = p.getQuaternionFromEuler([0.0, tilt, 0.0])
+    bodies = []
+    for d in solids:
+        centre = pivot + rot @ (np.array([0.0, 0.0, d.bottom + d.centre]) - pivot)
+        body = _add_drum(p, cid, d, settings, centre, quat)
+        if rate:
+            arm = centre - pivot
+            p.resetBaseVelocity(
+                body,
+                linearVelocity=np.cross([0.0, rate, 0.0], arm).tolist(),
+                angularVelocity=[0.0, rate, 0.0],
+                physicsClientId=cid,
+            )
+        bodies.append(body)
+    return bodies
+
+
+def _reset_world(p, cid, settings: EngineSettings) -> None:
+    """Empty the world, set the engine's parameters and lay the ground plane."""
     p.resetSimulation(physicsClientId=cid)
     p.setPhysicsEngineParameter(
         fixedTimeStep=settings.time_step,
@@ -62,47 +70,35 @@ def build_scene(solids, settings: EngineSettings, tilt: float = 0.0, rate: float
     plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=cid)
     ground = p.createMultiBody(0.0, plane, physicsClientId=cid)
     _contact_dynamics(p, cid, ground, settings)
-    pivot = np.array([math.copysign(solids[0].half_bottom, tilt or 1.0), 0.0, 0.0])
-    c, s = math.cos(tilt), math.sin(tilt)
-    rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-    quat = p.getQuaternionFromEuler([0.0, tilt, 0.0])
-    bodies = []
-    for d in solids:
-        if d.box:
-            shape = p.createCollisionShape(
-                p.GEOM_BOX, halfExtents=[float(v) for v in d.half_extents], physicsClientId=cid
-            )
-        else:  # a convex hull; SAT features give full contact manifolds between faces
-            shape = p.createCollisionShape(
-                p.GEOM_MESH,
-                vertices=d.vertices.tolist(),
-                flags=p.URDF_INITIALIZE_SAT_FEATURES,
-                physicsClientId=cid,
-            )
-        centre = pivot + rot @ (np.array([0.0, 0.0, d.bottom + d.centre]) - pivot)
-        body = p.createMultiBody(  # the body frame is the centre of mass (box: its centre)
-            float(d.mass),
-            shape,
-            basePosition=centre.tolist(),
-            baseOrientation=quat,
+
+
+def _add_drum(p, cid, d, settings: EngineSettings, centre: np.ndarray, quat) -> int:
+    """One drum (a DrumSolid) as a multibody with its centre of mass at `centre` [m]."""
+    if d.box:
+        shape = p.createCollisionShape(
+            p.GEOM_BOX, halfExtents=[float(v) for v in d.half_extents], physicsClientId=cid
+        )
+    else:  # a convex hull; SAT features give full contact manifolds between faces
+        shape = p.createCollisionShape(
+            p.GEOM_MESH,
+            vertices=d.vertices.tolist(),
+            flags=p.URDF_INITIALIZE_SAT_FEATURES,
             physicsClientId=cid,
         )
-        # (a multibody: PyBullet zeroes the mass of a maximal-coordinates rigid
-        # body given localInertiaDiagonal; Bullet's own inertia of a hull is its box's)
-        p.changeDynamics(
-            body, -1, localInertiaDiagonal=[float(v) for v in d.inertia], physicsClientId=cid
-        )
-        _contact_dynamics(p, cid, body, settings)
-        if rate:
-            arm = centre - pivot
-            p.resetBaseVelocity(
-                body,
-                linearVelocity=np.cross([0.0, rate, 0.0], arm).tolist(),
-                angularVelocity=[0.0, rate, 0.0],
-                physicsClientId=cid,
-            )
-        bodies.append(body)
-    return p, cid, bodies
+    body = p.createMultiBody(  # the body frame is the centre of mass (box: its centre)
+        float(d.mass),
+        shape,
+        basePosition=centre.tolist(),
+        baseOrientation=quat,
+        physicsClientId=cid,
+    )
+    # (a multibody: PyBullet zeroes the mass of a maximal-coordinates rigid
+    # body given localInertiaDiagonal; Bullet's own inertia of a hull is its box's)
+    p.changeDynamics(
+        body, -1, localInertiaDiagonal=[float(v) for v in d.inertia], physicsClientId=cid
+    )
+    _contact_dynamics(p, cid, body, settings)
+    return body
 
 
 def keep_in_plane(p, cid, bodies, pose: bool = False) -> Frame | None:

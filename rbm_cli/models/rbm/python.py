@@ -179,5 +179,6 @@ def integrate(
         stop = _run_segment(run, motion, seg_end, free_seg, can_stop)
         if stop is not None:
             return stop
-    run.out.t_end = run.t
-    return run.out
+    out, t = run.out, run.t
+    out.t_end = t
+    return out

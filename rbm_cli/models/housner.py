@@ -22,16 +22,20 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import NamedTuple
 
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
-from scipy.optimize import brentq
 
 from rbm_cli.config.types import G, SolverConfig
 from rbm_cli.models.events import EVENT_EPS, REST_RATE, first_crossing, hermite_dip
 from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun, Recorder
+from rbm_cli.models.housner_steps import (
+    HousnerBlock,
+    HousnerRun,
+    HousnerSide,
+    HousnerStep,
+    peak_in_step,
+)
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.block import BlockGeometry, housner_energy, top_displacement
 from rbm_cli.physics.excitation import GroundMotion
@@ -40,76 +44,11 @@ from rbm_cli.physics.restitution import block_restitution, resolve
 _METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23}
 
 
-@dataclass(frozen=True)
-class _Block:
-    """The block's constants and the run's thresholds and settings."""
-
-    alpha: float  # slenderness [rad]
-    p: float  # frequency parameter [rad/s]
-    e_rest: float  # restitution [-]
-    limit: float  # collapse rotation c alpha [rad]
-    barrier: float  # energy at min(c, 1) alpha [rad^2/s^2]
-    rest_rate: float  # post-impact rate below which the block rests [rad/s]
-    eps: float  # offset of the impact surface [rad]
-    level: float  # uplift level g tan(alpha) [m/s^2]
-    atol: np.ndarray  # absolute tolerances of theta [rad] and rate [rad/s]
-    amp_g: float  # ground amplitude [g]
-    om: float  # ground circular frequency [rad/s]
-    ph: float  # ground phase [rad]
-    solver: SolverConfig
-    record: bool
-
-
-@dataclass(frozen=True)
-class _Side:
-    """Housner's equation on side s (forced or free) and its event distances, >= 0 inside:
-    impact (s theta + eps), collapse (limit - s theta)."""
-
-    blk: _Block
-    s: int
-    forced: bool
-    out: Outcome
-
-    def rhs(self, tt, yy):
-        self.out.n_rhs += 1
-        blk, s = self.blk, self.s
-        alpha, p = blk.alpha, blk.p
-        arg = alpha * s - yy[0]
-        a = blk.amp_g * math.sin(blk.om * tt + blk.ph) if self.forced else 0.0
-        return np.array([yy[1], -p * p * (math.sin(arg) + a * math.cos(arg))])
-
-    def dist(self, yy):
-        s = self.s
-        return np.array([s * yy[0] + self.blk.eps, self.blk.limit - s * yy[0]])
-
-    def ddist(self, yy):
-        s = self.s
-        return np.array([s * yy[1], -s * yy[1]])
-
-
-@dataclass
-class _Run(BlockRun):
-    """BlockRun with the state y = (theta [rad], rate [rad/s])."""
-
-    y: np.ndarray = field(default_factory=lambda: np.zeros(2))
-
-
-class _Step(NamedTuple):
-    """One step taken, cut at its first event (kind 'impact' or 'collapse', else None)."""
-
-    t_old: float
-    y_old: np.ndarray
-    t_new: float
-    y_new: np.ndarray
-    kind: str | None
-    dense: object  # the step's dense output, if it was made
-
-
 def _start(geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, initial, events):
     """The block's constants and the state of the run at t = 0."""
     alpha, p = geometry.slenderness, geometry.frequency_parameter
     limit = collapse_ratio * alpha
-    blk = _Block(
+    blk = HousnerBlock(
         alpha=alpha,
         p=p,
         e_rest=e_rest,
@@ -126,7 +65,7 @@ def _start(geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, 
         record=record,
     )
     y = np.array([float(initial[0]), float(initial[1])])
-    run = _Run(
+    run = HousnerRun(
         alpha=alpha,
         limit=limit,
         **BlockRun.parts(record, output_dt, events),
@@ -139,7 +78,7 @@ def _start(geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, 
     return blk, run
 
 
-def _cut_at_event(eqs: _Side, integ, y_old) -> _Step:
+def _cut_at_event(eqs: HousnerSide, integ, y_old) -> HousnerStep:
     """The step just taken, cut at its first impact or collapse: a distance below zero at
     the step's end, or a dip of the cubic Hermite confirmed on the dense output; each
     row's own root (_earliest), an impact polished onto theta = 0."""
@@ -161,27 +100,10 @@ def _cut_at_event(eqs: _Side, integ, y_old) -> _Step:
         if kind == "impact":
             t_e = _polish_zero(dense, t_e, t_old)
         t_new, y_new = t_e, dense(t_e)
-    return _Step(t_old, y_old, t_new, y_new, kind, dense)
+    return HousnerStep(t_old, y_old, t_new, y_new, kind, dense)
 
 
-def _peak_in_step(run: _Run, s: int, integ, step: _Step):
-    """The time of a peak (the rate turning inward) inside the step, or None, and the
-    step's dense output (made if needed); the run's peak rotation updated."""
-    t_old, y_old, t_new, y_new = step.t_old, step.y_old, step.t_new, step.y_new
-    dense = step.dense
-    t_pk = None
-    if s * y_old[1] > 0.0 >= s * y_new[1]:
-        dense = integ.dense_output() if dense is None else dense
-        if s * dense(t_new)[1] < 0.0:
-            t_pk = brentq(lambda x, d=dense: d(x)[1], t_old, t_new, xtol=1e-15)
-        else:
-            t_pk = t_new
-        run.peak = max(run.peak, abs(float(dense(t_pk)[0])))
-    run.peak = max(run.peak, abs(float(y_new[0])) if step.kind != "impact" else 0.0)
-    return t_pk, dense
-
-
-def _step_to_event(blk: _Block, run: _Run, eqs: _Side, integ, stop_ok: bool):
+def _step_to_event(blk: HousnerBlock, run: HousnerRun, eqs: HousnerSide, integ, stop_ok: bool):
     """Step the integrator up to the first event on this side.
 
     Returns
@@ -199,7 +121,7 @@ def _step_to_event(blk: _Block, run: _Run, eqs: _Side, integ, stop_ok: bool):
         if out.n_steps > solver.max_steps:
             return _fail(run.finish(), f"step budget exceeded ({solver.max_steps} steps)")
         step = _cut_at_event(eqs, integ, run.y)
-        t_pk, dense = _peak_in_step(run, eqs.s, integ, step)
+        t_pk, dense = peak_in_step(run, eqs.s, integ, step)
         if t_pk is not None and stop_ok:
             if blk.record:
                 _emit(run.rec, dense, t_pk)
@@ -213,7 +135,7 @@ def _step_to_event(blk: _Block, run: _Run, eqs: _Side, integ, stop_ok: bool):
     return None
 
 
-def _on_event(blk: _Block, run: _Run, kind: str) -> Outcome | None:
+def _on_event(blk: HousnerBlock, run: HousnerRun, kind: str) -> Outcome | None:
     """Collapse ends the run (returns the Outcome); an impact multiplies the rate by e,
     flips the side and rests a block whose rate is below the rest rate."""
     out, t = run.out, run.t
@@ -235,7 +157,12 @@ def _on_event(blk: _Block, run: _Run, kind: str) -> Outcome | None:
 
 
 def _segment(
-    blk: _Block, run: _Run, motion: GroundMotion, seg_end: float, forced: bool, can_stop: bool
+    blk: HousnerBlock,
+    run: HousnerRun,
+    motion: GroundMotion,
+    seg_end: float,
+    forced: bool,
+    can_stop: bool,
 ) -> Outcome | None:
     """Run up to seg_end [s], the end of a segment of the motion, from rest to uplift and
     from impact to impact (the stepper restarted at each). Returns the Outcome if the run
@@ -251,7 +178,7 @@ def _segment(
             run.y = np.zeros(2)
             if out.n_uplifts + out.n_impacts > solver.max_events:
                 return _fail(run.finish(), f"event budget exceeded ({solver.max_events} events)")
-        eqs = _Side(blk, run.side, forced, out)
+        eqs = HousnerSide(blk, run.side, forced, out)
         y = run.y
         stop_ok = can_stop and housner_energy(y[0], y[1], blk.alpha, blk.p) < blk.barrier * (
             1.0 - STOP_MARGIN

@@ -25,12 +25,18 @@ import math
 
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
-from scipy.optimize import brentq
 
 from rbm_cli.config.types import Config, G, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.events import EVENT_EPS, REST_RATE, first_crossing, hermite_dip
-from rbm_cli.models.housner_linear import STOP_MARGIN, Recorder
+from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun, Recorder
+from rbm_cli.models.housner_steps import (
+    HousnerBlock,
+    HousnerRun,
+    HousnerSide,
+    HousnerStep,
+    peak_in_step,
+)
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.result import history_from_samples
 from rbm_cli.physics.block import (
@@ -44,6 +50,159 @@ from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.restitution import block_restitution, resolve
 
 _METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23}
+
+
+def _start(geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, initial, events):
+    """The block's constants and the state of the run at t = 0."""
+    alpha, p = geometry.slenderness, geometry.frequency_parameter
+    limit = collapse_ratio * alpha
+    blk = HousnerBlock(
+        alpha=alpha,
+        p=p,
+        e_rest=e_rest,
+        limit=limit,
+        barrier=float(housner_energy(min(limit, alpha), 0.0, alpha, p)),
+        rest_rate=REST_RATE * p * alpha,
+        eps=EVENT_EPS * alpha,
+        level=G * math.tan(alpha),
+        atol=solver.atol * np.array([alpha, p * alpha]),
+        amp_g=motion.amplitude / G,
+        om=motion.omega,
+        ph=motion.phase,
+        solver=solver,
+        record=record,
+    )
+    y = np.array([float(initial[0]), float(initial[1])])
+    run = HousnerRun(
+        alpha=alpha,
+        limit=limit,
+        **BlockRun.parts(record, output_dt, events),
+        top=lambda peak: float(top_displacement(geometry, peak)),
+        side=int(np.sign(y[0])) or int(np.sign(y[1])) or 1,
+        at_rest=not np.any(y),
+        peak=abs(y[0]),
+        y=y,
+    )
+    return blk, run
+
+
+def _cut_at_event(eqs: HousnerSide, integ, y_old) -> HousnerStep:
+    """The step just taken, cut at its first impact or collapse: a distance below zero at
+    the step's end, or a dip of the cubic Hermite confirmed on the dense output; each
+    row's own root (_earliest), an impact polished onto theta = 0."""
+    t_old, t_new, y_new = integ.t_old, integ.t, integ.y
+    kind = None
+    dense = None
+    d_old, d_new = eqs.dist(y_old), eqs.dist(y_new)
+    t_hit = t_new if d_new.min() < 0.0 else None
+    if t_hit is None:
+        t_min = hermite_dip(d_old, d_new, eqs.ddist(y_old), eqs.ddist(y_new), t_new - t_old)
+        if t_min is not None:
+            dense = integ.dense_output()
+            if eqs.dist(dense(t_old + t_min)).min() < 0.0:
+                t_hit = t_old + t_min
+    if t_hit is not None:
+        dense = integ.dense_output() if dense is None else dense
+        t_e, row = _earliest(dense, eqs.dist, eqs.ddist, t_old, t_hit)
+        kind = "impact" if row == 0 else "collapse"
+        if kind == "impact":
+            t_e = _polish_zero(dense, t_e, t_old)
+        t_new, y_new = t_e, dense(t_e)
+    return HousnerStep(t_old, y_old, t_new, y_new, kind, dense)
+
+
+def _step_to_event(blk: HousnerBlock, run: HousnerRun, eqs: HousnerSide, integ, stop_ok: bool):
+    """Step the integrator up to the first event on this side.
+
+    Returns
+    -------
+    str, None or Outcome  The event's kind ('impact' or 'collapse'; the state is then on
+        it), None when the stepper reached its bound, the Outcome when the run ends here
+        (a budget exceeded, or a peak of free motion below the barrier when stop_ok).
+    """
+    solver, out = blk.solver, run.out
+    while integ.status == "running":
+        msg = integ.step()
+        if integ.status == "failed":
+            return _fail(run.finish(), f"integrator: {msg} at t={run.t:.6g} s")
+        out.n_steps += 1
+        if out.n_steps > solver.max_steps:
+            return _fail(run.finish(), f"step budget exceeded ({solver.max_steps} steps)")
+        step = _cut_at_event(eqs, integ, run.y)
+        t_pk, dense = peak_in_step(run, eqs.s, integ, step)
+        if t_pk is not None and stop_ok:
+            if blk.record:
+                _emit(run.rec, dense, t_pk)
+            run.t = t_pk
+            return run.finish(message="free motion below the collapse barrier: stopped early")
+        if blk.record:
+            _emit(run.rec, integ.dense_output() if dense is None else dense, step.t_new)
+        run.t, run.y = step.t_new, step.y_new
+        if step.kind is not None:
+            return step.kind
+    return None
+
+
+def _on_event(blk: HousnerBlock, run: HousnerRun, kind: str) -> Outcome | None:
+    """Collapse ends the run (returns the Outcome); an impact multiplies the rate by e,
+    flips the side and rests a block whose rate is below the rest rate."""
+    out, t = run.out, run.t
+    if kind == "collapse":
+        out.t_collapse, out.collapse_interface = t, 1
+        run.peak = max(run.peak, blk.limit)
+        run.note((t, "collapse"))
+        return run.finish("collapsed", "the block reached its collapse limit")
+    out.n_impacts += 1
+    run.note((t, "impact"))
+    if out.n_uplifts + out.n_impacts > blk.solver.max_events:
+        return _fail(run.finish(), f"event budget exceeded ({blk.solver.max_events} events)")
+    run.y = np.array([0.0, blk.e_rest * run.y[1]])
+    run.side = -run.side
+    if abs(run.y[1]) < blk.rest_rate:
+        run.y, run.at_rest = np.zeros(2), True
+        run.note((t, "rest"))
+    return None
+
+
+def _segment(
+    blk: HousnerBlock,
+    run: HousnerRun,
+    motion: GroundMotion,
+    seg_end: float,
+    forced: bool,
+    can_stop: bool,
+) -> Outcome | None:
+    """Run up to seg_end [s], the end of a segment of the motion, from rest to uplift and
+    from impact to impact (the stepper restarted at each). Returns the Outcome if the run
+    ends inside the segment, else None."""
+    out, solver = run.out, blk.solver
+    while run.t < seg_end:
+        if run.at_rest:
+            kind = run.wait(motion, seg_end, blk.level, forced)
+            if kind == "end":  # no ground motion from here on: rests to the end
+                return run.finish(message="at rest in free motion: stopped")
+            if kind == "segment":
+                return None
+            run.y = np.zeros(2)
+            if out.n_uplifts + out.n_impacts > solver.max_events:
+                return _fail(run.finish(), f"event budget exceeded ({solver.max_events} events)")
+        eqs = HousnerSide(blk, run.side, forced, out)
+        y = run.y
+        stop_ok = can_stop and housner_energy(y[0], y[1], blk.alpha, blk.p) < blk.barrier * (
+            1.0 - STOP_MARGIN
+        )
+        stepper = _METHODS[solver.method]
+        integ = stepper(eqs.rhs, run.t, y, seg_end, rtol=solver.rtol, atol=blk.atol)
+        kind = _step_to_event(blk, run, eqs, integ, stop_ok)
+        if isinstance(kind, Outcome):
+            return kind
+        if kind is None:
+            run.t = seg_end
+            continue
+        stop = _on_event(blk, run, kind)
+        if stop is not None:
+            return stop
+    return None
 
 
 def housner_run(
@@ -96,142 +255,24 @@ def housner_run(
     ----------
     Housner (1963): see the module references.
     """
-    alpha, p = geometry.slenderness, geometry.frequency_parameter
     e_rest = resolve(restitution, lambda: block_restitution(geometry))
     if not 0.0 < e_rest <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
-    out = Outcome()
-    out.friction = np.array([math.nan])
-    rec = Recorder(output_dt, out.samples if record else None)
-    note = events.append if events is not None else (lambda item: None)
-    limit = collapse_ratio * alpha
-    barrier = float(housner_energy(min(limit, alpha), 0.0, alpha, p))
-    rest_rate = REST_RATE * p * alpha
-    eps = EVENT_EPS * alpha
-    level = G * math.tan(alpha)
-    atol = solver.atol * np.array([alpha, p * alpha])
-    stepper = _METHODS[solver.method]
-    amp_g, om, ph = motion.amplitude / G, motion.omega, motion.phase
-    y = np.array([float(initial[0]), float(initial[1])])
-    side = int(np.sign(y[0])) or int(np.sign(y[1])) or 1
-    at_rest = not np.any(y)
-    peak = abs(y[0])
-    t = 0.0
-
-    def finish(status: str = "survived", message: str = "") -> Outcome:
-        out.n_events = out.n_uplifts + out.n_impacts
-        out.max_ratio = np.array([peak / alpha])
-        out.max_top = float(top_displacement(geometry, peak))
-        out.status, out.message, out.t_end = status, message, t
-        return out
-
-    if peak >= limit:
-        out.t_collapse, out.collapse_interface = 0.0, 1
-        return finish("collapsed", "initial rotation beyond the collapse limit")
-
+    blk, run = _start(
+        geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, initial, events
+    )
+    collapsed = run.collapsed_at_start()
+    if collapsed is not None:
+        return collapsed
     for seg_start, seg_end in motion.segments():
-        if t >= seg_end:
+        if run.t >= seg_end:
             continue
         forced = motion.forced(seg_start)
         can_stop = early_stop and motion.after_pulse(seg_start)
-        while t < seg_end:
-            if at_rest:
-                kind, t_stop = motion.rest_end(t, seg_end, level, forced)
-                rec.rest(t_stop - (1e-15 if kind == "uplift" else 0.0))
-                t = t_stop
-                if kind == "end":  # no ground motion from here on: rests to the end
-                    return finish(message="at rest in free motion: stopped")
-                if kind == "segment":
-                    break
-                y = np.zeros(2)
-                side = motion.uplift_side(t)
-                at_rest = False
-                out.n_uplifts += 1
-                note((t, "uplift"))
-                if out.n_uplifts + out.n_impacts > solver.max_events:
-                    return _fail(finish(), f"event budget exceeded ({solver.max_events} events)")
-            s = side
-
-            def fun(tt, yy, s=s, forced=forced):
-                out.n_rhs += 1
-                arg = alpha * s - yy[0]
-                a = amp_g * math.sin(om * tt + ph) if forced else 0.0
-                return np.array([yy[1], -p * p * (math.sin(arg) + a * math.cos(arg))])
-
-            def dist(yy, s=s):
-                # event distances, >= 0 inside: impact, collapse
-                return np.array([s * yy[0] + eps, limit - s * yy[0]])
-
-            def ddist(yy, s=s):
-                return np.array([s * yy[1], -s * yy[1]])
-
-            stop_ok = can_stop and housner_energy(y[0], y[1], alpha, p) < barrier * (
-                1.0 - STOP_MARGIN
-            )
-            integ = stepper(fun, t, y, seg_end, rtol=solver.rtol, atol=atol)
-            kind = None
-            while integ.status == "running":
-                msg = integ.step()
-                if integ.status == "failed":
-                    return _fail(finish(), f"integrator: {msg} at t={t:.6g} s")
-                out.n_steps += 1
-                if out.n_steps > solver.max_steps:
-                    return _fail(finish(), f"step budget exceeded ({solver.max_steps} steps)")
-                t_old, y_old, t_new, y_new = integ.t_old, y, integ.t, integ.y
-                dense = None
-                d_old, d_new = dist(y_old), dist(y_new)
-                t_hit = t_new if d_new.min() < 0.0 else None
-                if t_hit is None:
-                    t_min = hermite_dip(d_old, d_new, ddist(y_old), ddist(y_new), t_new - t_old)
-                    if t_min is not None:
-                        dense = integ.dense_output()
-                        if dist(dense(t_old + t_min)).min() < 0.0:
-                            t_hit = t_old + t_min
-                if t_hit is not None:
-                    dense = integ.dense_output() if dense is None else dense
-                    t_e, row = _earliest(dense, dist, ddist, t_old, t_hit)
-                    kind = "impact" if row == 0 else "collapse"
-                    if kind == "impact":
-                        t_e = _polish_zero(dense, t_e, t_old)
-                    t_new, y_new = t_e, dense(t_e)
-                # peak: the rate turning inward inside [t_old, t_new]
-                t_pk = None
-                if s * y_old[1] > 0.0 >= s * y_new[1]:
-                    dense = integ.dense_output() if dense is None else dense
-                    if s * dense(t_new)[1] < 0.0:
-                        t_pk = brentq(lambda x, d=dense: d(x)[1], t_old, t_new, xtol=1e-15)
-                    else:
-                        t_pk = t_new
-                    peak = max(peak, abs(float(dense(t_pk)[0])))
-                peak = max(peak, abs(float(y_new[0])) if kind != "impact" else 0.0)
-                if t_pk is not None and stop_ok:
-                    if record:
-                        _emit(rec, dense, t_pk)
-                    t = t_pk
-                    return finish(message="free motion below the collapse barrier: stopped early")
-                if record:
-                    _emit(rec, integ.dense_output() if dense is None else dense, t_new)
-                t, y = t_new, y_new
-                if kind is not None:
-                    break
-            if kind is None:
-                t = seg_end
-                continue
-            if kind == "collapse":
-                out.t_collapse, out.collapse_interface = t, 1
-                peak = max(peak, limit)
-                note((t, "collapse"))
-                return finish("collapsed", "the block reached its collapse limit")
-            out.n_impacts += 1
-            note((t, "impact"))
-            if out.n_uplifts + out.n_impacts > solver.max_events:
-                return _fail(finish(), f"event budget exceeded ({solver.max_events} events)")
-            y = np.array([0.0, e_rest * y[1]])
-            side = -side
-            if abs(y[1]) < rest_rate:
-                y, at_rest = np.zeros(2), True
-                note((t, "rest"))
-    return finish()
+        stop = _segment(blk, run, motion, seg_end, forced, can_stop)
+        if stop is not None:
+            return stop
+    return run.finish()
 
 
 def _earliest(dense, dist, ddist, t_old: float, t_hit: float) -> tuple[float, int]:

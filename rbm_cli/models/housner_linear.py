@@ -22,15 +22,15 @@ References
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from rbm_cli.config.types import Config, G, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.events import EVENT_EPS, REST_RATE
+from rbm_cli.models.housner_linear_piece import LinearPiece, PieceScanner, Scan
+from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.result import history_from_samples
 from rbm_cli.physics.block import block_geometry, block_initial
@@ -41,100 +41,10 @@ from rbm_cli.physics.restitution import block_restitution, resolve
 _CHUNK = 64
 #: Scanning step, in units of the shorter of 1/p and 1/omega [-].
 _SCAN_STEP = 0.05
-#: Energy margin of the early stop of free motion [fraction of the barrier].
-STOP_MARGIN = 1e-9
 
 
 def _sign(x: float) -> int:
     return 1 if x > 0 else -1 if x < 0 else 0
-
-
-class Recorder:
-    """Time-history samples (t, [theta], [rate]) every output_dt [s], at k * output_dt."""
-
-    def __init__(self, output_dt: float, samples: list | None):
-        self.dt = output_dt
-        self.samples = samples
-        self.k = 0
-
-    def times(self, t_stop: float) -> np.ndarray:
-        """The sample times not yet emitted up to t_stop [s] (consumed)."""
-        if self.samples is None:
-            return np.zeros(0)
-        k_last = math.floor((t_stop + 1e-12) / self.dt)
-        ts = self.dt * np.arange(self.k, k_last + 1)
-        self.k = max(self.k, k_last + 1)
-        return ts
-
-    def emit(self, ts, theta, rate) -> None:
-        for t, th, v in zip(
-            ts, np.broadcast_to(theta, ts.shape), np.broadcast_to(rate, ts.shape), strict=True
-        ):
-            self.samples.append((float(t), np.array([float(th)]), np.array([float(v)])))
-
-    def rest(self, t_stop: float) -> None:
-        ts = self.times(t_stop)
-        self.emit(ts, 0.0, 0.0)
-
-
-@dataclass(frozen=True)
-class LinearPiece:
-    """Closed-form motion on side s between two events, from time t0 [s].
-
-    theta(tau) = s alpha + C sin(omega tau + phi0) + c1 exp(p tau) + c2 exp(-p tau),
-    tau = t - t0 [s]; C = p^2 A / (p^2 + omega^2), A the ground amplitude in g
-    (C = 0 in free motion).
-    """
-
-    t0: float
-    side: int
-    alpha: float
-    p: float
-    forced_amplitude: float  # C [rad]
-    omega: float
-    phi0: float
-    c1: float
-    c2: float
-
-    @classmethod
-    def start(cls, t0, theta0, rate0, side, alpha, p, amplitude_g, omega, phase):
-        """The piece through (theta0 [rad], rate0 [rad/s]) at t0 [s]; amplitude_g = A [g]."""
-        c = p * p * amplitude_g / (p * p + omega * omega) if amplitude_g else 0.0
-        phi0 = math.fmod(omega * t0 + phase, 2.0 * math.pi) if c else 0.0
-        x0 = theta0 - side * alpha - c * math.sin(phi0)
-        v0 = rate0 - c * omega * math.cos(phi0)
-        return cls(t0, side, alpha, p, c, omega, phi0, 0.5 * (x0 + v0 / p), 0.5 * (x0 - v0 / p))
-
-    def _exps(self, tau):
-        tau = np.asarray(tau, dtype=float)
-        with np.errstate(divide="ignore", over="ignore"):
-            # c * exp(x) as sign(c) exp(log|c| + x): no 0 * inf when c = 0
-            e1 = np.sign(self.c1) * np.exp(np.log(abs(self.c1)) + self.p * tau)
-            e2 = np.sign(self.c2) * np.exp(np.log(abs(self.c2)) - self.p * tau)
-        return tau, e1, e2
-
-    def theta(self, tau):
-        """Rotation theta(t0 + tau) [rad]."""
-        tau, e1, e2 = self._exps(tau)
-        forced = self.forced_amplitude * np.sin(self.omega * tau + self.phi0)
-        return self.side * self.alpha + forced + e1 + e2
-
-    def rate(self, tau):
-        """Rate theta'(t0 + tau) [rad/s]."""
-        tau, e1, e2 = self._exps(tau)
-        forced = self.forced_amplitude * self.omega * np.cos(self.omega * tau + self.phi0)
-        return forced + self.p * (e1 - e2)
-
-
-@dataclass
-class Scan:
-    """What a piece does up to its first event (times from the piece start) [s]."""
-
-    tau: float  # end of the piece: the event, or the end of the segment
-    kind: str | None  # 'impact', 'collapse' or None
-    peak: float  # largest s theta on [0, tau] [rad]
-    tau_peak: float | None  # time of an interior maximum (theta' = 0) holding the peak
-    n_evals: int
 
 
 def scan_piece(piece: LinearPiece, tau_max: float, limit: float) -> Scan:
@@ -146,35 +56,8 @@ def scan_piece(piece: LinearPiece, tau_max: float, limit: float) -> Scan:
     rate and checked, so grazing returns and grazing collapses are not missed.
     Roots are then refined by brentq on the closed form (xtol 1e-15 s).
     """
-    s = piece.side
-    eps = EVENT_EPS * piece.alpha
-    n_evals = 0
-
-    def f(x):
-        nonlocal n_evals
-        n_evals += 1
-        return s * float(piece.theta(x))
-
-    def df(x):
-        nonlocal n_evals
-        n_evals += 1
-        return s * float(piece.rate(x))
-
-    def root(fun, a, b):
-        return brentq(fun, a, b, xtol=1e-15)
-
-    def impact(a, b):
-        # f(a) > 0 >= f(b) or f(a) = 0 at a restart: root of f + eps, then Newton to f = 0
-        if f(a) > 0.0:
-            return root(f, a, b)
-        tau = root(lambda x: f(x) + eps, a, b)
-        for _ in range(2):
-            v = df(tau)
-            if v >= 0.0:
-                break
-            tau = min(max(tau - f(tau) / v, a), b)
-        return tau
-
+    sc = PieceScanner(piece, EVENT_EPS * piece.alpha, limit)
+    s, eps, f, df, root = sc.s, sc.eps, sc.f, sc.df, sc.root
     omega = piece.omega if piece.forced_amplitude else 0.0
     h = _SCAN_STEP / max(piece.p, omega)
     a, fa, da = 0.0, f(0.0), df(0.0)
@@ -185,7 +68,7 @@ def scan_piece(piece: LinearPiece, tau_max: float, limit: float) -> Scan:
             taus = np.append(taus[taus < tau_max], tau_max)
         big_f = s * piece.theta(taus)
         big_d = s * piece.rate(taus)
-        n_evals += 2 * len(taus)
+        sc.n_evals += 2 * len(taus)
         lo_t = np.concatenate([[a], taus[:-1]])
         lo_d = np.concatenate([[da], big_d[:-1]])
         turn_max = (lo_d > 0.0) & (big_d < 0.0)
@@ -197,23 +80,21 @@ def scan_piece(piece: LinearPiece, tau_max: float, limit: float) -> Scan:
                 tm = root(df, ta, tb)
                 fm = f(tm)
                 if fm >= limit:
-                    return Scan(
-                        root(lambda x: f(x) - limit, ta, tm), "collapse", limit, None, n_evals
-                    )
+                    return Scan(sc.collapse(ta, tm), "collapse", limit, None, sc.n_evals)
                 if fm > peak:
                     peak, tau_peak = fm, tm
             elif turn_min[i]:
                 tm = root(df, ta, tb)
                 if f(tm) + eps <= 0.0:
-                    return Scan(impact(ta, tm), "impact", peak, tau_peak, n_evals)
+                    return Scan(sc.impact(ta, tm), "impact", peak, tau_peak, sc.n_evals)
             if big_f[i] >= limit:
-                return Scan(root(lambda x: f(x) - limit, ta, tb), "collapse", limit, None, n_evals)
+                return Scan(sc.collapse(ta, tb), "collapse", limit, None, sc.n_evals)
             if big_f[i] + eps <= 0.0:
-                return Scan(impact(ta, tb), "impact", peak, tau_peak, n_evals)
+                return Scan(sc.impact(ta, tb), "impact", peak, tau_peak, sc.n_evals)
         a, fa, da = taus[-1], big_f[-1], big_d[-1]
     if fa > peak:
         peak, tau_peak = fa, None
-    return Scan(tau_max, None, peak, tau_peak, n_evals)
+    return Scan(tau_max, None, peak, tau_peak, sc.n_evals)
 
 
 def linear_energy(theta: float, rate: float, alpha: float, p: float) -> float:
@@ -223,6 +104,142 @@ def linear_energy(theta: float, rate: float, alpha: float, p: float) -> float:
     """
     a = abs(theta)
     return 0.5 * rate * rate + p * p * (alpha * a - 0.5 * a * a)
+
+
+@dataclass(frozen=True)
+class _LinearBlock:
+    """The block's constants and the run's thresholds and settings."""
+
+    alpha: float  # slenderness [rad]
+    p: float  # frequency parameter [rad/s]
+    restitution: float  # [-]
+    limit: float  # collapse rotation c alpha [rad]
+    barrier: float  # energy at min(c, 1) alpha [rad^2/s^2]
+    rest_rate: float  # post-impact rate below which the block rests [rad/s]
+    amp_g: float  # ground amplitude [g]
+    omega: float  # ground circular frequency [rad/s]
+    phase: float  # ground phase [rad]
+    max_pieces: int
+    record: bool
+
+    @classmethod
+    def make(cls, alpha, p, motion, restitution, collapse_ratio, max_pieces, record):
+        limit = collapse_ratio * alpha
+        lim_e = min(limit, alpha)
+        return cls(
+            alpha=alpha,
+            p=p,
+            restitution=restitution,
+            limit=limit,
+            barrier=p * p * (alpha * lim_e - 0.5 * lim_e * lim_e),
+            rest_rate=REST_RATE * p * alpha,
+            amp_g=motion.amplitude / G,
+            omega=motion.omega,
+            phase=motion.phase,
+            max_pieces=max_pieces,
+            record=record,
+        )
+
+
+@dataclass
+class _LinearRun(BlockRun):
+    """BlockRun with the state theta [rad], rate [rad/s]."""
+
+    theta: float = 0.0
+    rate: float = 0.0
+
+    @classmethod
+    def make(cls, blk: _LinearBlock, record, output_dt, events, height, initial) -> _LinearRun:
+        """The state at t = 0 from initial = (theta [rad], rate [rad/s])."""
+        theta, rate = float(initial[0]), float(initial[1])
+        return cls(
+            alpha=blk.alpha,
+            limit=blk.limit,
+            **BlockRun.parts(record, output_dt, events),
+            top=lambda peak: height * peak if height else 0.0,
+            side=_sign(theta) or _sign(rate) or 1,
+            at_rest=theta == 0.0 and rate == 0.0,
+            peak=abs(theta),
+            theta=theta,
+            rate=rate,
+        )
+
+
+def _piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: bool, can_stop: bool):
+    """One closed-form piece from the current state up to its first event, a peak of free
+    motion below the barrier (when can_stop) or seg_end [s]. Returns the Outcome if the
+    run ends there, else None."""
+    out, rec, t = run.out, run.rec, run.t
+    alpha, p = blk.alpha, blk.p
+    piece = LinearPiece.start(
+        t,
+        run.theta,
+        run.rate,
+        run.side,
+        alpha,
+        p,
+        blk.amp_g if forced else 0.0,
+        blk.omega,
+        blk.phase,
+    )
+    out.n_steps += 1
+    sc = scan_piece(piece, seg_end - t, blk.limit)
+    out.n_rhs += sc.n_evals
+    stop_here = (
+        can_stop
+        and sc.tau_peak is not None
+        and linear_energy(run.theta, run.rate, alpha, p) < blk.barrier * (1.0 - STOP_MARGIN)
+    )
+    tau_end = sc.tau_peak if stop_here else sc.tau
+    t_new = seg_end if sc.kind is None and not stop_here else t + tau_end
+    if blk.record:
+        ts = rec.times(t_new)
+        rec.emit(ts, piece.theta(ts - t), piece.rate(ts - t))
+    run.peak = max(run.peak, sc.peak)
+    run.theta, run.rate = float(piece.theta(tau_end)), float(piece.rate(tau_end))
+    run.t = t = t_new
+    if stop_here:
+        return run.finish(message="free motion below the collapse barrier: stopped early")
+    if sc.kind == "collapse":
+        out.t_collapse, out.collapse_interface = t, 1
+        run.note((t, "collapse"))
+        return run.finish("collapsed", "the block reached its collapse limit")
+    if sc.kind == "impact":
+        out.n_impacts += 1
+        run.note((t, "impact"))
+        run.theta, run.rate, run.side = 0.0, blk.restitution * run.rate, -run.side
+        if abs(run.rate) < blk.rest_rate:
+            run.theta, run.rate, run.at_rest = 0.0, 0.0, True
+            run.note((t, "rest"))
+    return None
+
+
+def _linear_segment(
+    blk: _LinearBlock,
+    run: _LinearRun,
+    motion: GroundMotion,
+    seg_end: float,
+    forced: bool,
+    can_stop: bool,
+) -> Outcome | None:
+    """Run up to seg_end [s], the end of a segment of the motion, from rest to uplift and
+    piece by piece. Returns the Outcome if the run ends inside the segment, else None."""
+    while run.t < seg_end:
+        if run.at_rest:
+            kind = run.wait(motion, seg_end, G * blk.alpha, forced)
+            if kind == "end":  # no ground motion from here on: rests to the end
+                return run.finish(message="at rest in free motion: stopped")
+            if kind == "segment":
+                return None
+            run.theta, run.rate = 0.0, 0.0
+        if run.out.n_steps >= blk.max_pieces:
+            return run.finish(
+                "failed", f"piece budget exceeded ({blk.max_pieces} pieces) at t={run.t:.6g} s"
+            )
+        stop = _piece(blk, run, seg_end, forced, can_stop)
+        if stop is not None:
+            return stop
+    return None
 
 
 def housner_linear_run(
@@ -287,96 +304,19 @@ def housner_linear_run(
         raise ValueError("alpha [rad] and p [rad/s] must be > 0")
     if not 0.0 < restitution <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
-    out = Outcome()
-    out.friction = np.array([math.nan])
-    rec = Recorder(output_dt, out.samples if record else None)
-    note = events.append if events is not None else (lambda item: None)
-    limit = collapse_ratio * alpha
-    lim_e = min(limit, alpha)
-    barrier = p * p * (alpha * lim_e - 0.5 * lim_e * lim_e)
-    rest_rate = REST_RATE * p * alpha
-    amp_g = motion.amplitude / G
-    theta, rate = float(initial[0]), float(initial[1])
-    side = _sign(theta) or _sign(rate) or 1
-    at_rest = theta == 0.0 and rate == 0.0
-    peak = abs(theta)
-    t = 0.0
-
-    def finish(status: str = "survived", message: str = "") -> Outcome:
-        out.n_events = out.n_uplifts + out.n_impacts
-        out.max_ratio = np.array([peak / alpha])
-        out.max_top = height * peak if height else 0.0
-        out.status, out.message = status, message
-        out.t_end = t
-        return out
-
-    if abs(theta) >= limit:
-        out.t_collapse, out.collapse_interface = 0.0, 1
-        return finish("collapsed", "initial rotation beyond the collapse limit")
-
+    blk = _LinearBlock.make(alpha, p, motion, restitution, collapse_ratio, max_pieces, record)
+    run = _LinearRun.make(blk, record, output_dt, events, height, initial)
+    finish = run.finish
+    if run.collapsed_at_start() is not None:
+        return run.out
     for seg_start, seg_end in motion.segments():
-        if t >= seg_end:
+        if run.t >= seg_end:
             continue
         forced = motion.forced(seg_start)
         can_stop = early_stop and motion.after_pulse(seg_start)
-        while t < seg_end:
-            if at_rest:
-                kind, t_stop = motion.rest_end(t, seg_end, G * alpha, forced)
-                rec.rest(t_stop - (1e-15 if kind == "uplift" else 0.0))
-                t = t_stop
-                if kind == "end":  # no ground motion from here on: rests to the end
-                    return finish(message="at rest in free motion: stopped")
-                if kind == "segment":
-                    break
-                theta, rate = 0.0, 0.0
-                side = motion.uplift_side(t)
-                at_rest = False
-                out.n_uplifts += 1
-                note((t, "uplift"))
-            if out.n_steps >= max_pieces:
-                return finish(
-                    "failed", f"piece budget exceeded ({max_pieces} pieces) at t={t:.6g} s"
-                )
-            piece = LinearPiece.start(
-                t,
-                theta,
-                rate,
-                side,
-                alpha,
-                p,
-                amp_g if forced else 0.0,
-                motion.omega,
-                motion.phase,
-            )
-            out.n_steps += 1
-            sc = scan_piece(piece, seg_end - t, limit)
-            out.n_rhs += sc.n_evals
-            stop_here = (
-                can_stop
-                and sc.tau_peak is not None
-                and linear_energy(theta, rate, alpha, p) < barrier * (1.0 - STOP_MARGIN)
-            )
-            tau_end = sc.tau_peak if stop_here else sc.tau
-            t_new = seg_end if sc.kind is None and not stop_here else t + tau_end
-            if record:
-                ts = rec.times(t_new)
-                rec.emit(ts, piece.theta(ts - t), piece.rate(ts - t))
-            peak = max(peak, sc.peak)
-            theta, rate = float(piece.theta(tau_end)), float(piece.rate(tau_end))
-            t = t_new
-            if stop_here:
-                return finish(message="free motion below the collapse barrier: stopped early")
-            if sc.kind == "collapse":
-                out.t_collapse, out.collapse_interface = t, 1
-                note((t, "collapse"))
-                return finish("collapsed", "the block reached its collapse limit")
-            if sc.kind == "impact":
-                out.n_impacts += 1
-                note((t, "impact"))
-                theta, rate, side = 0.0, restitution * rate, -side
-                if abs(rate) < rest_rate:
-                    theta, rate, at_rest = 0.0, 0.0, True
-                    note((t, "rest"))
+        stop = _linear_segment(blk, run, motion, seg_end, forced, can_stop)
+        if stop is not None:
+            return stop
     return finish()
 
 

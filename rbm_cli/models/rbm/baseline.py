@@ -36,6 +36,68 @@ def _event(row, offset):
     return ev
 
 
+def _surfaces(pieces: Pieces, argmap, cmap, c: float, n: int):
+    """The event functions of the current pieces.
+
+    Returns lo, hi (the pieces' bounds of the law arguments), `events` (4 per interface:
+    law bound below and above, None where infinite, collapse on either side), `live` (the
+    terminal ones, then one peak event per interface: a zero of a collapse quantity's
+    rate) and the number of terminal events."""
+    lo, hi = pieces.bounds()
+    events = []
+    for i in range(n):
+        row = argmap[i]
+        events.append(_event(row, -lo[i]) if np.isfinite(lo[i]) else None)
+        events.append(_event(-row, hi[i]) if np.isfinite(hi[i]) else None)
+        events.append(_event(-cmap[i], c))
+        events.append(_event(cmap[i], c))
+    live = [e for e in events if e is not None]
+    n_terminal = len(live)
+    for i in range(n):  # peaks: zero crossings of the collapse quantities' rates
+
+        def peak_event(tt, yy, row=cmap[i]):
+            return float(row @ yy[n:])
+
+        live.append(peak_event)
+    return lo, hi, events, live, n_terminal
+
+
+def _rhs(motion: GroundMotion, n: int, A, cvec, evec, amp: float):
+    """dy/dt of the current pieces, y = (theta [rad], rate [rad/s]); amp [m/s^2] is 0 in
+    free motion."""
+
+    def fun(tt, yy, A=A, cvec=cvec, evec=evec, amp=amp):
+        g = amp * math.sin(motion.omega * tt + motion.phase) if amp else 0.0
+        return np.concatenate([yy[n:], A @ yy[:n] + cvec + evec * g])
+
+    return fun
+
+
+def _solution_peak(sol, cmap, n: int, n_terminal: int, peak: float) -> float:
+    """The peak collapse ratio updated from the solver's steps and its peak events."""
+    peak = max(peak, float(np.max(np.abs(cmap @ sol.y[:n]))))
+    for ye in sol.y_events[n_terminal:]:
+        if ye.size:
+            peak = max(peak, float(np.max(np.abs(ye[:, :n] @ cmap.T))))
+    return peak
+
+
+def _cross(model: Model, pieces: Pieces, y, i: int, going_up: bool, bounds, arg_inv, rest_rate):
+    """Put interface i's argument on the bound it crossed and move it to its next piece;
+    at an impact apply the restitution and put a rigid block slower than rest_rate [rad/s]
+    to rest. Returns the state and whether it rests."""
+    n, argmap = model.n, model.arg_map
+    lo, hi = bounds
+    bound = hi[i] if going_up else lo[i]
+    y[:n] += arg_inv[:, i] * (bound - float(argmap[i] @ y[:n]))
+    if pieces.cross(i, going_up) == "impact":
+        if model.restitution < 1.0:
+            y[n:] = model.impact_rates(y[n:], i)
+        if model.uplift_level is not None and abs(y[n]) < rest_rate:
+            return np.zeros(2 * n), True
+    return y, False
+
+
 def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) -> dict:
     """One run of the baseline; returns status, t_collapse_s, max_rotation_ratio, wall_time_s.
     A run longer than budget_s [s] of wall time stops as 'failed' (its time still counts)."""
@@ -71,34 +133,12 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
                 return {"status": "failed", "t_collapse_s": math.nan, "max_rotation_ratio": peak,
                         "wall_time_s": time.perf_counter() - start}  # fmt: skip
             A, cvec, evec = pieces.system()
-            lo, hi = pieces.bounds()
-            events = []
-            for i in range(n):
-                row = argmap[i]
-                events.append(_event(row, -lo[i]) if np.isfinite(lo[i]) else None)
-                events.append(_event(-row, hi[i]) if np.isfinite(hi[i]) else None)
-                events.append(_event(-cmap[i], c))
-                events.append(_event(cmap[i], c))
-            live = [e for e in events if e is not None]
-            n_terminal = len(live)
-            for i in range(n):  # peaks: zero crossings of the collapse quantities' rates
-
-                def peak_event(tt, yy, row=cmap[i]):
-                    return float(row @ yy[n:])
-
-                live.append(peak_event)
-
-            def fun(tt, yy, A=A, cvec=cvec, evec=evec, amp=amp):
-                g = amp * math.sin(motion.omega * tt + motion.phase) if amp else 0.0
-                return np.concatenate([yy[n:], A @ yy[:n] + cvec + evec * g])
-
+            lo, hi, events, live, n_terminal = _surfaces(pieces, argmap, cmap, c, n)
+            fun = _rhs(motion, n, A, cvec, evec, amp)
             sol = solve_ivp(
                 fun, (t, seg_end), y, method="RK45", rtol=BASELINE_RTOL, atol=atol, events=live
             )
-            peak = max(peak, float(np.max(np.abs(cmap @ sol.y[:n]))))
-            for ye in sol.y_events[n_terminal:]:
-                if ye.size:
-                    peak = max(peak, float(np.max(np.abs(ye[:, :n] @ cmap.T))))
+            peak = _solution_peak(sol, cmap, n, n_terminal, peak)
             if sol.status != 1:
                 if sol.status < 0:
                     return {"status": "failed", "t_collapse_s": math.nan,
@@ -108,19 +148,11 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
                 break
             hit = next(j for j, te in enumerate(sol.t_events[:n_terminal]) if te.size)
             t, y = float(sol.t_events[hit][0]), sol.y_events[hit][0].copy()
-            kind_i = events.index(live[hit])
-            i, which = divmod(kind_i, 4)
+            i, which = divmod(events.index(live[hit]), 4)
             if which >= 2:
                 status, t_col, peak = "collapsed", t, max(peak, c)
                 return {"status": status, "t_collapse_s": t_col, "max_rotation_ratio": peak,
                         "wall_time_s": time.perf_counter() - start}  # fmt: skip
-            going_up = which == 1
-            bound = hi[i] if going_up else lo[i]
-            y[:n] += arg_inv[:, i] * (bound - float(argmap[i] @ y[:n]))
-            if pieces.cross(i, going_up) == "impact":
-                if model.restitution < 1.0:
-                    y[n:] = model.impact_rates(y[n:], i)
-                if uplift is not None and abs(y[n]) < rest_rate:
-                    y, at_rest = np.zeros(2 * n), True
+            y, at_rest = _cross(model, pieces, y, i, which == 1, (lo, hi), arg_inv, rest_rate)
     return {"status": status, "t_collapse_s": t_col, "max_rotation_ratio": peak,
             "wall_time_s": time.perf_counter() - start}  # fmt: skip

@@ -34,8 +34,8 @@ import pandas as pd  # noqa: E402
 from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import ExcitationConfig, GridConfig, InitialConfig  # noqa: E402
-from rbm_cli.models.housner import block_geometry  # noqa: E402
 from rbm_cli.models.housner_linear import housner_linear_run  # noqa: E402
+from rbm_cli.physics.block import block_geometry  # noqa: E402
 from rbm_cli.physics.closed_forms import (  # noqa: E402
     free_rocking_period,
     halfsine_threshold_curves,

@@ -18,6 +18,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rbm_cli.models.events import REST_RATE, Pieces
+from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -98,9 +99,17 @@ def _cross(model: Model, pieces: Pieces, y, i: int, going_up: bool, bounds, arg_
     return y, False
 
 
-def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) -> dict:
-    """One run of the baseline; returns status, t_collapse_s, max_rotation_ratio, wall_time_s.
-    A run longer than budget_s [s] of wall time stops as 'failed' (its time still counts)."""
+def _outcome(status: str, t_collapse: float, peak: float, message: str = "") -> Outcome:
+    """The baseline's Outcome: its status, collapse time [s] and largest collapse ratio
+    (over all interfaces, in max_ratio[0]); it counts no steps or events."""
+    out = Outcome(status=status, message=message, t_collapse=t_collapse)
+    out.max_ratio = np.array([peak])
+    return out
+
+
+def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) -> Outcome:
+    """One run of the baseline (an Outcome, the one result type of the models). A run
+    longer than budget_s [s] of wall time stops as 'failed'."""
     start = time.perf_counter()
     n = model.n
     tu = model.column.rotation_capacity
@@ -130,8 +139,7 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
                 pieces.side[0], pieces.k[0] = motion.uplift_side(t), 0
                 at_rest = False
             if time.perf_counter() - start > budget_s:
-                return {"status": "failed", "t_collapse_s": math.nan, "max_rotation_ratio": peak,
-                        "wall_time_s": time.perf_counter() - start}  # fmt: skip
+                return _outcome("failed", math.nan, peak, "wall-time budget exceeded")
             A, cvec, evec = pieces.system()
             lo, hi, events, live, n_terminal = _surfaces(pieces, argmap, cmap, c, n)
             fun = _rhs(motion, n, A, cvec, evec, amp)
@@ -141,9 +149,7 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
             peak = _solution_peak(sol, cmap, n, n_terminal, peak)
             if sol.status != 1:
                 if sol.status < 0:
-                    return {"status": "failed", "t_collapse_s": math.nan,
-                            "max_rotation_ratio": peak,
-                            "wall_time_s": time.perf_counter() - start}  # fmt: skip
+                    return _outcome("failed", math.nan, peak, "solve_ivp failed")
                 t, y = seg_end, sol.y[:, -1]
                 break
             hit = next(j for j, te in enumerate(sol.t_events[:n_terminal]) if te.size)
@@ -151,8 +157,6 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
             i, which = divmod(events.index(live[hit]), 4)
             if which >= 2:
                 status, t_col, peak = "collapsed", t, max(peak, c)
-                return {"status": status, "t_collapse_s": t_col, "max_rotation_ratio": peak,
-                        "wall_time_s": time.perf_counter() - start}  # fmt: skip
+                return _outcome(status, t_col, peak)
             y, at_rest = _cross(model, pieces, y, i, which == 1, (lo, hi), arg_inv, rest_rate)
-    return {"status": status, "t_collapse_s": t_col, "max_rotation_ratio": peak,
-            "wall_time_s": time.perf_counter() - start}  # fmt: skip
+    return _outcome(status, t_col, peak)

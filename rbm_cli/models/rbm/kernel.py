@@ -80,7 +80,8 @@ def integrate_compiled(
                    bool(early_stop), bool(record), float(output_dt), samples)  # fmt: skip
     armed = arm()  # Ctrl-C reaches the kernel through poll (kernel_guard)
     try:
-        res = run_kernel(prepared.arrays, excitation(motion), settings, task)
+        res = run_kernel(tuple(prepared.arrays), tuple(excitation(motion)), tuple(settings),
+                         tuple(task))  # fmt: skip
     finally:
         disarm(armed)
     return _outcome(res, samples, n, record, solver)

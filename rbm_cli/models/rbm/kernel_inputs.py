@@ -1,8 +1,8 @@
 """The inputs of the compiled kernel, as four typed records (named tuples).
 
-numba passes a named tuple of arrays and scalars to a compiled function as one
-argument and reads its fields at no cost, so the stepper (kernel_step.run_kernel)
-takes four records instead of some 45 positional arguments:
+numba reads the fields of a tuple of arrays and scalars at no cost, so the stepper
+(kernel_step.run_kernel) takes four records instead of some 45 positional arguments
+(passed as plain tuples, named again inside the kernel: see run_kernel):
 
 - :class:`ModelArrays`: everything the kernel needs of a model, made once per
   model by :func:`prepare_kernel` (a sweep prepares a column once, runs it many times);

@@ -31,7 +31,6 @@ import numpy as np
 from rbm_cli.models.rbm.kernel_guard import arm, disarm, poll
 from rbm_cli.models.rbm.kernel_inputs import (
     PreparedModel,
-    RunTask,
     excitation,
     model_arrays,
     prepare_kernel,
@@ -76,12 +75,12 @@ def integrate_compiled(
     samples = np.zeros((n_max, 1 + 2 * n))
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)
-    task = RunTask(np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
-                   bool(early_stop), bool(record), float(output_dt), samples)  # fmt: skip
+    # a RunTask, as a plain tuple (kernel_inputs)
+    task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), bool(early_stop),
+            bool(record), float(output_dt), samples)  # fmt: skip
     armed = arm()  # Ctrl-C reaches the kernel through poll (kernel_guard)
     try:
-        res = run_kernel(tuple(prepared.arrays), tuple(excitation(motion)), tuple(settings),
-                         tuple(task))  # fmt: skip
+        res = run_kernel(prepared.packed, excitation(motion), settings, task)
     finally:
         disarm(armed)
     return _outcome(res, samples, n, record, solver)

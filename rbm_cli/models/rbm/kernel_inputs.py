@@ -2,7 +2,8 @@
 
 numba reads the fields of a tuple of arrays and scalars at no cost, so the stepper
 (kernel_step.run_kernel) takes four records instead of some 45 positional arguments
-(passed as plain tuples, named again inside the kernel: see run_kernel):
+(passed as plain tuples in the order of their fields, named again inside the kernel:
+a named tuple costs more to pass, see run_kernel):
 
 - :class:`ModelArrays`: everything the kernel needs of a model, made once per
   model by :func:`prepare_kernel` (a sweep prepares a column once, runs it many times);
@@ -100,10 +101,12 @@ class RunTask(NamedTuple):
 
 @dataclass(frozen=True)
 class PreparedModel:
-    """What :func:`prepare_kernel` makes of a model: its kernel arrays, and the scale of
-    atol (theta_u for rotations, 10 theta_u for rates) [rad, rad/s]."""
+    """What :func:`prepare_kernel` makes of a model: its kernel arrays (named, and as the
+    plain tuple run_kernel takes) and the scale of atol (theta_u for rotations, 10 theta_u
+    for rates) [rad, rad/s]."""
 
     arrays: ModelArrays
+    packed: tuple
     atol_scale: np.ndarray
 
 
@@ -204,22 +207,21 @@ def prepare_kernel(model: Model) -> PreparedModel:
     n = model.n
     tu = float(model.column.rotation_capacity.min())
     atol_scale = np.concatenate([np.full(n, tu), np.full(n, 10.0 * tu)])
-    return PreparedModel(arrays=model_arrays(model), atol_scale=atol_scale)
+    arrays = model_arrays(model)
+    return PreparedModel(arrays=arrays, packed=tuple(arrays), atol_scale=atol_scale)
 
 
-def excitation(motion: GroundMotion) -> Excitation:
-    """The kernel's record of a ground motion."""
-    return Excitation(
-        KIND_CODES[motion.kind], float(motion.amplitude), float(motion.omega),
-        float(motion.phase), float(motion.pulse_end), float(motion.t_end),
-    )  # fmt: skip
+def excitation(motion: GroundMotion) -> tuple:
+    """The kernel's Excitation of a ground motion, as the plain tuple run_kernel takes."""
+    return (KIND_CODES[motion.kind], float(motion.amplitude), float(motion.omega),
+            float(motion.phase), float(motion.pulse_end), float(motion.t_end))  # fmt: skip
 
 
-def solver_settings(solver, atol_scale: np.ndarray, deadline: float) -> SolverSettings:
-    """The kernel's record of a SolverConfig (atol scaled by atol_scale; deadline [s])."""
-    return SolverSettings(METHOD_CODES[solver.method], float(solver.rtol),
-                          solver.atol * atol_scale, int(solver.max_steps),
-                          int(solver.max_events), deadline)  # fmt: skip
+def solver_settings(solver, atol_scale: np.ndarray, deadline: float) -> tuple:
+    """The kernel's SolverSettings of a SolverConfig (atol scaled by atol_scale; deadline
+    [s]), as the plain tuple run_kernel takes."""
+    return (METHOD_CODES[solver.method], float(solver.rtol), solver.atol * atol_scale,
+            int(solver.max_steps), int(solver.max_events), deadline)  # fmt: skip
 
 
 __all__ = [

@@ -5,6 +5,10 @@ state moves exactly onto the kink and the interface's piece changes: an uplift
 from closure, one piece out or in, or an impact (closure crossed, restitution
 applied, and a rigid monolith slow enough comes to rest). As
 rbm_cli.models.rbm.python does it.
+
+Both functions are inlined into the stepper (inline="always"): a call would pass the
+model record by value, some 30 arrays, at every event (+5 % on the slender block's
+runs, measured).
 """
 
 from __future__ import annotations
@@ -15,7 +19,7 @@ from numba import njit
 PIECE, UPLIFT, IMPACT, REST = 0, 1, 2, 3
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _restitution(model, i, y, n):
     """The impact's loss of rate at interface i (e < 1), on y's rates in place."""
     argmap, arg_inv, e_rest = model.argmap, model.arg_inv, model.e_rest
@@ -31,7 +35,7 @@ def _restitution(model, i, y, n):
             y[n + j] += model.impulse_dir[j, i] * lam
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono):
     """Interface i's event at argument bound [rad]: y (state), side, k (piece),
     pending and awaiting (silent impacts) updated in place.

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 
 import pytest
 from click.testing import CliRunner
@@ -215,12 +218,21 @@ def test_run_says_when_it_compiles_the_kernel(tmp_path, monkeypatch, cold):
     assert ("compiling the integrator" in res.stderr) == cold
 
 
-def test_needs_compile_sees_the_cache():
-    """After a compiled run in this process, the on-disk cache exists."""
+def test_needs_compile_sees_the_cache(tmp_path):
+    """needs_compile reads numba's cache index of the kernel: False after a compiled run in
+    this process (the on-disk cache exists), True in a process whose cache folder is empty.
+    Guards against a check that cannot fail: it once answered False on any error, and it
+    answers None when numba's cache internals are no longer the ones it reads."""
     from rbm_cli.models.rbm.kernel import needs_compile, warm_up
 
     warm_up()
     assert needs_compile() is False
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
+    code = "from rbm_cli.models.rbm.kernel import needs_compile; print(needs_compile())"
+    res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         timeout=300)  # fmt: skip
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stdout.strip() == "True"
 
 
 def test_info_gives_the_engine_its_own_uplift_level(tmp_path):

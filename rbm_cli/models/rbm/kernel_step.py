@@ -1,0 +1,397 @@
+"""The compiled stepper of the Rigid Beam Model (numba): one call runs a whole motion
+(the algorithm: rbm_cli.models.rbm.kernel), from four typed records (kernel_inputs)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rbm_cli.base.detmath import matvec, pow_pos
+from rbm_cli.models.rbm.kernel_events import (
+    CHECK_INTERVALS,
+    _affine,
+    _bounds,
+    _brentq,
+    _emit,
+    _emit_rest,
+    _energy1,
+    _event_rows,
+    _first_crossing,
+    _n_below,
+    _next_exceedance,
+    _poly_val,
+    _row_poly,
+    _system,
+    _within_reach,
+)
+from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, POLL_STEPS, poll
+from rbm_cli.models.rbm.kernel_inputs import Excitation, ModelArrays, RunTask, SolverSettings
+from rbm_cli.models.rbm.kernel_rk import (
+    _MAX_FACTOR,
+    _MIN_FACTOR,
+    _NS_MAX,
+    _SAFETY,
+    COLLAPSED,
+    FAILED_EVENTS,
+    FAILED_NONFINITE,
+    FAILED_STEP,
+    FAILED_STEPS,
+    FAILED_WALL,
+    INTERRUPTED,
+    STOPPED_EARLY,
+    SURVIVED,
+    TAB_EST,
+    TAB_NS,
+    _dense_eval,
+    _dense_prepare,
+    _error_norm,
+    _ground,
+    _initial_step,
+    _rhs,
+    _rk_attempt,
+)
+from rbm_cli.models.rbm.kernel_state import IMPACT, REST, UPLIFT, switch
+from rbm_cli.models.rbm.python import BIG, EVENT_EPS
+
+
+@njit(cache=True)
+def run_kernel(model, motion, solver, task):
+    """Run one motion of one model.
+
+    The four records come as plain tuples (their fields in order: tuple(record)) and
+    are named here, at no cost: numba unboxes a named tuple argument about twice as
+    slowly as a plain one (some 4 us a call for these four, measured).
+
+    Parameters
+    ----------
+    model : tuple  A kernel_inputs.ModelArrays (kernel_inputs.prepare_kernel).
+    motion : tuple  A kernel_inputs.Excitation: the ground motion.
+    solver : tuple  A kernel_inputs.SolverSettings: method, tolerances, budgets, deadline.
+    task : tuple  A kernel_inputs.RunTask: initial state, early stop, samples (in place).
+
+    Returns
+    -------
+    tuple  (status code (kernel_rk), t_end [s], t_collapse [s], collapsed interface,
+        max_ratio (n,), max_top, friction (n,), n_uplifts, n_impacts, n_steps, n_rhs,
+        n_events, n_samples).
+    """
+    model, motion = ModelArrays(*model), Excitation(*motion)
+    solver, task = SolverSettings(*solver), RunTask(*task)
+    mass, argmap, gravity = model.mass, model.argmap, model.gravity
+    edges, nedges, intercepts, slopes = model.edges, model.nedges, model.intercepts, model.slopes
+    rigid, silent, tu, c_ratio = model.rigid, model.silent, model.tu, model.c_ratio
+    centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
+    uplift_level, barrier = model.uplift_level, model.barrier
+    kind, amplitude, omega, phase = motion.kind, motion.amplitude, motion.omega, motion.phase
+    pulse_end, t_end = motion.pulse_end, motion.t_end
+    mc, rtol, atol, deadline = solver.mc, solver.rtol, solver.atol, solver.deadline
+    max_steps, max_events = solver.max_steps, solver.max_events
+    theta0, rate0, early_stop = task.theta0, task.rate0, task.early_stop
+    record, output_dt, samples = task.record, task.output_dt, task.samples
+
+    n = theta0.size
+    n_out = 0
+    next_out = 0.0
+    m = 2 * n
+    max_ratio = np.zeros(n)
+    friction = np.zeros(n)
+    max_top = 0.0
+    n_upl, n_imp, n_steps, n_rhs, n_ev = 0, 0, 0, 0, 0
+    status = SURVIVED
+    t_col, c_if = np.nan, -1
+
+    side = np.ones(n, dtype=np.int64)
+    k = np.zeros(n, dtype=np.int64)
+    pending = np.zeros(n, dtype=np.bool_)
+    # silent impacts (Model.silent_impacts): counted at step ends, not stopped at
+    any_silent = silent.any()
+    awaiting = np.zeros(n, dtype=np.bool_)
+    lo, hi = np.empty(n), np.empty(n)
+    nt = n + 1
+    G, gx, gc, same, md, mg, track, es = (model.G, model.gx, model.gc, model.same, model.md,
+                                          model.mg, model.track, model.es)  # fmt: skip
+    peaks = np.zeros(nt)
+    As, cs = np.empty((n, n)), np.empty(n)
+    h0 = np.empty(4 * n)
+    K = np.empty((_NS_MAX, m))
+    F = np.empty((8, m))
+    f = np.empty(m)
+    ynew = np.empty(m)
+    tmp = np.empty(m)
+    work = np.empty(m)
+    scale = np.empty(m)
+    nrow = 4 * n
+    d_old, d_new = np.empty(nrow), np.empty(nrow)
+    dd_old, dd_new = np.empty(nrow), np.empty(nrow)
+    d2_old, d2_new = np.empty(nrow), np.empty(nrow)
+    Dq, Rq = np.empty((nrow, CHECK_INTERVALS + 1)), np.empty((nrow, CHECK_INTERVALS + 1))
+    dc0, dc1, rc0, rc1 = np.empty(nrow), np.empty(nrow), np.empty(nrow), np.empty(nrow)
+    near = np.zeros(nrow, dtype=np.bool_)
+    CP, CR = np.empty((nrow, 7)), np.empty((nrow, 7))
+    BP, BR = np.empty(nrow), np.empty(nrow)
+    coef = np.empty(7)
+    zero_t = np.zeros(nt)
+    z_old, z_new, z_prev = np.empty(nt), np.empty(nt), np.empty(nt)
+    dz_old, dz_new, dz_prev = np.empty(nt), np.empty(nt), np.empty(nt)
+    acc = np.empty(n)
+    no_offset = np.empty(0)
+    y_new = np.empty(m)
+    est_order = TAB_EST[mc]
+    err_exp = -1.0 / (est_order + 1)
+    ns = TAB_NS[mc]
+    stage_rhs = ns  # rhs calls per attempt (stages 1..ns-1 and f_new)
+
+    t = 0.0
+    y = np.empty(m)
+    y[:n] = theta0
+    y[n:] = rate0
+    rigid_mono = uplift_level >= 0.0
+    at_rest = rigid_mono
+    for i in range(m):
+        if y[i] != 0.0:
+            at_rest = False
+    x0 = matvec(argmap, y[:n], np.empty(n))
+    r0 = matvec(argmap, y[n:], np.empty(n))
+    for i in range(n):
+        s = 1 if x0[i] > 0 else (-1 if x0[i] < 0 else (1 if r0[i] >= 0 else -1))
+        side[i] = s
+        k[i] = _n_below(edges[i], nedges[i], abs(x0[i]))
+        pending[i] = k[i] > 0 and not rigid[i]
+
+    n_seg = 2 if (kind == 1 and pulse_end < t_end) else 1
+    for seg in range(n_seg):
+        seg_start = 0.0 if seg == 0 else pulse_end
+        seg_end = t_end if (seg == n_seg - 1) else pulse_end
+        if t >= seg_end:
+            continue
+        free_seg = amplitude == 0.0 or (kind == 1 and seg_start >= pulse_end)
+        amp = 0.0 if free_seg else amplitude
+        can_stop = early_stop and free_seg and kind == 1 and n == 1
+        h_carry = -1.0  # the step size proposed before an event, carried over it
+        while t < seg_end:
+            if at_rest:
+                if free_seg:
+                    if record:
+                        n_out, next_out = _emit_rest(t_end, samples, n_out, next_out, output_dt)
+                    return (status, t_end, t_col, c_if, max_ratio, max_top, friction,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                last = min(pulse_end, t_end)
+                t_up = _next_exceedance(t, uplift_level, amplitude, omega, phase, last)
+                if t_up < 0.0 or t_up >= seg_end:
+                    if record:
+                        n_out, next_out = _emit_rest(seg_end, samples, n_out, next_out, output_dt)
+                    t = seg_end
+                    break
+                if record:
+                    n_out, next_out = _emit_rest(t_up - 1e-15, samples, n_out, next_out, output_dt)
+                t = t_up
+                for i in range(m):
+                    y[i] = 0.0
+                side[0] = -1 if _ground(t, amplitude, omega, phase) > 0.0 else 1
+                k[0] = 0
+                at_rest = False
+                n_upl += 1
+                h_carry = -1.0
+
+            _system(side, k, intercepts, slopes, md, mg, argmap, As, cs)
+            for i in range(n):
+                _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi)
+                h0[i] = min(-lo[i] / tu[i], BIG) + EVENT_EPS
+                h0[n + i] = min(hi[i] / tu[i], BIG) + EVENT_EPS
+                h0[2 * n + i] = c_ratio + EVENT_EPS
+                h0[3 * n + i] = c_ratio + EVENT_EPS
+
+            # a new stepper from (t, y)
+            _rhs(t, y, n, As, cs, es, amp, omega, phase, f)
+            if h_carry > 0.0:
+                h_abs = min(h_carry, seg_end - t)
+                n_rhs += 1
+            else:
+                h_abs = _initial_step(t, y, f, seg_end, est_order, rtol, atol, n, As, cs, es,
+                                      amp, omega, phase, work)  # fmt: skip
+                n_rhs += 2
+            _affine(track, y, 0, no_offset, z_old)
+            _affine(track, y, n, no_offset, dz_old)
+            _event_rows(gx, gc, same, y, 0, h0, True, d_old)
+            _event_rows(gx, gc, same, y, n, h0, False, dd_old)
+            g0 = _ground(t, amp, omega, phase)
+            _affine(As, y, 0, cs, acc)
+            for i in range(n):
+                acc[i] += es[i] * g0
+            _event_rows(gx, gc, same, acc, 0, h0, False, d2_old)
+            event = False
+            running = True
+            while running:
+                # ---- one accepted step (scipy RungeKutta._step_impl)
+                min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+                if h_abs < min_step:
+                    h_abs = min_step
+                rejected = False
+                while True:
+                    if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
+                        t_fail = t
+                        return (FAILED_STEP, t_fail, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                    t_new = t + h_abs
+                    if t_new - seg_end > 0:
+                        t_new = seg_end
+                    h = t_new - t
+                    h_abs = abs(h)
+                    _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, amp, omega, phase)
+                    n_rhs += stage_rhs
+                    err = _error_norm(mc, K, h, y, ynew, atol, rtol, scale)
+                    if not (err == err and abs(err) < math.inf):  # NaN or inf state
+                        return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                    if err < 1.0:
+                        if err == 0.0:
+                            factor = _MAX_FACTOR
+                        else:
+                            factor = min(_MAX_FACTOR, _SAFETY * pow_pos(err, err_exp))
+                        if rejected:
+                            factor = min(1.0, factor)
+                        h_abs *= factor
+                        break
+                    h_abs *= max(_MIN_FACTOR, _SAFETY * pow_pos(err, err_exp))
+                    rejected = True
+                n_steps += 1
+                if n_steps > max_steps:
+                    return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                if n_steps % POLL_STEPS == 0:  # the wall-clock budget and Ctrl-C
+                    guard = poll(deadline)
+                    if guard != GO_ON:
+                        code = FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
+                        return (code, t, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                if t_new - seg_end >= 0:
+                    running = False
+                t_old = t
+                y_old = y
+                y_new[:] = ynew
+                _event_rows(gx, gc, same, y_new, 0, h0, True, d_new)
+                _event_rows(gx, gc, same, y_new, n, h0, False, dd_new)
+                dense_ready = False
+                g_new = _ground(t_new, amp, omega, phase)
+                _affine(As, y_new, 0, cs, acc)
+                for i in range(n):
+                    acc[i] += es[i] * g_new
+                _event_rows(gx, gc, same, acc, 0, h0, False, d2_new)
+                event_row = -1
+                t_e = t_new
+                if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
+                    n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
+                                            cs, es, amp, omega, phase)  # fmt: skip
+                    dense_ready = True
+                    t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, G, h0, n, Dq,
+                                                     Rq, dc0, dc1, rc0, rc1, near, CP, BP, CR,
+                                                     BR)  # fmt: skip
+                if event_row >= 0:
+                    _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
+                    t_new = t_e
+                    event = True
+                    g_new = _ground(t_new, amp, omega, phase)
+                    _affine(As, y_new, 0, cs, acc)
+                    for i in range(n):
+                        acc[i] += es[i] * g_new
+                    if record:
+                        n_out, next_out = _emit(mc, t_e, t_old, h, y_old, F, samples, n_out,
+                                                next_out, output_dt)  # fmt: skip
+                elif record:
+                    if not dense_ready:
+                        n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
+                                                cs, es, amp, omega, phase)  # fmt: skip
+                        dense_ready = True
+                    n_out, next_out = _emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
+                                            next_out, output_dt)  # fmt: skip
+                if any_silent:
+                    for i in range(n):
+                        if awaiting[i]:
+                            x_i = 0.0
+                            for j in range(n):
+                                x_i += argmap[i, j] * y_new[j]
+                            if side[i] * x_i < 0.0:
+                                side[i] = -side[i]
+                                awaiting[i] = False
+                                n_imp += 1
+                # peaks and friction demand over [t_old, t_new]
+                _affine(track, y_new, 0, no_offset, z_new)
+                _affine(track, y_new, n, no_offset, dz_new)
+                # peaks inside the step: at the root of the rate, on the dense output
+                for r in range(nt):
+                    v = max(abs(z_old[r]), abs(z_new[r]))
+                    # a turn inside the step that may beat the running maximum: the
+                    # step's cubic Hermite exceeds its end values by at most
+                    # 4/27 h (|rate0| + |rate1|); the margin used is 1/2 (the dense
+                    # output is of higher order than the Hermite)
+                    reach = v + 0.5 * (t_new - t_old) * (abs(dz_old[r]) + abs(dz_new[r]))
+                    if dz_old[r] * dz_new[r] < 0.0 and reach > peaks[r]:
+                        if not dense_ready:
+                            n_rhs += _dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
+                                                    As, cs, es, amp, omega, phase)  # fmt: skip
+                            dense_ready = True
+                        base = _row_poly(mc, F, y_old, track, r, zero_t, n, True, coef)
+                        t_pk = _brentq(mc, t_old, t_new, t_old, h, coef, base)
+                        base = _row_poly(mc, F, y_old, track, r, zero_t, n, False, coef)
+                        v = max(v, abs(_poly_val(mc, t_pk, t_old, h, coef, base)))
+                    if v > peaks[r]:
+                        peaks[r] = v
+                for i in range(n):
+                    if peaks[i] > max_ratio[i]:
+                        max_ratio[i] = peaks[i]
+                if peaks[n] > max_top:
+                    max_top = peaks[n]
+                shear = 0.0
+                for i in range(n - 1, -1, -1):
+                    a_abs = g_new
+                    for j in range(n):
+                        a_abs += centre_map[i, j] * acc[j]
+                    shear += a_abs * masses[i]
+                    fr = abs(shear) / normal_forces[i]
+                    if fr > friction[i]:
+                        friction[i] = fr
+                z_prev, z_old, z_new = z_old, z_new, z_prev
+                dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
+                d_old, d_new = d_new, d_old
+                dd_old, dd_new = dd_new, dd_old
+                d2_old, d2_new = d2_new, d2_old
+                t = t_new
+                y, y_new = y_new, y
+                f[:] = K[ns]
+                if event:
+                    break
+                if can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]:
+                    en = _energy1(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
+                                  intercepts, slopes)  # fmt: skip
+                    if en < barrier * (1.0 - 1e-9):
+                        return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction,
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+            if not event:
+                t = seg_end if not running else t
+                continue
+
+            # ---- the event at (t, y)
+            h_carry = h_abs
+            n_ev += 1
+            if n_ev > max_events:
+                return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction,
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+            which, i = event_row // n, event_row % n
+            if which >= 2:
+                t_col, c_if = t, i + 1
+                if c_ratio > max_ratio[i]:
+                    max_ratio[i] = c_ratio
+                return (COLLAPSED, t, t_col, c_if, max_ratio, max_top, friction,
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+            going_up = which == 1
+            bound = hi[i] if going_up else lo[i]
+            what = switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
+            if what == UPLIFT:
+                n_upl += 1
+            elif what >= IMPACT:
+                n_imp += 1
+                at_rest = what == REST
+    return (status, t, t_col, c_if, max_ratio, max_top, friction,
+            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip

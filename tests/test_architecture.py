@@ -17,7 +17,7 @@ LEVELS = {"base": 0, "config": 1, "physics": 2, "models": 3, "study": 4, "report
 MAX_MODULE_LINES = 400
 MAX_FUNCTION_LINES = 80
 #: numba compiles each of these as one body (docs/architecture.md)
-COMPILED_STEPPERS = {"models/rbm/kernel.py:run_kernel"}
+COMPILED_STEPPERS = {"models/rbm/kernel_step.py:run_kernel"}
 
 
 def modules() -> dict[str, Path]:

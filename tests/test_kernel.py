@@ -20,6 +20,7 @@ from rbm_cli.config.load import load_config
 from rbm_cli.models.housner_linear import housner_linear_run
 from rbm_cli.models.rbm.kernel import integrate_compiled
 from rbm_cli.models.rbm.python import integrate
+from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.physics.closed_forms import linear_rocking_parameters
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.study.simulate import model_from_config, simulate
@@ -89,7 +90,7 @@ def test_kernel_peak_matches_the_closed_form(amplitude, frequency):
     alpha, p = linear_rocking_parameters(model.column)
     motion = make_ground_motion(cfg.excitation, amplitude, frequency)
     exact = housner_linear_run(alpha, p, motion, restitution=model.restitution)
-    res = simulate(cfg, amplitude, frequency, model=model)
+    res = simulate(cfg, amplitude, frequency, runner=RbmRunner(cfg, model=model))
     assert res.status == exact.status
     if res.status == "collapsed":
         assert abs(res.t_collapse_s - exact.t_collapse) < 1e-7

@@ -28,6 +28,7 @@ import time
 
 import numpy as np
 
+from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.kernel_guard import arm, disarm, poll
 from rbm_cli.models.rbm.kernel_inputs import (
     PreparedModel,
@@ -47,7 +48,6 @@ from rbm_cli.models.rbm.kernel_rk import (
     STOPPED_EARLY,
 )
 from rbm_cli.models.rbm.kernel_step import run_kernel
-from rbm_cli.models.rbm.python import Outcome
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 

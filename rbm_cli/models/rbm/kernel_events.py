@@ -17,30 +17,30 @@ from rbm_cli.models.rbm.kernel_rk import TAB_NP, _dense_eval
 
 
 @njit(cache=True)
-def _affine(G, y, off, h0, out):
-    """out = G @ y[off:off + cols] (+ h0 if given): no allocation."""
-    for r in range(G.shape[0]):
+def _affine(event_rows, y, off, h0, out):
+    """out = event_rows @ y[off:off + cols] (+ h0 if given): no allocation."""
+    for r in range(event_rows.shape[0]):
         d = 0.0 if h0.size == 0 else h0[r]
-        for j in range(G.shape[1]):
-            d += G[r, j] * y[off + j]
+        for j in range(event_rows.shape[1]):
+            d += event_rows[r, j] * y[off + j]
         out[r] = d
 
 
 @njit(cache=True)
-def _row_poly(mc, F, y_old, G, row, h0, n, rate, coef):
-    """One row of the step's interpolant, projected: the distance G[row] theta +
-    h0[row] (or, rate, the rate G[row] theta') as a polynomial in the step's
+def _row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
+    """One row of the step's interpolant, projected: the distance event_rows[row] theta +
+    h0[row] (or, rate, the rate event_rows[row] theta') as a polynomial in the step's
     fraction, with _dense_eval's form. Fills coef, returns the constant term;
     _poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
     off = n if rate else 0
     for q in range(TAB_NP[mc]):
         v = 0.0
         for j in range(n):
-            v += G[row, j] * F[q, off + j]
+            v += event_rows[row, j] * F[q, off + j]
         coef[q] = v
     base = 0.0 if rate else h0[row]
     for j in range(n):
-        base += G[row, j] * y_old[off + j]
+        base += event_rows[row, j] * y_old[off + j]
     return base
 
 
@@ -174,7 +174,7 @@ def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
 
 
 @njit(cache=True)
-def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
+def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
                     CP, BP, CR, BR):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
     (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
@@ -182,11 +182,11 @@ def _first_crossing(mc, t0, t1, y_old, F, G, h0, n, D, R, dcol0, dcol1, rcol0, r
     rates) and evaluated as scalars."""
     nseg = CHECK_INTERVALS
     h = t1 - t0
-    nrow = G.shape[0]
+    nrow = event_rows.shape[0]
     for r in range(nrow):
         if mask[r]:
-            BP[r] = _row_poly(mc, F, y_old, G, r, h0, n, False, CP[r])
-            BR[r] = _row_poly(mc, F, y_old, G, r, h0, n, True, CR[r])
+            BP[r] = _row_poly(mc, F, y_old, event_rows, r, h0, n, False, CP[r])
+            BR[r] = _row_poly(mc, F, y_old, event_rows, r, h0, n, True, CR[r])
     for q in range(nseg + 1):
         tq = t0 + h * q / nseg if q < nseg else t1
         for r in range(nrow):
@@ -281,8 +281,8 @@ def _system(side, k, intercepts, slopes, md, mg, argmap, As, cs):
 
 @njit(cache=True)
 def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
-    """The event rows G v[off:off + n] (+ h0) of the kernel, from their two
-    distinct blocks: G = [gx; -gx; -gc; gc] (gx = argmap / theta_u, gc the
+    """The event rows event_rows v[off:off + n] (+ h0) of the kernel, from their two
+    distinct blocks: event_rows = [gx; -gx; -gc; gc] (gx = argmap / theta_u, gc the
     normalised collapse map; `same` when gc == gx, as for `relative`)."""
     n = gx.shape[0]
     for i in range(n):

@@ -22,8 +22,8 @@ import numpy as np
 from numba import njit
 
 from rbm_cli.base.detmath import matmul, matvec
+from rbm_cli.models.events import REST_RATE
 from rbm_cli.models.rbm.kernel_rk import METHOD_CODES
-from rbm_cli.models.rbm.python import REST_RATE
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -56,9 +56,9 @@ class ModelArrays(NamedTuple):
     uplift_level: float  #: ground acceleration that uplifts a rigid monolith [m/s^2] (-1: none)
     rest_rate: float  #: rate below which a rigid monolith comes to rest after an impact [rad/s]
     barrier: float  #: energy barrier of the early stop [J] (NaN unless n = 1)
-    G: np.ndarray  #: event rows: argmap / tu, -argmap / tu, -cmap, cmap (4n, n)
-    gx: np.ndarray  #: G[:n]
-    gc: np.ndarray  #: G[3n:]
+    event_rows: np.ndarray  #: event rows: argmap / tu, -argmap / tu, -cmap, cmap (4n, n)
+    gx: np.ndarray  #: event_rows[:n]
+    gc: np.ndarray  #: event_rows[3n:]
     same: bool  #: gx equals gc (the same rows serve both)
     md: np.ndarray  #: minv @ diff.T, minv the inverse mass matrix (n, n)
     mg: np.ndarray  #: minv @ gravity (n, n)
@@ -130,16 +130,16 @@ def _pad_laws(model: Model):
 
 @njit(cache=True)
 def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
-    """The kernel's products of the model's arrays: (G, same, md, mg, track, es)."""
+    """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es)."""
     n = argmap.shape[0]
-    G = np.empty((4 * n, n))
+    event_rows = np.empty((4 * n, n))
     for i in range(n):
         for j in range(n):
-            G[i, j] = argmap[i, j] / tu[i]
-            G[n + i, j] = -argmap[i, j] / tu[i]
-            G[2 * n + i, j] = -cmap[i, j]
-            G[3 * n + i, j] = cmap[i, j]
-    gx, gc = G[:n], G[3 * n :]
+            event_rows[i, j] = argmap[i, j] / tu[i]
+            event_rows[n + i, j] = -argmap[i, j] / tu[i]
+            event_rows[2 * n + i, j] = -cmap[i, j]
+            event_rows[3 * n + i, j] = cmap[i, j]
+    gx, gc = event_rows[:n], event_rows[3 * n :]
     same = True
     for i in range(n):
         for j in range(n):
@@ -150,7 +150,7 @@ def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
     track[:n, :] = cmap
     track[n, :] = top
     es = -matvec(minv, ground_load, np.empty(n))
-    return G, same, md, mg, track, es
+    return event_rows, same, md, mg, track, es
 
 
 def _early_stop_levels(model: Model) -> tuple[float, float, float]:
@@ -174,7 +174,7 @@ def model_arrays(model: Model) -> ModelArrays:
     top = col.heights.astype(float)
     impulse_dir, impulse_w = model.impulse_directions
     edges, nedges, inter, slopes, rigid = _pad_laws(model)
-    G, same, md, mg, track, es = _derived(argmap, tu, cmap, top, model.mass_inv,
+    event_rows, same, md, mg, track, es = _derived(argmap, tu, cmap, top, model.mass_inv,
                                           model.diff.astype(float), model.gravity,
                                           model.ground_load)  # fmt: skip
     n = model.n
@@ -187,7 +187,8 @@ def model_arrays(model: Model) -> ModelArrays:
         literal_impact=model.formulation == "absolute", impulse_dir=impulse_dir,
         impulse_w=impulse_w, centre_map=model.centre_map, masses=col.masses.astype(float),
         normal_forces=col.normal_forces.astype(float), uplift_level=float(uplift),
-        rest_rate=float(rest_rate), barrier=float(barrier), G=G, gx=G[:n], gc=G[3 * n :],
+        rest_rate=float(rest_rate), barrier=float(barrier), event_rows=event_rows,
+        gx=event_rows[:n], gc=event_rows[3 * n :],
         same=bool(same), md=md, mg=mg, track=track, es=es,
     )  # fmt: skip
 

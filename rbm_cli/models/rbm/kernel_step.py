@@ -9,6 +9,7 @@ import numpy as np
 from numba import njit
 
 from rbm_cli.base.detmath import matvec, pow_pos
+from rbm_cli.models.events import BIG, EVENT_EPS
 from rbm_cli.models.rbm.kernel_events import (
     CHECK_INTERVALS,
     _affine,
@@ -53,7 +54,6 @@ from rbm_cli.models.rbm.kernel_rk import (
     _rk_attempt,
 )
 from rbm_cli.models.rbm.kernel_state import IMPACT, REST, UPLIFT, switch
-from rbm_cli.models.rbm.python import BIG, EVENT_EPS
 
 
 @njit(cache=True)
@@ -110,8 +110,8 @@ def run_kernel(model, motion, solver, task):
     awaiting = np.zeros(n, dtype=np.bool_)
     lo, hi = np.empty(n), np.empty(n)
     nt = n + 1
-    G, gx, gc, same, md, mg, track, es = (model.G, model.gx, model.gc, model.same, model.md,
-                                          model.mg, model.track, model.es)  # fmt: skip
+    event_rows, gx, gc, same = model.event_rows, model.gx, model.gc, model.same
+    md, mg, track, es = model.md, model.mg, model.track, model.es
     peaks = np.zeros(nt)
     As, cs = np.empty((n, n)), np.empty(n)
     h0 = np.empty(4 * n)
@@ -285,9 +285,9 @@ def run_kernel(model, motion, solver, task):
                     n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
                                             cs, es, amp, omega, phase)  # fmt: skip
                     dense_ready = True
-                    t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, G, h0, n, Dq,
-                                                     Rq, dc0, dc1, rc0, rc1, near, CP, BP, CR,
-                                                     BR)  # fmt: skip
+                    t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, event_rows, h0,
+                                                     n, Dq, Rq, dc0, dc1, rc0, rc1, near, CP,
+                                                     BP, CR, BR)  # fmt: skip
                 if event_row >= 0:
                     _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e

@@ -5,6 +5,7 @@ kernel (default) or the readable Python loop, two implementations of the same in
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 
@@ -115,6 +116,7 @@ class RbmRunner:
         n = self.model.n
         self.theta0 = np.zeros(n) if not init.rotations else np.asarray(init.rotations, float)
         self.rate0 = np.zeros(n) if not init.velocities else np.asarray(init.velocities, float)
+        self._prepared = None  # the compiled kernel's inputs, made on the first compiled run
 
     def run(
         self,
@@ -127,7 +129,11 @@ class RbmRunner:
     ) -> Outcome:
         """One run (rbm_cli.models.contract.Runner.run)."""
         if solver.implementation == "compiled":
-            from rbm_cli.models.rbm.kernel import integrate_compiled as integrator
+            from rbm_cli.models.rbm.kernel import integrate_compiled, prepare_kernel
+
+            if self._prepared is None:  # the kernel's arrays of this column, made once
+                self._prepared = prepare_kernel(self.model)
+            integrator = partial(integrate_compiled, prepared=self._prepared)
         else:
             from rbm_cli.models.rbm.python import integrate as integrator
         n = self.model.n

@@ -26,8 +26,8 @@ import math
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 
-from rbm_cli.config.types import Config, G, SolverConfig
-from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
+from rbm_cli.config.types import G, SolverConfig
+from rbm_cli.models.block_runner import BlockRunner
 from rbm_cli.models.events import EVENT_EPS, REST_RATE, first_crossing, hermite_dip
 from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun, Recorder
 from rbm_cli.models.housner_steps import (
@@ -38,11 +38,8 @@ from rbm_cli.models.housner_steps import (
     peak_in_step,
 )
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.result import history_from_samples
 from rbm_cli.physics.block import (
     BlockGeometry,
-    block_geometry,
-    block_initial,
     housner_energy,
     top_displacement,
 )
@@ -312,42 +309,17 @@ def _fail(out: Outcome, message: str) -> Outcome:
     return out
 
 
-class HousnerRunner:
+class HousnerRunner(BlockRunner):
     """`housner` (rbm_cli.models.contract.Runner): the config's monolithic column as Housner's
     rigid block, with its true geometry (rbm_cli.physics.block)."""
 
-    n_interfaces = 1
-
-    def __init__(self, config: Config) -> None:
-        self.config = config
-        self.geometry = block_geometry(config.column)
-        self.restitution = resolve(
-            config.interface.restitution, lambda: block_restitution(self.geometry)
-        )
-        self.initial = block_initial(config)
-        self.node_map = np.array([[0.0], [config.column.height]])
-
-    def run(
-        self,
-        motion: GroundMotion,
-        solver: SolverConfig,
-        *,
-        record: bool = False,
-        output_dt: float = DEFAULT_OUTPUT_DT,
-        early_stop: bool = True,
-    ) -> Outcome:
-        """One run (rbm_cli.models.contract.Runner.run)."""
-        out = housner_run(
+    def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
+        return housner_run(
             self.geometry,
             motion,
             solver=solver,
             restitution=self.restitution,
             collapse_ratio=self.config.collapse.ratio,
-            record=record,
-            output_dt=output_dt,
             initial=self.initial,
-            early_stop=early_stop,
+            **options,
         )
-        if record:
-            out.history = history_from_samples(self.node_map, motion, out.samples)
-        return out

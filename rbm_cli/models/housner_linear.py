@@ -26,16 +26,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rbm_cli.config.types import Config, G, SolverConfig
-from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
+from rbm_cli.config.types import G, SolverConfig
+from rbm_cli.models.block_runner import BlockRunner
 from rbm_cli.models.events import EVENT_EPS, REST_RATE
 from rbm_cli.models.housner_linear_piece import LinearPiece, PieceScanner, Scan
 from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.result import history_from_samples
-from rbm_cli.physics.block import block_geometry, block_initial
 from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.restitution import block_restitution, resolve
 
 #: Samples per scanning chunk of a closed-form piece.
 _CHUNK = 64
@@ -320,43 +317,19 @@ def housner_linear_run(
     return finish()
 
 
-class HousnerLinearRunner:
+class HousnerLinearRunner(BlockRunner):
     """`housner-linear` (rbm_cli.models.contract.Runner): the config's monolithic column as
-    Spanos and Koh's piecewise-linear block (true geometry), integrated in closed form."""
+    Spanos and Koh's piecewise-linear block (true geometry), integrated in closed form
+    (`solver` is unused)."""
 
-    n_interfaces = 1
-
-    def __init__(self, config: Config) -> None:
-        self.config = config
-        self.geometry = block_geometry(config.column)
-        self.restitution = resolve(
-            config.interface.restitution, lambda: block_restitution(self.geometry)
-        )
-        self.initial = block_initial(config)
-        self.node_map = np.array([[0.0], [config.column.height]])
-
-    def run(
-        self,
-        motion: GroundMotion,
-        solver: SolverConfig,
-        *,
-        record: bool = False,
-        output_dt: float = DEFAULT_OUTPUT_DT,
-        early_stop: bool = True,
-    ) -> Outcome:
-        """One run (rbm_cli.models.contract.Runner.run); closed form, so `solver` is unused."""
-        out = housner_linear_run(
+    def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
+        return housner_linear_run(
             self.geometry.slenderness,
             self.geometry.frequency_parameter,
             motion,
             restitution=self.restitution,
             collapse_ratio=self.config.collapse.ratio,
-            record=record,
-            output_dt=output_dt,
             height=self.config.column.height,
             initial=self.initial,
-            early_stop=early_stop,
+            **options,
         )
-        if record:
-            out.history = history_from_samples(self.node_map, motion, out.samples)
-        return out

@@ -11,9 +11,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from rbm_cli.models.result import History
+from rbm_cli.report.shape_geometry import base_slip, drum_outlines, round_factor
 
 #: Target of the shape exaggeration: largest drawn top displacement / height.
 SHAPE_TARGET_RATIO = 0.25
+#: Largest drawn drum rotation s |theta_i| the exaggeration allows [rad].
+SHAPE_MAX_ANGLE = 0.35
 
 
 def _new_axes(ax):
@@ -123,17 +126,33 @@ def infer_elevations(history: History) -> np.ndarray:
 
 
 def exaggeration_factor(history: History, times_index: Sequence[int], height: float) -> float:
-    """Displacement scale of a shapes plot.
+    """Displacement scale of a shapes plot: a round number (1, 2, 5, 10, 20, 50, ...).
 
-    The largest top displacement (relative to the base) at the drawn instants
-    becomes ~25% of the height, but the factor is never below 1.
+    The largest round factor s (never below 1) that keeps, at the drawn
+    instants, the largest top displacement relative to the base within
+    SHAPE_TARGET_RATIO of the height and every drawn drum rotation s |theta_i|
+    within SHAPE_MAX_ANGLE (a drum drawn on its side would mislead).
     """
     top = np.abs(top_relative_displacement(history))
+    theta = np.abs(np.atleast_2d(np.asarray(history.rotations, dtype=float)))
     idx = list(times_index)
     peak = float(np.max(top[idx])) if idx else 0.0
+    angle = float(np.max(theta[idx])) if idx else 0.0
     if not np.isfinite(peak) or peak <= 0.0:
         return 1.0
-    return max(1.0, SHAPE_TARGET_RATIO * height / peak)
+    target = SHAPE_TARGET_RATIO * height / peak
+    if np.isfinite(angle) and angle > 0.0:
+        target = min(target, SHAPE_MAX_ANGLE / angle)
+    return round_factor(target)
+
+
+def _shape_label(t: float, t_collapse: float | None, slip: float) -> str:
+    label = f"t = {t:.3g} s"
+    if slip != 0.0:
+        label += f"\nslip {1e3 * slip:+.3g} mm"
+    if t_collapse is not None and np.isfinite(t_collapse) and t >= t_collapse - 1e-12:
+        label += "\n(collapse)"
+    return label
 
 
 def plot_shapes(
@@ -146,7 +165,7 @@ def plot_shapes(
     scale: float | None = None,
     t_collapse: float | None = None,
 ):
-    """Deformed column, to scale, at chosen instants side by side (paper fig. 3).
+    """Deformed column at chosen instants side by side (paper fig. 3), rotations exaggerated.
 
     Parameters
     ----------
@@ -157,17 +176,27 @@ def plot_shapes(
     ax : matplotlib Axes, optional
     elevations : (n+1,), optional  Node elevations z_i [m]; inferred from the
         history if omitted (see :func:`infer_elevations`)
-    scale : float, optional  Displacement exaggeration; default from
-        :func:`exaggeration_factor`
+    scale : float, optional  Exaggeration s [-]; default from
+        :func:`exaggeration_factor` (a round number)
     t_collapse : float, optional  Collapse time [s]; the instant at or after
         it is labelled "collapse"
 
+    Returns
+    -------
+    matplotlib Axes; its patches are the drums (gid 'drum', instant by instant,
+    bottom drum first), the title states the exaggeration.
+
     Notes
     -----
-    Drum i is drawn as the quadrilateral of its end widths whose axis goes from
-    node i at (s u_i, z_i) to node i+1 at (s u_{i+1}, z_{i+1}), s the
-    exaggeration and u relative to the ground; its faces stay horizontal, as
-    in the small-displacement RBM.
+    Drum i is drawn rigid, turned by s theta_i about the corner it rocks on,
+    which sits on the corner of the drum below, so an open joint shows as a
+    wedge (:func:`rbm_cli.report.shape_geometry.drum_outlines`: exact for drums
+    rocking without sliding, and equal to the RBM's node displacements to first
+    order). A base that moves on the ground (a contact engine's history) is
+    drawn displaced by s times its slip (:func:`~rbm_cli.report.shape_geometry.base_slip`);
+    the slip of upper joints is not drawn. Heights are to scale; the x axis has
+    no scale of its own (the instants stand side by side, each over its rest
+    position, marked by a tick on the ground).
     """
     from matplotlib.patches import Polygon
 
@@ -179,39 +208,101 @@ def plot_shapes(
     height = float(z[-1] - z[0])
     idx = [int(k) for k in times_index]
     s = exaggeration_factor(history, idx, height) if scale is None else float(scale)
-    u = np.atleast_2d(np.asarray(history.node_displacements, dtype=float))
+    theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
     t = np.asarray(history.t, dtype=float)
+    slip = base_slip(history.node_displacements, theta[:, 0], float(widths[0]))
 
-    drawn = s * u[idx] if idx else np.zeros((0, z.size))
-    reach = float(np.max(np.abs(drawn))) if drawn.size else 0.0
-    pitch = 1.4 * float(np.max(widths)) + 2.0 * reach + 0.1 * height
-    n = z.size - 1
+    shapes = [drum_outlines(s * theta[k], widths, np.diff(z), s * slip[k]) for k in idx]
+    reach = max([float(np.max(np.abs(np.vstack(o)[:, 0]))) for o in shapes] or [0.0])
+    pitch = 2.0 * max(reach, 0.5 * float(np.max(widths))) + 0.15 * height
     colors = ("#c9b79c", "#b39d7d")
-    for j, k in enumerate(idx):
+    for j, (k, outlines) in enumerate(zip(idx, shapes, strict=True)):
         x0 = j * pitch
-        for i in range(n):
-            xb, xt = x0 + s * u[k, i], x0 + s * u[k, i + 1]
-            corners = [
-                (xb - widths[i] / 2, z[i]),
-                (xb + widths[i] / 2, z[i]),
-                (xt + widths[i + 1] / 2, z[i + 1]),
-                (xt - widths[i + 1] / 2, z[i + 1]),
-            ]
+        for i, corners in enumerate(outlines):
             ax.add_patch(
                 Polygon(
-                    corners, closed=True, facecolor=colors[i % 2], edgecolor="0.2", linewidth=0.8
+                    corners + [x0, z[0]],
+                    closed=True,
+                    facecolor=colors[i % 2],
+                    edgecolor="0.2",
+                    linewidth=0.8,
+                    gid="drum",
                 )
             )
         ax.plot([x0 - pitch / 2.2, x0 + pitch / 2.2], [z[0], z[0]], color="0.3", linewidth=1.2)
-        label = f"t = {t[k]:.3g} s"
-        if t_collapse is not None and np.isfinite(t_collapse) and t[k] >= t_collapse - 1e-12:
-            label += "\n(collapse)"
+        ax.plot([x0, x0], [z[0], z[0] - 0.02 * height], color="0.3", linewidth=1.0)
+        label = _shape_label(float(t[k]), t_collapse, float(slip[k]))
         ax.text(x0, z[0] - 0.04 * height, label, ha="center", va="top", fontsize="small")
 
     ax.set_xlim(-pitch / 2, (max(len(idx), 1) - 0.5) * pitch)
-    ax.set_ylim(z[0] - 0.2 * height, z[-1] + 0.05 * height)
+    ax.set_ylim(z[0] - 0.22 * height, z[-1] + 0.05 * height)
     ax.set_aspect("equal")
-    ax.set_xlabel("horizontal position [m] (columns side by side)")
+    ax.set_xticks([])
     ax.set_ylabel("height [m]")
-    ax.set_title(f"Deformed shapes, displacements exaggerated x{s:.3g}")
+    ax.set_title(f"Deformed shapes: rotations{' and slip' if np.any(slip) else ''} drawn x{s:g}")
+    return ax
+
+
+def plot_joint_rotations(
+    history: History,
+    rotation_capacity: Sequence[float],
+    ax=None,
+    *,
+    formulation: str = "relative",
+    collapse_ratio: float = 1.0,
+    t_collapse: float | None = None,
+):
+    """Each joint's rotation over its limit against time, with the collapse level.
+
+    Parameters
+    ----------
+    history : History  Recorded run
+    rotation_capacity : (n,) theta_u,i [rad] (``Column.rotation_capacity``)
+    ax : matplotlib Axes, optional
+    formulation : str  'relative' or 'geometric': the joint's relative rotation
+        phi_i = theta_i - theta_{i-1} (theta_0 = 0); 'absolute': theta_i
+    collapse_ratio : float  The config's collapse.ratio c: dashed lines at +-c
+    t_collapse : float, optional  Collapse time [s], drawn as a dashed line
+
+    Returns
+    -------
+    matplotlib Axes; line k (gid 'joint-<k+1>') is joint k+1's rotation / theta_u,k+1 [-]
+    """
+    ax = _new_axes(ax)
+    theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
+    limits = np.asarray(rotation_capacity, dtype=float)
+    if limits.shape != (theta.shape[1],):
+        n = theta.shape[1]
+        raise ValueError(f"rotation_capacity has {limits.size} entries, the history {n} drums")
+    if formulation == "absolute":
+        angle, symbol = theta, r"\theta_i"
+    else:
+        angle, symbol = np.diff(theta, axis=1, prepend=0.0), r"\varphi_i"
+    from matplotlib import colormaps
+
+    colours = colormaps["viridis"](np.linspace(0.0, 0.85, theta.shape[1]))
+    t = np.asarray(history.t, dtype=float)
+    for i in range(theta.shape[1]):
+        ax.plot(
+            t,
+            angle[:, i] / limits[i],
+            color=colours[i],
+            linewidth=1.0,
+            label=f"joint {i + 1}",
+            gid=f"joint-{i + 1}",
+        )
+    for sign in (1.0, -1.0):
+        ax.axhline(
+            sign * collapse_ratio,
+            color="tab:red",
+            linestyle=":",
+            linewidth=1.0,
+            label="collapse limit" if sign > 0 else None,
+            gid="limit",
+        )
+    _mark_collapse(ax, t_collapse)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(rf"${symbol}/\theta_{{u,i}}$ [-]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small", borderaxespad=0.0)
     return ax

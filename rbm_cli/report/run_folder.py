@@ -112,21 +112,78 @@ def run_summary(
     return json_ready(summary)
 
 
-def _history_figure(history: History, t_collapse: float | None):
+def run_title(summary: dict) -> str | None:
+    """'<config name>: A = <a> g, f = <f> Hz' (or ': free motion') from a summary.json
+    made by :func:`run_summary`; None if the summary does not hold them."""
+    try:
+        name = summary["config_written"]["name"]
+        inputs = summary["inputs"]
+        kind = summary["config_written"].get("excitation", {}).get("type", "harmonic")
+        if kind == "free":
+            return f"{name}: free motion"
+        amplitude, frequency = float(inputs["amplitude_g"]), float(inputs["frequency_hz"])
+        cell = f"A = {amplitude:.4g} g, f = {frequency:.4g} Hz"
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return None
+    return f"{name} ({kind}): {cell}"
+
+
+def _run_column(summary: dict):
+    """(Column, formulation, collapse ratio) of the config a summary.json holds, or None."""
+    from rbm_cli.base.errors import RbmError
+    from rbm_cli.config.load import parse_config
+    from rbm_cli.physics.column import build_column
+
+    try:
+        config = parse_config(summary["config_written"])
+        column = build_column(config.column, config.interface)
+    except (KeyError, TypeError, ValueError, RbmError):
+        return None
+    return column, config.interface.formulation, config.collapse.ratio
+
+
+def _history_figure(
+    history: History,
+    t_collapse: float | None,
+    title: str | None = None,
+    joints: tuple | None = None,
+):
+    """history.png: base and top displacement, top relative to base, and for more than
+    one drum each joint's rotation over its limit (``joints`` = (Column, formulation,
+    collapse ratio), see :func:`rbm_cli.report.plots.plot_joint_rotations`)."""
     from matplotlib.figure import Figure
 
-    from rbm_cli.report.plots import plot_history, plot_top_relative
+    from rbm_cli.report.plots import plot_history, plot_joint_rotations, plot_top_relative
 
-    fig = Figure(figsize=(8.0, 6.0))
-    ax_abs, ax_rel = fig.subplots(2, 1, sharex=True)
-    plot_history(history, ax=ax_abs, t_collapse=t_collapse)
-    plot_top_relative(history, ax=ax_rel, t_collapse=t_collapse)
-    ax_abs.set_xlabel("")
+    multi = joints is not None and joints[0].n > 1
+    fig = Figure(figsize=(9.0, 8.5 if multi else 6.0))
+    axes = fig.subplots(3 if multi else 2, 1, sharex=True)
+    plot_history(history, ax=axes[0], t_collapse=t_collapse)
+    plot_top_relative(history, ax=axes[1], t_collapse=t_collapse)
+    if multi:
+        column, formulation, ratio = joints
+        plot_joint_rotations(
+            history,
+            column.rotation_capacity,
+            ax=axes[2],
+            formulation=formulation,
+            collapse_ratio=ratio,
+            t_collapse=t_collapse,
+        )
+        axes[2].set_title("joint rotations against their limits", fontsize="medium")
+    for ax in axes[:-1]:
+        ax.set_xlabel("")
+    for ax in axes:  # legends beside the axes, so every panel has the same width
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small")
+    if title:
+        fig.suptitle(title)
     fig.tight_layout()
     return fig
 
 
-def _shapes_figure(history: History, widths, elevations, t_collapse: float | None):
+def _shapes_figure(
+    history: History, widths, elevations, t_collapse: float | None, title: str | None = None
+):
     from matplotlib.figure import Figure
 
     from rbm_cli.report.plots import plot_shapes
@@ -141,6 +198,11 @@ def _shapes_figure(history: History, widths, elevations, t_collapse: float | Non
         elevations=elevations,
         t_collapse=t_collapse,
     )
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    fig.set_size_inches(10.0, float(np.clip(9.0 * (y1 - y0) / (x1 - x0) + 1.0, 3.0, 8.0)))
+    if title:
+        fig.suptitle(title)
     fig.tight_layout()
     return fig
 
@@ -167,7 +229,8 @@ def write_run(
     name : str  Config name (second level of the output tree)
     folder : str  Run folder name, see :func:`run_folder_name`
     result : RunResult  A run with its history recorded
-    summary : dict  Contents of summary.json
+    summary : dict  Contents of summary.json; when made by :func:`run_summary`, the
+        figures' title (config and cell) and the column's rotation limits come from it
     widths : (n+1,) Column widths at the nodes [m]
     elevations : (n+1,) Node elevations [m]
 
@@ -197,9 +260,11 @@ def write_run(
         raise OutputError(f"cannot write in output folder {parent}: {exc.strerror}") from None
     try:
         write_csv_atomic(staging / "history.csv", history_frame(result.history))
-        save_figure_atomic(_history_figure(result.history, t_collapse), staging / "history.png")
+        title = run_title(summary)
+        figure = _history_figure(result.history, t_collapse, title, _run_column(summary))
+        save_figure_atomic(figure, staging / "history.png")
         save_figure_atomic(
-            _shapes_figure(result.history, widths, elevations, t_collapse),
+            _shapes_figure(result.history, widths, elevations, t_collapse, title),
             staging / "shapes.png",
         )
         write_json_atomic(staging / "summary.json", summary)

@@ -44,6 +44,8 @@ def domain_figure(
     ax = fig.add_subplot()
     if config is None:  # a domain without its config: no column, no curves of it
         plot_domain(df, ax=ax, compare=compare, labels=labels)
+        if labels:
+            ax.set_title(f"{labels[0]}: safe-unsafe domain")
         fig.tight_layout()
         return fig
     column = build_column(config.column, config.interface)
@@ -58,6 +60,6 @@ def domain_figure(
         static_multiplier=level,
         static_label=level_label,
     )
-    ax.set_title(f"{config.name}: safe (o) / unsafe (x) domain")
+    ax.set_title(f"{config.name}: safe-unsafe domain ({config.excitation.type})")
     fig.tight_layout()
     return fig

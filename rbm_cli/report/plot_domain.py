@@ -22,8 +22,19 @@ __all__ = ["boundary", "plot_domain"]
 
 #: Colours of compared domains' boundaries (the main boundary is black).
 COMPARE_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")
-#: Colour map of the collapse fraction of ensemble sweeps.
-FRACTION_CMAP = "viridis"
+#: Colour map of the collapse fraction of ensemble sweeps, and the part of it used: plasma
+#: without its light yellow end, so every mark stays visible on white.
+FRACTION_CMAP = ("plasma", 0.0, 0.82)
+#: Legend and colour-bar wording of ensemble domains.
+FRACTION_LABEL = "fraction of ensemble members that collapsed [-]"
+#: Legend title of ensemble domains: what marker and colour say.
+FRACTION_TITLE = "marker: member 0's outcome\ncolour: fraction collapsed"
+#: Label of the boundary line of a domain.
+BOUNDARY_LABEL = "boundary (lowest collapsed amplitude)"
+#: Marker size range [points] and its share of the grid spacing on screen.
+MARKER_MAX, MARKER_MIN, MARKER_SHARE = 5.0, 1.5, 0.75
+#: z-order of the cells: above the boundary and level lines.
+CELL_Z = 3
 #: Points of the closed-form curves over the frequency range.
 CURVE_POINTS = 300
 
@@ -36,6 +47,37 @@ def _new_axes(ax):
     return Figure(figsize=(7, 5)).subplots()
 
 
+def _fraction_cmap():
+    from matplotlib import colormaps
+    from matplotlib.colors import ListedColormap
+
+    name, lo, hi = FRACTION_CMAP
+    return ListedColormap(colormaps[name](np.linspace(lo, hi, 256)), name=f"{name}-dark")
+
+
+def marker_size(ax, df: pd.DataFrame) -> float:
+    """Marker size [points] of the cells: MARKER_SHARE of the smaller on-screen spacing of
+    the grid's distinct frequencies and amplitudes, within [MARKER_MIN, MARKER_MAX].
+
+    The spacing is estimated from the axes' size in the figure and the ranges of the grid."""
+    bbox = ax.get_position()
+    width_in, height_in = ax.figure.get_size_inches()
+    points = []
+    for column, extent in (
+        ("frequency_hz", bbox.width * width_in),
+        ("amplitude_g", bbox.height * height_in),
+    ):
+        values = np.unique(df[column].to_numpy(float))
+        values = values[np.isfinite(values)]
+        if values.size > 1:
+            span = 1.1 * (values[-1] - values[0]) if column == "frequency_hz" else 1.06 * values[-1]
+            step = float(np.min(np.diff(values)))
+            points.append(72.0 * extent * step / span)
+    if not points:
+        return MARKER_MAX
+    return float(np.clip(MARKER_SHARE * min(points), MARKER_MIN, MARKER_MAX))
+
+
 def _masks(df: pd.DataFrame):
     """Boolean masks of the safe, unsafe and failed cells."""
     status = df["status"].astype(str)
@@ -45,97 +87,61 @@ def _masks(df: pd.DataFrame):
 
 
 def _plot_cells(ax, df: pd.DataFrame) -> None:
-    """Safe cells as open circles, unsafe as crosses, failed as grey squares."""
+    """Safe cells as open circles, unsafe as crosses, failed as grey squares, above the lines."""
     f = df["frequency_hz"].to_numpy(float)
     a = df["amplitude_g"].to_numpy(float)
     safe, unsafe, failed = _masks(df)
-    style = dict(linestyle="none", markersize=5)
-    ax.plot(
-        f[safe],
-        a[safe],
-        marker="o",
-        markerfacecolor="none",
-        color="tab:green",
-        label="safe (survived)",
-        gid="safe",
-        **style,
-    )
-    ax.plot(
-        f[unsafe],
-        a[unsafe],
-        marker="x",
-        color="tab:red",
-        label="unsafe (collapsed)",
-        gid="unsafe",
-        **style,
-    )
+    style = dict(linestyle="none", markersize=marker_size(ax, df), zorder=CELL_Z)
+    ax.plot(f[safe], a[safe], marker="o", markerfacecolor="none", color="tab:green",
+            label="safe (survived)", gid="safe", **style)  # fmt: skip
+    ax.plot(f[unsafe], a[unsafe], marker="x", color="tab:red", label="unsafe (collapsed)",
+            gid="unsafe", **style)  # fmt: skip
     if failed.any():
-        ax.plot(
-            f[failed],
-            a[failed],
-            marker="s",
-            color="0.55",
-            label="failed run",
-            gid="failed",
-            **style,
-        )
+        ax.plot(f[failed], a[failed], marker="s", color="0.45", label="failed run",
+                gid="failed", **style)  # fmt: skip
 
 
 def _plot_fraction_cells(ax, df: pd.DataFrame) -> list:
-    """Cells coloured by the ensemble's collapse fraction, with a colour bar.
+    """Cells of an ensemble domain: the marker is member 0's outcome (the domain's row),
+    the colour the fraction of members that collapsed, with a colour bar.
 
-    Returns grey legend proxies of the markers (the points' colours vary).
-    """
-    from matplotlib import colormaps
+    Returns dark legend proxies of the markers (the points' colours vary)."""
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
     from matplotlib.lines import Line2D
 
-    cmap, norm = colormaps[FRACTION_CMAP], Normalize(0.0, 1.0)
+    cmap, norm = _fraction_cmap(), Normalize(0.0, 1.0)
     f = df["frequency_hz"].to_numpy(float)
     a = df["amplitude_g"].to_numpy(float)
     frac = df["collapse_fraction"].to_numpy(float)
     safe, unsafe, failed = _masks(df)
     colours = cmap(norm(np.nan_to_num(frac, nan=0.0)))
-    ax.scatter(
-        f[safe],
-        a[safe],
-        marker="o",
-        facecolors="none",
-        edgecolors=colours[safe],
-        s=28,
-        linewidths=1.2,
-        gid="safe",
-    )
-    ax.scatter(
-        f[unsafe], a[unsafe], marker="x", c=colours[unsafe], s=28, linewidths=1.2, gid="unsafe"
-    )
-    proxy = dict(linestyle="none", color="0.3", markersize=5)
+    size = marker_size(ax, df)
+    width = max(0.6, size / 4.0)
+    ax.scatter(f[safe], a[safe], marker="o", facecolors="none", edgecolors=colours[safe],
+               s=size**2, linewidths=width, gid="safe", zorder=CELL_Z)  # fmt: skip
+    ax.scatter(f[unsafe], a[unsafe], marker="x", c=colours[unsafe], s=size**2,
+               linewidths=width, gid="unsafe", zorder=CELL_Z)  # fmt: skip
+    proxy = dict(linestyle="none", color="0.2", markersize=5)
     handles = [
-        Line2D([], [], marker="o", markerfacecolor="none", label="safe (survived)", **proxy),
-        Line2D([], [], marker="x", label="unsafe (collapsed)", **proxy),
+        Line2D([], [], marker="o", markerfacecolor="none", label="member 0 survived", **proxy),
+        Line2D([], [], marker="x", label="member 0 collapsed", **proxy),
     ]
     if failed.any():
-        ax.scatter(f[failed], a[failed], marker="s", c="0.55", s=22, gid="failed")
-        handles.append(Line2D([], [], marker="s", label="failed run", **{**proxy, "color": "0.55"}))
+        ax.scatter(f[failed], a[failed], marker="s", c="0.45", s=(0.8 * size) ** 2,
+                   gid="failed", zorder=CELL_Z)  # fmt: skip
+        handles.append(Line2D([], [], marker="s", label="failed run", **{**proxy, "color": "0.45"}))
     # below the axes: the legend sits beside them
-    ax.figure.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, label="collapse fraction [-]",
+    ax.figure.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, label=FRACTION_LABEL,
                        location="bottom", pad=0.16, fraction=0.06, aspect=40)  # fmt: skip
     return handles
 
 
 def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str) -> None:
+    """The boundary as a line under the cells (no markers of its own)."""
     bnd = boundary(df)
-    ax.plot(
-        bnd["frequency_hz"].to_numpy(float),
-        bnd["lowest_unsafe_g"].to_numpy(float),
-        color=colour,
-        marker=".",
-        linewidth=1.4,
-        markersize=6,
-        label=label,
-        gid=gid,
-    )
+    ax.plot(bnd["frequency_hz"].to_numpy(float), bnd["lowest_unsafe_g"].to_numpy(float),
+            color=colour, linewidth=1.4, label=label, gid=gid, zorder=2)  # fmt: skip
 
 
 def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
@@ -163,16 +169,21 @@ def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
 
 
 def _labels(labels: Sequence[str] | None, n_compare: int) -> list[str]:
-    """The legend labels of the boundaries: the domain's, then one per compared domain."""
+    """The legend labels of the boundaries: the domain's, then one per compared domain.
+
+    Alone, the domain's line is the BOUNDARY_LABEL (what the line is; the figure's title
+    names the study). With compared domains each line is '<name>: boundary'."""
     if labels is None:
-        return ["boundary"] + [f"boundary, domain {k + 2}" for k in range(n_compare)]
+        labels = ["domain 1"] + [f"domain {k + 2}" for k in range(n_compare)]
     labels = list(labels)
     if len(labels) != 1 + n_compare:
         raise ValueError(
             f"labels needs {1 + n_compare} entries (the domain, then one per compared "
             f"domain), got {len(labels)}"
         )
-    return labels
+    if n_compare == 0:
+        return [BOUNDARY_LABEL]
+    return [f"{name}: boundary" for name in labels]
 
 
 def _finish_axes(ax, domains: list, static_multiplier: float | None, proxies: list) -> None:
@@ -187,6 +198,8 @@ def _finish_axes(ax, domains: list, static_multiplier: float | None, proxies: li
     ax.grid(True, alpha=0.3)
     handles, texts = ax.get_legend_handles_labels()
     ax.legend(
+        title=FRACTION_TITLE if proxies else None,
+        title_fontsize="small",
         handles=proxies + handles,
         labels=[h.get_label() for h in proxies] + texts,
         loc="upper left",
@@ -268,7 +281,13 @@ def plot_domain(
     Notes
     -----
     Safe cells are open circles, unsafe (collapsed) cells crosses, failed runs
-    grey squares (in the legend only if there are any). The boundary is the
+    grey squares (in the legend only if there are any), drawn above the lines and
+    sized to the grid's spacing on screen (:func:`marker_size`). In an ensemble
+    domain the marker is member 0's outcome (the row's status) and the colour the
+    fraction of members that collapsed (a colour map without a light end, so
+    every mark shows on white), as the legend's title and the colour bar say.
+    Alone, the domain's line is labelled "boundary (lowest collapsed amplitude)";
+    with compared domains each line is "<label>: boundary". The boundary is the
     lowest collapsed amplitude per frequency (:func:`rbm_cli.study.domain.boundary`;
     gaps where nothing collapses). The closed forms use the mapping of SPEC
     section 2 (:func:`rbm_cli.physics.closed_forms.linear_rocking_parameters`): the

@@ -141,7 +141,7 @@ def test_compared_boundaries_have_labels_and_colours():
     np.testing.assert_allclose(line.get_ydata(), [0.2, 0.3, 0.5, np.nan, np.nan], equal_nan=True)
     assert line.get_color() != _line(ax, "boundary").get_color()
     texts = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert "RBM" in texts and "housner-linear" in texts
+    assert "RBM: boundary" in texts and "housner-linear: boundary" in texts
     with pytest.raises(ValueError, match="labels"):
         plot_domain(main, compare=[other], labels=["only one"])
 
@@ -210,7 +210,7 @@ def test_collapse_fraction_colours_points_with_colourbar():
     assert len(failed.get_offsets()) == 1
     assert len(fig.axes) == 2  # the colour bar
     cbar = fig.axes[1]  # below the axes (horizontal): the label is on its x axis
-    assert cbar.get_xlabel() == "collapse fraction [-]"
+    assert cbar.get_xlabel() == "fraction of ensemble members that collapsed [-]"
     # colours follow the fraction: collapsed cells (fraction 1) share one colour
     assert len(np.unique(np.asarray(unsafe.get_facecolors()), axis=0)) == 1
     assert len(np.unique(np.asarray(safe.get_edgecolors()), axis=0)) > 1
@@ -240,3 +240,56 @@ def test_rendered_png_is_written_only_where_asked(tmp_path_factory):
     image = plt.imread(str(out))
     assert image.shape[:2] == (5 * fig.dpi, 7 * fig.dpi)
     assert len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 10
+
+
+# --------------------------------------------------------------------------- readability
+def test_a_lone_boundary_is_labelled_by_what_it_is_not_by_a_file_name():
+    ax = plot_domain(synthetic_domain(), labels=["spanos_koh_slender"])
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "boundary (lowest collapsed amplitude)" in texts
+    assert not any("spanos_koh_slender" in t for t in texts)
+
+
+@pytest.mark.parametrize("fraction", [False, True])
+def test_cells_are_drawn_above_the_boundary_and_level_lines(fraction):
+    ax = plot_domain(synthetic_domain(fraction=fraction), static_multiplier=0.2)
+    cells = [a.get_zorder() for g in ("safe", "unsafe") for a in _by_gid(ax, g)]
+    lines = [_line(ax, "boundary").get_zorder(), _line(ax, "static").get_zorder()]
+    assert min(cells) > max(lines)
+
+
+def test_ensemble_legend_says_marker_is_member_0_and_colour_the_fraction():
+    ax = plot_domain(synthetic_domain(fraction=True))
+    legend = ax.get_legend()
+    texts = [t.get_text() for t in legend.get_texts()]
+    assert "member 0 survived" in texts and "member 0 collapsed" in texts
+    title = legend.get_title().get_text()
+    assert "member 0" in title and "fraction" in title
+
+
+def test_every_ensemble_mark_is_dark_enough_to_see_on_white():
+    """Relative luminance of every drawn colour below 0.6 (white is 1; viridis's yellow 0.8)."""
+    ax = plot_domain(synthetic_domain(fraction=True))
+    colours = np.vstack([ax.collections[0].get_edgecolors(), ax.collections[1].get_facecolors()])
+    rgb = colours[:, :3]
+    lin = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    luminance = lin @ [0.2126, 0.7152, 0.0722]
+    assert luminance.max() < 0.6
+
+
+def test_markers_shrink_with_a_denser_grid():
+    """Marker size follows the grid spacing: a 30 x 59 grid gets smaller marks than 5 x 10,
+    and neighbouring marks do not overlap (size below the spacing in points)."""
+    from rbm_cli.report.plot_domain import marker_size
+
+    fig = Figure(figsize=(9.5, 5))
+    ax = fig.add_subplot()
+    dense = pd.DataFrame(
+        [(a, f) for f in np.linspace(0.1, 3.0, 30) for a in np.linspace(0.05, 3.0, 59)],
+        columns=["amplitude_g", "frequency_hz"],
+    )
+    coarse = synthetic_domain()
+    assert marker_size(ax, dense) < marker_size(ax, coarse)
+    height_pt = ax.get_position().height * 5 * 72
+    spacing_pt = height_pt * (2.95 / 58) / (1.06 * 3.0)
+    assert marker_size(ax, dense) < spacing_pt

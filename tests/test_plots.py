@@ -88,17 +88,19 @@ def test_top_relative_is_top_minus_base():
     np.testing.assert_allclose(ax.get_lines()[0].get_ydata(), expected)
 
 
-def test_exaggeration_is_a_quarter_of_the_height_but_never_below_one():
-    small = synthetic_history(top=0.01)
+def test_exaggeration_is_a_round_number_within_a_quarter_of_the_height():
+    small = synthetic_history(top=0.01)  # 0.25 * 2 m / 0.01 m = 50 exactly: round already
     idx = [10, 49]
-    assert exaggeration_factor(small, idx, 2.0) == pytest.approx(0.25 * 2.0 / 0.01)
+    assert exaggeration_factor(small, idx, 2.0) == pytest.approx(50.0)
+    # 0.25 * 2 / 0.003 = 166.7: the round factor below it is 100
+    assert exaggeration_factor(synthetic_history(top=0.003), idx, 2.0) == pytest.approx(100.0)
     large = synthetic_history(top=1.5)  # already beyond 25 % of the height
     assert exaggeration_factor(large, idx, 2.0) == 1.0
     assert exaggeration_factor(synthetic_history(top=0.0), idx, 2.0) == 1.0
     assert exaggeration_factor(small, [], 2.0) == 1.0
 
 
-def test_shapes_draw_each_drum_from_node_to_node_at_its_widths(three_drum_run):
+def test_shapes_draw_each_drum_rigid_turned_by_its_rotation(three_drum_run):
     _, column, result = three_drum_run
     hist = result.history
     z = np.concatenate([column.bottoms, [column.height]])
@@ -107,25 +109,34 @@ def test_shapes_draw_each_drum_from_node_to_node_at_its_widths(three_drum_run):
     polys = [p for p in ax.patches if isinstance(p, Polygon)]
     assert len(polys) == column.n * len(idx)
     assert "x3" in ax.get_title()
-    # the first instant is drawn at x offset 0: check its drums against the history
-    u = hist.node_displacements[idx[0]]
+    k = idx[0]  # drawn at x offset 0
     for i, poly in enumerate(polys[: column.n]):
         xy = poly.get_xy()[:4]
-        bottom_centre = xy[:2].mean(axis=0)
-        top_centre = xy[2:4].mean(axis=0)
-        assert bottom_centre == pytest.approx([3.0 * u[i], z[i]], abs=1e-12)
-        assert top_centre == pytest.approx([3.0 * u[i + 1], z[i + 1]], abs=1e-12)
-        assert xy[1, 0] - xy[0, 0] == pytest.approx(column.widths[i])
-        assert xy[2, 0] - xy[3, 0] == pytest.approx(column.widths[i + 1])
+        # rigid: the end faces keep their widths and the axis its height
+        assert np.linalg.norm(xy[1] - xy[0]) == pytest.approx(column.widths[i])
+        assert np.linalg.norm(xy[2] - xy[3]) == pytest.approx(column.widths[i + 1])
+        axis = xy[2:4].mean(axis=0) - xy[:2].mean(axis=0)
+        assert np.linalg.norm(axis) == pytest.approx(column.heights[i])
+        # turned by 3 theta_i: the bottom face's slope, and the axis leans the same way
+        face = xy[1] - xy[0]
+        angle = -np.arctan2(face[1], face[0])
+        assert angle == pytest.approx(3.0 * hist.rotations[k, i], abs=1e-12)
+        # nodes where the small-rotation RBM puts them, to first order
+        assert xy[:2].mean(axis=0)[0] == pytest.approx(
+            3.0 * hist.node_displacements[k, i], abs=1e-3 * column.height
+        )
 
 
-def test_shapes_title_states_the_automatic_exaggeration(three_drum_run):
+def test_shapes_title_states_the_automatic_round_exaggeration(three_drum_run):
     _, column, result = three_drum_run
     idx = shape_instants(result.history.t)
     z = np.concatenate([column.bottoms, [column.height]])
     ax = plot_shapes(result.history, column.widths, idx, elevations=z)
     factor = exaggeration_factor(result.history, idx, column.height)
-    assert factor >= 1.0 and f"x{factor:.3g}" in ax.get_title()
+    mantissa = factor / 10.0 ** np.floor(np.log10(factor))
+    assert min(abs(mantissa - m) for m in (1.0, 2.0, 5.0)) < 1e-9
+    assert f"x{factor:g}" in ax.get_title()
+    assert ax.get_xticks().size == 0 and ax.get_ylabel() == "height [m]"
 
 
 def test_elevations_are_recovered_from_the_history(three_drum_run):

@@ -155,6 +155,22 @@ def _shape_label(t: float, t_collapse: float | None, slip: float) -> str:
     return label
 
 
+def _draw_instant(ax, outlines, x0: float, z0: float, pitch: float, height: float, label):
+    """One instant of plot_shapes: its drums, the ground with a tick at the rest position,
+    and the label under it."""
+    from matplotlib.patches import Polygon
+
+    colors = ("#c9b79c", "#b39d7d")
+    for i, corners in enumerate(outlines):
+        ax.add_patch(
+            Polygon(corners + [x0, z0], closed=True, facecolor=colors[i % 2],
+                    edgecolor="0.2", linewidth=0.8, gid="drum")
+        )  # fmt: skip
+    ax.plot([x0 - pitch / 2.2, x0 + pitch / 2.2], [z0, z0], color="0.3", linewidth=1.2)
+    ax.plot([x0, x0], [z0, z0 - 0.02 * height], color="0.3", linewidth=1.0)
+    ax.text(x0, z0 - 0.04 * height, label, ha="center", va="top", fontsize="small")
+
+
 def plot_shapes(
     history: History,
     widths: Sequence[float],
@@ -198,8 +214,6 @@ def plot_shapes(
     no scale of its own (the instants stand side by side, each over its rest
     position, marked by a tick on the ground).
     """
-    from matplotlib.patches import Polygon
-
     ax = _new_axes(ax)
     widths = np.asarray(widths, dtype=float)
     z = infer_elevations(history) if elevations is None else np.asarray(elevations, float)
@@ -215,24 +229,9 @@ def plot_shapes(
     shapes = [drum_outlines(s * theta[k], widths, np.diff(z), s * slip[k]) for k in idx]
     reach = max([float(np.max(np.abs(np.vstack(o)[:, 0]))) for o in shapes] or [0.0])
     pitch = 2.0 * max(reach, 0.5 * float(np.max(widths))) + 0.15 * height
-    colors = ("#c9b79c", "#b39d7d")
     for j, (k, outlines) in enumerate(zip(idx, shapes, strict=True)):
-        x0 = j * pitch
-        for i, corners in enumerate(outlines):
-            ax.add_patch(
-                Polygon(
-                    corners + [x0, z[0]],
-                    closed=True,
-                    facecolor=colors[i % 2],
-                    edgecolor="0.2",
-                    linewidth=0.8,
-                    gid="drum",
-                )
-            )
-        ax.plot([x0 - pitch / 2.2, x0 + pitch / 2.2], [z[0], z[0]], color="0.3", linewidth=1.2)
-        ax.plot([x0, x0], [z[0], z[0] - 0.02 * height], color="0.3", linewidth=1.0)
         label = _shape_label(float(t[k]), t_collapse, float(slip[k]))
-        ax.text(x0, z[0] - 0.04 * height, label, ha="center", va="top", fontsize="small")
+        _draw_instant(ax, outlines, j * pitch, z[0], pitch, height, label)
 
     ax.set_xlim(-pitch / 2, (max(len(idx), 1) - 0.5) * pitch)
     ax.set_ylim(z[0] - 0.22 * height, z[-1] + 0.05 * height)

@@ -129,11 +129,13 @@ def exaggeration_factor(history: History, times_index: Sequence[int], height: fl
     """Displacement scale of a shapes plot: a round number (1, 2, 5, 10, 20, 50, ...).
 
     The largest round factor s (never below 1) that keeps, at the drawn
-    instants, the largest top displacement relative to the base within
-    SHAPE_TARGET_RATIO of the height and every drawn drum rotation s |theta_i|
-    within SHAPE_MAX_ANGLE (a drum drawn on its side would mislead).
+    instants, the largest node displacement relative to the ground (the base's
+    slip included, if the history has one) within SHAPE_TARGET_RATIO of the
+    height and every drawn drum rotation s |theta_i| within SHAPE_MAX_ANGLE (a
+    drum drawn on its side would mislead).
     """
-    top = np.abs(top_relative_displacement(history))
+    u = np.abs(np.atleast_2d(np.asarray(history.node_displacements, dtype=float)))
+    top = np.max(u, axis=1)
     theta = np.abs(np.atleast_2d(np.asarray(history.rotations, dtype=float)))
     idx = list(times_index)
     peak = float(np.max(top[idx])) if idx else 0.0
@@ -234,7 +236,8 @@ def plot_shapes(
         _draw_instant(ax, outlines, j * pitch, z[0], pitch, height, label)
 
     ax.set_xlim(-pitch / 2, (max(len(idx), 1) - 0.5) * pitch)
-    ax.set_ylim(z[0] - 0.22 * height, z[-1] + 0.05 * height)
+    top = max([z[-1]] + [float(np.max(np.vstack(o)[:, 1])) for o in shapes])
+    ax.set_ylim(z[0] - 0.22 * height, top + 0.05 * height)
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_ylabel("height [m]")

@@ -1,31 +1,279 @@
-"""The library's entry points for scripts and the CLI: load a config, run one cell, run a
-sweep with its figure. Above report (it wires the report's figure into the study's sweep)
-and below the CLI.
+"""The library's entry points for scripts, notebooks and the CLI: load a config (a file or a
+dict), change a value, run one cell, run a sweep, plot a domain or a history; the `rbm`
+package re-exports them (docs/api.md). Above report (it wires the report's figures into the
+study's runs), below the CLI. Amplitudes in g (9.81 m/s^2), frequencies in Hz, times in s,
+lengths in m.
 """
 
 from __future__ import annotations
 
+import copy
+import math
 import os
-from collections.abc import Callable
+import re
+import tempfile
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pandas as pd
 
-from rbm_cli.config import load_config, parse_config
+from rbm_cli import __version__
+from rbm_cli.base.errors import ConfigError, RbmError
+from rbm_cli.config import parse_config
+from rbm_cli.config.load import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ
+from rbm_cli.config.load import load_config as _load_file
 from rbm_cli.config.types import Config
-from rbm_cli.report.domain_figure import domain_figure
+from rbm_cli.models.result import RunResult
+from rbm_cli.physics.column import build_column
+from rbm_cli.report.domain_figure import domain_figure, uplift_level
+from rbm_cli.report.plot_domain import plot_domain as _plot_domain
+from rbm_cli.report.plots import plot_history as _plot_history
+from rbm_cli.report.run_folder import history_frame
+from rbm_cli.study.domain import read_domain
 from rbm_cli.study.simulate import simulate
 from rbm_cli.study.sweep import SweepInterrupted, SweepSummary
 from rbm_cli.study.sweep import run_sweep as _run_sweep
 
 __all__ = [
+    "CellRun",
+    "Config",
+    "ConfigError",
+    "RbmError",
     "SweepInterrupted",
-    "SweepSummary",
-    "domain_figure",
+    "__version__",
     "load_config",
-    "parse_config",
+    "plot_domain",
+    "plot_history",
+    "read_domain",
+    "run",
     "run_sweep",
-    "simulate",
+    "sweep",
+    "with_value",
+    "with_values",
 ]
+
+#: One key of a key path.
+_KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+# --------------------------------------------------------------------------- configs
+
+
+def load_config(source: str | os.PathLike | Mapping[str, Any]) -> Config:
+    """A validated config from a YAML file or from a mapping (a dict).
+
+    Parameters
+    ----------
+    source : str, path-like or mapping  A YAML file or the mapping it holds (numbers may be
+        numpy numbers, lists numpy arrays); lengths [m], stiffnesses [N m/rad] or [Pa/m],
+        grid amplitudes [g] and frequencies [Hz] (SPEC section 4)
+
+    Returns
+    -------
+    Config  Frozen, in SI (the grid in g and Hz); ``Config.written`` keeps the mapping
+
+    Raises
+    ------
+    ConfigError  One line naming the key path (``<dict>: column.height must be ...``)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> cfg.column.height, cfg.model
+    (2.0, 'rbm')
+    >>> cfg = rbm.load_config("configs/spanos_koh_slender.yaml")  # doctest: +SKIP
+    """
+    if isinstance(source, Mapping):
+        return parse_config(_plain(source), "<dict>")
+    if isinstance(source, str | os.PathLike):
+        return _load_file(source)
+    raise ConfigError(f"a config is a YAML file's path or a mapping, got {type(source).__name__}")
+
+
+def _plain(data: Any) -> Any:
+    """``data`` with numpy arrays as lists (parse_config reads numpy scalars itself)."""
+    if isinstance(data, Mapping):
+        return {k: _plain(v) for k, v in data.items()}
+    return [_plain(v) for v in data] if isinstance(data, list | tuple | np.ndarray) else data
+
+
+def _as_config(config: Config | str | os.PathLike | Mapping[str, Any]) -> Config:
+    return config if isinstance(config, Config) else load_config(config)
+
+
+def with_values(config: Config, changes: Mapping[str, Any]) -> Config:
+    """The config with values changed at dotted key paths, validated again: the changes are
+    made on the mapping the user wrote (``config.written``), validated as a file is.
+
+    Parameters
+    ----------
+    config : Config  A config from :func:`load_config`; it is not changed
+    changes : mapping  {key path: value}, paths as error messages name them, in the config's
+        units: ``column.height`` [m], ``interface.stiffness.normal`` [Pa/m], ``column.drums``
+        (a list is given whole). Missing sections are made; a value on the way that is not
+        a mapping (``stiffness: rigid``) is replaced by one
+
+    Returns
+    -------
+    Config  The new config
+
+    Raises
+    ------
+    ConfigError  A malformed path, or a bad value (one line naming its key path)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> taller = rbm.with_values(cfg, {"column.height": 4.0, "interface.restitution": 0.9})
+    >>> taller.column.height, taller.interface.restitution, cfg.column.height
+    (4.0, 0.9, 2.0)
+    """
+    if config.written is None:
+        raise ConfigError(f"config {config.name} keeps no written mapping: use rbm.load_config")
+    written = copy.deepcopy(config.written)
+    for path, value in changes.items():
+        _set(written, path, _plain(value))
+    told = ", ".join(f"{path} = {value!r}" for path, value in changes.items())
+    return parse_config(written, f"{config.name} with {told}" if told else config.name)
+
+
+def with_value(config: Config, path: str, value: Any) -> Config:
+    """The config with one value changed at a dotted key path, validated again.
+
+    ``with_value(cfg, path, value)`` is ``with_values(cfg, {path: value})`` (which see).
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> rbm.with_value(cfg, "column.height", 6.0).column.height
+    6.0
+    >>> rbm.with_value(cfg, "column.height", -1.0)
+    Traceback (most recent call last):
+    ...
+    rbm_cli.base.errors.ConfigError: block with column.height = -1.0: column.height must be a number > 0 [m], got -1
+    """  # noqa: E501
+    return with_values(config, {path: value})
+
+
+def _set(data: dict, path: str, value: Any) -> None:
+    """Set ``value`` at a dotted key path in the nested mapping ``data``."""
+    keys = path.split(".") if isinstance(path, str) else []
+    if not keys or not all(_KEY.fullmatch(key) for key in keys):
+        raise ConfigError(f"{path!r} is not a key path (keys joined by dots: column.height)")
+    node = data
+    for key in keys[:-1]:
+        if not isinstance(node.get(key), dict):
+            node[key] = {}
+        node = node[key]
+    node[keys[-1]] = value
+
+
+# --------------------------------------------------------------------------- one cell
+
+
+@dataclass(frozen=True)
+class CellRun:
+    """One cell's run: its outcome, times and (when recorded) its history.
+
+    Attributes
+    ----------
+    config : Config  The config it ran
+    result : RunResult  Every figure of the run (rbm_cli.models.result.RunResult): amplitude_g
+        [g], frequency_hz [Hz], max_rotation_ratio [-], max_top_displacement_m [m],
+        n_uplifts, n_impacts, wall_time_s [s], ...
+    status : str  'collapsed', 'survived' or 'failed'
+    t_collapse_s : float  Time of collapse [s]; nan if none
+    """
+
+    config: Config
+    result: RunResult
+
+    @property
+    def status(self) -> str:
+        return self.result.status
+
+    @property
+    def t_collapse_s(self) -> float:
+        return self.result.t_collapse_s
+
+    @cached_property
+    def history(self) -> pd.DataFrame | None:
+        """history.csv's table (None unless recorded): t_s [s], ag_m_s2 [m/s^2] and ug_m [m]
+        (ground), u1_m..u{n+1}_m (nodes, relative to the ground) [m], theta1_rad.. [rad]."""
+        h = self.result.history
+        return None if h is None else history_frame(h)
+
+
+def run(
+    config: Config | str | os.PathLike | Mapping[str, Any],
+    amplitude_g: float | None = None,
+    frequency_hz: float | None = None,
+    *,
+    record: bool = True,
+    output_dt: float | None = None,
+) -> CellRun:
+    """Run one cell of a config: its model under one ground motion.
+
+    Parameters
+    ----------
+    config : Config, path or mapping  The config (else loaded with :func:`load_config`)
+    amplitude_g : float  Peak ground acceleration [g], in [0, 1000] (not used by `free`)
+    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by `free`)
+    record : bool  Keep the history, as ``rbm run`` (the run goes on to the end of the
+        motion or to collapse); False: as a sweep, stop once the outcome cannot change
+    output_dt : float, optional  Sampling interval of the history [s]; default 0.002 s
+
+    Returns
+    -------
+    CellRun  ``.status``, ``.t_collapse_s`` [s], ``.history`` (a DataFrame), ``.result``
+
+    Raises
+    ------
+    RbmError  A missing or out-of-range amplitude or frequency, a bad config (one line)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> calm = rbm.run(cfg, amplitude_g=0.1, frequency_hz=1.0)  # below B/H = 0.25 g
+    >>> calm.status, float(calm.history["theta1_rad"].abs().max())
+    ('survived', 0.0)
+    >>> list(calm.history.columns)
+    ['t_s', 'ag_m_s2', 'ug_m', 'u1_m', 'u2_m', 'theta1_rad']
+    >>> rbm.run(cfg, amplitude_g=2.5, frequency_hz=0.5).status  # ten times B/H
+    'collapsed'
+    """
+    cfg = _as_config(config)
+    if cfg.excitation.type == "free":
+        amplitude_g, frequency_hz = 0.0, 0.0
+    for name, value, (lo, hi), unit in (
+        ("amplitude_g", amplitude_g, AMPLITUDE_RANGE_G, "g"),
+        ("frequency_hz", frequency_hz, FREQUENCY_RANGE_HZ, "Hz"),
+    ):
+        if value is None:
+            raise RbmError(f"{name} [{unit}] is required for excitation.type {cfg.excitation.type}")
+        if cfg.excitation.type != "free" and not (_finite(value) and lo <= value <= hi):
+            raise RbmError(f"{name} must be a number in [{lo:g}, {hi:g}] [{unit}], got {value!r}")
+    if output_dt is not None and not (_finite(output_dt) and output_dt > 0.0):
+        raise RbmError(f"output_dt must be a number > 0 [s], got {output_dt!r}")
+    result = simulate(
+        cfg, float(amplitude_g), float(frequency_hz), record=record, output_dt=output_dt
+    )
+    return CellRun(config=cfg, result=result)
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, int | float | np.number) and math.isfinite(value)
+
+
+# --------------------------------------------------------------------------- sweeps
 
 
 def run_sweep(
@@ -37,12 +285,116 @@ def run_sweep(
 ) -> SweepSummary:
     """Run a config's grid into OUTPUT/<name>/ (domain.csv, boundary.csv, domain.png,
     meta.json): rbm_cli.study.sweep.run_sweep with the domain figure of
-    rbm_cli.report.domain_figure (or `figure`). Same parameters.
+    rbm_cli.report.domain_figure (or `figure`). Same parameters; :func:`sweep` returns the
+    domain itself."""
+    draw = figure if figure is not None else domain_figure
+    return _run_sweep(config, output, *args, figure=draw, **kwargs)
+
+
+def sweep(
+    config: Config | str | os.PathLike | Mapping[str, Any],
+    output: str | os.PathLike | None = None,
+    *,
+    jobs: int = 1,
+    **options,
+) -> pd.DataFrame:
+    """Run a config's grid and return its domain: the rows of domain.csv.
+
+    Parameters
+    ----------
+    config : Config, path or mapping  A config with a grid (amplitudes [g], frequencies [Hz])
+    output : path, optional  Output root: writes OUTPUT/<name>/ (domain.csv, boundary.csv,
+        domain.png, meta.json) as ``rbm sweep -o OUTPUT``; None: a temporary folder,
+        deleted once the domain is read
+    jobs : int  Worker processes; 1 (the default) runs in this process
+    **options  Other settings of rbm_cli.study.sweep.run_sweep (resume, force, ensemble...)
+
+    Returns
+    -------
+    pandas.DataFrame  The rows of domain.csv, one per cell (amplitude_g [g], frequency_hz
+        [Hz], status, collapsed, t_collapse_s [s], ...); ``attrs["folder"]``: the folder
 
     Examples
     --------
-    >>> from rbm_cli.api import load_config, run_sweep
-    >>> summary = run_sweep(load_config("configs/ci/slender_small.yaml"), "out")  # doctest: +SKIP
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5},
+    ...     "grid": {"amplitudes": [0.1, 2.5], "frequencies": [0.5, 1.0]}})
+    >>> df = rbm.sweep(cfg)
+    >>> df[["amplitude_g", "frequency_hz", "status"]].values.tolist()
+    [[0.1, 0.5, 'survived'], [2.5, 0.5, 'collapsed'], [0.1, 1.0, 'survived'], [2.5, 1.0, 'collapsed']]
+    """  # noqa: E501
+    cfg = _as_config(config)
+    with tempfile.TemporaryDirectory(prefix="rbm-sweep-") as tmp:
+        summary = run_sweep(cfg, tmp if output is None else output, jobs=jobs, **options)
+        df = read_domain(Path(summary.folder) / "domain.csv")
+    df.attrs["folder"] = None if output is None else str(summary.folder)
+    return df
+
+
+# --------------------------------------------------------------------------- plots
+
+
+def plot_domain(
+    df: pd.DataFrame,
+    ax=None,
+    config: Config | str | os.PathLike | Mapping[str, Any] | None = None,
+    **options,
+):
+    """Draw a safe-unsafe domain (frequency [Hz] x amplitude [g]) on a matplotlib axes.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame  A domain: :func:`sweep`'s or :func:`read_domain`'s
+    ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
+    config : Config, path or mapping, optional  The config swept: adds the level [g] where
+        the column starts to rock (B/H for a rigid monolith) and the closed forms that apply
+    **options  For rbm_cli.report.plot_domain.plot_domain (compare, labels, ...)
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Examples
+    --------
+    >>> import rbm
+    >>> ax = rbm.plot_domain(rbm.read_domain("out/block/domain.csv"))  # doctest: +SKIP
     """
-    draw = figure if figure is not None else domain_figure
-    return _run_sweep(config, output, *args, figure=draw, **kwargs)
+    if config is not None:
+        cfg = _as_config(config)
+        level, label = uplift_level(cfg)
+        defaults = {
+            "column": build_column(cfg.column, cfg.interface),
+            "excitation_type": cfg.excitation.type,
+            "static_multiplier": level,
+            "static_label": label,
+        }
+        options = {**defaults, **options}
+    return _plot_domain(df, ax=ax, **options)
+
+
+def plot_history(run: CellRun | RunResult, ax=None):
+    """Draw a run's base and top displacement [m] against time [s] on a matplotlib axes.
+
+    Parameters
+    ----------
+    run : CellRun or RunResult  A recorded run; its collapse time is marked
+    ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> ax = rbm.plot_history(rbm.run(cfg, amplitude_g=2.5, frequency_hz=0.5))
+    >>> ax.get_xlabel()
+    'time [s]'
+    """
+    result = run.result if isinstance(run, CellRun) else run
+    if not isinstance(result, RunResult):
+        raise RbmError(f"plot_history takes a run, got a value of type {type(run).__name__}")
+    if result.history is None:
+        raise RbmError("this run kept no history: run it with record=True")
+    return _plot_history(result.history, ax=ax, t_collapse=result.t_collapse_s)

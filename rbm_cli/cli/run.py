@@ -119,10 +119,10 @@ def run(
         rbm run configs/spanos_koh_slender.yaml --amplitude 0.5 --frequency 1
         rbm run configs/harmonic_multidrum.yaml -a 0.3 -f 2 -o /tmp/rbm-out
     """
+    from rbm_cli.api import run as run_cell
     from rbm_cli.base.files import check_writable_dir
     from rbm_cli.physics.column import build_column
     from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
-    from rbm_cli.study.simulate import simulate
 
     cfg = load(config)
     kind = cfg.excitation.type
@@ -142,7 +142,7 @@ def run(
         check_writable_dir(Path(output) / cfg.name)
         column = build_column(cfg.column, cfg.interface)
         compile_notice(cfg)
-        result = simulate(cfg, amplitude_g, frequency_hz, record=True, output_dt=output_dt)
+        result = run_cell(cfg, amplitude_g, frequency_hz, output_dt=output_dt).result
         summary = run_summary(
             result,
             cfg,

@@ -156,7 +156,7 @@ def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
 
     Parameters
     ----------
-    data : mapping  Parsed YAML (keys of SPEC section 4)
+    data : mapping  Parsed YAML or a dict (keys of SPEC section 4; numpy numbers allowed)
     source : str  Where ``data`` came from, prefixed to error messages
 
     Returns
@@ -167,11 +167,12 @@ def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
     ------
     ConfigError  One line: ``<source>: <key path> must be <allowed>, got <value>``.
     """
+    written = plain_copy(data)  # numpy numbers (a notebook's) read as the numbers they are
     try:
-        config = _config(data)
+        config = _config(written)
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
-    return dataclasses.replace(config, written=plain_copy(data))
+    return dataclasses.replace(config, written=written)
 
 
 def _config(data: Any) -> Config:

@@ -61,6 +61,13 @@ def describe(value: Any) -> str:
             float(value)
         except ValueError:
             return repr(text)
+        if _YAML11_STRING.match(value):
+            dotted = re.sub(r"([0-9])([eE])", r"\1.0\2", value, count=1)
+            return (
+                f"{text!r} (a quoted string, or a number a YAML 1.1 reader such as"
+                f" yaml.safe_load left as a string: write it unquoted with a dot, {dotted},"
+                " or read the file with rbm.load_config)"
+            )
         return f"{text!r} (a quoted string; write numbers without quotes)"
     if isinstance(value, Mapping):
         return "a mapping"
@@ -210,6 +217,9 @@ def number_list(
 _YAML11_NUMBER = re.compile(
     r"^[-+]?(?:[0-9][0-9_]*(?::[0-5]?[0-9])+(?:\.[0-9_]*)?|0[0-9_]+|0x[0-9a-fA-F_]+|0b[01_]+)$"
 )
+
+#: Floats YAML 1.1 (PyYAML's yaml.safe_load) reads as strings: an exponent with no dot.
+_YAML11_STRING = re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$")
 
 
 def one_line(text: str) -> str:

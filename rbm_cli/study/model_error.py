@@ -123,7 +123,7 @@ def model_error(model: pd.DataFrame, reference: pd.DataFrame) -> ModelError:
     shifts = compare(model, reference).shifts.rename(
         columns={"boundary_a_g": "boundary_model_g", "boundary_b_g": "boundary_reference_g"}
     )
-    shifts["shift_g"] = -shifts["shift_g"]
+    shifts["shift_g"] = 0.0 - shifts["shift_g"]  # model minus reference, no -0.0
     return ModelError(
         n_common=len(common) - n_failed, cells=table, shifts=shifts, n_failed=n_failed
     )

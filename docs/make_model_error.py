@@ -3,11 +3,13 @@
     python docs/make_model_error.py                 # docs/figures/rbm_vs_housner.png
     python docs/make_model_error.py --out /tmp/fig.png
 
-Reads the stored domains (results/<study>/domain.csv and results/<study>_housner/domain.csv of the STUDIES below,
-made by `rbm sweep configs/<study>.yaml -o results --ensemble 16`), prints for each pair what
-`rbm compare` prints and the side of every differing cell (rbm_cli.study.model_error), and
-draws one panel per study: the RBM's cells and boundary, the exact block's boundary, the
-differing cells by side, and the two uplift levels. Runs nothing; takes a few seconds.
+Reads the stored domains of the STUDIES below (results/<study>/domain.csv and
+results/<study>_housner/domain.csv, made by `rbm sweep configs/<study>.yaml -o results
+--ensemble 16`), prints for each pair its ModelError (rbm_cli.study.model_error: the
+fraction that differs, the cells by side, the boundary shifts) and the cells where the RBM
+is unconservative, and draws one panel per study: the RBM's cells and boundary, the exact
+block's boundary, the differing cells by side, and the two uplift levels. Runs nothing;
+takes a few seconds.
 """
 
 from __future__ import annotations
@@ -68,7 +70,7 @@ def draw_panel(ax, study: str, title: str, results: Path = RESULTS) -> ModelErro
         plain,
         ax=ax,
         compare=[exact],
-        labels=["RBM boundary (alpha = B/H, small rotations)", "exact block boundary (housner)"],
+        labels=["RBM boundary (small rotations)", "exact block boundary (housner)"],
         static_multiplier=level_rbm,
         static_label="RBM uplift",
     )

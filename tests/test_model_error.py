@@ -219,3 +219,37 @@ def test_model_error_calls_a_cell_robust_only_when_robust_in_both():
     both = model_error(model.assign(robust=1), flipped.assign(robust=1))
     one = model_error(model.assign(robust=1), flipped.assign(robust=0))
     assert both.cells["robust"].tolist() == [True] and one.cells["robust"].tolist() == [False]
+
+
+# ------------------------------------------------------------ the figure, read back
+
+
+def test_the_figure_draws_each_pair_and_its_sides():
+    """docs/make_model_error.py: per panel, the exact block's boundary is that of the stored
+    housner domain, the marked cells are the differing cells by side, and the title's
+    percentage is the fraction of the table above."""
+    import importlib.util
+
+    from rbm_cli.study.domain import boundary
+
+    spec = importlib.util.spec_from_file_location(
+        "make_model_error", CONFIGS.parent / "docs" / "make_model_error.py"
+    )
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    fig, errors = script.make_figure()
+    assert list(errors) == list(script.STUDIES) and set(script.STUDIES) == set(STUDIES)
+    for ax, study in zip(fig.axes, script.STUDIES, strict=False):
+        lines = {line.get_gid(): line for line in ax.get_lines()}
+        exact = boundary(stored(study)[1])
+        assert list(lines["compare-0"].get_ydata()) == pytest.approx(
+            exact["lowest_unsafe_g"].tolist(), nan_ok=True
+        )
+        rbm, exact_df = stored(study)
+        flags = rbm.merge(exact_df, on=["amplitude_g", "frequency_hz"], suffixes=("", "_x"))
+        unsafe = flags[(flags.status == "survived") & (flags.status_x == "collapsed")]
+        assert len(lines[UNCONSERVATIVE].get_xdata()) == len(unsafe)
+        assert sorted(zip(lines[UNCONSERVATIVE].get_xdata(), lines[UNCONSERVATIVE].get_ydata(),
+                          strict=True)) == sorted(zip(unsafe.frequency_hz, unsafe.amplitude_g,
+                                                      strict=True))  # fmt: skip
+        assert f"{STATED[study][0]:.1f} % of cells differ" in ax.get_title()

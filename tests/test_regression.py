@@ -43,6 +43,13 @@ STUDIES = {
     "harmonic_monolithic": CONFIGS / "harmonic_monolithic.yaml",
     "harmonic_multidrum": CONFIGS / "harmonic_multidrum.yaml",
     "harmonic_multidrum_ci": CONFIGS / "ci" / "harmonic_multidrum_ci.yaml",
+    # the exact block (housner) of each monolithic rigid RBM study (tests/test_model_error.py)
+    "spanos_koh_slender_housner": CONFIGS / "spanos_koh_slender_housner.yaml",
+    "spanos_koh_thick_housner": CONFIGS / "spanos_koh_thick_housner.yaml",
+    "spanos_koh_thick_housner_e_housner": CONFIGS / "spanos_koh_thick_housner_e_housner.yaml",
+    "housner_halfsine_housner": CONFIGS / "housner_halfsine_housner.yaml",
+    "spanos_koh_slender_housner_e": CONFIGS / "spanos_koh_slender_housner_e.yaml",
+    "spanos_koh_slender_housner_e_housner": CONFIGS / "spanos_koh_slender_housner_e_housner.yaml",
 }
 
 

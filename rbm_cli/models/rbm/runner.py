@@ -116,7 +116,18 @@ class RbmRunner:
         n = self.model.n
         self.theta0 = np.zeros(n) if not init.rotations else np.asarray(init.rotations, float)
         self.rate0 = np.zeros(n) if not init.velocities else np.asarray(init.velocities, float)
-        self._prepared = None  # the compiled kernel's inputs, made on the first compiled run
+        self._integrators: dict = {}  # implementation -> integrator, resolved on first use
+
+    def _integrator(self, implementation: str):
+        """The integrator of an implementation, imported only when a run needs it; the
+        compiled one with this column's kernel inputs, prepared once."""
+        if implementation == "compiled":
+            from rbm_cli.models.rbm.kernel import integrate_compiled, prepare_kernel
+
+            return partial(integrate_compiled, prepared=prepare_kernel(self.model))
+        from rbm_cli.models.rbm.python import integrate
+
+        return integrate
 
     def run(
         self,
@@ -128,14 +139,11 @@ class RbmRunner:
         early_stop: bool = True,
     ) -> Outcome:
         """One run (rbm_cli.models.contract.Runner.run)."""
-        if solver.implementation == "compiled":
-            from rbm_cli.models.rbm.kernel import integrate_compiled, prepare_kernel
-
-            if self._prepared is None:  # the kernel's arrays of this column, made once
-                self._prepared = prepare_kernel(self.model)
-            integrator = partial(integrate_compiled, prepared=self._prepared)
-        else:
-            from rbm_cli.models.rbm.python import integrate as integrator
+        integrator = self._integrators.get(solver.implementation)
+        if integrator is None:
+            integrator = self._integrators[solver.implementation] = self._integrator(
+                solver.implementation
+            )
         n = self.model.n
         try:
             out = integrator(

@@ -93,7 +93,7 @@ class Harness:
         self.config.write_text(CONFIG)
         cfg = load_config(self.config)
         self.digest = config_hash(cfg)
-        self.grid = {(f"{a:.12g}", f"{f:.12g}") for a, f in grid_cells(cfg)}
+        self.grid = {(f"{a:.12g}", f"{f:.12g}") for a, f, _ in grid_cells(cfg)}
         ref = run_sweep(cfg, tmp / "reference", jobs=1)
         self.reference = (ref.folder / "domain.csv").read_bytes()
         self.tally = Tally()

@@ -25,7 +25,7 @@ def small_config(amps=(0.2, 0.3, 0.5, 0.8, 1.2), freqs=(0.5, 1.0, 2.0)):
 
 def test_grid_order_is_frequency_major():
     cfg = small_config(amps=(0.1, 0.2), freqs=(1.0, 2.0))
-    assert grid_cells(cfg) == [(0.1, 1.0), (0.2, 1.0), (0.1, 2.0), (0.2, 2.0)]
+    assert grid_cells(cfg) == [(0.1, 1.0, ()), (0.2, 1.0, ()), (0.1, 2.0, ()), (0.2, 2.0, ())]
 
 
 def test_jobs_do_not_change_the_csv(tmp_path):

@@ -21,7 +21,9 @@ from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, parse_grid
 from rbm_cli.config.interface import interface_section
+from rbm_cli.config.points import expand
 from rbm_cli.config.types import (
     EXCITATIONS,
     IMPLEMENTATIONS,
@@ -32,7 +34,6 @@ from rbm_cli.config.types import (
     ColumnConfig,
     Config,
     ExcitationConfig,
-    GridConfig,
     InitialConfig,
     SolverConfig,
 )
@@ -40,7 +41,6 @@ from rbm_cli.config.validate import (
     choice,
     describe,
     fmt,
-    grid_axis,
     integer,
     join,
     mapping,
@@ -51,13 +51,12 @@ from rbm_cli.config.validate import (
 from rbm_cli.config.written import plain_copy
 from rbm_cli.config.yaml_reader import read_yaml
 
-__all__ = ["load_config", "parse_config"]
+__all__ = ["AMPLITUDE_RANGE_G", "FREQUENCY_RANGE_HZ", "load_config", "parse_config"]
 
 TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
 COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
 EXCITATION_KEYS = ("type", "duration", "phase", "initial")
 INITIAL_KEYS = ("rotations", "velocities")
-GRID_KEYS = ("amplitudes", "frequencies")
 COLLAPSE_KEYS = ("ratio",)
 SOLVER_KEYS = (
     "method",
@@ -93,9 +92,6 @@ DENSITY_RANGE = (1.0, 1e5)
 #: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
 INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
 PHASE_MAX = 1e3
-#: Grid and command-line excitation ranges [assumption]: g and Hz at the edges.
-AMPLITUDE_RANGE_G = (0.0, 1e3)
-FREQUENCY_RANGE_HZ = (1e-3, 1e3)
 #: Largest step and event budgets (a 64-bit count; 1e300 failed in the compiled kernel).
 MAX_BUDGET = 1_000_000_000
 #: Range of solver.max_wall_time, the wall-clock budget of one run [s].
@@ -169,10 +165,11 @@ def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
     """
     written = plain_copy(data)  # numpy numbers (a notebook's) read as the numbers they are
     try:
-        config = _config(written)
+        config = dataclasses.replace(_config(written), written=written)
+        expand(config, parse_config)  # every point of the grid's axes validates, or one line
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
-    return dataclasses.replace(config, written=written)
+    return config
 
 
 def _config(data: Any) -> Config:
@@ -202,7 +199,7 @@ def _config(data: Any) -> Config:
         model=model,
         interface=interface_section(top.get("interface"), n, model),
         excitation=_excitation(top.get("excitation"), n),
-        grid=_grid(top.get("grid")),
+        grid=parse_grid(top.get("grid")),
         collapse=CollapseConfig(
             ratio=number(
                 mapping(top.get("collapse"), "collapse", COLLAPSE_KEYS).get("ratio", 1.0),
@@ -350,20 +347,6 @@ def _excitation(raw: Any, n: int) -> ExcitationConfig:
     return ExcitationConfig(
         type=kind, duration=duration, phase=phase, initial=InitialConfig(**values)
     )
-
-
-def _grid(raw: Any) -> GridConfig:
-    g = mapping(raw, "grid", GRID_KEYS)
-    amplitudes, frequencies = (
-        grid_axis(g[key], join("grid", key), unit, lo_open=lo_open, bounds=bounds)
-        if key in g
-        else ()
-        for key, unit, lo_open, bounds in (
-            ("amplitudes", "g", False, AMPLITUDE_RANGE_G),
-            ("frequencies", "Hz", True, FREQUENCY_RANGE_HZ),
-        )
-    )
-    return GridConfig(amplitudes_g=amplitudes, frequencies_hz=frequencies)
 
 
 def _solver(raw: Any) -> SolverConfig:

@@ -128,11 +128,28 @@ class ExcitationConfig:
 
 
 @dataclass(frozen=True)
+class Axis:
+    """A grid axis over config keys (rbm_cli.config.grid): ``paths`` (one, or several
+    linked) and its points, each a tuple of one value per path (numbers or strings, as
+    written; ``column.size`` and ``column.slenderness`` are virtual paths)."""
+
+    paths: tuple[str, ...]
+    points: tuple[tuple, ...]
+
+
+@dataclass(frozen=True)
 class GridConfig:
-    """Sweep grid, at the edge of the program: amplitudes in g, frequencies in Hz."""
+    """Sweep grid, at the edge of the program: amplitudes in g, frequencies in Hz, and the
+    axes over other config keys (outermost first; the cells are the product of all)."""
 
     amplitudes_g: tuple[float, ...] = ()
     frequencies_hz: tuple[float, ...] = ()
+    axes: tuple[Axis, ...] = ()
+
+    @property
+    def axis_paths(self) -> tuple[str, ...]:
+        """The config key paths the grid varies beside amplitude and frequency."""
+        return tuple(p for axis in self.axes for p in axis.paths)
 
 
 @dataclass(frozen=True)
@@ -189,4 +206,6 @@ class Config:
         """Every resolved setting as plain data (dataclasses.asdict without ``written``)."""
         out = asdict(self)
         out.pop("written", None)
+        if not out["grid"]["axes"]:  # a plain grid resolves (and hashes) as it always did
+            del out["grid"]["axes"]
         return out

@@ -17,7 +17,8 @@ import numpy as np
 
 from rbm_cli.base.errors import ConfigError
 
-RANGE_KEYS = ("start", "stop", "step", "num")
+RANGE_KEYS = ("start", "stop", "step", "num", "spacing")
+SPACINGS = ("linear", "log")
 MAX_GRID_VALUES = 10_000  # per axis
 GRID_STOP_TOL = 1e-9  # in units of step: stop is included when within it
 GRID_DIGITS = 12  # significant digits of generated grid values
@@ -238,8 +239,9 @@ def grid_axis(
     lo_open: bool,
     bounds: tuple[float, float] | None = None,
 ) -> tuple[float, ...]:
-    """One grid axis: a number, a list, or {start, stop, step} / {start, stop, num};
-    every value > 0 (lo_open) or >= 0, and within ``bounds`` if given."""
+    """One grid axis: a number, a list, or {start, stop, step} / {start, stop, num} (with
+    ``spacing: log``, num values evenly spaced in log, start > 0); every value > 0
+    (lo_open) or >= 0, and within ``bounds`` if given."""
     values = _grid_values(value, path, unit, lo_open=lo_open)
     if bounds is not None:
         for i, x in enumerate(values):
@@ -285,8 +287,12 @@ def _generated(
     if ("step" in m) == ("num" in m):
         given = "both" if "step" in m else "neither"
         raise ConfigError(f"{path} needs exactly one of step and num, got {given}")
-    start = number(m["start"], join(path, "start"), unit, 0.0, lo_open=lo_open)
-    stop = number(m["stop"], join(path, "stop"), unit, 0.0, lo_open=lo_open)
+    spacing = choice(m.get("spacing", "linear"), join(path, "spacing"), SPACINGS)
+    if spacing == "log" and "num" not in m:
+        raise ConfigError(f"{join(path, 'spacing')}: log needs num (not step)")
+    log = spacing == "log"
+    start = number(m["start"], join(path, "start"), unit, 0.0, lo_open=lo_open or log)
+    stop = number(m["stop"], join(path, "stop"), unit, 0.0, lo_open=lo_open or log)
     if stop < start:
         raise ConfigError(
             f"{join(path, 'stop')} must be >= {join(path, 'start')} ({fmt(start)}), got {fmt(stop)}"
@@ -307,7 +313,7 @@ def _generated(
                 f"{join(path, 'num')} is 1 but stop ({fmt(stop)}) differs from start"
                 f" ({fmt(start)}): use num >= 2, or stop equal to start"
             )
-        raw = np.linspace(start, stop, count)
+        raw = np.geomspace(start, stop, count) if log else np.linspace(start, stop, count)
     values = tuple(float(f"{x:.{GRID_DIGITS}g}") for x in raw)
     if len(set(values)) != len(values):
         key = join(path, "step" if "step" in m else "num")

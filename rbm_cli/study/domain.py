@@ -45,9 +45,30 @@ def csv_text(rows: list[dict], fields=CSV_FIELDS) -> str:
     return ",".join(fields) + "\n" + "".join(format_row(r, fields) + "\n" for r in rows)
 
 
-def cell_key(amplitude_g: float, frequency_hz: float) -> tuple[str, str]:
-    """Identity of a grid cell, stable through a CSV round trip."""
-    return (f"{float(amplitude_g):.12g}", f"{float(frequency_hz):.12g}")
+def _key_text(value) -> str:
+    if value is None or (isinstance(value, float | np.floating) and math.isnan(value)):
+        return ""
+    if isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool):
+        return f"{float(value):.12g}"
+    return str(value)
+
+
+def cell_key(amplitude_g: float, frequency_hz: float | None, *values) -> tuple[str, ...]:
+    """Identity of a grid cell, stable through a CSV round trip: amplitude, frequency
+    (empty for none) and the values of its point's axes (rbm_cli.study.cells)."""
+    return (_key_text(amplitude_g), _key_text(frequency_hz), *(_key_text(v) for v in values))
+
+
+def axis_columns(columns) -> tuple[str, ...]:
+    """The columns of a domain that hold its point's axes: named by a dotted config path."""
+    return tuple(c for c in columns if "." in str(c))
+
+
+def keys_of(df: pd.DataFrame) -> list[tuple[str, ...]]:
+    """The cell identity of every row of a domain table (its axis columns included)."""
+    paths = axis_columns(df.columns)
+    cols = [df["amplitude_g"], df["frequency_hz"], *(df[p] for p in paths)]
+    return [cell_key(*vals) for vals in zip(*cols, strict=True)]
 
 
 def read_domain(path: str | Path) -> pd.DataFrame:
@@ -92,6 +113,8 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
         x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
         with np.errstate(invalid="ignore"):
             bad = ~np.isfinite(x) | ((x <= 0.0) if positive else (x < 0.0))
+        if positive and raw.isna().all():
+            bad[:] = False  # no frequency at all: an excitation without one (a record)
         if bad.any():
             i = int(np.argmax(bad))
             rng = "> 0" if positive else ">= 0"
@@ -109,13 +132,14 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
         )
     if "collapsed" in df.columns:
         _check_collapsed(df, path, got)
-    keys = [cell_key(a, f) for a, f in zip(df["amplitude_g"], df["frequency_hz"], strict=True)]
-    seen: dict[tuple[str, str], int] = {}
-    for i, key in enumerate(keys):
+    seen: dict[tuple[str, ...], int] = {}
+    paths = axis_columns(df.columns)
+    for i, key in enumerate(keys_of(df)):
         if key in seen:
+            point = "".join(f", {p} {v}" for p, v in zip(paths, key[2:], strict=False))
             raise RbmError(
                 f"{path}: line {i + 2} repeats the cell of line {seen[key] + 2}"
-                f" (amplitude {key[0]} g, frequency {key[1]} Hz)"
+                f" (amplitude {key[0]} g, frequency {key[1] or 'none'} Hz{point})"
             )
         seen[key] = i
 
@@ -141,23 +165,37 @@ def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
     df["collapsed"] = flags
 
 
+def _groups(df: pd.DataFrame):
+    """(group columns, groupby) of a domain's boundary lines: one per point of its axes
+    and frequency (NaN frequency kept: a record's)."""
+    by = [*axis_columns(df.columns), "frequency_hz"]
+    return by, df.groupby(by if len(by) > 1 else by[0], sort=True, dropna=False)
+
+
+def _group_row(by: list[str], values) -> dict:
+    values = values if isinstance(values, tuple) else (values,)
+    return {c: (float(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
+
+
 def boundary(df: pd.DataFrame) -> pd.DataFrame:
     """Lowest unsafe (collapsed) amplitude per frequency, and the highest safe one below it.
 
     Returns a DataFrame sorted by frequency with columns frequency_hz,
     lowest_unsafe_g (NaN where nothing collapses) and highest_safe_g (largest
-    survived amplitude below lowest_unsafe_g; NaN if none).
+    survived amplitude below lowest_unsafe_g; NaN if none). A domain with axes over
+    config keys has one line per point and frequency, the axis columns first.
     """
+    by, groups = _groups(df)
     rows = []
-    for f, grp in df.groupby("frequency_hz", sort=True):
+    for values, grp in groups:
         unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
         low = float(unsafe.min()) if len(unsafe) else math.nan
         safe = grp.loc[grp["status"] == "survived", "amplitude_g"]
         if math.isfinite(low):
             safe = safe[safe < low]
         high = float(safe.max()) if len(safe) else math.nan
-        rows.append({"frequency_hz": float(f), "lowest_unsafe_g": low, "highest_safe_g": high})
-    return pd.DataFrame(rows, columns=["frequency_hz", "lowest_unsafe_g", "highest_safe_g"])
+        rows.append({**_group_row(by, values), "lowest_unsafe_g": low, "highest_safe_g": high})
+    return pd.DataFrame(rows, columns=[*by, "lowest_unsafe_g", "highest_safe_g"])
 
 
 @dataclass(frozen=True)
@@ -183,46 +221,50 @@ class Comparison:
     first_missing: tuple[str, str] | None = None
 
 
+def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
+    """The boundary amplitude [g] of each boundary line (compare's rule), by its key."""
+    by, groups = _groups(df)
+    out = {}
+    for values, grp in groups:
+        amps = np.sort(grp["amplitude_g"].to_numpy(float))
+        unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
+        if len(unsafe):
+            edge = float(unsafe.min())
+        else:
+            step = float(np.min(np.diff(amps))) if len(amps) > 1 else 0.0
+            edge = float(amps[-1]) + step
+        row = _group_row(by, values)
+        keys = [row[c] for c in by]
+        out[cell_key(0.0, keys[-1], *keys[:-1])[1:]] = (row, edge)
+    return by, out
+
+
 def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
     """Compare two domains cell by cell and boundary by boundary.
 
     Where one domain has no collapsed cell at a frequency, its boundary is
     taken as one grid step above its highest amplitude there (just above the
-    grid), so a boundary that leaves the grid counts as a finite shift.
+    grid), so a boundary that leaves the grid counts as a finite shift. Cells are
+    matched on amplitude, frequency and the values of any axes over config keys.
     """
 
     def flags(df):
-        cols = (df.amplitude_g, df.frequency_hz, df.collapsed)
-        return {cell_key(x, y): int(c) for x, y, c in zip(*cols, strict=True)}
+        return dict(zip(keys_of(df), df["collapsed"].astype(int), strict=True))
 
     ka, kb = flags(a), flags(b)
     common = ka.keys() & kb.keys()
     differ = sum(ka[k] != kb[k] for k in common)
-
-    def edge(df):
-        out = {}
-        for f, grp in df.groupby("frequency_hz"):
-            amps = np.sort(grp["amplitude_g"].to_numpy(float))
-            unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
-            if len(unsafe):
-                out[f"{float(f):.12g}"] = float(unsafe.min())
-            else:
-                step = float(np.min(np.diff(amps))) if len(amps) > 1 else 0.0
-                out[f"{float(f):.12g}"] = float(amps[-1]) + step
-        return out
-
-    ea, eb = edge(a), edge(b)
+    by, ea = _edges(a)
+    _, eb = _edges(b)
     rows = []
-    for f in sorted(ea.keys() & eb.keys(), key=float):
-        rows.append(
-            {
-                "frequency_hz": float(f),
-                "boundary_a_g": ea[f],
-                "boundary_b_g": eb[f],
-                "shift_g": eb[f] - ea[f],
-            }
-        )
-    shifts = pd.DataFrame(rows, columns=["frequency_hz", "boundary_a_g", "boundary_b_g", "shift_g"])
+    for k in sorted(ea.keys() & eb.keys(), key=lambda k: ea[k][0]["frequency_hz"]):
+        row, edge_a = ea[k]
+        rows.append({**row, "boundary_a_g": edge_a, "boundary_b_g": eb[k][1],
+                     "shift_g": eb[k][1] - edge_a})  # fmt: skip
+    columns = [*by, "boundary_a_g", "boundary_b_g", "shift_g"]
+    shifts = pd.DataFrame(rows, columns=columns)
+    if len(by) > 1 and len(shifts):
+        shifts = shifts.sort_values(by, kind="stable").reset_index(drop=True)
     max_shift = float(shifts["shift_g"].abs().max()) if len(shifts) else 0.0
     return Comparison(
         n_common=len(common),
@@ -232,10 +274,20 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
         shifts=shifts,
         only_a=len(ka.keys() - kb.keys()),
         only_b=len(kb.keys() - ka.keys()),
-        first_missing=min(
-            ka.keys() ^ kb.keys(), key=lambda k: (float(k[1]), float(k[0])), default=None
-        ),
+        first_missing=min(ka.keys() ^ kb.keys(), key=_grid_order, default=None),
     )
+
+
+def _grid_order(key: tuple[str, ...]):
+    """Sort key of a cell key: point, then frequency, then amplitude (numbers as numbers)."""
+
+    def num(text: str):
+        try:
+            return (0, float(text), "")
+        except ValueError:
+            return (1, 0.0, text)
+
+    return (*[num(t) for t in key[2:]], num(key[1]), num(key[0]))
 
 
 def domain_config(domain_csv: str | Path) -> Config | None:

@@ -24,7 +24,12 @@ def _nan_or_none(x) -> bool:
 
 
 def validate_row(
-    row, digest: str, grid: set[tuple[str, str]], n_interfaces: int, ensemble: int
+    row,
+    digest: str,
+    grid: set[tuple[str, ...]],
+    n_interfaces: int,
+    ensemble: int,
+    paths: tuple[str, ...] = (),
 ) -> str:
     """'' if a journal row is a finished cell of this config, else what is wrong.
 
@@ -32,7 +37,9 @@ def validate_row(
     hash was written carry none: the caller allows that only with a matching state
     file), a cell of the grid, a status of STATUSES, collapsed 0/1 agreeing with it, and
     every other domain.csv field of the right type and range (a failed run may leave
-    them out or NaN)."""
+    them out or NaN). ``paths``: the grid's axes over config keys, whose values the row
+    carries in columns of those names (rbm_cli.study.cells); n_interfaces: the most
+    interfaces of any point's column."""
     if not isinstance(row, dict):
         return "not a JSON object"
     if "config_hash" in row and row["config_hash"] != digest:
@@ -40,10 +47,11 @@ def validate_row(
     a, f = row.get("amplitude_g"), row.get("frequency_hz")
     if not (_is_number(a) and math.isfinite(a) and a >= 0):
         return f"amplitude_g must be a finite number >= 0, got {a!r}"
-    if not (_is_number(f) and math.isfinite(f) and f > 0):
-        return f"frequency_hz must be a finite number > 0, got {f!r}"
-    if cell_key(a, f) not in grid:
-        return f"the cell ({a} g, {f} Hz) is not in the config's grid"
+    if not (f is None or (_is_number(f) and math.isfinite(f) and f > 0)):
+        return f"frequency_hz must be a finite number > 0 (or empty), got {f!r}"
+    if cell_key(a, f, *(row.get(p) for p in paths)) not in grid:
+        point = "".join(f", {p} {row.get(p)!r}" for p in paths)
+        return f"the cell ({a} g, {f} Hz{point}) is not in the config's grid"
     status = row.get("status")
     if status not in STATUSES:
         return f"status must be one of {', '.join(STATUSES)}, got {str(status)[:40]!r}"

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.study.domain import cell_key
+from rbm_cli.study.domain import keys_of
 
 #: The bound on the re-made count of sensitive cells: the stored count plus
 #: max(SLACK_CELLS, SLACK_FRACTION x the stored count). Measured: re-drawing
@@ -49,7 +49,9 @@ class RegressionCheck:
     extra: int  # re-made cells not in the stored grid
     fresh_sensitive: int | None  # None unless the re-made domain is an ensemble
     bound: int
-    differing: list = field(default_factory=list)  # robust cells that differ: (a [g], f [Hz])
+    differing: list = field(
+        default_factory=list
+    )  # robust cells that differ: (a [g], f [Hz], *point)
 
     @property
     def ok(self) -> bool:
@@ -67,14 +69,16 @@ class RegressionCheck:
         if self.missing or self.extra:
             text += f"; cells missing: {self.missing}, not in the stored grid: {self.extra}"
         if self.differing:
-            cells = ", ".join(f"{a:g} g at {f:g} Hz" for a, f in self.differing[:5])
+            cells = ", ".join(
+                f"{c[0]:g} g at {c[1]:g} Hz" + "".join(f" ({v})" for v in c[2:])
+                for c in self.differing[:5]
+            )
             text += f" [{cells}{', ...' if len(self.differing) > 5 else ''}]"
         return text
 
 
 def _flags(df: pd.DataFrame, column: str) -> dict:
-    cols = (df["amplitude_g"], df["frequency_hz"], df[column])
-    return {cell_key(a, f): v for a, f, v in zip(*cols, strict=True)}
+    return dict(zip(keys_of(df), df[column], strict=True))
 
 
 def check(stored: pd.DataFrame, fresh: pd.DataFrame) -> RegressionCheck:
@@ -88,7 +92,9 @@ def check(stored: pd.DataFrame, fresh: pd.DataFrame) -> RegressionCheck:
     old, new = _flags(stored, "collapsed"), _flags(fresh, "collapsed")
     common = old.keys() & new.keys()
     robust_differ = sorted(
-        (float(k[0]), float(k[1])) for k in common if int(robust[k]) == 1 and old[k] != new[k]
+        (float(k[0]), float(k[1] or "nan"), *k[2:])
+        for k in common
+        if int(robust[k]) == 1 and old[k] != new[k]
     )
     sensitive_differ = sum(1 for k in common if int(robust[k]) != 1 and old[k] != new[k])
     n_sensitive = sum(1 for v in robust.values() if int(v) != 1)

@@ -58,7 +58,7 @@ class FolderBusy(RbmError):
 class JournalRead:
     """What a journal holds: the valid rows by cell, and what was not trusted."""
 
-    rows: dict[tuple[str, str], dict] = field(default_factory=dict)
+    rows: dict[tuple[str, ...], dict] = field(default_factory=dict)
     hashes: set[str] = field(default_factory=set)  # config hashes seen (header and rows)
     rejected: int = 0  # lines that failed validation (run again)
     first_problem: str = ""
@@ -209,7 +209,12 @@ class SweepStore:
         return value if isinstance(value, str) else None
 
     def read_journal(
-        self, digest: str, grid: set[tuple[str, str]], n_interfaces: int, ensemble: int
+        self,
+        digest: str,
+        grid: set[tuple[str, ...]],
+        n_interfaces: int,
+        ensemble: int,
+        paths: tuple[str, ...] = (),
     ) -> JournalRead:
         """Every line of the journal, validated (see validate_row). A line cut by a kill
         (the last one, without its newline) is expected and not counted as rejected."""
@@ -242,7 +247,7 @@ class SweepStore:
                 continue
             if isinstance(row, dict) and isinstance(row.get("config_hash"), str):
                 out.hashes.add(row["config_hash"])
-            problem = validate_row(row, digest, grid, n_interfaces, ensemble)
+            problem = validate_row(row, digest, grid, n_interfaces, ensemble, paths)
             if not problem and "config_hash" not in row and not legacy:
                 problem = "no config hash, and no state file of this config to vouch for it"
             if problem:
@@ -250,7 +255,7 @@ class SweepStore:
                     out.rejected += 1
                     out.first_problem = out.first_problem or f"line {number}: {problem}"
                 continue
-            key = cell_key(row["amplitude_g"], row["frequency_hz"])
+            key = cell_key(row["amplitude_g"], row["frequency_hz"], *(row[p] for p in paths))
             out.rows.setdefault(key, row)
         return out
 

@@ -16,28 +16,34 @@ import dataclasses
 import hashlib
 import json
 import os
-import platform
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import joblib
-import numpy as np
 import pandas as pd
 
-from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import CSV_FIELDS
-from rbm_cli.study.domain import cell_key
+from rbm_cli.study.cells import (
+    Cell,
+    add_point,
+    count_cells,
+    domain_fields,
+    grid_cells,
+    grid_points,
+    key,
+    max_drums,
+    row_key,
+    tasks,
+)
 from rbm_cli.study.parallel import run_chunks
-from rbm_cli.study.provenance import provenance
-from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
 from rbm_cli.study.robustness import Member, member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
-from rbm_cli.study.sweep_folder import prepare_folder, publish_result
+from rbm_cli.study.sweep_folder import prepare_folder, publish_result, sweep_meta
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -63,11 +69,6 @@ class SweepSummary:
     already_finished: bool = False  # resume on a folder that holds this config's result
 
 
-def grid_cells(config: Config) -> list[tuple[float, float]]:
-    """The cells of a config's grid, frequency-major: [(amplitude_g, frequency_hz), ...]."""
-    return [(a, f) for f in config.grid.frequencies_hz for a in config.grid.amplitudes_g]
-
-
 def config_hash(config: Config) -> str:
     """Fingerprint of everything that changes a domain (the resolved config).
 
@@ -85,7 +86,7 @@ def ensemble_member(config: Config, a: float, member: Member) -> tuple[Config, f
     return member_config(config, a, member)
 
 
-def _run_cell(config: Config, a: float, f: float, runner) -> dict:
+def _run_cell(config: Config, a: float, f: float | None, runner) -> dict:
     from rbm_cli.study.simulate import simulate
 
     try:
@@ -100,20 +101,25 @@ def _run_cell(config: Config, a: float, f: float, runner) -> dict:
         }
 
 
-def run_chunk(config: Config, cells: list[tuple[float, float]], ensemble: int = 1) -> list[dict]:
-    """Run cells of one config in this process; a cell that raises is 'failed'.
+def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict]:
+    """Run cells of one point's config in this process; a cell that raises is 'failed'.
 
-    With ensemble K > 1 each cell is run K times (rbm_cli.study.robustness.members) and
-    its row is member 0's, plus collapse_fraction (the fraction of the members
-    that did not fail which collapsed; NaN if all failed) and robust (1 when all
-    members agree and none failed: the robustness rule)."""
+    Cells are (amplitude_g, frequency_hz, point values) (rbm_cli.study.cells); each row
+    gets its point's values and its column's scales. With ensemble K > 1 each cell is
+    run K times (rbm_cli.study.robustness.members) and its row is member 0's, plus
+    collapse_fraction (the fraction of the members that did not fail which collapsed;
+    NaN if all failed) and robust (1 when all members agree and none failed: the
+    robustness rule)."""
     from rbm_cli.models.registry import make_runner
+    from rbm_cli.physics.similarity import rocking_scales
 
     runner = make_runner(config)  # the column assembled once for every cell and member
+    scales = rocking_scales(config)
     rows = []
     others = members(ensemble)[1:]
-    for a, f in cells:
-        row = _run_cell(config, a, f, runner)
+    for cell in cells:
+        a, f, _ = cell
+        row = add_point(_run_cell(config, a, f, runner), config, cell, scales)
         if ensemble > 1:
             runs = [row] + [_run_cell(*ensemble_member(config, a, m), f, runner) for m in others]
             flags = [r["collapsed"] for r in runs if r["status"] != "failed"]
@@ -123,33 +129,13 @@ def run_chunk(config: Config, cells: list[tuple[float, float]], ensemble: int = 
     return rows
 
 
-def _chunks(cells: list, jobs: int) -> list[list]:
-    size = int(np.clip(len(cells) // max(1, 16 * jobs), 1, 32))
-    return [cells[i : i + size] for i in range(0, len(cells), size)]
-
-
-def _versions() -> dict:
-    import matplotlib
-    import scipy
-
-    return {
-        "rbm": __version__,
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "scipy": scipy.__version__,
-        "pandas": pd.__version__,
-        "joblib": joblib.__version__,
-        "matplotlib": matplotlib.__version__,
-    }
-
-
 def _check_request(
     config: Config, jobs: int, ensemble: int, backend: str, scheduler: str | None, force: bool
 ) -> int:
     """The number of cells, once every argument is checked (before any folder exists)."""
     # counted before the cells are listed: a 10^8-cell grid is refused at once
-    n_cells = len(config.grid.amplitudes_g) * len(config.grid.frequencies_hz)
-    if not n_cells:
+    n_cells = count_cells(config)
+    if not n_cells or not config.grid.frequencies_hz:  # (a record needs no frequencies)
         raise RbmError("the config has no grid: give grid.amplitudes and grid.frequencies")
     if n_cells > MAX_CELLS and not force:
         raise RbmError(
@@ -165,11 +151,20 @@ def _check_request(
         from rbm_cli.study.parallel import probe_dask
 
         probe_dask(scheduler)  # an address that is not a Dask scheduler: one line, bounded
-    if config.model == "rbm":
-        from rbm_cli.models.rbm.runner import model_from_config
-
-        model_from_config(config)  # every derived quantity finite, or one line now
     return n_cells
+
+
+def _check_points(points: list[GridPoint]) -> None:
+    """Every point's RBM has finite derived quantities, or one line naming the point."""
+    from rbm_cli.models.rbm.runner import model_from_config
+
+    for point in points:
+        if point.config.model == "rbm":
+            try:
+                model_from_config(point.config)
+            except RbmError as exc:
+                text = f"grid point {point.label}: {exc}" if point.values else str(exc)
+                raise type(exc)(text) from None
 
 
 def run_sweep(
@@ -225,24 +220,26 @@ def run_sweep(
     SweepInterrupted  Ctrl-C (a KeyboardInterrupt): finished cells kept, see its message
     """
     n_cells = _check_request(config, jobs, ensemble, backend, scheduler, force)
-    cells = grid_cells(config)
+    points = grid_points(config)
+    _check_points(points)
+    cells = grid_cells(config, points)
     folder = Path(output) / config.name
     digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
-    fields = CSV_FIELDS + (ENSEMBLE_FIELDS if ensemble > 1 else ())
+    fields = domain_fields(config, CSV_FIELDS) + (ENSEMBLE_FIELDS if ensemble > 1 else ())
     resume_command = resume_command or f"rbm sweep CONFIG.yaml -o {output} --resume"
     note = notify or (lambda text: None)
     with SweepStore(folder) as store:
-        done = prepare_folder(store, config, cells, digest, ensemble, resume, force, note,
-                              resume_command)  # fmt: skip
+        done = prepare_folder(store, config, points, cells, digest, ensemble, resume, force,
+                              note, resume_command)  # fmt: skip
         if done is None:
             return _finished_summary(folder, n_cells)
-        todo = [c for c in cells if cell_key(*c) not in done]
-        run = _Run(store, config, cells, digest, ensemble, resume_command, done)
+        todo = [c for c in cells if key(c) not in done]
+        run = _Run(store, config, points, cells, digest, ensemble, resume_command, done)
         compile_s, wall = run.run(todo, jobs, backend, scheduler, progress, stop_after)
-        rows = [done[cell_key(*c)] for c in cells]
+        rows = [done[key(c)] for c in cells]
         df = pd.DataFrame(rows, columns=list(fields))
         counts = df["status"].value_counts().to_dict()
-        meta = _meta(config, digest, len(cells), len(todo), counts, ensemble)
+        meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble)
         meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler)
         meta["compile_time_s"] = compile_s
         try:
@@ -268,34 +265,13 @@ def _summary(folder, n_cells, n_run, counts, wall, compile_s) -> SweepSummary:
     )
 
 
-def _meta(config: Config, digest: str, n_cells: int, n_run: int, counts: dict, ensemble: int):
-    """meta.json's record of a sweep (wall time, workers and compile time added after)."""
-    return {
-        "name": config.name,
-        "config": config.resolved(),
-        "config_written": config.written,
-        "config_hash": digest,
-        "versions": _versions(),
-        "wall_time_s": None,
-        "jobs": None,
-        "backend": None,
-        "scheduler": None,
-        "n_cells": n_cells,
-        "n_run": n_run,
-        "n_resumed": n_cells - n_run,
-        "status_counts": counts,
-        "ensemble": {"members": ensemble, "rule": ROBUSTNESS_RULE if ensemble > 1 else None},
-        "provenance": provenance(),
-        "cpu_count": os.cpu_count(),
-    }
-
-
 @dataclass
 class _Run:
     """The cells of one sweep being run into its store (journal rows land in `done`)."""
 
     store: SweepStore
     config: Config
+    points: list
     cells: list
     digest: str
     ensemble: int
@@ -305,23 +281,24 @@ class _Run:
     def cells_kept(self) -> int:
         """Cells kept after a Ctrl-C, counted from the journal: Ctrl-C may land between a
         chunk's write and its count."""
-        keys = {cell_key(*c) for c in self.cells}
-        read = self.store.read_journal(self.digest, keys, self.config.column.n_drums,
-                                       self.ensemble)  # fmt: skip
+        read = self.store.read_journal(self.digest, {key(c) for c in self.cells},
+                                       max_drums(self.points), self.ensemble,
+                                       self.config.grid.axis_paths)  # fmt: skip
         return max(len(self.done), len(read.rows))
 
     def run(self, todo, jobs, backend, scheduler, progress, stop_after) -> tuple[float, float]:
         """Run the cells still to do; (compile time, wall time) [s]."""
         n_cells = len(self.cells)
         try:
-            compile_s = _warm_up(self.config, todo)
+            compile_s = _warm_up(self.points, todo)
             start = time.perf_counter()
-            chunks = _chunks(todo, jobs)
+            chunks = tasks(self.config, self.points, todo, jobs)
             if stop_after is not None:
                 chunks = chunks[:stop_after]
-            tasks = [(self.config, c, self.ensemble) for c in chunks]
-            _run_tasks(self.store, tasks, jobs, backend, scheduler, self.digest, self.done,
-                       n_cells, progress, self.resume_command)  # fmt: skip
+            work = [(cfg, c, self.ensemble) for cfg, c in chunks]
+            _run_tasks(self.store, work, jobs, backend, scheduler, self.digest, self.done,
+                       n_cells, progress, self.resume_command,
+                       self.config.grid.axis_paths)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(self.store.folder, self.cells_kept(), n_cells,
                                    self.resume_command) from None  # fmt: skip
@@ -333,7 +310,7 @@ class _Run:
 
 
 def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
-               resume_command) -> None:  # fmt: skip
+               resume_command, paths) -> None:  # fmt: skip
     """Run the chunks; each one's rows go to the journal (fsync'ed), then into done."""
     n_done = len(done)
     if progress:
@@ -344,7 +321,7 @@ def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, pr
             if rows is not None:
                 store.append(rows, digest)
                 for row in rows:
-                    done[cell_key(row["amplitude_g"], row["frequency_hz"])] = row
+                    done[row_key(row, paths)] = row
                 n_done += len(rows)
             if progress:
                 progress(n_done, n_cells)
@@ -381,10 +358,13 @@ def _finished_summary(folder: Path, n_cells: int) -> SweepSummary:
     )
 
 
-def _warm_up(config: Config, todo: list) -> float:
+def _warm_up(points: list[GridPoint], todo: list) -> float:
     """Compile (or load) the kernel once here, so the workers load it from numba's
     cache; its time [s], which the sweep's wall time and ETA leave out."""
-    if not (todo and config.model == "rbm" and config.solver.implementation == "compiled"):
+    compiled = any(
+        p.config.model == "rbm" and p.config.solver.implementation == "compiled" for p in points
+    )
+    if not (todo and compiled):
         return 0.0
     from rbm_cli.models.rbm.kernel import warm_up
 

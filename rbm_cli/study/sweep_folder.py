@@ -9,22 +9,34 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import platform
 from collections.abc import Callable
 from pathlib import Path
 
+import joblib
+import numpy as np
+import pandas as pd
+
+from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
-from rbm_cli.study.domain import boundary, cell_key, csv_text
+from rbm_cli.config.types import Config
+from rbm_cli.study.cells import key, max_drums
+from rbm_cli.study.domain import boundary, csv_text
+from rbm_cli.study.provenance import provenance
+from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
 from rbm_cli.study.store import FINALS, JOURNAL, STATE
 
 
-def prepare_folder(store, config, cells, digest, ensemble, resume, force, note, command):
+def prepare_folder(store, config, points, cells, digest, ensemble, resume, force, note, command):
     """The finished rows to keep (resume), {} for a new sweep, None if the folder
     already holds this config's finished result and resume is asked. Refuses (RbmError)
     whatever would lose finished work."""
     folder = store.folder
     if store.journal.exists():
-        grid = {cell_key(*c) for c in cells}
-        read = store.read_journal(digest, grid, config.column.n_drums, ensemble)
+        grid = {key(c) for c in cells}
+        read = store.read_journal(digest, grid, max_drums(points), ensemble,
+                                  config.grid.axis_paths)  # fmt: skip
         ours = digest in read.hashes or store.state_hash() == digest
         n = len(read.rows) if ours else read.rejected  # rows of the other config
         if not read.rows and not read.rejected and (ours or not read.hashes):
@@ -146,3 +158,40 @@ def _common_equal(a, b) -> bool:
     if isinstance(a, dict) and isinstance(b, dict):
         return all(_common_equal(a[k], b[k]) for k in a.keys() & b.keys())
     return a == b
+
+
+def _versions() -> dict:
+    import matplotlib
+    import scipy
+
+    return {
+        "rbm": __version__,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "pandas": pd.__version__,
+        "joblib": joblib.__version__,
+        "matplotlib": matplotlib.__version__,
+    }
+
+
+def sweep_meta(config: Config, digest: str, n_cells: int, n_run: int, counts: dict, ensemble: int):
+    """meta.json's record of a sweep (wall time, workers and compile time added after)."""
+    return {
+        "name": config.name,
+        "config": config.resolved(),
+        "config_written": config.written,
+        "config_hash": digest,
+        "versions": _versions(),
+        "wall_time_s": None,
+        "jobs": None,
+        "backend": None,
+        "scheduler": None,
+        "n_cells": n_cells,
+        "n_run": n_run,
+        "n_resumed": n_cells - n_run,
+        "status_counts": counts,
+        "ensemble": {"members": ensemble, "rule": ROBUSTNESS_RULE if ensemble > 1 else None},
+        "provenance": provenance(),
+        "cpu_count": os.cpu_count(),
+    }

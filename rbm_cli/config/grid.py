@@ -1,0 +1,191 @@
+"""The ``grid`` section: amplitudes x frequencies x any other config key.
+
+A grid is the product of its axes. ``amplitudes`` [g] and ``frequencies`` [Hz] are the
+excitation's; every other key is an **axis over a config key** named by its dotted path
+(``column.height``, ``interface.stiffness.normal``, ``excitation.file`` ...),
+with the same value syntax (a value, a list, or ``{start, stop, num | step, spacing}``).
+Axes that vary together are **linked**: ``linked`` is a list of mappings, each of two or
+more paths to lists of one length, one axis whose k-th point sets every path to its k-th
+value. Two virtual paths describe a column by shape and size instead of its keys:
+
+- ``column.size`` [m]: the height of a geometrically similar column: every length of the
+  column (height, widths, depth, listed drum heights) is scaled by size / height;
+- ``column.slenderness`` [-]: H / B_1: the base width becomes height / slenderness and
+  the top width and depth scale with it (the taper is kept).
+
+Each point of the axes is a config of its own, validated as a config is (rbm_cli.config
+.points): a bad value is refused in one line naming the axis, the value and the problem.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from typing import Any
+
+from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.types import Axis, GridConfig
+from rbm_cli.config.validate import (
+    MAX_GRID_VALUES,
+    describe,
+    fmt,
+    grid_axis,
+    is_number,
+    join,
+)
+
+#: Grid and command-line excitation ranges [assumption]: g and Hz at the edges.
+AMPLITUDE_RANGE_G = (0.0, 1e3)
+FREQUENCY_RANGE_HZ = (1e-3, 1e3)
+#: Keys of the excitation's own axes, and the key of linked axes.
+EXCITATION_AXES = ("amplitudes", "frequencies")
+LINKED = "linked"
+#: Paths that are not config keys but describe the column by similarity (module docstring).
+VIRTUAL_PATHS = {"column.size": "m", "column.slenderness": ""}
+#: Keys that cannot vary over a grid: the folder name, the grid itself.
+FIXED_KEYS = ("name", "grid")
+#: Largest number of points of the non-excitation axes together (each is one config).
+MAX_POINTS = 10_000
+PATH_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
+
+
+def parse_grid(raw: Any) -> GridConfig:
+    """The validated ``grid`` section (module docstring); an empty grid when absent."""
+    if raw is not None and not isinstance(raw, Mapping):
+        raise ConfigError(
+            "grid must be a mapping (amplitudes, frequencies, linked, or config key paths),"
+            f" got {describe(raw)}"
+        )
+    g = dict(raw or {})
+    amplitudes, frequencies = (
+        grid_axis(g[key], join("grid", key), unit, lo_open=lo_open, bounds=bounds)
+        if key in g
+        else ()
+        for key, unit, lo_open, bounds in (
+            ("amplitudes", "g", False, AMPLITUDE_RANGE_G),
+            ("frequencies", "Hz", True, FREQUENCY_RANGE_HZ),
+        )
+    )
+    return GridConfig(amplitudes_g=amplitudes, frequencies_hz=frequencies, axes=parse_axes(g))
+
+
+def parse_axes(raw: Mapping[str, Any]) -> tuple[Axis, ...]:
+    """The axes over config keys of a grid mapping (every key but amplitudes and
+    frequencies), in the order written."""
+    axes = []
+    for key, value in raw.items():
+        if key in EXCITATION_AXES:
+            continue
+        if key == LINKED:
+            axes.extend(_linked(value))
+            continue
+        path = _path(key, f"grid.{key}")
+        axes.append(Axis((path,), tuple((v,) for v in _values(value, f"grid.{key}", path))))
+    paths = [p for axis in axes for p in axis.paths]
+    for p in set(paths):
+        if paths.count(p) > 1:
+            raise ConfigError(f"grid: the axis {p} is given twice (once per grid)")
+    if "column.size" in paths and "column.height" in paths:
+        raise ConfigError("grid: column.size and column.height both set the height: use one")
+    if "column.slenderness" in paths and "column.base_width" in paths:
+        raise ConfigError(
+            "grid: column.slenderness and column.base_width both set the base width: use one"
+        )
+    n_points = 1
+    for axis in axes:
+        n_points *= len(axis.points)
+    if n_points > MAX_POINTS:
+        raise ConfigError(
+            f"grid: the axes over config keys make {n_points:,} points (at most {MAX_POINTS:,})"
+        )
+    return tuple(axes)
+
+
+def _path(key: Any, where: str) -> str:
+    if not isinstance(key, str) or not PATH_RE.fullmatch(key):
+        raise ConfigError(
+            f"{where}: a grid key is amplitudes, frequencies, {LINKED}, or a config key by its"
+            f" dotted path (column.height, interface.restitution, ...), got {describe(key)}"
+        )
+    if key.split(".")[0] in FIXED_KEYS:
+        raise ConfigError(f"{where}: {key} cannot vary over a grid")
+    if "." not in key:
+        raise ConfigError(
+            f"unknown key {key!r} in grid (allowed: amplitudes, frequencies, {LINKED},"
+            " or a config key by its dotted path such as column.height)"
+        )
+    return key
+
+
+def _values(value: Any, where: str, path: str, unique: bool = True) -> tuple[Any, ...]:
+    """The values of one axis: numbers through grid_axis (lists and ranges), or a list
+    of strings (restitution "housner", excitation.file ...)."""
+    unit = VIRTUAL_PATHS.get(path, "")
+    if isinstance(value, Mapping):
+        return grid_axis(value, where, unit, lo_open=False, bounds=None)
+    if is_number(value) or isinstance(value, str | bool):
+        return (value,)
+    if not isinstance(value, list | tuple) or not value:
+        raise ConfigError(
+            f"{where} must be a value, a non-empty list, or {{start, stop, step | num}},"
+            f" got {describe(value)}"
+        )
+    if len(value) > MAX_GRID_VALUES:
+        raise ConfigError(f"{where} must have at most {MAX_GRID_VALUES} values, got {len(value)}")
+    out = []
+    for i, v in enumerate(value):
+        if not (is_number(v) or isinstance(v, str | bool)):
+            raise ConfigError(f"{join(where, i)} must be a number or a string, got {describe(v)}")
+        if unique and any(v == w and type(v) is type(w) for w in out):
+            raise ConfigError(f"{join(where, i)} repeats {_text(v)}: list each value once")
+        out.append(v)
+    return tuple(out)
+
+
+def _linked(value: Any) -> list[Axis]:
+    where = f"grid.{LINKED}"
+    if not isinstance(value, list | tuple) or not value:
+        raise ConfigError(
+            f"{where} must be a list of mappings, each of two or more config key paths to"
+            f" lists of one length, got {describe(value)}"
+        )
+    axes = []
+    for i, group in enumerate(value):
+        at = join(where, i)
+        if not isinstance(group, Mapping) or len(group) < 2:
+            raise ConfigError(f"{at} must map two or more config key paths to lists of values")
+        paths = tuple(_path(k, join(at, str(k))) for k in group)
+        columns = [
+            _values(group[k], join(at, str(k)), p, False)
+            for k, p in zip(group, paths, strict=False)
+        ]
+        lengths = {len(c) for c in columns}
+        if len(lengths) != 1:
+            sizes = ", ".join(f"{p}: {len(c)}" for p, c in zip(paths, columns, strict=False))
+            raise ConfigError(f"{at}: linked axes must have as many values each, got {sizes}")
+        points = tuple(zip(*columns, strict=False))
+        if len(set(points)) != len(points):
+            raise ConfigError(f"{at}: a point repeats (each set of linked values once)")
+        axes.append(Axis(paths, points))
+    return axes
+
+
+def _text(value: Any) -> str:
+    return fmt(value) if is_number(value) else repr(value)
+
+
+def point_label(paths: tuple[str, ...], point: tuple[Any, ...]) -> str:
+    """``column.height = 2, column.base_width = 0.5``: a point, for messages and legends."""
+    return ", ".join(f"{p} = {_text(v)}" for p, v in zip(paths, point, strict=False))
+
+
+__all__ = [
+    "AMPLITUDE_RANGE_G",
+    "FREQUENCY_RANGE_HZ",
+    "LINKED",
+    "MAX_POINTS",
+    "VIRTUAL_PATHS",
+    "parse_axes",
+    "parse_grid",
+    "point_label",
+]

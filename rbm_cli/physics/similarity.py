@@ -1,0 +1,86 @@
+"""The scales of a rocking column that make a domain dimensionless.
+
+Every rocking model here obeys one similarity law: with the slenderness alpha [rad] (the
+uplift level is g tan alpha) and the frequency parameter p [rad/s], a ground motion of
+amplitude A and circular frequency omega acts on the column only through
+A / (g tan alpha) and omega / p (and the restitution, a function of the shape). So two
+geometrically similar columns (same alpha) of different size (different p) under
+excitations of equal A / (g tan alpha) and omega / p rock alike, in time units 1 / p:
+Housner's size effect is that p falls as the size grows, so at one frequency the larger
+column sits at a larger omega / p and needs a larger amplitude to overturn.
+
+The scales are those of the column taken as one rigid body (its drums glued), the
+column's own first scales however many drums it has:
+
+- ``rbm``: the RBM's rigid monolith (rbm_cli.physics.closed_forms.linear_rocking_parameters:
+  tan alpha = theta_u,1, p^2 = m g (H / 2) / (I_G + m H^2 / 4));
+- ``housner``, ``housner-linear``, ``bullet`` (true geometry, rigid blocks): the block's
+  tan alpha = b / z_c and p^2 = m g R / I_O (rbm_cli.physics.block.block_geometry).
+
+The static multiplier is the uniform horizontal acceleration [g] that starts the column
+rocking: min over the interfaces of theta_u,i for the RBM (the weakest stack), tan alpha
+for a rigid block.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+from rbm_cli.config.types import Config, InterfaceConfig, StiffnessConfig
+
+#: The columns a domain gets from :func:`cell_scales` (domain.csv, SPEC section 5).
+SCALE_FIELDS = ("alpha_rad", "p_rad_s", "static_multiplier", "a_over_g_alpha", "omega_over_p")
+
+
+@dataclass(frozen=True)
+class RockingScales:
+    """alpha [rad], p [rad/s] and the static multiplier [g] of a config's column."""
+
+    alpha: float
+    p: float
+    static_multiplier: float
+
+    def dimensionless(self, amplitude_g: float, frequency_hz: float | None) -> tuple[float, float]:
+        """(A / (g tan alpha), omega / p) of an excitation of amplitude A [g] and frequency
+        f [Hz] (omega = 2 pi f); omega / p is NaN without a frequency (a record)."""
+        if frequency_hz is None or not math.isfinite(frequency_hz):
+            ratio = math.nan
+        else:
+            ratio = 2.0 * math.pi * frequency_hz / self.p
+        return amplitude_g / math.tan(self.alpha), ratio
+
+
+def rocking_scales(config: Config) -> RockingScales:
+    """The scales of a config's column (module docstring); the model decides which."""
+    from rbm_cli.physics.closed_forms import linear_rocking_parameters
+    from rbm_cli.physics.column import build_column
+
+    rigid = InterfaceConfig(stiffness=StiffnessConfig("rigid", ()))
+    column = build_column(config.column, rigid)
+    glued = dataclasses.replace(config.column, drum_heights=(config.column.height,))
+    if config.model == "rbm":
+        tan_alpha, p = linear_rocking_parameters(build_column(glued, rigid))
+        return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)
+    from rbm_cli.physics.block import block_geometry
+
+    block = block_geometry(glued)
+    tan_alpha = math.tan(block.slenderness)
+    static = tan_alpha if config.column.n_drums == 1 else min(tan_alpha, column.static_multiplier)
+    return RockingScales(block.slenderness, block.frequency_parameter, static)
+
+
+def scale_fields(scales: RockingScales, amplitude_g: float, frequency_hz: float | None) -> dict:
+    """The :data:`SCALE_FIELDS` of one cell, as domain.csv holds them."""
+    a_ratio, w_ratio = scales.dimensionless(amplitude_g, frequency_hz)
+    return {
+        "alpha_rad": scales.alpha,
+        "p_rad_s": scales.p,
+        "static_multiplier": scales.static_multiplier,
+        "a_over_g_alpha": a_ratio,
+        "omega_over_p": w_ratio,
+    }
+
+
+__all__ = ["SCALE_FIELDS", "RockingScales", "rocking_scales", "scale_fields"]

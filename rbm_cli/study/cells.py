@@ -1,0 +1,111 @@
+"""The cells of a sweep: the points of the axes over config keys x frequencies x amplitudes.
+
+A cell is ``(amplitude_g, frequency_hz, values)``: values are the (path, value) pairs of its
+point (rbm_cli.config.points), empty for a plain amplitude x frequency grid; frequency_hz
+is None for an excitation without one (a record). Cells are listed point-major, then
+frequency-major, so a plain grid lists its cells as it always did. A domain.csv row
+carries its point as one column per path, named by the path (the dots tell them from the
+result's columns), and the scales of its column (rbm_cli.physics.similarity).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rbm_cli.config.load import parse_config
+from rbm_cli.config.points import GridPoint, expand
+from rbm_cli.config.types import Config
+from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
+from rbm_cli.study.domain import cell_key
+
+Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
+
+
+def grid_points(config: Config) -> list[GridPoint]:
+    """The points of a config's axes over config keys, each with its validated config."""
+    return expand(config, parse_config)
+
+
+def frequencies(config: Config) -> tuple:
+    """The grid's frequencies [Hz], or (None,) for an excitation without one."""
+    return config.grid.frequencies_hz or (None,)
+
+
+def grid_cells(config: Config, points: list[GridPoint] | None = None) -> list[Cell]:
+    """Every cell of the grid: point-major, then frequency-major (module docstring)."""
+    points = grid_points(config) if points is None else points
+    return [
+        (a, f, point.values)
+        for point in points
+        for f in frequencies(config)
+        for a in config.grid.amplitudes_g
+    ]
+
+
+def count_cells(config: Config) -> int:
+    """The number of cells, counted without listing them."""
+    n = len(config.grid.amplitudes_g) * len(frequencies(config))
+    for axis in config.grid.axes:
+        n *= len(axis.points)
+    return n
+
+
+def key(cell: Cell) -> tuple[str, ...]:
+    """The identity of a cell (rbm_cli.study.domain.cell_key of its values)."""
+    a, f, values = cell
+    return cell_key(a, f, *(v for _, v in values))
+
+
+def row_key(row: dict, paths: tuple[str, ...]) -> tuple[str, ...]:
+    """The identity of a domain row whose point is in the columns ``paths``."""
+    return cell_key(row.get("amplitude_g"), row.get("frequency_hz"), *(row.get(p) for p in paths))
+
+
+def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
+    """domain.csv's columns: the axis paths, the result's ``fields``, the scales."""
+    return config.grid.axis_paths + tuple(fields) + SCALE_FIELDS
+
+
+def tasks(
+    config: Config, points: list[GridPoint], todo: list[Cell], jobs: int
+) -> list[tuple[Config, list[Cell]]]:
+    """The cells still to do in chunks of one point each (one column per chunk, so a
+    worker assembles it once): (the point's config, cells), in grid order."""
+    by_point: dict[tuple, list[Cell]] = {}
+    for cell in todo:
+        by_point.setdefault(cell[2], []).append(cell)
+    configs = {p.values: p.config for p in points}
+    size = int(np.clip(len(todo) // max(1, 16 * jobs), 1, 32))
+    out = []
+    for values, cells in by_point.items():
+        out.extend((configs[values], cells[i : i + size]) for i in range(0, len(cells), size))
+    return out
+
+
+def max_drums(points: list[GridPoint]) -> int:
+    """The most drums of any point's column (the journal's collapse_interface range)."""
+    return max(p.config.column.n_drums for p in points)
+
+
+def add_point(row: dict, config: Config, cell: Cell, scales=None) -> dict:
+    """The row with its point's values and its column's scales."""
+    a, f, values = cell
+    row.update(dict(values))
+    scales = scales or rocking_scales(config)
+    row.update(scale_fields(scales, a, f))
+    return row
+
+
+__all__ = [
+    "Cell",
+    "add_point",
+    "count_cells",
+    "domain_fields",
+    "frequencies",
+    "grid_cells",
+    "grid_points",
+    "key",
+    "max_drums",
+    "row_key",
+    "tasks",
+]

@@ -229,3 +229,16 @@ def test_a_journal_row_of_another_point_is_not_trusted(tmp_path):
     notes: list[str] = []
     run_sweep(cfg, tmp_path, jobs=1, resume=True, notify=notes.append)
     assert any("not in the config's grid" in n for n in notes), notes
+
+
+def test_dask_sweeps_axes_as_the_local_workers_do(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    cfg = config({"frequencies": [1.0], "column.slenderness": [3.0, 5.0]})
+    ref = run_sweep(cfg, tmp_path / "ref", jobs=1)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+    ) as cluster:
+        got = run_sweep(
+            cfg, tmp_path / "dask", jobs=2, backend="dask", scheduler=cluster.scheduler_address
+        )
+    assert (got.folder / "domain.csv").read_bytes() == (ref.folder / "domain.csv").read_bytes()

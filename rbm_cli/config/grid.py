@@ -19,8 +19,10 @@ Each point of the axes is a config of its own, validated as a config is (rbm_cli
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
@@ -186,6 +188,66 @@ __all__ = [
     "MAX_POINTS",
     "VIRTUAL_PATHS",
     "parse_axes",
+    "hoist_suite",
     "parse_grid",
     "point_label",
 ]
+
+
+#: File names a folder of records is read for (``excitation.file: <folder>``).
+RECORD_SUFFIXES = (".at2", ".csv")
+GLOB_CHARS = "*?["
+
+
+def hoist_suite(top: Mapping[str, Any], base_dir: str | os.PathLike | None) -> dict:
+    """A config mapping whose ``excitation.file`` names several records (a list, a folder
+    or a glob) turned into a grid axis ``excitation.file`` over each file (sorted for a
+    folder or a glob; relative to ``base_dir`` as written), the excitation keeping the
+    first so that it validates as one record. Any other mapping comes back as it is."""
+    excitation = top.get("excitation")
+    if not isinstance(excitation, Mapping) or "file" not in excitation:
+        return dict(top)
+    files = _suite_files(excitation["file"], Path(base_dir or "."))
+    if files is None:
+        return dict(top)
+    grid = top.get("grid")
+    grid = dict(grid) if isinstance(grid, Mapping) else {}
+    if "excitation.file" in grid:
+        raise ConfigError(
+            "excitation.file names several records and grid.excitation.file is given too: use one"
+        )
+    grid["excitation.file"] = files
+    return {**top, "excitation": {**excitation, "file": files[0]}, "grid": grid}
+
+
+def _suite_files(value: Any, base: Path) -> list[str] | None:
+    """The files of a suite, or None for one file (left to the excitation's own checks)."""
+    where = "excitation.file"
+    if isinstance(value, list | tuple):
+        if not value:
+            raise ConfigError(f"{where} must not be an empty list")
+        for i, v in enumerate(value):
+            if not isinstance(v, str) or not v.strip():
+                raise ConfigError(f"{join(where, i)} must be a file path, got {describe(v)}")
+        return list(value)
+    if not isinstance(value, str) or not value.strip():
+        return None
+    if any(c in value for c in GLOB_CHARS):
+        found = sorted(p for p in base.glob(value) if p.is_file())
+        if not found:
+            raise ConfigError(f"{where}: the pattern {value!r} matches no file (in {base})")
+        return [_relative(p, base) for p in found]
+    folder = base / value
+    if not folder.is_dir():
+        return None
+    found = sorted(p for p in folder.iterdir() if p.suffix.lower() in RECORD_SUFFIXES)
+    if not found:
+        raise ConfigError(f"{where}: the folder {value!r} holds no .AT2 or .csv record")
+    return [_relative(p, base) for p in found if p.is_file()]
+
+
+def _relative(path: Path, base: Path) -> str:
+    try:
+        return path.relative_to(base).as_posix()
+    except ValueError:
+        return path.as_posix()

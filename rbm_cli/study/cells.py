@@ -10,6 +10,8 @@ result's columns), and the scales of its column (rbm_cli.physics.similarity).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from rbm_cli.config.load import parse_config
@@ -61,9 +63,16 @@ def row_key(row: dict, paths: tuple[str, ...]) -> tuple[str, ...]:
     return cell_key(row.get("amplitude_g"), row.get("frequency_hz"), *(row.get(p) for p in paths))
 
 
+def has_records(config: Config) -> bool:
+    """Whether the config's ground motion is a record (or a suite of records)."""
+    return config.excitation.type == "record"
+
+
 def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
-    """domain.csv's columns: the axis paths, the result's ``fields``, the scales."""
-    return config.grid.axis_paths + tuple(fields) + SCALE_FIELDS
+    """domain.csv's columns: the axis paths, ``record`` (the record's name, for record
+    excitations), the result's ``fields``, the scales."""
+    record = ("record",) if has_records(config) else ()
+    return config.grid.axis_paths + record + tuple(fields) + SCALE_FIELDS
 
 
 def tasks(
@@ -91,6 +100,8 @@ def add_point(row: dict, config: Config, cell: Cell, scales=None) -> dict:
     """The row with its point's values and its column's scales."""
     a, f, values = cell
     row.update(dict(values))
+    if has_records(config):
+        row["record"] = Path(str(config.excitation.file)).stem
     scales = scales or rocking_scales(config)
     row.update(scale_fields(scales, a, f))
     return row

@@ -154,8 +154,9 @@ def _check_request(
     return n_cells
 
 
-def _check_points(points: list[GridPoint]) -> None:
-    """Every point's RBM has finite derived quantities, or one line naming the point."""
+def _check_points(points: list[GridPoint]) -> list[GridPoint]:
+    """The points, once every point's RBM has finite derived quantities (or one line
+    naming the point)."""
     from rbm_cli.models.rbm.runner import model_from_config
 
     for point in points:
@@ -165,6 +166,7 @@ def _check_points(points: list[GridPoint]) -> None:
             except RbmError as exc:
                 text = f"grid point {point.label}: {exc}" if point.values else str(exc)
                 raise type(exc)(text) from None
+    return points
 
 
 def run_sweep(
@@ -220,8 +222,7 @@ def run_sweep(
     SweepInterrupted  Ctrl-C (a KeyboardInterrupt): finished cells kept, see its message
     """
     n_cells = _check_request(config, jobs, ensemble, backend, scheduler, force)
-    points = grid_points(config)
-    _check_points(points)
+    points = _check_points(grid_points(config))
     cells = grid_cells(config, points)
     folder = Path(output) / config.name
     digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
@@ -240,8 +241,8 @@ def run_sweep(
         df = pd.DataFrame(rows, columns=list(fields))
         counts = df["status"].value_counts().to_dict()
         meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble)
-        meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler)
-        meta["compile_time_s"] = compile_s
+        meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler,
+                    compile_time_s=compile_s)  # fmt: skip
         try:
             publish_result(
                 store, lambda: figure(df, config), rows, df, fields, meta, resume_command

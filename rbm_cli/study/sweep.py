@@ -244,9 +244,8 @@ def run_sweep(
         meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler,
                     compile_time_s=compile_s)  # fmt: skip
         try:
-            publish_result(
-                store, lambda: figure(df, config), rows, df, fields, meta, resume_command
-            )
+            publish_result(store, lambda: figure(df, config), rows, df, fields, meta,
+                           resume_command)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
     return _summary(folder, len(cells), len(todo), counts, wall, compile_s)

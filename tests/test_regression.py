@@ -50,6 +50,9 @@ STUDIES = {
     "housner_halfsine_housner": CONFIGS / "housner_halfsine_housner.yaml",
     "spanos_koh_slender_housner_e": CONFIGS / "spanos_koh_slender_housner_e.yaml",
     "spanos_koh_slender_housner_e_housner": CONFIGS / "spanos_koh_slender_housner_e_housner.yaml",
+    # grids over config keys (issue 16): the size effect, the drum count
+    "size_effect": CONFIGS / "size_effect.yaml",
+    "drum_count": CONFIGS / "drum_count.yaml",
 }
 
 

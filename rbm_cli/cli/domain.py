@@ -253,6 +253,22 @@ def _config_for(domain_csv: str, config_path: str | None):
         raise UserError(f"the config stored beside {domain_csv}: {one_line(exc)}") from None
 
 
+def _print_shifts(shifts) -> None:
+    """The boundary shifts, one line per frequency (and point of any axes over config
+    keys, whose columns come first)."""
+    from rbm_cli.study.domain import axis_columns
+
+    axes = axis_columns(shifts.columns)
+    head = "".join(f"{p:>22} " for p in axes)
+    click.echo(f"{head}{'frequency [Hz]':>15} {'A [g]':>8} {'B [g]':>8} {'shift [g]':>10}")
+    for _, r in shifts.iterrows():
+        point = "".join(f"{str(r[p]):>22} " for p in axes)
+        click.echo(
+            f"{point}{r.frequency_hz:>15.6g} {r.boundary_a_g:>8.4g} {r.boundary_b_g:>8.4g} "
+            f"{r.shift_g:>+10.4g}"
+        )
+
+
 @cli.command()
 @click.argument("a_csv", metavar="A.csv", type=str)
 @click.argument("b_csv", metavar="B.csv", type=str)
@@ -302,7 +318,8 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         first = cmp.first_missing
         raise UserError(
             f"the domains do not cover the same cells: {cmp.only_a} only in {a_csv}, "
-            f"{cmp.only_b} only in {b_csv} (first: {first[0]} g, {first[1]} Hz); compare "
+            f"{cmp.only_b} only in {b_csv} (first: {first[0]} g, {first[1] or 'no'} Hz"
+            f"{''.join(', ' + v for v in first[2:])}); compare "
             "complete domains of the same grid"
         )
     click.echo(
@@ -310,12 +327,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         f"({100 * cmp.fraction:.3g} %); only in A: {cmp.only_a}, only in B: {cmp.only_b}"
     )
     click.echo(f"largest boundary shift: {cmp.max_shift_g:.4g} g")
-    click.echo(f"{'frequency [Hz]':>15} {'A [g]':>8} {'B [g]':>8} {'shift [g]':>10}")
-    for r in cmp.shifts.itertuples():
-        click.echo(
-            f"{r.frequency_hz:>15.6g} {r.boundary_a_g:>8.4g} {r.boundary_b_g:>8.4g} "
-            f"{r.shift_g:>+10.4g}"
-        )
+    _print_shifts(cmp.shifts)
     failed = []
     if "robust" in dom_a.columns:
         from rbm_cli.study.regression import check

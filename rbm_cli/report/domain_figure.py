@@ -7,6 +7,7 @@ states the layout rule, rbm_cli.report.plot_axes what is drawn)."""
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 
 import pandas as pd
@@ -17,7 +18,7 @@ from rbm_cli.config.types import Config
 from rbm_cli.physics.column import build_column
 from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
 from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
-from rbm_cli.report.plot_domain import plot_domain
+from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.study.domain import axis_columns
 
 __all__ = ["domain_figure", "draw_domain_on", "uplift_level"]
@@ -75,6 +76,7 @@ def draw_domain_on(
     labels: Sequence[str] | None = None,
     compare_configs: Sequence[Config | None] | None = None,
     where: str = "the domain",
+    colorbar: bool = True,
     **options,
 ):
     """Draw a domain on an axes (a new Figure's when None), as domain_view lays it out.
@@ -83,7 +85,8 @@ def draw_domain_on(
     ``ax`` in its figure). ``options`` (column, excitation_type, static_multiplier,
     static_label of rbm_cli.report.plot_domain.plot_domain) apply to the plain plot only;
     ``config`` gives them otherwise. ``compare_configs``: the compared domains' configs,
-    for dimensionless axes of domains written without their scale columns."""
+    for dimensionless axes of domains written without their scale columns; ``colorbar``
+    False: panels of an ensemble leave their colour bar to the caller."""
     if _plain(df, dimensionless, layout):
         options = {**_config_options(config), **options}
         return plot_domain(df, ax=ax, compare=compare, labels=labels, **options)
@@ -101,7 +104,7 @@ def draw_domain_on(
         if spec is None:
             raise RbmError("panels take the place of an axes on a grid: pass ax=None or a subplot")
         ax.remove()
-        return draw_panels(fig, view, spec, others, labels)
+        return draw_panels(fig, view, spec, others, labels, colorbar)
     if view.layout == "overlay":
         draw_overlay(ax, view, numeric=_numeric(view))
     else:
@@ -110,10 +113,11 @@ def draw_domain_on(
 
 
 def _numeric(view: DomainView) -> bool:
-    """The overlaid points are the values of one numeric axis (ordered colours)."""
-    if len(view.point_paths) != 1:
-        return False
-    return all(isinstance(p.values[0], int | float) for p in view.points)
+    """The overlaid points are the values of one numeric axis (linked ones count as one:
+    the first value names the point), drawn in ordered colours."""
+    first = [p.values[0] for p in view.points]
+    numeric = all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in first)
+    return numeric and len(set(first)) == len(first)
 
 
 def figure_size(view: DomainView) -> tuple[float, float]:
@@ -157,7 +161,7 @@ def domain_figure(
     ax = fig.add_subplot()
     drawn = draw_domain_on(df, ax, config, dimensionless=dimensionless, layout=layout,
                            compare=compare, labels=labels, compare_configs=compare_configs,
-                           where=where)  # fmt: skip
+                           where=where, colorbar=False)  # fmt: skip
     name = config.name if config is not None else (labels[0] if labels else "")
     kind = f" ({config.excitation.type})" if config is not None else ""
     title = f"{name}: safe-unsafe domain{kind}" + (", dimensionless" if dimensionless else "")
@@ -169,7 +173,26 @@ def domain_figure(
     else:
         drawn.set_title(title)
     fig.tight_layout()
+    if isinstance(drawn, list) and "collapse_fraction" in df.columns:
+        _colorbar_below(fig, drawn)
     return fig
+
+
+def _colorbar_below(fig, axes: list) -> None:
+    """The collapse fraction's colour bar in a band added below the panels (after the
+    tight layout, which cannot place a colour bar shared by several axes)."""
+    width, old = fig.get_size_inches()
+    band = 0.85  # [in]: the bar, its ticks and label, under the panels' own margin
+    height = old + band
+    fig.set_size_inches(width, height)
+    pars = fig.subplotpars
+    top = 1.0 - (1.0 - pars.top) * old / height  # the margins keep their inches
+    fig.subplots_adjust(bottom=(pars.bottom * old + band) / height, top=top)
+    fig._suptitle.set_y(1.0 - (1.0 - fig._suptitle.get_position()[1]) * old / height)
+    x0 = min(ax.get_position().x0 for ax in axes)
+    x1 = max(ax.get_position().x1 for ax in axes)
+    cax = fig.add_axes((x0, 0.45 / height, x1 - x0, 0.12 / height))
+    fraction_colorbar(fig, None, cax=cax)
 
 
 def _plain_figure(df, config, compare, labels) -> Figure:

@@ -217,11 +217,14 @@ def point_colours(n: int, numeric: bool) -> list:
 
 
 def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
-    """One axes: every cell faint, each point's boundary a line of its own colour labelled
-    by the point, the levels, and the closed forms that apply (module docstring)."""
+    """One axes: the cells faint (once per place and status), each point's boundary a line
+    of its own colour labelled by the point, the levels, and the closed forms that apply
+    (module docstring)."""
     rows = pd.concat([p.rows for p in view.points])
     plane = view.plane(rows).drop(columns=["collapse_fraction"], errors="ignore")
-    draw_cells(ax, plane, size=LOG_MARKER if view.log_x else None)
+    # cells of several points at one place are drawn once per status (faint marks add up)
+    cells = plane.drop_duplicates(["frequency_hz", "amplitude_g", "status"])
+    draw_cells(ax, cells, size=LOG_MARKER if view.log_x else None)
     for artist in (*ax.lines, *ax.collections):
         artist.set_alpha(FAINT)
     colours = point_colours(len(view.points), numeric)
@@ -229,6 +232,7 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
         bnd = boundary(view.plane(point.rows))
         ax.plot(bnd["frequency_hz"].to_numpy(float), bnd["lowest_unsafe_g"].to_numpy(float),
                 color=colour, linewidth=1.5, marker="o", markersize=3.5, label=point.label,
+                linestyle=("-", "--", "-.")[k // 10 % 3] if not numeric else "-",
                 gid=f"boundary-{k}", zorder=4)  # fmt: skip
     tops = [
         _overlay_levels(ax, view, point, k, colour)
@@ -281,11 +285,12 @@ def _overlay_static(ax, view: DomainView, levels: list) -> None:
                    else "_", gid=gid, **STATIC)  # fmt: skip
 
 
-def draw_panels(fig, view: DomainView, spec=None, compare=(), labels=None) -> list:
+def draw_panels(fig, view: DomainView, spec=None, compare=(), labels=None, colorbar=True) -> list:
     """One panel per point on a grid of shared axes (in ``spec``, a SubplotSpec, or the
     whole figure), titled by its point; one legend beside the top right panel and, for an
-    ensemble, one colour bar below. ``compare``: per point, the rows of each compared
-    domain there (a list of lists, or empty). Returns the axes."""
+    ensemble, one colour bar below (unless ``colorbar`` is False: the caller places it).
+    ``compare``: per point, the rows of each compared domain there (a list of lists, or
+    empty). Returns the axes."""
     n = len(view.points)
     ncols = min(4, math.ceil(math.sqrt(n)))
     nrows = math.ceil(n / ncols)
@@ -305,7 +310,7 @@ def draw_panels(fig, view: DomainView, spec=None, compare=(), labels=None) -> li
         axes.append(ax)
     axes[0].set_ylim(0.0, top)
     _panel_legend(axes[min(ncols, n) - 1], axes, proxies)
-    if any("collapse_fraction" in p.rows.columns for p in view.points):
+    if colorbar and any("collapse_fraction" in p.rows.columns for p in view.points):
         fraction_colorbar(fig, axes)
     return axes
 
@@ -321,6 +326,7 @@ def _panel_legend(ax, axes: list, proxies: list) -> None:
     for entries in by_gid.values():
         h, text = entries[0]
         if len({t for _, t in entries}) > 1:
-            h.set_label(text.rsplit(" ", 2)[0] if text.endswith(" g") else text.split(" = ")[0])
+            name = text.rsplit(" ", 2)[0] if text.endswith(" g") else text.split(" = ")[0]
+            h.set_label(f"{name} (each panel's own)")
         handles.append(h)
     legend_beside(ax, proxies, handles)

@@ -147,15 +147,18 @@ def _plot_fraction_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None)
     return handles
 
 
-def fraction_colorbar(fig, axes) -> None:
-    """The colour bar of the collapse fraction, below ``axes`` (one or a list): the
-    legend sits beside them."""
+def fraction_colorbar(fig, axes, cax=None) -> None:
+    """The colour bar of the collapse fraction, below ``axes`` (one or a list; the legend
+    sits beside them), or in ``cax``."""
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
 
-    fig.colorbar(ScalarMappable(norm=Normalize(0.0, 1.0), cmap=_fraction_cmap()), ax=axes,
-                 label=FRACTION_LABEL, location="bottom", pad=0.16, fraction=0.06,
-                 aspect=40)  # fmt: skip
+    mappable = ScalarMappable(norm=Normalize(0.0, 1.0), cmap=_fraction_cmap())
+    if cax is not None:
+        fig.colorbar(mappable, cax=cax, label=FRACTION_LABEL, orientation="horizontal")
+        return
+    fig.colorbar(mappable, ax=axes, label=FRACTION_LABEL, location="bottom", pad=0.16,
+                 fraction=0.06, aspect=40)  # fmt: skip
 
 
 def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str) -> None:

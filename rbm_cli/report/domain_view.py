@@ -19,6 +19,11 @@ values go one to one, count as one axis) and the frequencies decide:
 - asking for 'panels' or 'overlay' where no axis is left for the points puts the
   frequency back on the line (each point then a panel, or one mark per frequency);
   a domain without axes over config keys has no points and refuses both.
+
+In dimensionless axes x is omega / p whatever the line variable: a size axis at one
+frequency spreads along omega / p (p falls as the size grows) in one plane, and an overlay
+of a size sweep over several frequencies puts every size's boundary on one curve. The
+sweep's domain.png follows the same rule (rbm_cli.report.domain_figure).
 """
 
 from __future__ import annotations

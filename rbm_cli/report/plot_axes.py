@@ -83,7 +83,8 @@ def _dimensionless_levels(view: DomainView, rows: pd.DataFrame, configs: list):
     level = rows["static_multiplier"].to_numpy(float) / np.tan(rows["alpha_rad"].to_numpy(float))
     x = rows[view.x].to_numpy(float)
     pairs = np.unique(np.column_stack([x, level]), axis=0)
-    apply = bool(configs) and all(closed_forms_apply(c) for c in configs)
+    distinct = {id(c): c for c in configs}.values()  # one config per point, not per row
+    apply = bool(distinct) and all(closed_forms_apply(c) for c in distinct)
     return pairs, apply
 
 

@@ -11,9 +11,11 @@ exit 2, nothing written.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -123,6 +125,7 @@ def test_recovers_the_generating_lognormal(tmp_path, figures):
     assert summary["n_runs"] == n * LEVELS.size - 40
     assert summary["seed"] == 3 and summary["n_resamples"] == 300
     assert "Baker 2015" in summary["method"] and summary["domain"] == "domain.csv"
+    assert summary["domain_sha256"] == hashlib.sha256(Path(domain).read_bytes()).hexdigest()
 
     # per intensity: counted here from the capacities and the failed rows
     table = pd.read_csv(folder / "fragility.csv")

@@ -9,11 +9,14 @@ fragility and IDA figures (:mod:`rbm_cli.report.fragility_report`) and publishes
 into the output folder (default: the domain's folder) as one step: everything is computed
 and rendered in memory, staged in full under temporary names, then moved onto the five
 names (:func:`rbm_cli.base.files.publish_files_atomic`). A failure before that leaves the
-folder as it was; no other file is touched, none deleted. The CLI and the API call this.
+folder as it was; no other file is touched, none deleted. fragility.json names the domain
+and its SHA-256, so files left beside a domain swept again show whose they are. The CLI
+calls this; the API can call the same.
 """
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import os
@@ -110,8 +113,11 @@ def run_fragility(
         "fragility.png": _png(fragility_figure(result, label, title)),
         "ida.png": _png(ida_figure(df, result.intensity_column, label, title)),
     }
-    source = os.path.relpath(domain.resolve(), folder.resolve())
-    contents.update(fragility_texts(result, extra={"domain": source}))
+    source = {
+        "domain": os.path.relpath(domain.resolve(), folder.resolve()),
+        "domain_sha256": _sha256(domain),  # which domain.csv these files are of
+    }
+    contents.update(fragility_texts(result, extra=source))
     make_dirs(folder)
     try:
         paths = publish_files_atomic(folder, {name: contents[name] for name in FILES})
@@ -157,6 +163,13 @@ def _png(fig, dpi: int = 150) -> bytes:
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
     return buffer.getvalue()
+
+
+def _sha256(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError as exc:
+        raise RbmError(f"cannot read {path}: {exc.strerror or exc}") from None
 
 
 def _meta(domain: Path) -> dict:

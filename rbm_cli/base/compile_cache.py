@@ -30,7 +30,8 @@ kernel's modules); functions decorated earlier get the stamp afterwards, when st
 unused. tests/test_kernel_cache.py checks that every compiled function has it.
 
 numba's cache internals are private (``numba.core.caching``); if they change, the key is
-not set (:func:`key_numba_cache` returns False) and numba's own check is what remains.
+not set (:func:`key_numba_cache` returns False) and numba's own check is what remains. So
+it is when ``NUMBA_CACHE_LOCATOR_CLASSES`` replaces numba's list of locators.
 """
 
 from __future__ import annotations

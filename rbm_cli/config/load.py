@@ -21,9 +21,9 @@ from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.excitation import excitation_section
 from rbm_cli.config.interface import interface_section
 from rbm_cli.config.types import (
-    EXCITATIONS,
     IMPLEMENTATIONS,
     METHODS,
     MODELS,
@@ -31,9 +31,7 @@ from rbm_cli.config.types import (
     CollapseConfig,
     ColumnConfig,
     Config,
-    ExcitationConfig,
     GridConfig,
-    InitialConfig,
     SolverConfig,
 )
 from rbm_cli.config.validate import (
@@ -55,8 +53,6 @@ __all__ = ["load_config", "parse_config"]
 
 TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
 COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
-EXCITATION_KEYS = ("type", "duration", "phase", "initial")
-INITIAL_KEYS = ("rotations", "velocities")
 GRID_KEYS = ("amplitudes", "frequencies")
 COLLAPSE_KEYS = ("ratio",)
 SOLVER_KEYS = (
@@ -76,9 +72,6 @@ PLANNED_MODELS: tuple[str, ...] = ()
 MULTI_DRUM_MODELS = tuple(name for name, entry in MODELS.items() if entry.multi_drum)
 #: Range of solver.time_step, the contact engine's fixed step [s].
 TIME_STEP_RANGE = (1e-6, 1e-2)
-#: Default ``excitation.duration`` per type [s] (SPEC section 3).
-DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
-MAX_DURATION = 1e4  # [s]
 MAX_DRUMS = 200
 MAX_TOP_TAPER = 3.0  # top_width <= MAX_TOP_TAPER * base_width (and <= height)
 #: Heights of a column or block the tool accepts [m] [assumption]: a laboratory
@@ -90,9 +83,6 @@ HEIGHT_RANGE = (1e-3, 1e3)
 #: and reported a collapsing column as survived: issue 14).
 LENGTH_RANGE = (1e-4, 1e3)
 DENSITY_RANGE = (1.0, 1e5)
-#: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
-INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
-PHASE_MAX = 1e3
 #: Grid and command-line excitation ranges [assumption]: g and Hz at the edges.
 AMPLITUDE_RANGE_G = (0.0, 1e3)
 FREQUENCY_RANGE_HZ = (1e-3, 1e3)
@@ -145,19 +135,26 @@ def load_config(path: str | os.PathLike[str]) -> Config:
         raise ConfigError(
             f"cannot parse {source}: not UTF-8 text (bad byte at offset {exc.start})"
         ) from None
-    return parse_config(read_yaml(text, source), source)
+    return parse_config(read_yaml(text, source), source, base_dir=file.parent)
 
 
 # ------------------------------------------------------------------------ sections
 
 
-def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
+def parse_config(
+    data: Mapping[str, Any],
+    source: str = "<config>",
+    base_dir: str | os.PathLike[str] | None = None,
+) -> Config:
     """Validate the mapping a YAML config holds and build a :class:`Config`.
 
     Parameters
     ----------
     data : mapping  Parsed YAML or a dict (keys of SPEC section 4; numpy numbers allowed)
     source : str  Where ``data`` came from, prefixed to error messages
+    base_dir : path or None  Folder that relative paths in the config (a record's
+        ``excitation.file``) are taken from; None: the current directory.
+        :func:`load_config` passes the config file's folder.
 
     Returns
     -------
@@ -169,13 +166,13 @@ def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
     """
     written = plain_copy(data)  # numpy numbers (a notebook's) read as the numbers they are
     try:
-        config = _config(written)
+        config = _config(written, base_dir)
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
     return dataclasses.replace(config, written=written)
 
 
-def _config(data: Any) -> Config:
+def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
     if data is None:
         raise ConfigError("the config is empty (it needs at least name and column)")
     if isinstance(data, Mapping) and "initial" in data:
@@ -201,7 +198,7 @@ def _config(data: Any) -> Config:
         column=column,
         model=model,
         interface=interface_section(top.get("interface"), n, model),
-        excitation=_excitation(top.get("excitation"), n),
+        excitation=excitation_section(top.get("excitation"), n, base_dir),
         grid=_grid(top.get("grid")),
         collapse=CollapseConfig(
             ratio=number(
@@ -310,46 +307,6 @@ def _drums(value: Any, height: float) -> tuple[float, ...]:
             " (they must agree within 1e-9 relative)"
         )
     return heights
-
-
-def _excitation(raw: Any, n: int) -> ExcitationConfig:
-    e = mapping(raw, "excitation", EXCITATION_KEYS)
-    kind = choice(e.get("type", "harmonic"), "excitation.type", EXCITATIONS)
-    duration = number(
-        e.get("duration", DEFAULT_DURATION.get(kind, 10.0)),
-        "excitation.duration",
-        "s",
-        0.0,
-        MAX_DURATION,
-    )
-    phase = number(e.get("phase", 0.0), "excitation.phase", "rad")
-    phase = _bounded(phase, "excitation.phase", "rad", (-PHASE_MAX, PHASE_MAX))
-    if phase != 0.0 and kind != "harmonic":
-        raise ConfigError(
-            f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"
-        )
-    path = "excitation.initial"
-    init = mapping(e.get("initial"), path, INITIAL_KEYS)
-    per = f"one value per drum ({n})"
-    values = {
-        key: tuple(
-            _bounded(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
-            for i, x in enumerate(
-                number_list(init[key], join(path, key), unit, length=n, length_text=per)
-            )
-        )
-        if key in init
-        else ()
-        for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
-    }
-    if kind == "free" and not any(values["rotations"]) and not any(values["velocities"]):
-        raise ConfigError(
-            f"{path}: excitation type free needs a non-zero initial rotation or velocity"
-            f" ({path}.rotations or .velocities); with none the column stays at rest"
-        )
-    return ExcitationConfig(
-        type=kind, duration=duration, phase=phase, initial=InitialConfig(**values)
-    )
 
 
 def _grid(raw: Any) -> GridConfig:

@@ -15,7 +15,16 @@ G = 9.81
 
 SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
-EXCITATIONS = ("harmonic", "half-sine", "free")
+EXCITATIONS = ("harmonic", "half-sine", "free", "record")
+#: Units of a record file's accelerations (excitation.units) and how a record is scaled to
+#: the grid's amplitude (excitation.scale: its PGA [g], or a plain factor).
+RECORD_UNITS = ("g", "m/s2")
+RECORD_SCALES = ("pga", "factor")
+#: Default free motion after a record's last sample [s] (excitation.free_time)
+#: [assumption]: a few rocking half-periods of a stone column (0.5-2 s each), so a column
+#: still rocking when the shaking ends has time to collapse or settle; a monolithic
+#: column whose energy is below its collapse barrier is stopped early anyway.
+DEFAULT_FREE_TIME = 5.0
 METHODS = ("DOP853", "RK45", "RK23")
 IMPLEMENTATIONS = ("compiled", "python")
 
@@ -111,20 +120,63 @@ class InitialConfig:
     velocities: tuple[float, ...] = ()
 
 
+#: ExcitationConfig fields of type 'record' only, and those never in Config.resolved()
+#: (the absolute path of the file depends on where the checkout lives; the path as
+#: written and the file's digest identify the record).
+_RECORD_FIELDS = ("file", "file_sha256", "units", "free_time", "scale")
+_VERTICAL_FIELDS = ("vertical", "vertical_sha256")
+_LOCAL_FIELDS = ("file_path", "vertical_path")
+
+
 @dataclass(frozen=True)
 class ExcitationConfig:
     """Ground motion shape; amplitude and frequency come from the grid or the CLI.
 
-    type : str  'harmonic', 'half-sine' or 'free'
+    type : str  'harmonic', 'half-sine', 'free' or 'record'
     duration : float  Harmonic: length of the excitation; half-sine: maximum
-        simulated time; free: simulated time [s]
+        simulated time; free: simulated time; record: the simulated time, set by the
+        loader to the record's last sample time plus free_time (not written by the
+        user) [s]
     phase : float  Phase of the harmonic [rad]
+    file : str or None  Record: its file (PEER NGA .AT2 or CSV) as written in the config
+    file_sha256 : str or None  Record: SHA-256 of the file's bytes (identifies the record
+        in the config's hash wherever the checkout lives)
+    units : str  Record: units of a CSV's accelerations, 'g' or 'm/s2' (an .AT2 is in g)
+    free_time : float  Record: free motion simulated after its last sample [s]
+    scale : str  Record: 'pga' (the grid's amplitude [g] is the scaled record's peak
+        ground acceleration: the record is multiplied by amplitude / its own PGA) or
+        'factor' (the amplitude is a plain scale factor [-])
+    file_path : str or None  Record: the file's absolute path (resolved against the
+        config's folder); not in :meth:`resolved`, not compared
     """
 
     type: str = "harmonic"
     duration: float = 10.0
     phase: float = 0.0
     initial: InitialConfig = field(default_factory=InitialConfig)
+    file: str | None = None
+    file_sha256: str | None = None
+    units: str = "g"
+    free_time: float = DEFAULT_FREE_TIME
+    scale: str = "pga"
+    vertical: str | None = None
+    vertical_sha256: str | None = None
+    file_path: str | None = field(default=None, compare=False)
+    vertical_path: str | None = field(default=None, compare=False)
+
+    def resolved(self) -> dict:
+        """The settings that define the motion, as plain data: the fields of other
+        excitation types and the absolute paths are left out (so a config that does not
+        use them has the same resolved form, and hash, as before they existed)."""
+        out = asdict(self)
+        drop = list(_LOCAL_FIELDS)
+        if self.type != "record":
+            drop += _RECORD_FIELDS
+        if self.vertical is None:
+            drop += _VERTICAL_FIELDS
+        for key in drop:
+            out.pop(key)
+        return out
 
 
 @dataclass(frozen=True)
@@ -189,4 +241,5 @@ class Config:
         """Every resolved setting as plain data (dataclasses.asdict without ``written``)."""
         out = asdict(self)
         out.pop("written", None)
+        out["excitation"] = self.excitation.resolved()
         return out

@@ -169,7 +169,8 @@ def parse_config(
         config = _config(written, base_dir)
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
-    return dataclasses.replace(config, written=written)
+    folder = os.getcwd() if base_dir is None else os.path.abspath(base_dir)
+    return dataclasses.replace(config, written=written, base_dir=folder)
 
 
 def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:

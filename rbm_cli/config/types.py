@@ -224,7 +224,11 @@ class Config:
     The sections are typed and in SI (the grid in g and Hz); ``written`` is the mapping the
     user wrote (YAML or a dict), kept as given once it validated, so that a stored result
     (meta.json) can be re-read exactly as it was configured, never rebuilt from derived
-    values. It takes no part in equality, in the config's hash or in :meth:`resolved`.
+    values. It takes no part in equality, in the config's hash or in :meth:`resolved`;
+    nor does ``base_dir``, the folder relative paths in it (a record's file) were taken
+    from (the config file's folder, or the current directory of the time it was parsed),
+    so that ``written`` can be validated again as it was:
+    ``parse_config(config.written, base_dir=config.base_dir)``.
     """
 
     name: str
@@ -236,10 +240,14 @@ class Config:
     collapse: CollapseConfig = field(default_factory=CollapseConfig)
     solver: SolverConfig = field(default_factory=SolverConfig)
     written: dict | None = field(default=None, compare=False, repr=False)
+    base_dir: str | None = field(default=None, compare=False, repr=False)
 
     def resolved(self) -> dict:
-        """Every resolved setting as plain data (dataclasses.asdict without ``written``)."""
+        """Every resolved setting as plain data (dataclasses.asdict without ``written``,
+        ``base_dir`` and the excitation's fields that do not apply,
+        :meth:`ExcitationConfig.resolved`)."""
         out = asdict(self)
         out.pop("written", None)
+        out.pop("base_dir", None)
         out["excitation"] = self.excitation.resolved()
         return out

@@ -35,8 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import G  # gravity [m/s^2], the one definition
 from rbm_cli.config import record_files as record_parsers
+from rbm_cli.config.types import G  # gravity [m/s^2], the one definition
 
 _UNITS = record_parsers.UNITS
 

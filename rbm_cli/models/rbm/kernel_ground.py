@@ -1,50 +1,38 @@
 """The ground acceleration in the compiled kernel (numba): the forms of
 rbm_cli.physics.ground_forms, evaluated with the same operations, the exact first
-exceedance of an uplift level on their monotone pieces, and the knot a step must end at.
+exceedance of an uplift level on their monotone pieces, and a record's straight pieces.
 
-The kernel carries the ground as one tuple ``gr = (form, gain, omega, phase, center,
-gamma, knots, values)`` (see kernel_inputs.ground); gain = 0 is a free segment. A cosine
-is sin(y + pi/2) here and in the Python forms alike (detmath has no cosine).
+The Runge-Kutta routines see the ground as a tuple of six numbers,
+``gr = (form, gain, omega, phase, center, gamma)`` (gain 0: a free segment), never as
+arrays: an array passed down to them costs reference counts at every call (a tuple
+holding a record's samples made harmonic runs 5-10 % slower). A record reaches them one
+straight piece at a time: its steps end at every sample (the kinks of a_g), so inside a
+step a_g is the line through two samples, ``(LINE, gain, a_{k+1} - a_k, a_k, t_k,
+t_{k+1} - t_k)``, evaluated as ground_forms.sampled_value does (:func:`_record_piece`
+picks it). A cosine is sin(y + pi/2) here and in the Python forms alike (detmath has
+no cosine).
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from rbm_cli.base.detmath import asin as dasin
 from rbm_cli.base.detmath import exp as dexp
 from rbm_cli.base.detmath import sin as dsin
-from rbm_cli.physics.ground_forms import BISECTION_STEPS, MP, RICKER, SINE
+from rbm_cli.physics.ground_forms import BISECTION_STEPS, MP, RICKER, SAMPLED, SINE
 
+#: A straight piece of a record (a form of the kernel's only).
+LINE = 4
 _HALF_PI = 0.5 * math.pi
 
 
 @njit(cache=True)
-def _sampled(t, knots, values):
-    """ground_forms.sampled_value: linear between samples, 0 outside them."""
-    n = knots.size
-    if t < knots[0] or t > knots[n - 1]:
-        return 0.0
-    lo, hi = 0, n
-    while lo < hi:  # the number of knots <= t (np.searchsorted, side='right')
-        mid = (lo + hi) >> 1
-        if knots[mid] <= t:
-            lo = mid + 1
-        else:
-            hi = mid
-    k = lo - 1
-    if k >= n - 1:
-        return values[n - 1]
-    t0 = knots[k]
-    return values[k] + (values[k + 1] - values[k]) * ((t - t0) / (knots[k + 1] - t0))
-
-
-@njit(cache=True)
-def _ground_other(t, gr):
+def _ground_other(t, form, amp, om, ph, c, gamma):
     """a_g of the forms other than the sine [m/s^2]."""
-    form, amp, om, ph, c, gamma, knots, values = gr
     if form == RICKER:
         u = 0.5 * om * (t - c)
         u2 = u * u
@@ -61,41 +49,20 @@ def _ground_other(t, gr):
                 + gamma * dsin(x + ph) * (1.0 + dsin(xg + _HALF_PI))
             )
         )
-    v = _sampled(t, knots, values)
+    # LINE: om = a_{k+1} - a_k, ph = a_k, c = t_k, gamma = t_{k+1} - t_k
+    v = ph + om * ((t - c) / gamma)
     return v if amp == 1.0 else amp * v
 
 
 @njit(cache=True, inline="always")
 def _ground(t, gr):
     """a_g(t) [m/s^2] of the ground tuple gr (0 on a free segment: gain 0)."""
-    # the tuple is indexed, not unpacked: binding its arrays to names would count
-    # references on every call (the sine's cost grew by a tenth)
-    amp = gr[1]
+    form, amp, om, ph, c, gamma = gr
     if amp == 0.0:
         return 0.0
-    if gr[0] == SINE:
-        return amp * dsin(gr[2] * t + gr[3])
-    return _ground_other(t, gr)
-
-
-@njit(cache=True)
-def _next_exceedance(t0, level, amp, om, ph, last):
-    """GroundMotion.next_exceedance; -1 for none before `last`."""
-    if amp <= level or t0 >= last:
-        return -1.0
-    s = level / amp
-    psi0 = om * t0 + ph
-    if abs(dsin(psi0)) > s:
-        return t0
-    lo = dasin(s)
-    kk = math.ceil((psi0 - lo) / math.pi)
-    psi = lo + kk * math.pi
-    if psi < psi0:
-        psi += math.pi
-    t = (psi - ph) / om
-    if t >= last:
-        return -1.0
-    return t
+    if form == SINE:
+        return amp * dsin(om * t + ph)
+    return _ground_other(t, form, amp, om, ph, c, gamma)
 
 
 @njit(cache=True)
@@ -112,13 +79,56 @@ def _first_after(knots, x):
 
 
 @njit(cache=True)
-def _next_knot(knots, x, bound):
-    """The first knot > x if it is before bound, else bound [s] (a record's steps end at
-    every sample: x = t + the smallest step)."""
-    k = _first_after(knots, x)
-    if k < knots.size and knots[k] < bound:
-        return knots[k]
-    return bound
+def _record_piece(t, knots, values, gain, seg_end):
+    """The straight piece of a record a step from t [s] runs on, as a ground tuple, and
+    the time that step ends at: the first sample past t + the smallest step (10 ulp of
+    t, as python.Stepper takes it), or seg_end if sooner. Before the first sample and
+    after the last the ground rests (gain 0)."""
+    min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+    j = _first_after(knots, t + min_step)
+    n = knots.size
+    bound = knots[j] if j < n and knots[j] < seg_end else seg_end
+    if 0 < j < n:
+        gr = (LINE, gain, values[j] - values[j - 1], values[j - 1], knots[j - 1],
+              knots[j] - knots[j - 1])  # fmt: skip
+    else:
+        gr = (LINE, 0.0, 0.0, 0.0, 0.0, 1.0)
+    return gr, bound
+
+
+@njit(cache=True)
+def _ground_at(t, gr, knots, values):
+    """a_g(t) [m/s^2] of the motion (gr its formula, or a record's samples)."""
+    if gr[0] != SAMPLED:
+        return _ground(t, gr)
+    if t < knots[0] or t > knots[knots.size - 1]:
+        return 0.0
+    if t == knots[knots.size - 1]:
+        return values[knots.size - 1] if gr[1] == 1.0 else gr[1] * values[knots.size - 1]
+    k = _first_after(knots, t)  # piece [knots[k - 1], knots[k]] holds t
+    piece = (LINE, gr[1], values[k] - values[k - 1], values[k - 1], knots[k - 1],
+             knots[k] - knots[k - 1])  # fmt: skip
+    return _ground(t, piece)
+
+
+@njit(cache=True)
+def _next_exceedance(t0, level, amp, om, ph, last):
+    """GroundMotion.next_exceedance of a sine; -1 for none before `last`."""
+    if amp <= level or t0 >= last:
+        return -1.0
+    s = level / amp
+    psi0 = om * t0 + ph
+    if abs(dsin(psi0)) > s:
+        return t0
+    lo = dasin(s)
+    kk = math.ceil((psi0 - lo) / math.pi)
+    psi = lo + kk * math.pi
+    if psi < psi0:
+        psi += math.pi
+    t = (psi - ph) / om
+    if t >= last:
+        return -1.0
+    return t
 
 
 @njit(cache=True)
@@ -138,16 +148,16 @@ def _solve_piece(gr, tl, tr, target):
 
 
 @njit(cache=True)
-def _exceedance_pieces(t0, level, last, gr, sampled):
+def _exceedance_pieces(t0, level, last, gr, knots, values):
     """ground_forms.exceedance_on_pieces; -1 for none before `last`."""
-    knots, values = gr[6], gr[7]
-    if abs(_ground(t0, gr)) > level:
+    sampled = gr[0] == SAMPLED
+    if abs(_ground_at(t0, gr, knots, values)) > level:
         return t0
     k = _first_after(knots, t0)
     tl = t0
     while True:
         tr = min(knots[k] if k < knots.size else last, last)
-        ar = _ground(tr, gr)
+        ar = _ground_at(tr, gr, knots, values)
         if abs(ar) > level:
             target = level if ar > 0.0 else -level
             if not sampled:
@@ -167,11 +177,11 @@ def _exceedance_pieces(t0, level, last, gr, sampled):
 
 
 @njit(cache=True)
-def _next_uplift(t0, level, peak, gr, last):
+def _next_uplift(t0, level, peak, gr, knots, values, last):
     """GroundMotion.next_exceedance: the first time >= t0 with |a_g| > level [m/s^2]
     (peak = max |a_g|); -1 for none before `last`."""
     if gr[0] == SINE:
         return _next_exceedance(t0, level, gr[1], gr[2], gr[3], last)
     if peak <= level or t0 >= last:
         return -1.0
-    return _exceedance_pieces(t0, level, last, gr, gr[0] != RICKER and gr[0] != MP)
+    return _exceedance_pieces(t0, level, last, gr, knots, values)

@@ -90,7 +90,7 @@ class Excitation(NamedTuple):
     center: float  #: centre of a Ricker or MP pulse [s]
     gamma: float  #: MP's gamma [-]
     knots: np.ndarray  #: times a_g is monotone between [s] (a record's samples)
-    values: np.ndarray  #: a record's a_g at its samples [m/s^2]
+    values: np.ndarray  #: a record's a_g at its samples [m/s^2] (gain 1)
     clipped: bool  #: steps end at every knot (a record)
     bounds: np.ndarray  #: segment boundaries, from 0 to t_end [s]
     forced: np.ndarray  #: whether a_g acts on each segment (bool)

@@ -27,7 +27,7 @@ from rbm_cli.models.rbm.kernel_events import (
     _system,
     _within_reach,
 )
-from rbm_cli.models.rbm.kernel_ground import _ground, _next_knot, _next_uplift
+from rbm_cli.models.rbm.kernel_ground import _ground, _ground_at, _next_uplift, _record_piece
 from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, POLL_STEPS, poll
 from rbm_cli.models.rbm.kernel_inputs import Excitation, ModelArrays, RunTask, SolverSettings
 from rbm_cli.models.rbm.kernel_rk import (
@@ -85,12 +85,13 @@ def run_kernel(model, motion, solver, task):
     centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
     uplift_level, barrier = model.uplift_level, model.barrier
     amplitude, pulse_end, t_end = motion.amplitude, motion.pulse_end, motion.t_end
-    knots, clipped, bounds, forced = motion.knots, motion.clipped, motion.bounds, motion.forced
-    # the ground (kernel_ground): of the motion, and nothing (a free segment)
+    knots, values, clipped = motion.knots, motion.values, motion.clipped
+    bounds, forced = motion.bounds, motion.forced
+    # the ground (kernel_ground): of the motion, and nothing (a free segment); a record
+    # one straight piece a step (_record_piece)
     gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
-               motion.gamma, knots, motion.values)  # fmt: skip
-    gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center,
-               motion.gamma, knots, motion.values)  # fmt: skip
+               motion.gamma)  # fmt: skip
+    gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center, motion.gamma)
     mc, rtol, atol, deadline = solver.mc, solver.rtol, solver.atol, solver.deadline
     max_steps, max_events = solver.max_steps, solver.max_events
     theta0, rate0, early_stop = task.theta0, task.rate0, task.early_stop
@@ -171,6 +172,7 @@ def run_kernel(model, motion, solver, task):
             continue
         free_seg = not forced[seg]
         gr = gr_free if free_seg else gr_full
+        seg_gain = gr[1]
         can_stop = early_stop and free_seg and motion.pulse and n == 1
         h_carry = -1.0  # the step size proposed before an event, carried over it
         while t < seg_end:
@@ -181,7 +183,7 @@ def run_kernel(model, motion, solver, task):
                     return (status, t_end, t_col, c_if, max_ratio, max_top, friction,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 last = min(pulse_end, t_end)
-                t_up = _next_uplift(t, uplift_level, amplitude, gr_full, last)
+                t_up = _next_uplift(t, uplift_level, amplitude, gr_full, knots, values, last)
                 if t_up < 0.0 or t_up >= seg_end:
                     if record:
                         n_out, next_out = _emit_rest(seg_end, samples, n_out, next_out, output_dt)
@@ -192,7 +194,7 @@ def run_kernel(model, motion, solver, task):
                 t = t_up
                 for i in range(m):
                     y[i] = 0.0
-                side[0] = -1 if _ground(t, gr_full) > 0.0 else 1
+                side[0] = -1 if _ground_at(t, gr_full, knots, values) > 0.0 else 1
                 k[0] = 0
                 at_rest = False
                 n_upl += 1
@@ -207,12 +209,15 @@ def run_kernel(model, motion, solver, task):
                 h0[3 * n + i] = c_ratio + EVENT_EPS
 
             # a new stepper from (t, y)
+            t_bound = seg_end
+            if clipped:
+                gr, t_bound = _record_piece(t, knots, values, seg_gain, seg_end)
             _rhs(t, y, n, As, cs, es, gr, f)
             if h_carry > 0.0:
                 h_abs = min(h_carry, seg_end - t)
                 n_rhs += 1
             else:
-                h_abs = _initial_step(t, y, f, seg_end, est_order, rtol, atol, n, As, cs, es,
+                h_abs = _initial_step(t, y, f, t_bound, est_order, rtol, atol, n, As, cs, es,
                                       gr, work)  # fmt: skip
                 n_rhs += 2
             _affine(track, y, 0, no_offset, z_old)
@@ -231,8 +236,9 @@ def run_kernel(model, motion, solver, task):
                 min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
                 if h_abs < min_step:
                     h_abs = min_step
-                # a record's steps end at its samples (the kinks of a_g), python.Stepper's
-                bound = _next_knot(knots, t + min_step, seg_end) if clipped else seg_end
+                bound = seg_end  # a record's steps end at its samples (python.Stepper's)
+                if clipped:
+                    gr, bound = _record_piece(t, knots, values, seg_gain, seg_end)
                 rejected = False
                 while True:
                     if not (h_abs >= min_step):  # also a NaN step or time: no endless loop

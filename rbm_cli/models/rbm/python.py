@@ -36,7 +36,7 @@ from scipy.integrate import DOP853, RK23, RK45
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.config.types import SolverConfig
 from rbm_cli.models.events import BIG, EVENT_EPS, REST_RATE, Pieces  # noqa: F401 (kernel's)
-from rbm_cli.models.knots import clip_at_knots
+from rbm_cli.models.knots import clip_at_knots, next_knot
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.python_steps import (
     RunState,
@@ -104,8 +104,12 @@ def _start_stepper(run: RunState, piece: SmoothPiece, seg_end: float):
     stepper = _METHODS[solver.method]
     if run.h_carry is None:  # counted as scipy counts it: its own f0, then one call
         f0 = piece.rhs(run.t, run.y, counted=False)
+        bound = seg_end  # a record: its guess stays on the straight piece (the kernel's)
+        if run.knots is not None:
+            t = run.t
+            bound = next_knot(run.knots, t + 10 * abs(np.nextafter(t, np.inf) - t), seg_end)
         first = initial_step(
-            piece.rhs, run.t, run.y, f0, seg_end, stepper.order, solver.rtol, run.atol
+            piece.rhs, run.t, run.y, f0, bound, stepper.order, solver.rtol, run.atol
         )
     else:
         first = min(run.h_carry, seg_end - run.t)

@@ -5,6 +5,10 @@ Keys, by excitation type (a key of another type is refused, naming it):
 - every type: ``type``, ``initial: {rotations, velocities}`` [rad, rad/s];
 - ``harmonic``, ``half-sine``, ``free``: ``duration`` [s]; ``harmonic``: ``phase`` [rad]
   (0 is accepted with any type);
+- pulses, ``one-sine``, ``cycloidal``, ``ricker``, ``mavroeidis-papageorgiou``: as
+  ``half-sine``, ``duration`` [s] is the maximum simulated time (default 20 s), the pulse
+  then free motion; ``mavroeidis-papageorgiou`` also ``gamma`` (> 1, at most 20 [-]) and
+  ``nu`` (in [-2 pi, 2 pi] [rad]), both required;
 - ``record``: ``file`` (one PEER NGA ``.AT2`` or CSV file; a relative path is taken from the
   folder of the config file, or from the current directory for a config given as a
   mapping), ``units`` (``g``, default, or ``m/s2``: a CSV's values; an ``.AT2`` is in g),
@@ -25,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,6 +42,7 @@ from rbm_cli.config.record_files import read_file
 from rbm_cli.config.types import (
     DEFAULT_FREE_TIME,
     EXCITATIONS,
+    PULSES,
     RECORD_SCALES,
     RECORD_UNITS,
     ExcitationConfig,
@@ -56,10 +62,17 @@ EXCITATION_KEYS = (
     "units",
     "free_time",
     "scale",
+    "gamma",
+    "nu",
 )
 INITIAL_KEYS = ("rotations", "velocities")
 #: Default ``excitation.duration`` per type [s] (SPEC section 3).
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
+DEFAULT_DURATION.update({kind: 20.0 for kind in PULSES})  # as the half-sine [assumption]
+#: Mavroeidis-Papageorgiou's gamma [-] (> 1; their fits 1.5-3; a long train above 20 is
+#: a harmonic) and nu [rad] (a phase: one turn either way).
+GAMMA_MAX = 20.0
+NU_MAX = 2.0 * math.pi
 MAX_DURATION = 1e4  # [s]
 #: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
 INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
@@ -71,6 +84,8 @@ ONLY_FOR = {
     "units": ("record",),
     "free_time": ("record",),
     "scale": ("record",),
+    "gamma": ("mavroeidis-papageorgiou",),
+    "nu": ("mavroeidis-papageorgiou",),
 }
 _DIGEST_CHUNK = 1 << 20
 
@@ -257,6 +272,20 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
     )
 
 
+def _mp_fields(e: dict) -> dict:
+    """gamma and nu of the Mavroeidis-Papageorgiou pulse (both required)."""
+    for key in ("gamma", "nu"):
+        if key not in e:
+            raise ConfigError(
+                f"excitation.{key} is required for type mavroeidis-papageorgiou (gamma > 1,"
+                " at most 20 [-]: the pulse's oscillatory character; nu in [-2 pi, 2 pi]"
+                " [rad]: its phase)"
+            )
+    gamma = number(e["gamma"], "excitation.gamma", "", 1.0, GAMMA_MAX)
+    nu = number(e["nu"], "excitation.nu", "rad", -NU_MAX, NU_MAX, lo_open=False)
+    return dict(gamma=gamma, nu=nu)
+
+
 def excitation_section(
     raw: Any, n: int, base_dir: str | os.PathLike | None = None
 ) -> ExcitationConfig:
@@ -279,6 +308,8 @@ def excitation_section(
     fields: dict = {}
     if kind == "record":
         fields = _record_fields(e, base_dir)
+    if kind == "mavroeidis-papageorgiou":
+        fields.update(_mp_fields(e))
     else:
         fields["duration"] = number(
             e.get("duration", DEFAULT_DURATION.get(kind, 10.0)),

@@ -15,7 +15,10 @@ G = 9.81
 
 SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
-EXCITATIONS = ("harmonic", "half-sine", "free", "record")
+#: Near-fault pulses (one cycle or wavelet, then free motion), by the rocking literature's
+#: names: amplitude [g] and frequency [Hz] from the grid, as the half-sine.
+PULSES = ("one-sine", "cycloidal", "ricker", "mavroeidis-papageorgiou")
+EXCITATIONS = ("harmonic", "half-sine", "free", *PULSES, "record")
 #: Units of a record file's accelerations (excitation.units) and how a record is scaled to
 #: the grid's amplitude (excitation.scale: its PGA [g], or a plain factor).
 RECORD_UNITS = ("g", "m/s2")
@@ -125,6 +128,7 @@ class InitialConfig:
 #: written and the file's digest identify the record).
 _RECORD_FIELDS = ("file", "file_sha256", "units", "free_time", "scale")
 _VERTICAL_FIELDS = ("vertical", "vertical_sha256")
+_MP_FIELDS = ("gamma", "nu")
 _LOCAL_FIELDS = ("file_path", "vertical_path")
 
 
@@ -132,8 +136,9 @@ _LOCAL_FIELDS = ("file_path", "vertical_path")
 class ExcitationConfig:
     """Ground motion shape; amplitude and frequency come from the grid or the CLI.
 
-    type : str  'harmonic', 'half-sine', 'free' or 'record'
-    duration : float  Harmonic: length of the excitation; half-sine: maximum
+    type : str  'harmonic', 'half-sine', 'free', a pulse ('one-sine', 'cycloidal',
+        'ricker', 'mavroeidis-papageorgiou') or 'record'
+    duration : float  Harmonic: length of the excitation; half-sine and pulses: maximum
         simulated time; free: simulated time; record: the simulated time, set by the
         loader to the record's last sample time plus free_time (not written by the
         user) [s]
@@ -146,6 +151,8 @@ class ExcitationConfig:
     scale : str  Record: 'pga' (the grid's amplitude [g] is the scaled record's peak
         ground acceleration: the record is multiplied by amplitude / its own PGA) or
         'factor' (the amplitude is a plain scale factor [-])
+    gamma : float or None  Mavroeidis-Papageorgiou: oscillatory character, > 1 [-]
+    nu : float or None  Mavroeidis-Papageorgiou: phase of the harmonic [rad]
     file_path : str or None  Record: the file's absolute path (resolved against the
         config's folder); not in :meth:`resolved`, not compared
     """
@@ -159,6 +166,8 @@ class ExcitationConfig:
     units: str = "g"
     free_time: float = DEFAULT_FREE_TIME
     scale: str = "pga"
+    gamma: float | None = None
+    nu: float | None = None
     vertical: str | None = None
     vertical_sha256: str | None = None
     file_path: str | None = field(default=None, compare=False)
@@ -174,6 +183,8 @@ class ExcitationConfig:
             drop += _RECORD_FIELDS
         if self.vertical is None:
             drop += _VERTICAL_FIELDS
+        if self.type != "mavroeidis-papageorgiou":
+            drop += _MP_FIELDS
         for key in drop:
             out.pop(key)
         return out

@@ -118,6 +118,8 @@ class _LinearBlock:
     phase: float  # ground phase [rad]
     max_pieces: int
     record: bool
+    knots: np.ndarray | None = None  # a record's sample times [s] (pieces end there)
+    values: np.ndarray | None = None  # its accelerations [m/s^2]
 
     @classmethod
     def make(cls, alpha, p, motion, restitution, collapse_ratio, max_pieces, record):
@@ -135,6 +137,8 @@ class _LinearBlock:
             phase=motion.phase,
             max_pieces=max_pieces,
             record=record,
+            knots=motion.knots if motion.clipped else None,
+            values=motion.values if motion.clipped else None,
         )
 
 
@@ -162,23 +166,34 @@ class _LinearRun(BlockRun):
         )
 
 
+def _start_piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: bool):
+    """The closed-form piece from the current state, and where it ends [s]: seg_end, or
+    under a record the next sample (the ground acceleration is one line up to it)."""
+    t = run.t
+    if not forced or blk.knots is None:
+        amp = blk.amp_g if forced else 0.0
+        piece = LinearPiece.start(
+            t, run.theta, run.rate, run.side, blk.alpha, blk.p, amp, blk.omega, blk.phase
+        )
+        return piece, seg_end
+    knots, values = blk.knots, blk.values
+    k = int(np.searchsorted(knots, t, side="right"))  # the first sample after t
+    end = min(float(knots[k]), seg_end) if k < knots.size else seg_end
+    q0 = q1 = 0.0  # at rest before the first sample
+    if 0 < k < knots.size:
+        q1 = (values[k] - values[k - 1]) / (knots[k] - knots[k - 1]) / G
+        q0 = values[k - 1] / G + q1 * (t - knots[k - 1])
+    piece = LinearPiece.start_line(t, run.theta, run.rate, run.side, blk.alpha, blk.p, q0, q1)
+    return piece, end
+
+
 def _piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: bool, can_stop: bool):
     """One closed-form piece from the current state up to its first event, a peak of free
-    motion below the barrier (when can_stop) or seg_end [s]. Returns the Outcome if the
-    run ends there, else None."""
+    motion below the barrier (when can_stop) or its end (seg_end [s], or a record's next
+    sample). Returns the Outcome if the run ends there, else None."""
     out, rec, t = run.out, run.rec, run.t
     alpha, p = blk.alpha, blk.p
-    piece = LinearPiece.start(
-        t,
-        run.theta,
-        run.rate,
-        run.side,
-        alpha,
-        p,
-        blk.amp_g if forced else 0.0,
-        blk.omega,
-        blk.phase,
-    )
+    piece, seg_end = _start_piece(blk, run, seg_end, forced)
     out.n_steps += 1
     sc = scan_piece(piece, seg_end - t, blk.limit)
     out.n_rhs += sc.n_evals
@@ -278,6 +293,9 @@ def housner_linear_run(
     -------
     Outcome  status 'collapsed' or 'survived' (or 'failed' past the budget);
         n_steps counts closed-form pieces, n_rhs closed-form evaluations.
+        A record is linear between samples, so exact pieces end at every sample; a
+        Ricker or Mavroeidis-Papageorgiou pulse is first sampled
+        (GroundMotion.sampled: 2000 samples a period, linear between).
 
     Notes
     -----
@@ -301,6 +319,7 @@ def housner_linear_run(
         raise ValueError("alpha [rad] and p [rad/s] must be > 0")
     if not 0.0 < restitution <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
+    motion = motion.sampled()  # a pulse with no closed form as a record; else itself
     blk = _LinearBlock.make(alpha, p, motion, restitution, collapse_ratio, max_pieces, record)
     run = _LinearRun.make(blk, record, output_dt, events, height, initial)
     finish = run.finish

@@ -25,7 +25,7 @@ Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
 
 def grid_points(config: Config) -> list[GridPoint]:
     """The points of a config's axes over config keys, each with its validated config."""
-    return expand(config, parse_config)
+    return expand(config, parse_config, base_dir=config.base_dir)
 
 
 def frequencies(config: Config) -> tuple:

@@ -15,7 +15,6 @@ rbm_cli.models.rbm.python describes.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 from functools import partial
@@ -49,6 +48,7 @@ class RunState:
     at_rest : bool  A rigid monolithic column resting (no integration)
     next_out : float  Time of the next recorded sample [s]
     h_carry : float or None  Step size proposed before the last event, carried over it [s]
+    knots : ndarray or None  Times every step ends at (a record's samples) [s]
     track : (n + 1, n) ndarray  Collapse quantities over their limits [-], then the top
         displacement [m]
     g_rows : (4n, n) ndarray  Event surfaces (law bounds over theta_u, collapse)
@@ -82,6 +82,7 @@ class RunState:
     at_rest: bool
     next_out: float = 0.0
     h_carry: float | None = None
+    knots: np.ndarray | None = None  # times steps end at (a record's samples) [s]
 
     @classmethod
     def start(
@@ -158,21 +159,6 @@ class RunState:
                 yy = dense(self.next_out)
                 self.out.samples.append((self.next_out, yy[:n].copy(), yy[n:].copy()))
             self.next_out += self.output_dt
-
-
-def ground_acceleration(motion: GroundMotion, free: bool):
-    """a_g(t) [m/s^2] over one segment of the motion: zero in free motion, else the harmonic."""
-    if free:
-
-        def ag(tt):
-            return 0.0
-    else:
-        amp, om, ph = motion.amplitude, motion.omega, motion.phase
-
-        def ag(tt, amp=amp, om=om, ph=ph):
-            return amp * math.sin(om * tt + ph)
-
-    return ag
 
 
 class SmoothPiece:

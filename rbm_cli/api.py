@@ -252,19 +252,18 @@ def run(
     cfg = _as_config(config)
     if cfg.excitation.type == "free":
         amplitude_g, frequency_hz = 0.0, 0.0
-    for name, value, (lo, hi), unit in (
-        ("amplitude_g", amplitude_g, AMPLITUDE_RANGE_G, "g"),
-        ("frequency_hz", frequency_hz, FREQUENCY_RANGE_HZ, "Hz"),
-    ):
+    checks = [("amplitude_g", amplitude_g, AMPLITUDE_RANGE_G, "g")]
+    if cfg.excitation.type != "record":  # a record has no frequency
+        checks.append(("frequency_hz", frequency_hz, FREQUENCY_RANGE_HZ, "Hz"))
+    for name, value, (lo, hi), unit in checks:
         if value is None:
             raise RbmError(f"{name} [{unit}] is required for excitation.type {cfg.excitation.type}")
         if cfg.excitation.type != "free" and not (_finite(value) and lo <= value <= hi):
             raise RbmError(f"{name} must be a number in [{lo:g}, {hi:g}] [{unit}], got {value!r}")
     if output_dt is not None and not (_finite(output_dt) and output_dt > 0.0):
         raise RbmError(f"output_dt must be a number > 0 [s], got {output_dt!r}")
-    result = simulate(
-        cfg, float(amplitude_g), float(frequency_hz), record=record, output_dt=output_dt
-    )
+    f = None if cfg.excitation.type == "record" else float(frequency_hz)
+    result = simulate(cfg, float(amplitude_g), f, record=record, output_dt=output_dt)
     return CellRun(config=cfg, result=result)
 
 

@@ -96,8 +96,8 @@ def _axis_levels(view: DomainView, point: Point):
     rows = []
     for x, cfg, f in zip(plane["frequency_hz"], row_configs(point), point.rows["frequency_hz"],
                          strict=True):  # fmt: skip
-        if cfg is not None:
-            rows.append((float(x), cfg, float(f)))
+        if cfg is not None:  # a record has no frequency (None or NaN)
+            rows.append((float(x), cfg, np.nan if f is None else float(f)))
     seen = {}
     for x, cfg, f in rows:
         seen.setdefault(x, (cfg, f))

@@ -174,7 +174,11 @@ def _groups(df: pd.DataFrame):
 
 def _group_row(by: list[str], values) -> dict:
     values = values if isinstance(values, tuple) else (values,)
-    return {c: (float(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
+
+    def freq(v) -> float:
+        return math.nan if v is None else float(v)
+
+    return {c: (freq(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
 
 
 def boundary(df: pd.DataFrame) -> pd.DataFrame:

@@ -339,3 +339,31 @@ def test_publish_is_all_or_nothing(tmp_path):
     assert [p.name for p in paths] == ["a.csv", "c.png"]
     assert (tmp_path / "a.csv").read_text() == "new a"
     assert oct((tmp_path / "c.png").stat().st_mode & 0o777) != oct(0o600)  # not mkstemp's
+
+
+def test_compare_draws_each_domain_fitted_in_one_figure(tmp_path, figures):
+    """--compare: a second suite (capacities twice as large) is fitted with the same options
+    and drawn in fragility.png beside the first, each fitted curve the closed form of its own
+    fit, labelled by its folder; the compared domain's folder gets no files."""
+    df, _ = suite(seed=7)
+    strong = df.copy()
+    strong["amplitude_g"] = strong["amplitude_g"] * 2.0  # every capacity doubled
+    a = write_domain(tmp_path / "weak", df)
+    b = write_domain(tmp_path / "strong", strong)
+    res = invoke("fragility", a, "--compare", b, "--resamples", 50)
+    assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in (tmp_path / "strong").iterdir()) == ["domain.csv"]
+    summary = json.loads((tmp_path / "weak" / "fragility.json").read_text())
+    ax = figures[0].axes[0]
+    fitted = [line for line in ax.get_lines() if line.get_gid() == "fitted"]
+    assert len(fitted) == 2
+    labels = [line.get_label() for line in fitted]
+    assert any("weak" in t for t in labels) and any("strong" in t for t in labels)
+    medians = []
+    for line in fitted:
+        x, y = (np.asarray(v, float) for v in line.get_data())
+        i = int(np.argmin(np.abs(y - 0.5)))
+        medians.append(x[i])
+    # the doubled suite's median is twice the first's (scaling the intensities scales it)
+    assert medians[0] == pytest.approx(summary["median_g"], rel=0.02)
+    assert medians[1] == pytest.approx(2 * summary["median_g"], rel=0.02)

@@ -25,7 +25,10 @@ from rbm_cli.cli.common import UserError, check_output, cli, one_line
 @click.option("--ci", nargs=2, type=float, default=(5.0, 95.0), show_default=True,
               metavar="LOW HIGH",
               help="Percentiles of the bootstrap intervals and band.")  # fmt: skip
-def fragility(domain, output, resamples, seed, intensity_column, ci) -> None:
+@click.option("--compare", "others", multiple=True, metavar="OTHER.csv",
+              help="Another record-suite domain whose fragility is drawn in fragility.png "
+              "beside this one (repeatable; its own files are not written).")  # fmt: skip
+def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> None:
     """Fit a lognormal fragility curve to a record-suite domain and draw its IDA.
 
     DOMAIN.csv is the domain.csv of a sweep over records x intensities (one row
@@ -43,13 +46,15 @@ def fragility(domain, output, resamples, seed, intensity_column, ci) -> None:
     Example:
         rbm fragility out/suite/domain.csv
         rbm fragility out/suite/domain.csv -o out/suite_fragility --resamples 2000
+        rbm fragility results/suite_multidrum/domain.csv \
+            --compare results/suite_monolithic/domain.csv -o docs/figures/suite
     """
     from rbm_cli.report.fragility_run import run_fragility
 
     try:
         made = run_fragility(domain, output, n_resamples=resamples, seed=seed,
                              intensity_column=intensity_column,
-                             ci_percentiles=tuple(ci))  # fmt: skip
+                             ci_percentiles=tuple(ci), compare=others)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     res = made.result

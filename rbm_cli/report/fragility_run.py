@@ -62,6 +62,7 @@ def run_fragility(
     seed: int = 0,
     intensity_column: str | None = None,
     ci_percentiles: tuple[float, float] = (5.0, 95.0),
+    compare: tuple[str | os.PathLike, ...] = (),
 ) -> FragilityRun:
     """Fragility of a record-suite domain: fit, files and figures.
 
@@ -81,6 +82,10 @@ def run_fragility(
         Column of the intensity (default: the first of intensity_g, amplitude_g, intensity)
     ci_percentiles : (float, float)
         Percentiles of the bootstrap that bound the intervals and the band
+    compare : sequence of paths
+        Other record-suite domains (e.g. another column under the same suite), fitted with
+        the same options and drawn in fragility.png beside this one, each labelled by its
+        folder's name; their own files are not written
 
     Returns
     -------
@@ -109,8 +114,12 @@ def run_fragility(
     label = intensity_label(result.intensity_column, meta)
     title = f"{meta.get('name') or domain.parent.name or domain.stem}: " \
         f"{result.n_records} records, {len(result.table)} intensities"  # fmt: skip
+    others = [(_name(Path(p)), _fit_other(p, n_resamples, seed, intensity_column,
+                                          ci_percentiles)) for p in compare]  # fmt: skip
+    if others:
+        title = "fragility under one suite: " + ", ".join([_name(domain)] + [n for n, _ in others])
     contents = {
-        "fragility.png": _png(fragility_figure(result, label, title)),
+        "fragility.png": _png(fragility_figure(result, label, title, _name(domain), others)),
         "ida.png": _png(ida_figure(df, result.intensity_column, label, title)),
     }
     source = {
@@ -138,12 +147,35 @@ def intensity_label(column: str, meta: dict | None = None) -> str:
     return f"intensity: {column}"
 
 
-def fragility_figure(result: FragilityResult, label: str, title: str = ""):
-    """A new figure (no pyplot) with :func:`plot_fragility` of ``result``."""
+def _name(domain: Path) -> str:
+    """A domain's label: its sweep's name (meta.json), else its folder's name."""
+    return str(_meta(domain).get("name") or domain.parent.name or domain.stem)
+
+
+def _fit_other(path, n_resamples, seed, intensity_column, ci) -> FragilityResult:
+    """The fit of a compared domain (same options as the main one)."""
+    return fragility(read_suite_domain(Path(path)), n_resamples=n_resamples, seed=seed,
+                     ci_percentiles=ci, intensity_column=intensity_column)  # fmt: skip
+
+
+#: Colours of the fitted domains in one figure, the main one first.
+COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown")
+
+
+def fragility_figure(
+    result: FragilityResult, label: str, title: str = "", name: str = "", others=()
+):
+    """A new figure (no pyplot) with :func:`plot_fragility` of ``result`` and, labelled by
+    name, of each (name, result) of ``others`` (no counts then: they would overlap)."""
     from matplotlib.figure import Figure
 
     ax = Figure(figsize=(7, 5)).subplots()
-    plot_fragility(result, ax, xlabel=label)
+    if not others:
+        plot_fragility(result, ax, xlabel=label)
+    else:
+        for k, (who, res) in enumerate([(name, result), *others]):
+            plot_fragility(res, ax, xlabel=label, label=who, color=COLOURS[k % len(COLOURS)],
+                           counts=False)  # fmt: skip
     ax.set_title(title, fontsize=9)
     return ax.figure
 

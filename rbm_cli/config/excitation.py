@@ -308,9 +308,9 @@ def excitation_section(
     fields: dict = {}
     if kind == "record":
         fields = _record_fields(e, base_dir)
-    if kind == "mavroeidis-papageorgiou":
-        fields.update(_mp_fields(e))
     else:
+        if kind == "mavroeidis-papageorgiou":
+            fields = _mp_fields(e)
         fields["duration"] = number(
             e.get("duration", DEFAULT_DURATION.get(kind, 10.0)),
             "excitation.duration",

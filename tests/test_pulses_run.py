@@ -205,6 +205,9 @@ def test_pulse_keys_validated(excitation, needle):
 
 def test_pulse_duration_is_the_maximum_simulated_time():
     """Default 20 s; the whole pulse is always simulated (a 0.05 Hz Ricker lasts 60 s)."""
+    for kind, extra in PULSES:
+        cfg = _config(kind, extra)
+        assert cfg.excitation.duration == 20.0
+        assert make_ground_motion(cfg.excitation, 0.3, 1.0).t_end == 20.0
     cfg = _config("ricker", {})
-    assert make_ground_motion(cfg.excitation, 0.3, 1.0).t_end == 20.0
     assert make_ground_motion(cfg.excitation, 0.3, 0.05).t_end == pytest.approx(60.0)

@@ -108,7 +108,7 @@ def test_suite_band_matches_the_full_stored_suite():
     merged = full.merge(sub, on=["record", "amplitude_g"], suffixes=("", "_ci"))
     assert len(merged) == len(sub) == 4 * full["amplitude_g"].nunique()
     both = (merged["robust"] == 1) & (merged["robust_ci"] == 1)
-    assert both.sum() >= 0.8 * len(merged)
+    assert both.sum() >= 0.5 * len(merged)  # mostly robust cells, or the check says little
     assert (merged.loc[both, "collapsed"] == merged.loc[both, "collapsed_ci"]).all()
 
 

@@ -116,10 +116,10 @@ def run_fragility(
         f"{result.n_records} records, {len(result.table)} intensities"  # fmt: skip
     others = [(_name(Path(p)), _fit_other(p, n_resamples, seed, intensity_column,
                                           ci_percentiles)) for p in compare]  # fmt: skip
-    if others:
-        title = "fragility under one suite: " + ", ".join([_name(domain)] + [n for n, _ in others])
+    names = ", ".join([_name(domain)] + [n for n, _ in others])
+    frag_title = f"fragility under one suite: {names}" if others else title
     contents = {
-        "fragility.png": _png(fragility_figure(result, label, title, _name(domain), others)),
+        "fragility.png": _png(fragility_figure(result, label, frag_title, _name(domain), others)),
         "ida.png": _png(ida_figure(df, result.intensity_column, label, title)),
     }
     source = {

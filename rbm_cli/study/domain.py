@@ -308,9 +308,11 @@ def domain_config(domain_csv: str | Path) -> Config | None:
 
     meta = Path(domain_csv).with_name("meta.json")
     try:
-        written = json.loads(meta.read_text(encoding="utf-8")).get("config_written")
+        stored = json.loads(meta.read_text(encoding="utf-8"))
+        written, where = stored.get("config_written"), stored.get("config_dir")
     except (OSError, ValueError, AttributeError):
         return None
     if not isinstance(written, dict):
         return None
-    return parse_config(written, source=str(meta))
+    base = meta.parent / where if isinstance(where, str) else None  # relative record paths
+    return parse_config(written, source=str(meta), base_dir=base)

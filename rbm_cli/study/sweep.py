@@ -243,7 +243,7 @@ def run_sweep(
         rows = [done[key(c)] for c in cells]
         df = pd.DataFrame(rows, columns=list(fields))
         counts = df["status"].value_counts().to_dict()
-        meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble)
+        meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble, folder)
         meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler,
                     compile_time_s=compile_s)  # fmt: skip
         try:

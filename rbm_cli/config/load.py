@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
-from rbm_cli.config.excitation import excitation_section
+from rbm_cli.config.excitation import check_vertical, excitation_section
 from rbm_cli.config.interface import interface_section
 from rbm_cli.config.types import (
     IMPLEMENTATIONS,
@@ -194,12 +194,15 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
     n = column.n_drums
     if model not in MULTI_DRUM_MODELS and n != 1:
         raise ConfigError(f"model {model!r} needs a monolithic column (drums: 1), got {n} drums")
+    interface = interface_section(top.get("interface"), n, model)
+    excitation = excitation_section(top.get("excitation"), n, base_dir)
+    check_vertical(excitation, model, interface.stiffness.kind)
     return Config(
         name=name,
         column=column,
         model=model,
-        interface=interface_section(top.get("interface"), n, model),
-        excitation=excitation_section(top.get("excitation"), n, base_dir),
+        interface=interface,
+        excitation=excitation,
         grid=_grid(top.get("grid")),
         collapse=CollapseConfig(
             ratio=number(

@@ -172,7 +172,10 @@ class _LinearRun(BlockRun):
 
 def _start_piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: bool):
     """The closed-form piece from the current state, and where it ends [s]: seg_end, or
-    under a record the next sample (the ground acceleration is one line up to it)."""
+    under a record the next sample (the ground acceleration is one line up to it). With a
+    vertical record, theta'' = p^2 gam (theta - s alpha) - p^2 a_g / g, gam = (g + a_v) / g
+    taken constant on the piece at its middle: exact for a_v constant between samples (the
+    similarity test of tests/test_vertical.py), second order in the sample step otherwise."""
     t = run.t
     if not forced or blk.knots is None:
         amp = blk.amp_g if forced else 0.0
@@ -301,13 +304,9 @@ def housner_linear_run(
     -------
     Outcome  status 'collapsed' or 'survived' (or 'failed' past the budget);
         n_steps counts closed-form pieces, n_rhs closed-form evaluations.
-        A record is linear between samples, so exact pieces end at every sample; a
-        Ricker or Mavroeidis-Papageorgiou pulse is first sampled
-        (GroundMotion.sampled: 2000 samples a period, linear between). With a vertical
-        record, theta'' = p^2 gam (theta - s alpha) - p^2 a_g / g, gam = (g + a_v) / g
-        taken constant on each piece at its middle (exact for a_v constant between
-        samples, as the similarity test of tests/test_vertical.py; second order in the
-        sample step otherwise).
+        Records: exact pieces between samples; Ricker / MP pulses sampled first
+        (GroundMotion.sampled); a vertical record's gam = (g + a_v) / g constant on each
+        piece at its middle (_start_piece).
 
     Notes
     -----

@@ -176,9 +176,10 @@ def test_uplift_time_against_a_scan(kind, extra, level_g):
     level = level_g * G
     t_py = motion.next_exceedance(0.0, level)
     gr = (motion.form, motion.shape_gain, motion.omega, motion.phase, motion.center,
-          motion.gamma)  # fmt: skip
+          motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip
     knots = np.zeros(0) if motion.knots is None else np.array(motion.knots)
-    t_k = _next_uplift(0.0, level, motion.amplitude, gr, knots, np.zeros(0), motion.pulse_end)
+    none = np.zeros(0)
+    t_k = _next_uplift(0.0, level, motion.amplitude, gr, knots, none, none, motion.pulse_end)
     assert t_py is not None and t_k == pytest.approx(t_py, abs=1e-12)
     ts = np.linspace(0.0, motion.pulse_end, 1_000_001)
     first = ts[np.argmax(np.abs(motion.accel(ts)) > level)]

@@ -168,9 +168,9 @@ def test_uplift_time_on_a_straight_piece(tmp_path, level_g):
     assert motion.next_exceedance(t_above, level) == t_above
     t_fall = 2.0 - level_g / 2.0  # 2 g (2 - t) = L
     assert motion.next_exceedance(t_fall + 1e-9, level) is None
-    gr = (motion.form, 1.0, 0.0, 0.0, 0.0, 0.0)
-    knots, values = np.array(motion.knots), np.array(motion.values)
-    t_kernel = _next_uplift(0.0, level, motion.amplitude, gr, knots, values, motion.pulse_end)
+    gr = (motion.form, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    knots, values, none = np.array(motion.knots), np.array(motion.values), np.zeros(0)
+    t_kernel = _next_uplift(0.0, level, motion.amplitude, gr, knots, values, none, motion.pulse_end)
     assert t_kernel == pytest.approx(level_g / 2.0, abs=1e-12)
     assert motion.uplift_side(level_g / 2.0) == -1  # a_g > 0: it lifts on the -theta side
 

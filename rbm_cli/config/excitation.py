@@ -14,7 +14,10 @@ Keys, by excitation type (a key of another type is refused, naming it):
   mapping), ``units`` (``g``, default, or ``m/s2``: a CSV's values; an ``.AT2`` is in g),
   ``free_time`` [s] of free motion after the record's last sample (default
   :data:`~rbm_cli.config.types.DEFAULT_FREE_TIME`, 5 s), ``scale`` (``pga``, default: the
-  grid's amplitude [g] is the scaled record's PGA; ``factor``: a plain scale factor).
+  grid's amplitude [g] is the scaled record's PGA; ``factor``: a plain scale factor),
+  ``vertical`` (a second file, same formats and units: the upward ground acceleration,
+  scaled by the same factor as the horizontal record; rigid blocks only,
+  :func:`check_vertical`).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
   sets ``ExcitationConfig.duration`` to that.
 
@@ -51,7 +54,14 @@ from rbm_cli.config.types import (
 from rbm_cli.config.validate import choice, describe, fmt, join, mapping, number, number_list
 from rbm_cli.config.validate import one_line as _one_line
 
-__all__ = ["RecordFile", "excitation_section", "record_file", "resolve_record_path", "with_record"]
+__all__ = [
+    "RecordFile",
+    "check_vertical",
+    "excitation_section",
+    "record_file",
+    "resolve_record_path",
+    "with_record",
+]
 
 EXCITATION_KEYS = (
     "type",
@@ -64,6 +74,7 @@ EXCITATION_KEYS = (
     "scale",
     "gamma",
     "nu",
+    "vertical",
 )
 INITIAL_KEYS = ("rotations", "velocities")
 #: Default ``excitation.duration`` per type [s] (SPEC section 3).
@@ -86,6 +97,7 @@ ONLY_FOR = {
     "scale": ("record",),
     "gamma": ("mavroeidis-papageorgiou",),
     "nu": ("mavroeidis-papageorgiou",),
+    "vertical": ("record",),
 }
 _DIGEST_CHUNK = 1 << 20
 
@@ -166,7 +178,11 @@ def with_record(
     recomputed). For a grid axis over record files."""
     rec = record_file(value, key, base_dir, excitation.units)
     _check_scalable(rec, excitation.scale, key)
-    duration = _record_duration(rec.end, excitation.free_time, key)
+    end = rec.end
+    if excitation.vertical is not None:
+        ver = record_file(excitation.vertical, "excitation.vertical", base_dir, excitation.units)
+        end = max(end, ver.end)
+    duration = _record_duration(end, excitation.free_time, key)
     return dataclasses.replace(
         excitation,
         type="record",
@@ -261,15 +277,36 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
     )
     rec = record_file(e["file"], "excitation.file", base_dir, units)
     _check_scalable(rec, scale, "excitation.file")
+    fields = dict(file=rec.written, file_sha256=rec.sha256, file_path=rec.path)
+    end = rec.end
+    if "vertical" in e:
+        ver = record_file(e["vertical"], "excitation.vertical", base_dir, units)
+        fields.update(vertical=ver.written, vertical_sha256=ver.sha256, vertical_path=ver.path)
+        end = max(end, ver.end)
     return dict(
-        file=rec.written,
-        file_sha256=rec.sha256,
-        file_path=rec.path,
+        fields,
         units=units,
         scale=scale,
         free_time=free_time,
-        duration=_record_duration(rec.end, free_time, "excitation.file"),
+        duration=_record_duration(end, free_time, "excitation.file"),
     )
+
+
+def check_vertical(excitation: ExcitationConfig, model: str, stiffness_kind: str) -> None:
+    """excitation.vertical is integrated by rigid blocks only: the rigid RBM (whose joint
+    law scales with the weight as a whole) and housner / housner-linear. With a finite
+    joint stiffness the kinks of the law move with g + a_v(t) (not implemented), and the
+    contact engine does not take it."""
+    if excitation.vertical is None:
+        return
+    if model == "bullet" or (model == "rbm" and stiffness_kind != "rigid"):
+        what = "model bullet" if model == "bullet" else f"interface.stiffness {stiffness_kind}"
+        raise ConfigError(
+            f"excitation.vertical needs a rigid block (model rbm with interface.stiffness:"
+            f" rigid, or housner, housner-linear), not {what}: with a finite joint"
+            " stiffness the law's kinks move with g + a_v(t), which this version does not"
+            " integrate"
+        )
 
 
 def _mp_fields(e: dict) -> dict:

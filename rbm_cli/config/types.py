@@ -151,10 +151,13 @@ class ExcitationConfig:
     scale : str  Record: 'pga' (the grid's amplitude [g] is the scaled record's peak
         ground acceleration: the record is multiplied by amplitude / its own PGA) or
         'factor' (the amplitude is a plain scale factor [-])
+    vertical : str or None  Record: a second file, the upward ground acceleration, as
+        written (scaled by the same factor as the horizontal record)
+    vertical_sha256 : str or None  Its SHA-256
     gamma : float or None  Mavroeidis-Papageorgiou: oscillatory character, > 1 [-]
     nu : float or None  Mavroeidis-Papageorgiou: phase of the harmonic [rad]
-    file_path : str or None  Record: the file's absolute path (resolved against the
-        config's folder); not in :meth:`resolved`, not compared
+    file_path, vertical_path : str or None  Record: the files' absolute paths (resolved
+        against the config's folder); not in :meth:`resolved`, not compared
     """
 
     type: str = "harmonic"

@@ -78,6 +78,7 @@ def _start(geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, 
         level=G * math.tan(alpha),
         atol=solver.atol * np.array([alpha, p * alpha]),
         ground=ground_over_g(motion),
+        gravity=motion.gravity(True),
         solver=solver,
         record=record,
     )

@@ -22,6 +22,7 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,7 @@ from rbm_cli.models.housner_linear_piece import LinearPiece, PieceScanner, Scan
 from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.ground_forms import gravity_factor
 
 #: Samples per scanning chunk of a closed-form piece.
 _CHUNK = 64
@@ -120,6 +122,7 @@ class _LinearBlock:
     record: bool
     knots: np.ndarray | None = None  # a record's sample times [s] (pieces end there)
     values: np.ndarray | None = None  # its accelerations [m/s^2]
+    vertical: np.ndarray | None = None  # its upward accelerations a_v [m/s^2]
 
     @classmethod
     def make(cls, alpha, p, motion, restitution, collapse_ratio, max_pieces, record):
@@ -139,6 +142,7 @@ class _LinearBlock:
             record=record,
             knots=motion.knots if motion.clipped else None,
             values=motion.values if motion.clipped else None,
+            vertical=motion.vertical,
         )
 
 
@@ -168,7 +172,10 @@ class _LinearRun(BlockRun):
 
 def _start_piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: bool):
     """The closed-form piece from the current state, and where it ends [s]: seg_end, or
-    under a record the next sample (the ground acceleration is one line up to it)."""
+    under a record the next sample (the ground acceleration is one line up to it). With a
+    vertical record, theta'' = p^2 gam (theta - s alpha) - p^2 a_g / g, gam = (g + a_v) / g
+    taken constant on the piece at its middle: exact for a_v constant between samples (the
+    similarity test of tests/test_vertical.py), second order in the sample step otherwise."""
     t = run.t
     if not forced or blk.knots is None:
         amp = blk.amp_g if forced else 0.0
@@ -183,7 +190,11 @@ def _start_piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: boo
     if 0 < k < knots.size:
         q1 = (values[k] - values[k - 1]) / (knots[k] - knots[k - 1]) / G
         q0 = values[k - 1] / G + q1 * (t - knots[k - 1])
-    piece = LinearPiece.start_line(t, run.theta, run.rate, run.side, blk.alpha, blk.p, q0, q1)
+    p = blk.p
+    if blk.vertical is not None:  # g -> g + a_v: p^2 gam (theta - s alpha) - p^2 a_g / g
+        gam = gravity_factor(0.5 * (t + end), knots, blk.vertical)  # the piece's middle
+        p, q0, q1 = p * math.sqrt(gam), q0 / gam, q1 / gam
+    piece = LinearPiece.start_line(t, run.theta, run.rate, run.side, blk.alpha, p, q0, q1)
     return piece, end
 
 
@@ -293,9 +304,9 @@ def housner_linear_run(
     -------
     Outcome  status 'collapsed' or 'survived' (or 'failed' past the budget);
         n_steps counts closed-form pieces, n_rhs closed-form evaluations.
-        A record is linear between samples, so exact pieces end at every sample; a
-        Ricker or Mavroeidis-Papageorgiou pulse is first sampled
-        (GroundMotion.sampled: 2000 samples a period, linear between).
+        Records: exact pieces between samples; Ricker / MP pulses sampled first
+        (GroundMotion.sampled); a vertical record's gam = (g + a_v) / g constant on each
+        piece at its middle (_start_piece).
 
     Notes
     -----

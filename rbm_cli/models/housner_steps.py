@@ -31,6 +31,7 @@ class HousnerBlock:
     level: float  # uplift level g tan(alpha) [m/s^2]
     atol: np.ndarray  # absolute tolerances of theta [rad] and rate [rad/s]
     ground: Callable[[float], float]  # a_g(t) / g [-] of the forced segments, t [s]
+    gravity: Callable[[float], float] | None  # (g + a_v(t)) / g [-] (None: no vertical)
     solver: SolverConfig
     record: bool
 
@@ -52,7 +53,11 @@ class HousnerSide:
         alpha, p = blk.alpha, blk.p
         arg = alpha * s - yy[0]
         a = blk.ground(tt) if self.forced else 0.0
-        return np.array([yy[1], -p * p * (math.sin(arg) + a * math.cos(arg))])
+        if blk.gravity is None or not self.forced:
+            return np.array([yy[1], -p * p * (math.sin(arg) + a * math.cos(arg))])
+        # g -> g + a_v: p^2 and the weight's moment scale with it, a_g / g does not
+        gam = blk.gravity(tt)
+        return np.array([yy[1], -p * p * (gam * math.sin(arg) + a * math.cos(arg))])
 
     def dist(self, yy):
         """Event distances (impact, collapse) at the state(s) yy [rad]."""

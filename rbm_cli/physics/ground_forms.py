@@ -27,6 +27,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from rbm_cli.config.types import G
 from rbm_cli.physics.pulses import _mp_shape
 
 SINE, RICKER, MP, SAMPLED = 0, 1, 2, 3
@@ -126,42 +127,68 @@ def _solve_piece(a, tl: float, tr: float, target: float) -> float:
     return hi
 
 
+def gravity_factor(t: float, knots: np.ndarray, vertical: np.ndarray) -> float:
+    """(g + a_v(t)) / g [-] of an upward ground acceleration sampled at the knots (1 before
+    the first and after the last sample), as the kernel computes it."""
+    return 1.0 + sampled_value(t, knots, vertical) / G
+
+
 def exceedance_on_pieces(
-    a, knots: np.ndarray, t0: float, level: float, last: float, values: np.ndarray | None = None
+    a,
+    knots: np.ndarray,
+    t0: float,
+    level: float,
+    last: float,
+    values: np.ndarray | None = None,
+    vertical: np.ndarray | None = None,
 ) -> float | None:
     """First time t in [t0, last) with |a(t)| > level [m/s^2], or None.
 
     a_g must be monotone between consecutive knots [s] (and 0 before knots[0] and after
     knots[-1]). With ``values`` (a_g at the knots: a sampled form) the crossing is solved
-    on the straight line between two samples, and a jump at knots[0] is met there;
-    otherwise by bisection. The time returned is where |a_g| reaches the level (t0 itself
-    when already above).
+    on the straight line between two samples, and a jump (at knots[0], or a knot written
+    twice) is met there; otherwise by bisection. With ``vertical`` (a_v at the knots
+    [m/s^2], a sampled form only) the level is level (g + a_v(t)) / g, a line too. The
+    time returned is where |a_g| reaches the level (t0 itself when already above).
     """
     if t0 >= last:
         return None
-    if abs(a(t0)) > level:
+
+    def lev(t):
+        return level if vertical is None else level * gravity_factor(t, knots, vertical)
+
+    if abs(a(t0)) > lev(t0):
         return t0
     k = int(np.searchsorted(knots, t0, side="right"))
     tl = t0
     while True:
         tr = min(float(knots[k]) if k < knots.size else last, last)
         ar = a(tr)
-        if abs(ar) > level:
+        if abs(ar) > lev(tr):
             target = level if ar > 0.0 else -level
             if values is None:
                 t = _solve_piece(a, tl, tr, target)
-            elif k == 0:
-                t = tr  # the jump from rest to the first sample
+            elif k == 0 or knots[k] == knots[k - 1]:
+                t = tr  # a jump: from rest to the first sample, or a knot written twice
             else:
-                t_a, t_b = float(knots[k - 1]), float(knots[k])
-                a_a, a_b = float(values[k - 1]), float(values[k])
-                t = t_a + (target - a_a) * ((t_b - t_a) / (a_b - a_a))
+                t = _line_crossing(knots, values, vertical, k, target)
                 t = min(max(t, tl), tr)
             return t if t < last else None
         if tr >= last:
             return None
         tl = tr
         k += 1
+
+
+def _line_crossing(knots, values, vertical, k: int, target: float) -> float:
+    """Where a_g = target (g + a_v) / g on the straight piece [knots[k-1], knots[k]]."""
+    t_a, t_b = float(knots[k - 1]), float(knots[k])
+    a_a, a_b = float(values[k - 1]), float(values[k])
+    if vertical is None:
+        return t_a + (target - a_a) * ((t_b - t_a) / (a_b - a_a))
+    f_a = a_a - target * (1.0 + float(vertical[k - 1]) / G)
+    f_b = a_b - target * (1.0 + float(vertical[k]) / G)
+    return t_a + (t_b - t_a) * (f_a / (f_a - f_b))
 
 
 def ricker_knots(omega: float, center: float) -> np.ndarray:
@@ -201,8 +228,8 @@ def mp_knots(frequency_hz: float, gamma: float, nu: float) -> np.ndarray:
 
 def sampled_displacement(times: np.ndarray, values: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Ground displacement [m] from rest of the piecewise-linear acceleration (times [s],
-    values [m/s^2]), exact (cubic between samples); after the last sample the ground
-    keeps its velocity (the acceleration is 0 there)."""
+    values [m/s^2]), exact (cubic between samples; a time written twice is a jump);
+    after the last sample the ground keeps its velocity (the acceleration is 0 there)."""
     t = np.asarray(t, dtype=float)
     h = np.diff(times)
     a0, a1 = values[:-1], values[1:]
@@ -210,7 +237,8 @@ def sampled_displacement(times: np.ndarray, values: np.ndarray, t: np.ndarray) -
     u = np.concatenate([[0.0], np.cumsum(v[:-1] * h + h * h * (2.0 * a0 + a1) / 6.0)])
     k = np.clip(np.searchsorted(times, t, side="right") - 1, 0, times.size - 2)
     tau = np.clip(t - times[k], 0.0, None)
-    slope = (values[k + 1] - values[k]) / h[k]
+    slopes = np.divide(np.diff(values), h, out=np.zeros_like(h), where=h > 0.0)  # jumps: h = 0
+    slope = slopes[k]
     inside = u[k] + v[k] * tau + values[k] * tau**2 / 2.0 + slope * tau**3 / 6.0
     after = u[-1] + v[-1] * (t - times[-1])
     out = np.where(t > times[-1], after, inside)

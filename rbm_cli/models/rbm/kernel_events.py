@@ -321,10 +321,10 @@ def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slop
 
 
 @njit(cache=True, inline="always")
-def _friction(g_new, centre_map, acc, masses, normal_forces, friction):
+def _friction(g_new, gam, centre_map, acc, masses, normal_forces, friction):
     """Friction demand |T_i| / N_i at each interface at the step's end, kept in friction
     if larger: the shear from the drums above, their absolute accelerations g_new [m/s^2]
-    (the ground) + centre_map @ acc (theta'' [rad/s^2])."""
+    (the ground) + centre_map @ acc (theta'' [rad/s^2]); N_i times gam = (g + a_v) / g."""
     n = acc.size
     shear = 0.0
     for i in range(n - 1, -1, -1):
@@ -332,7 +332,7 @@ def _friction(g_new, centre_map, acc, masses, normal_forces, friction):
         for j in range(n):
             a_abs += centre_map[i, j] * acc[j]
         shear += a_abs * masses[i]
-        fr = abs(shear) / normal_forces[i]
+        fr = abs(shear) / (normal_forces[i] * gam)
         if fr > friction[i]:
             friction[i] = fr
 

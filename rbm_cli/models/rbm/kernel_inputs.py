@@ -91,6 +91,7 @@ class Excitation(NamedTuple):
     gamma: float  #: MP's gamma [-]
     knots: np.ndarray  #: times a_g is monotone between [s] (a record's samples)
     values: np.ndarray  #: a record's a_g at its samples [m/s^2] (gain 1)
+    vertical: np.ndarray  #: its upward a_v at the samples [m/s^2] (empty: none)
     clipped: bool  #: steps end at every knot (a record)
     bounds: np.ndarray  #: segment boundaries, from 0 to t_end [s]
     forced: np.ndarray  #: whether a_g acts on each segment (bool)
@@ -246,7 +247,8 @@ def excitation(motion: GroundMotion) -> tuple:
             float(motion.phase), float(motion.pulse_end), float(motion.t_end),
             int(motion.form), float(motion.shape_gain), float(motion.center),
             float(motion.gamma), _array(motion.knots), _array(motion.values),
-            bool(motion.clipped), bounds, forced, bool(motion.is_pulse))  # fmt: skip
+            _array(motion.vertical), bool(motion.clipped), bounds, forced,
+            bool(motion.is_pulse))  # fmt: skip
 
 
 def solver_settings(solver, atol_scale: np.ndarray, deadline: float) -> tuple:

@@ -13,7 +13,7 @@ from scipy.integrate._ivp.rk import RK23 as _RK23
 from scipy.integrate._ivp.rk import RK45 as _RK45
 
 from rbm_cli.base.detmath import pow_pos
-from rbm_cli.models.rbm.kernel_ground import _ground
+from rbm_cli.models.rbm.kernel_ground import _gravity, _ground
 
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
@@ -71,12 +71,36 @@ _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 @njit(cache=True, inline="always")
 def _rhs(t, y, n, As, cs, es, gr, out):
     g = _ground(t, gr)
+    if gr[6] == 0.0:
+        for i in range(n):
+            out[i] = y[n + i]
+            s = cs[i] + es[i] * g
+            for j in range(n):
+                s += As[i, j] * y[j]
+            out[n + i] = s
+        return
+    # a vertical record: every weight (the law and gravity, As and cs) times (g + a_v) / g
+    gam = _gravity(t, gr)
     for i in range(n):
         out[i] = y[n + i]
-        s = cs[i] + es[i] * g
+        s = cs[i]
         for j in range(n):
             s += As[i, j] * y[j]
-        out[n + i] = s
+        out[n + i] = gam * s + es[i] * g
+
+
+@njit(cache=True, inline="always")
+def _acc_of(t, y, n, As, cs, es, gr, acc):
+    """Angular accelerations theta'' at (t, y) into acc [rad/s^2]; returns a_g(t) [m/s^2]
+    and (g + a_v(t)) / g [-]. (gam * x + e g is x + e g to the bit when gam = 1.)"""
+    g = _ground(t, gr)
+    gam = _gravity(t, gr)
+    for i in range(n):
+        d = cs[i]
+        for j in range(n):
+            d += As[i, j] * y[j]
+        acc[i] = gam * d + es[i] * g
+    return g, gam
 
 
 @njit(cache=True)

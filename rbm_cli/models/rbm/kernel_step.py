@@ -27,7 +27,7 @@ from rbm_cli.models.rbm.kernel_events import (
     _system,
     _within_reach,
 )
-from rbm_cli.models.rbm.kernel_ground import _ground, _ground_at, _next_uplift, _record_piece
+from rbm_cli.models.rbm.kernel_ground import _ground_at, _next_uplift, _record_piece
 from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, POLL_STEPS, poll
 from rbm_cli.models.rbm.kernel_inputs import Excitation, ModelArrays, RunTask, SolverSettings
 from rbm_cli.models.rbm.kernel_rk import (
@@ -46,6 +46,7 @@ from rbm_cli.models.rbm.kernel_rk import (
     SURVIVED,
     TAB_EST,
     TAB_NS,
+    _acc_of,
     _dense_eval,
     _dense_prepare,
     _error_norm,
@@ -85,13 +86,14 @@ def run_kernel(model, motion, solver, task):
     centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
     uplift_level, barrier = model.uplift_level, model.barrier
     amplitude, pulse_end, t_end = motion.amplitude, motion.pulse_end, motion.t_end
-    knots, values, clipped = motion.knots, motion.values, motion.clipped
+    knots, values, vertical, clipped = motion.knots, motion.values, motion.vertical, motion.clipped
     bounds, forced = motion.bounds, motion.forced
     # the ground (kernel_ground): of the motion, and nothing (a free segment); a record
     # one straight piece a step (_record_piece)
     gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
-               motion.gamma)  # fmt: skip
-    gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center, motion.gamma)
+               motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip
+    gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center, motion.gamma,
+               0.0, 0.0, 0.0)  # fmt: skip
     mc, rtol, atol, deadline = solver.mc, solver.rtol, solver.atol, solver.deadline
     max_steps, max_events = solver.max_steps, solver.max_events
     theta0, rate0, early_stop = task.theta0, task.rate0, task.early_stop
@@ -183,7 +185,8 @@ def run_kernel(model, motion, solver, task):
                     return (status, t_end, t_col, c_if, max_ratio, max_top, friction,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 last = min(pulse_end, t_end)
-                t_up = _next_uplift(t, uplift_level, amplitude, gr_full, knots, values, last)
+                t_up = _next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical,
+                                    last)  # fmt: skip
                 if t_up < 0.0 or t_up >= seg_end:
                     if record:
                         n_out, next_out = _emit_rest(seg_end, samples, n_out, next_out, output_dt)
@@ -211,7 +214,7 @@ def run_kernel(model, motion, solver, task):
             # a new stepper from (t, y)
             t_bound = seg_end
             if clipped:
-                gr, t_bound = _record_piece(t, knots, values, seg_gain, seg_end)
+                gr, t_bound = _record_piece(t, knots, values, vertical, seg_gain, seg_end)
             _rhs(t, y, n, As, cs, es, gr, f)
             if h_carry > 0.0:
                 h_abs = min(h_carry, seg_end - t)
@@ -224,10 +227,7 @@ def run_kernel(model, motion, solver, task):
             _affine(track, y, n, no_offset, dz_old)
             _event_rows(gx, gc, same, y, 0, h0, True, d_old)
             _event_rows(gx, gc, same, y, n, h0, False, dd_old)
-            g0 = _ground(t, gr)
-            _affine(As, y, 0, cs, acc)
-            for i in range(n):
-                acc[i] += es[i] * g0
+            _acc_of(t, y, n, As, cs, es, gr, acc)
             _event_rows(gx, gc, same, acc, 0, h0, False, d2_old)
             event = False
             running = True
@@ -238,7 +238,7 @@ def run_kernel(model, motion, solver, task):
                     h_abs = min_step
                 bound = seg_end  # a record's steps end at its samples (python.Stepper's)
                 if clipped:
-                    gr, bound = _record_piece(t, knots, values, seg_gain, seg_end)
+                    gr, bound = _record_piece(t, knots, values, vertical, seg_gain, seg_end)
                 rejected = False
                 while True:
                     if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
@@ -285,10 +285,7 @@ def run_kernel(model, motion, solver, task):
                 _event_rows(gx, gc, same, y_new, 0, h0, True, d_new)
                 _event_rows(gx, gc, same, y_new, n, h0, False, dd_new)
                 dense_ready = False
-                g_new = _ground(t_new, gr)
-                _affine(As, y_new, 0, cs, acc)
-                for i in range(n):
-                    acc[i] += es[i] * g_new
+                g_new, gam_new = _acc_of(t_new, y_new, n, As, cs, es, gr, acc)
                 _event_rows(gx, gc, same, acc, 0, h0, False, d2_new)
                 event_row = -1
                 t_e = t_new
@@ -303,10 +300,7 @@ def run_kernel(model, motion, solver, task):
                     _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e
                     event = True
-                    g_new = _ground(t_new, gr)
-                    _affine(As, y_new, 0, cs, acc)
-                    for i in range(n):
-                        acc[i] += es[i] * g_new
+                    g_new, gam_new = _acc_of(t_new, y_new, n, As, cs, es, gr, acc)
                     if record:
                         n_out, next_out = _emit(mc, t_e, t_old, h, y_old, F, samples, n_out,
                                                 next_out, output_dt)  # fmt: skip
@@ -354,7 +348,7 @@ def run_kernel(model, motion, solver, task):
                         max_ratio[i] = peaks[i]
                 if peaks[n] > max_top:
                     max_top = peaks[n]
-                _friction(g_new, centre_map, acc, masses, normal_forces, friction)
+                _friction(g_new, gam_new, centre_map, acc, masses, normal_forces, friction)
                 z_prev, z_old, z_new = z_old, z_new, z_prev
                 dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
                 d_old, d_new = d_new, d_old

@@ -126,7 +126,7 @@ def _run_segment(
     """Integrate up to seg_end [s], the end of a segment of the motion (forced, or free
     when free_seg), piece by piece and event by event. Returns the Outcome if the run
     ends inside the segment, else None."""
-    ag = motion.scalar(not free_seg)
+    ag, gam = motion.scalar(not free_seg), motion.gravity(not free_seg)
     while run.t < seg_end:
         if run.at_rest:
             kind = leave_rest(run, motion, seg_end, not free_seg)
@@ -135,7 +135,7 @@ def _run_segment(
                 return run.out
             if kind == "segment":
                 return None
-        piece = SmoothPiece(run, ag)
+        piece = SmoothPiece(run, ag, gam)
         integ = _start_stepper(run, piece, seg_end)
         event = step_to_event(run, piece, integ, can_stop)
         if isinstance(event, Outcome):

@@ -163,12 +163,15 @@ class RunState:
 
 class SmoothPiece:
     """The linear system of the current law pieces, theta'' = A theta + c + e a_g(t), and
-    the distances to its event surfaces, linear in theta: d = G theta + h0 (>= 0 inside)."""
+    the distances to its event surfaces, linear in theta: d = G theta + h0 (>= 0 inside).
+    With a vertical record (gam(t) = (g + a_v(t)) / g, rigid laws only, whose A and c are
+    all weight): theta'' = gam(t) (A theta + c) + e a_g(t)."""
 
-    def __init__(self, run: RunState, ag):
+    def __init__(self, run: RunState, ag, gam=None):
         self.n = run.n
         self.out = run.out
         self.ag = ag
+        self.gam = gam
         self.g_rows = run.g_rows
         self.A, self.cvec, self.evec = run.pieces.system()
         self.lo, self.hi = run.pieces.bounds()
@@ -184,12 +187,14 @@ class SmoothPiece:
         """dy/dt at (tt [s], yy); counted in the outcome's n_rhs unless told not."""
         n = self.n
         self.out.n_rhs += counted
-        return np.concatenate([yy[n:], self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)])
+        return np.concatenate([yy[n:], self.acc(tt, yy)])
 
     def acc(self, tt, yy) -> np.ndarray:
         """Angular accelerations theta'' at (tt [s], yy) [rad/s^2]."""
         n = self.n
-        return self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)
+        if self.gam is None:
+            return self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)
+        return self.gam(tt) * (self.A @ yy[:n] + self.cvec) + self.evec * self.ag(tt)
 
     def distances(self, yy) -> tuple[np.ndarray, np.ndarray]:
         """Event distances and their rates at the state yy."""
@@ -254,13 +259,16 @@ def end_of_step(run: RunState, piece: SmoothPiece, integ, surfaces: tuple) -> St
     return StepEnd(t_new, y_new, acc, dense, (d_new, dd_new, d2_new), event_row)
 
 
-def account(run: RunState, z_old, z_new, dz_old, dz_new, dt: float, acc, ag_new) -> None:
-    """Peaks (collapse ratios, top displacement) and friction demand over a step of dt [s]."""
+def account(
+    run: RunState, z_old, z_new, dz_old, dz_new, dt: float, acc, ag_new, gam_new=1.0
+) -> None:
+    """Peaks (collapse ratios, top displacement) and friction demand over a step of dt [s]
+    (the normal forces times gam_new = (g + a_v) / g)."""
     out, n = run.out, run.n
     peaks = hermite_peaks(z_old, z_new, dz_old, dz_new, dt)
     out.max_ratio = np.maximum(out.max_ratio, peaks[:n])
     out.max_top = max(out.max_top, peaks[n])
-    fr = run.model.shear_ratios(acc[None, :], np.array([ag_new]))[0]
+    fr = run.model.shear_ratios(acc[None, :], np.array([ag_new]))[0] / gam_new
     out.friction = np.maximum(out.friction, fr)
 
 
@@ -303,7 +311,8 @@ def step_to_event(run: RunState, piece: SmoothPiece, integ, can_stop: bool):
         # peaks and friction demand over [t_old, t_new]
         z_new = track @ y_new[:n]
         dz_new = track @ y_new[n:]
-        account(run, z_old, z_new, dz_old, dz_new, t_new - t_old, end.acc, piece.ag(t_new))
+        gam_new = 1.0 if piece.gam is None else piece.gam(t_new)
+        account(run, z_old, z_new, dz_old, dz_new, t_new - t_old, end.acc, piece.ag(t_new), gam_new)
         z_prev, dz_prev = z_old, dz_old
         z_old, dz_old = z_new, dz_new
         surfaces = end.surfaces

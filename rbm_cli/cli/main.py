@@ -10,12 +10,16 @@ module registers its commands on it when imported here.
 
 from __future__ import annotations
 
-import matplotlib
+import os
+import sys
 
-matplotlib.use("Agg")  # the CLI saves figures to files; only the CLI picks a backend
+from rbm_cli.cli import bench, domain, run  # noqa: F401  (register the commands)
+from rbm_cli.cli.common import cli
 
-from rbm_cli.cli import bench, domain, run  # noqa: E402, F401  (register the commands)
-from rbm_cli.cli.common import cli  # noqa: E402
+if "matplotlib" in sys.modules:  # (main() called from a program that drew already)
+    sys.modules["matplotlib"].use("Agg")
+else:  # the CLI saves figures to files; only the CLI picks a backend; matplotlib is
+    os.environ["MPLBACKEND"] = "Agg"  # imported by the commands that draw, not here
 
 __all__ = ["cli", "main"]
 

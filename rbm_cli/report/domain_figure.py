@@ -5,13 +5,15 @@ uplift level for `bullet`) and the closed forms that apply."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-
-import pandas as pd
-from matplotlib.figure import Figure
+from typing import TYPE_CHECKING
 
 from rbm_cli.config.types import Config
 from rbm_cli.physics.column import build_column
 from rbm_cli.report.plot_domain import plot_domain
+
+if TYPE_CHECKING:  # matplotlib is imported when a figure is drawn, not with this module
+    import pandas as pd
+    from matplotlib.figure import Figure
 
 
 def uplift_level(config: Config) -> tuple[float, str]:
@@ -40,6 +42,8 @@ def domain_figure(
     compare : sequence of DataFrame  Other domains whose boundaries are drawn over it
     labels : sequence of str  Their legend labels
     """
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(9.5, 5))
     ax = fig.add_subplot()
     if config is None:  # a domain without its config: no column, no curves of it

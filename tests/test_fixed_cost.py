@@ -88,46 +88,66 @@ def _record_pool(monkeypatch) -> list:
     return handed
 
 
-def _busy_10ms(_=None) -> None:
-    end = time.perf_counter() + 0.01
-    while time.perf_counter() < end:
-        pass
+class Clock:
+    """parallel's clock, advanced only by the work of the items (exact binary times)."""
+
+    def __init__(self):
+        self.now = 0.0
+
+    def perf_counter(self) -> float:
+        return self.now
+
+    def work(self, seconds: float) -> None:
+        self.now += seconds
 
 
-def test_cheap_items_stay_here_and_costly_ones_go_to_the_pool(monkeypatch):
-    """Items of known cost (10 ms each): 20 would save 0.1 s on 2 workers, less than a
-    pool of 1 s costs: all run here; 1,000 would save 5 s: the pool gets every item
-    after the first (the first one's time is the estimate)."""
+@pytest.fixture
+def clock(monkeypatch) -> Clock:
+    fake = Clock()
+    monkeypatch.setattr(parallel, "time", fake)
     monkeypatch.setattr(parallel, "POOL_COST_S", 1.0)
+    monkeypatch.setattr(parallel, "PROBE_S", 0.25)
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
-    handed = _record_pool(monkeypatch)
-    cheap = [(None,)] * 20
-    assert list(parallel.run_chunks(_busy_10ms, cheap, 2, "loky", None)) == [None] * 20
-    assert handed == []
-    costly = [(None,)] * 1000
-    assert len(list(parallel.run_chunks(_busy_10ms, costly, 2, "loky", None))) == 1000
-    assert len(handed) == 999
+    return fake
 
 
-def test_sizes_weigh_the_estimate(monkeypatch):
-    """The first item, of 1 cell, took 10 ms: 400 cells left in one item are ~4 s here,
-    2 s saved on 2 workers: the pool pays; counted as 1 cell they would not be."""
-    monkeypatch.setattr(parallel, "POOL_COST_S", 1.0)
-    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+STEP = 2.0**-6  # s of work an item (0.015625 s: sums of it are exact)
+
+
+def test_cheap_items_stay_here(monkeypatch, clock):
+    """15 items of STEP: 0.23 s in all, less than PROBE_S, and 0.12 s saved on 2 workers
+    would not pay for a pool of 1 s anyway."""
     handed = _record_pool(monkeypatch)
-    args = [(None,), (None,)]
-    list(parallel.run_chunks(_busy_10ms, args, 2, "loky", None, sizes=[1, 400]))
+    items = [(STEP,)] * 15
+    assert list(parallel.run_chunks(clock.work, items, 2, "loky", None)) == [None] * 15
+    assert handed == [] and clock.now == 15 * STEP
+
+
+def test_costly_items_go_to_the_pool_once_probe_s_is_timed(monkeypatch, clock):
+    """1,000 items of STEP: after 16 (PROBE_S = 0.25 s timed) the 984 left would take
+    15.4 s here, 7.7 s saved on 2 workers > 1 s: the pool gets all 984."""
+    handed = _record_pool(monkeypatch)
+    results = list(parallel.run_chunks(clock.work, [(STEP,)] * 1000, 2, "loky", None))
+    assert len(results) == 1000 and len(handed) == 984 and clock.now == 16 * STEP
+
+
+def test_sizes_weigh_the_estimate(monkeypatch, clock):
+    """A first item of 1 cell that took 0.25 s: 400 cells left in one item are 100 s here,
+    the pool pays; 1 cell left is 0.25 s here (0.125 s saved): it does not."""
+    handed = _record_pool(monkeypatch)
+    items = [(0.25,), (0.25,)]
+    list(parallel.run_chunks(clock.work, items, 2, "loky", None, sizes=[1, 400]))
     assert len(handed) == 1
     handed.clear()
-    list(parallel.run_chunks(_busy_10ms, args, 2, "loky", None, sizes=[1, 1]))
+    list(parallel.run_chunks(clock.work, items, 2, "loky", None, sizes=[1, 1]))
     assert handed == []
 
 
-def test_jobs_1_never_starts_a_pool(monkeypatch):
+def test_jobs_1_never_starts_a_pool(monkeypatch, clock):
     handed = _record_pool(monkeypatch)
     monkeypatch.setattr(parallel, "POOL_COST_S", 0.0)
-    list(parallel.run_chunks(_busy_10ms, [(None,)] * 5, 1, "loky", None))
-    assert handed == []
+    list(parallel.run_chunks(clock.work, [(1.0,)] * 5, 1, "loky", None))
+    assert handed == [] and clock.now == 5.0
 
 
 # ------------------------------------------------------------------- sweeps
@@ -145,12 +165,13 @@ def test_a_cheap_sweep_with_two_jobs_starts_no_pool(tmp_path, monkeypatch):
 
 
 def test_rows_are_the_same_here_and_on_the_pool(tmp_path, monkeypatch, workers):
-    """A pool that always pays (cost 0): every chunk after the first piece runs on the
-    workers; domain.csv is byte-identical to the sweep in this process, and the workers
+    """A pool that always pays (cost 0, no probe): every chunk after the first piece
+    runs on the workers; domain.csv is byte-identical to the sweep in this process, and the workers
     are stopped and reaped when the sweep returns."""
     cfg = rigid(amps=(0.2, 0.3, 0.5, 0.8, 1.2, 1.5), freqs=(0.5, 1.0, 2.0, 3.0))
     here = run_sweep(cfg, tmp_path / "here", jobs=1)
     monkeypatch.setattr(parallel, "POOL_COST_S", 0.0)
+    monkeypatch.setattr(parallel, "PROBE_S", 0.0)
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
     started = []
     real = parallel._loky

@@ -5,11 +5,13 @@ Backends: ``loky`` (worker processes, the default), ``threading``, ``sequential`
 
 A pool costs a fixed time before it saves any (its workers start, import and load the
 kernel; POOL_COST_S), so ``loky`` starts one only when it pays (issue 18): the chunks
-run in this process, one at a time, while the time those left would take here,
-estimated from the time per cell of those done so far, is short; as soon as a pool of
-J workers would save more than it costs (1 - 1/J of that time > POOL_COST_S), the rest
-goes to the pool. A cheap sweep thus never starts one, whatever --jobs says; the rows
-do not depend on where a chunk ran. The pool is stopped once its chunks are done (its
+run in this process, one at a time, and once PROBE_S of them has been timed, the time
+those left would take here is estimated from the time per cell so far; as soon as a
+pool of J workers (J = --jobs, at most one per processor) would save more than it costs,
+(1 - 1/J) x that time > POOL_COST_S, the rest goes to the pool. A cheap sweep thus never
+starts one, whatever --jobs says, and a costly one runs a few cells here first (the
+first chunk is cut small: rbm_cli.study.sweep); the rows do not depend on where a chunk
+ran. A pool is stopped once its chunks are done (its
 workers are killed, not waited for: nothing of theirs is left to read).
 
 Interruption is part of the contract (issue 14):
@@ -47,6 +49,9 @@ IDLE_TIMEOUT_S = 60
 #: The fixed cost of a pool [s]: its workers' start, imports and kernel load, and their
 #: stop (measured for `rbm sweep` on 2 cores at low load: ~0.6-1 s).
 POOL_COST_S = 1.0
+#: Work timed in this process [s] before its time per cell is trusted: one cell's time
+#: (a first call's lazy set-up in it, or a cell below uplift) says little of the rest.
+PROBE_S = 0.2
 
 
 def _watch_parent(parent: int) -> None:
@@ -112,7 +117,7 @@ def _here_then_pool(fn: Callable, args: Sequence[tuple], jobs: int, sizes) -> It
     """Items in this process until the estimate says a pool pays, the rest on loky."""
     left, done, spent = sum(sizes), 0, 0.0
     for i, a in enumerate(args):
-        if done and pool_pays(spent / done * left, jobs):
+        if done and spent >= PROBE_S and pool_pays(spent / done * left, jobs):
             yield from _loky(fn, args[i:], jobs)
             return
         start = time.perf_counter()
@@ -149,7 +154,7 @@ def _loky(fn: Callable, args: Iterable[tuple], jobs: int) -> Iterator:
         # multiprocessing's resource tracker, started on first use, unblocks SIGINT as
         # it starts: started first, so that the workers below inherit the blocked mask
         resource_tracker.ensure_running()
-        with _sigint_blocked():  # the workers start in the first submits
+        with _sigint_deferred():  # the workers start in the first submits
             refill()
         while pending:
             done, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
@@ -168,17 +173,28 @@ def _loky(fn: Callable, args: Iterable[tuple], jobs: int) -> Iterator:
 
 
 @contextlib.contextmanager
-def _sigint_blocked() -> Iterator[None]:
-    """SIGINT blocked in this thread while the pool's workers start: they inherit the
-    mask (exec keeps it), so a Ctrl-C never reaches one, even before _worker_init has
-    run (once it had imported loky; a Ctrl-C before that printed its traceback). Not
-    lost here meanwhile: another thread of this process takes it (Python's handler
-    then raises KeyboardInterrupt in the main thread), or it waits until unblocked."""
+def _sigint_deferred() -> Iterator[None]:
+    """While the pool's workers start: SIGINT blocked in this thread, so that they inherit
+    the mask (exec keeps it) and never see a Ctrl-C, even before _worker_init has run
+    (once a worker has imported loky: a Ctrl-C before printed its traceback); and a Ctrl-C
+    meanwhile (another thread of this process takes it) only noted, and handled once they
+    are started: raised inside loky's start of a worker, it left that worker out of the
+    pool's table, never stopped, and the sweep hung at exit waiting for it."""
+    noted: list[int] = []
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.getsignal(signal.SIGINT) if main else None
+    deferred = callable(previous)  # a Python handler (not SIG_IGN, SIG_DFL or C's own)
+    if deferred:
+        signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum))
     mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # a pending Ctrl-C lands here
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # a pending Ctrl-C lands now
+        if deferred:
+            signal.signal(signal.SIGINT, previous)
+    if noted:
+        previous(signal.SIGINT, None)  # Python's default: raise KeyboardInterrupt
 
 
 def _stop(executor) -> None:

@@ -25,8 +25,15 @@ __all__ = ["cli", "main"]
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console-script entry point (``rbm``)."""
-    cli.main(args=argv, prog_name="rbm")
+    """Console-script entry point (``rbm``): the process ends with it, so what it holds is
+    frozen out of the garbage collector first, and the exit does not traverse it (a
+    sweep's ~200,000 objects: ~0.2-0.4 s of its wall time, issue 18)."""
+    import gc
+
+    try:
+        cli.main(args=argv, prog_name="rbm")
+    finally:
+        gc.freeze()
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -51,7 +51,16 @@ from rbm_cli.config.types import (
     ExcitationConfig,
     InitialConfig,
 )
-from rbm_cli.config.validate import choice, describe, fmt, join, mapping, number, number_list
+from rbm_cli.config.validate import (
+    choice,
+    describe,
+    fmt,
+    in_bounds,
+    join,
+    mapping,
+    number,
+    number_list,
+)
 from rbm_cli.config.validate import one_line as _one_line
 
 __all__ = [
@@ -211,22 +220,13 @@ def _record_duration(end: float, free_time: float, key: str) -> float:
     return total
 
 
-def _bounded(x: float, path: str, unit: str, bounds: tuple[float, float]) -> float:
-    if not bounds[0] <= x <= bounds[1]:
-        raise ConfigError(
-            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
-            f" masses, inertias and moments stay finite), got {fmt(x)}"
-        )
-    return x
-
-
 def _initial(raw: Any, n: int, kind: str) -> InitialConfig:
     path = "excitation.initial"
     init = mapping(raw, path, INITIAL_KEYS)
     per = f"one value per drum ({n})"
     values = {
         key: tuple(
-            _bounded(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
+            in_bounds(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
             for i, x in enumerate(
                 number_list(init[key], join(path, key), unit, length=n, length_text=per)
             )
@@ -356,7 +356,7 @@ def excitation_section(
             MAX_DURATION,
         )
     phase = number(e.get("phase", 0.0), "excitation.phase", "rad")
-    phase = _bounded(phase, "excitation.phase", "rad", (-PHASE_MAX, PHASE_MAX))
+    phase = in_bounds(phase, "excitation.phase", "rad", (-PHASE_MAX, PHASE_MAX))
     if phase != 0.0 and kind != "harmonic":
         raise ConfigError(
             f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"

@@ -39,6 +39,7 @@ from rbm_cli.config.validate import (
     choice,
     describe,
     fmt,
+    in_bounds,
     integer,
     join,
     mapping,
@@ -280,13 +281,8 @@ def _column(raw: Any) -> ColumnConfig:
 def _bounded(
     x: float, path: str, unit: str = "m", bounds: tuple[float, float] = LENGTH_RANGE
 ) -> float:
-    """x within bounds [assumption: the range where the arithmetic is sound]."""
-    if not bounds[0] <= x <= bounds[1]:
-        raise ConfigError(
-            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
-            f" masses, inertias and moments stay finite), got {fmt(x)}"
-        )
-    return x
+    """x within bounds (validate.in_bounds, lengths by default)."""
+    return in_bounds(x, path, unit, bounds)
 
 
 def _drums(value: Any, height: float) -> tuple[float, ...]:

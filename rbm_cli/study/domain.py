@@ -59,6 +59,11 @@ def cell_key(amplitude_g: float, frequency_hz: float | None, *values) -> tuple[s
     return (_key_text(amplitude_g), _key_text(frequency_hz), *(_key_text(v) for v in values))
 
 
+def row_key(row, paths: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The cell identity of a domain or journal row whose point is in the columns ``paths``."""
+    return cell_key(row.get("amplitude_g"), row.get("frequency_hz"), *(row.get(p) for p in paths))
+
+
 def axis_columns(columns) -> tuple[str, ...]:
     """The columns of a domain that hold its point's axes: named by a dotted config path."""
     return tuple(c for c in columns if "." in str(c))
@@ -238,8 +243,7 @@ def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
             step = float(np.min(np.diff(amps))) if len(amps) > 1 else 0.0
             edge = float(amps[-1]) + step
         row = _group_row(by, values)
-        keys = [row[c] for c in by]
-        out[cell_key(0.0, keys[-1], *keys[:-1])[1:]] = (row, edge)
+        out[tuple(_key_text(row[c]) for c in by)] = (row, edge)
     return by, out
 
 

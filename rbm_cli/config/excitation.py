@@ -16,7 +16,7 @@ Keys, by excitation type (a key of another type is refused, naming it):
   :data:`~rbm_cli.config.types.DEFAULT_FREE_TIME`, 5 s), ``scale`` (``pga``, default: the
   grid's amplitude [g] is the scaled record's PGA; ``factor``: a plain scale factor),
   ``vertical`` (a second file, same formats and units: the upward ground acceleration,
-  scaled by the same factor as the horizontal record; rigid blocks only,
+  scaled by the same factor as the horizontal record; not for model bullet,
   :func:`check_vertical`).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
   sets ``ExcitationConfig.duration`` to that.
@@ -293,19 +293,16 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
 
 
 def check_vertical(excitation: ExcitationConfig, model: str, stiffness_kind: str) -> None:
-    """excitation.vertical is integrated by rigid blocks only: the rigid RBM (whose joint
-    law scales with the weight as a whole) and housner / housner-linear. With a finite
-    joint stiffness the kinks of the law move with g + a_v(t) (not implemented), and the
-    contact engine does not take it."""
+    """excitation.vertical is integrated by the RBM, rigid or with elastic joints (the
+    weight part of its laws scales with g + a_v(t), the joint stiffness does not, and the
+    kinks between them move: SPEC "Vertical shaking"), and by housner / housner-linear; the
+    contact engine does not take it. stiffness_kind: any (kept for the callers)."""
     if excitation.vertical is None:
         return
-    if model == "bullet" or (model == "rbm" and stiffness_kind != "rigid"):
-        what = "model bullet" if model == "bullet" else f"interface.stiffness {stiffness_kind}"
+    if model == "bullet":
         raise ConfigError(
-            f"excitation.vertical needs a rigid block (model rbm with interface.stiffness:"
-            f" rigid, or housner, housner-linear), not {what}: with a finite joint"
-            " stiffness the law's kinks move with g + a_v(t), which this version does not"
-            " integrate"
+            "excitation.vertical needs model rbm, housner or housner-linear, not model"
+            " bullet: the contact engine does not integrate g + a_v(t)"
         )
 
 

@@ -53,6 +53,7 @@ class Model:
     collapse_ratio : float  c, collapse when |quantity| >= c * limit
     restitution : float  e, angular-velocity ratio at an impact
     formulation : str
+    xi : float  Smoothing parameter of the laws [-]
     """
 
     column: Column
@@ -70,6 +71,7 @@ class Model:
     collapse_ratio: float
     restitution: float
     formulation: str
+    xi: float = 1.0
 
     @property
     def n(self) -> int:
@@ -178,6 +180,81 @@ class Model:
         c = product(self.diff.T, intercepts)
         return -product(minv, stiff), -product(minv, c), -product(minv, self.ground_load)
 
+    # ---- vertical shaking: the weight and non-weight parts of the laws (SPEC "Vertical")
+    @cached_property
+    def slope_parts(self) -> tuple[np.ndarray, np.ndarray]:
+        """(weight, elastic) parts of every piece's slope, (n, max pieces) each, padded with 0
+        [N m/rad]: under g + a_v(t) a piece is f = gam (a_k + bs_k x) + be_k x with
+        gam = (g + a_v) / g. The weight part is the descending branch's -M_u / theta_u and the
+        `geometric` extra slope M_u / theta_u; the elastic part is K_M on the elastic branch
+        (piece 0 of a law with a finite stiffness), 0 elsewhere."""
+        width = max(len(law.slopes) for law in self.laws)
+        weight, elastic = np.zeros((self.n, width)), np.zeros((self.n, width))
+        for i, law in enumerate(self.laws):
+            m = len(law.slopes)
+            weight[i, :m] = law.slopes
+            if not law.rigid:
+                stiff = float(self.column.stiffness[i])
+                extra = self._extra_slope(i)
+                weight[i, 0], elastic[i, 0] = extra, stiff
+        return weight, elastic
+
+    def _extra_slope(self, i: int) -> float:
+        """The `geometric` formulation's extra slope M_u / theta_u of law i (0 otherwise)."""
+        if self.formulation != "geometric":
+            return 0.0
+        col = self.column
+        return float(col.moment_capacity[i] / col.rotation_capacity[i])
+
+    @cached_property
+    def edge_weight_shares(self) -> np.ndarray:
+        """(n, max edges) w_q, padded with 1: under gam = (g + a_v) / g the kink q between
+        pieces q and q+1 (where their lines cross) moves to x_q(gam) = E_q gam / (1 + w_q (gam
+        - 1)), E_q its position at gam = 1 [rad]: w = dbs / (dbs + dbe), the weight share of
+        the two lines' slope difference. 1: a kink between two weight lines, fixed (the cap's
+        end theta_u (1 - xi)); 0: elastic against the cap, x = gam xi M_u / K_M; between:
+        elastic against the descending branch."""
+        weight, elastic = self.slope_parts
+        width = max(1, max(len(law.edges) for law in self.laws))
+        shares = np.ones((self.n, width))
+        for i, law in enumerate(self.laws):
+            for q in range(len(law.edges)):
+                dbs = weight[i, q + 1] - weight[i, q]
+                dbe = elastic[i, q + 1] - elastic[i, q]
+                if dbe != 0.0:
+                    shares[i, q] = dbs / (dbs + dbe)
+        return shares
+
+    def shape_range(self) -> tuple[float, float]:
+        """(lowest, highest) gam = (g + a_v) / g [-] over which every law keeps the order of
+        its pieces (the lower envelope of K_M x, xi gam M_u, gam M_u (1 - x / theta_u)): with
+        xi < 1 and a finite K_M the cap xi gam M_u is on the envelope while the elastic end
+        xi gam M_u / K_M is below the cap's end theta_u (1 - xi), i.e. for gam below
+        gam_c = K_M theta_u (1 - xi) / (xi M_u). The integrators keep the pieces of gam = 1:
+        gam must stay on the same side of every gam_c."""
+        lo, hi = 0.0, math.inf
+        col = self.column
+        for i, law in enumerate(self.laws):
+            if law.rigid or self.xi >= 1.0:
+                continue
+            gam_c = (float(col.stiffness[i]) * float(col.rotation_capacity[i]) * (1.0 - self.xi)
+                     / (self.xi * float(col.moment_capacity[i])))  # fmt: skip
+            if len(law.edges) >= 2:  # elastic, cap, descending: the cap while gam < gam_c
+                hi = min(hi, gam_c)
+            else:  # elastic then descending: no cap while gam >= gam_c
+                lo = max(lo, gam_c)
+        return lo, hi
+
+    def vertical_system(self, intercepts: np.ndarray, weight: np.ndarray, elastic: np.ndarray):
+        """(Aw, Ae, c, e) of theta'' = gam (Aw theta + c) + Ae theta + e a_g for active pieces
+        f_i = gam (intercepts_i + weight_i x) + elastic_i x (gam = (g + a_v) / g): the weight
+        part (gravity of `geometric` included) scales with gam, the joint stiffness does not."""
+        minv = self.mass_inv
+        aw = -product(minv, product(self.diff.T, weight[:, None] * self.arg_map) - self.gravity)
+        ae = -product(minv, product(self.diff.T, elastic[:, None] * self.arg_map))
+        c = product(self.diff.T, intercepts)
+        return aw, ae, -product(minv, c), -product(minv, self.ground_load)
+
     def shear_ratios(self, accel: np.ndarray, ground_accel: np.ndarray) -> np.ndarray:
         """|T_i / N_i| (k, n) from drum angular accelerations (k, n) and a_g (k,).
 
@@ -253,4 +330,5 @@ def build_model(
         collapse_ratio=float(collapse_ratio),
         restitution=float(restitution),
         formulation=formulation,
+        xi=float(xi),
     )

@@ -1,7 +1,8 @@
 """Event search and law bookkeeping for the compiled kernel (numba): the
 transcriptions of rbm_cli.models.events (earliest crossing on the dense output,
-cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces), plus time-history
-sampling (the exact uplift time of a rigid block at rest is in kernel_ground)."""
+cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces); the moving kinks of
+a vertical record are kernel_vertical's (the exact uplift time of a rigid block at rest is
+in kernel_ground, time-history sampling in kernel_rk)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,8 @@ import numpy as np
 from numba import njit
 
 from rbm_cli.base.detmath import dot, matvec
-from rbm_cli.models.rbm.kernel_rk import TAB_NP, _dense_eval
+from rbm_cli.models.rbm.kernel_rk import TAB_NP
+from rbm_cli.models.rbm.kernel_vertical import add_moving, moving_rate, moving_value
 
 
 @njit(cache=True)
@@ -64,13 +66,24 @@ def _poly_val(mc, t, t_old, h, coef, base):
 XTOL, RTOL, MAXITER = 1e-14, 8.881784197001252e-16, 100
 
 
+@njit(cache=True, inline="always")
+def _row_val(mc, t, t_old, h, coef, base, mv):
+    """A projected row at t, plus its moving part mv = (e, w, ground tuple) if e != 0
+    (kernel_vertical: a kink moving with g + a_v(t))."""
+    v = _poly_val(mc, t, t_old, h, coef, base)
+    if mv[0] != 0.0:
+        v += moving_value(t, mv[2], mv[0], mv[1])
+    return v
+
+
 @njit(cache=True)
-def _brentq(mc, xa, xb, t_old, h, coef, base):
-    """scipy's brentq (zeros.c) along a projected row of the step's interpolant."""
+def _brentq(mc, xa, xb, t_old, h, coef, base, mv):
+    """scipy's brentq (zeros.c) along a projected row of the step's interpolant (plus its
+    moving part, _row_val)."""
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
-    fpre = _poly_val(mc, xpre, t_old, h, coef, base)
-    fcur = _poly_val(mc, xcur, t_old, h, coef, base)
+    fpre = _row_val(mc, xpre, t_old, h, coef, base, mv)
+    fcur = _row_val(mc, xcur, t_old, h, coef, base, mv)
     if fpre == 0.0:
         return xpre
     if fcur == 0.0:
@@ -104,7 +117,7 @@ def _brentq(mc, xa, xb, t_old, h, coef, base):
             xcur += scur
         else:
             xcur += delta if sbis > 0 else -delta
-        fcur = _poly_val(mc, xcur, t_old, h, coef, base)
+        fcur = _row_val(mc, xcur, t_old, h, coef, base, mv)
     return xcur
 
 
@@ -154,6 +167,14 @@ def _lowest_dip(d0, d1, r0, r1, dt):
     return t_best, row
 
 
+@njit(cache=True, inline="always")
+def _mv(r, gr, mv_e, mv_w):
+    """The moving part of row r as _row_val takes it ((0, 1, gr) for a fixed row)."""
+    if r < mv_e.size:
+        return (mv_e[r], mv_w[r], gr)
+    return (0.0, 1.0, gr)
+
+
 #: Sub-intervals of a step checked on the dense output (events.CHECK_INTERVALS).
 CHECK_INTERVALS = 8
 
@@ -173,11 +194,12 @@ def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
 
 @njit(cache=True)
 def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
-                    CP, BP, CR, BR):  # fmt: skip
+                    CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
     (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
     The masked rows' interpolants are projected once (CP, BP: distances; CR, BR:
-    rates) and evaluated as scalars."""
+    rates) and evaluated as scalars; rows r < mv_e.size with mv_e[r] != 0 add their
+    moving part (kernel_vertical) on the step's ground piece gr."""
     nseg = CHECK_INTERVALS
     h = t1 - t0
     nrow = event_rows.shape[0]
@@ -193,6 +215,9 @@ def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1,
                 continue
             D[r, q] = _poly_val(mc, tq, t0, h, CP[r], BP[r])
             R[r, q] = _poly_val(mc, tq, t0, h, CR[r], BR[r])
+            if r < mv_e.size and mv_e[r] != 0.0:
+                D[r, q] += moving_value(tq, gr, mv_e[r], mv_w[r])
+                R[r, q] += moving_rate(tq, gr, mv_e[r], mv_w[r])
     best, brow = np.inf, -1
     for r in range(nrow):
         if D[r, 0] < best:
@@ -218,13 +243,14 @@ def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1,
             rcol0[r], rcol1[r] = R[r, q], R[r, q + 1]
         for r in range(nrow):
             if D[r, q + 1] < 0.0:
-                tr = _brentq(mc, a, b, t0, h, CP[r], BP[r])
+                tr = _brentq(mc, a, b, t0, h, CP[r], BP[r], _mv(r, gr, mv_e, mv_w))
                 if tr < t_first:
                     t_first, r_first = tr, r
         s_dip, r_dip = _lowest_dip(dcol0, dcol1, rcol0, rcol1, b - a)
         if r_dip >= 0:
-            if _poly_val(mc, a + s_dip, t0, h, CP[r_dip], BP[r_dip]) < 0.0:
-                tr = _brentq(mc, a, a + s_dip, t0, h, CP[r_dip], BP[r_dip])
+            mv = _mv(r_dip, gr, mv_e, mv_w)
+            if _row_val(mc, a + s_dip, t0, h, CP[r_dip], BP[r_dip], mv) < 0.0:
+                tr = _brentq(mc, a, a + s_dip, t0, h, CP[r_dip], BP[r_dip], mv)
                 if tr < t_first:
                     t_first, r_first = tr, r_dip
         if r_first >= 0:
@@ -255,18 +281,23 @@ def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
 
 
 @njit(cache=True)
-def _system(side, k, intercepts, slopes, md, mg, argmap, As, cs):
-    """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place:
-    A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :], c = -(M^-1 D^T) a,
-    with md = M^-1 D^T and mg = M^-1 K_g assembled once (Model.linear_system)."""
+def _system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
+    """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place into
+    As[:, :n] and cs: A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :],
+    c = -(M^-1 D^T) a, with md = M^-1 D^T and mg = M^-1 K_g assembled once
+    (Model.linear_system). With a vertical record (vert), b is the slopes' weight part
+    parts[0] and As[:, n:] gets the elastic part parts[1] (Model.vertical_system):
+    theta'' = gam (As[:, :n] theta + c) + As[:, n:] theta + e a_g."""
     n = side.size
     for p in range(n):
         cs[p] = 0.0
         for q in range(n):
             As[p, q] = mg[p, q]
+            As[p, n + q] = 0.0
     for i in range(n):
         a = side[i] * intercepts[i, k[i]]
-        b = slopes[i, k[i]]
+        b = parts[0, i, k[i]] if vert else slopes[i, k[i]]
+        be = parts[1, i, k[i]] if vert else 0.0
         for p in range(n):
             w = md[p, i]
             if w == 0.0:
@@ -275,6 +306,8 @@ def _system(side, k, intercepts, slopes, md, mg, argmap, As, cs):
             for q in range(n):
                 if argmap[i, q] != 0.0:
                     As[p, q] -= w * b * argmap[i, q]
+                    if be != 0.0:
+                        As[p, n + q] -= w * be * argmap[i, q]
 
 
 @njit(cache=True)
@@ -297,6 +330,19 @@ def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
             out[2 * n + i], out[3 * n + i] = h0[2 * n + i] - c, c + h0[3 * n + i]
         else:
             out[i], out[n + i], out[2 * n + i], out[3 * n + i] = a, -a, -c, c
+
+
+@njit(cache=True)
+def _surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
+    """The event distances d, rates dd and second derivatives d2 at the state y (time t [s])
+    with accelerations acc; with a vertical record (mv_e not empty) the moving kinks'
+    parts added (kernel_vertical)."""
+    n = gx.shape[0]
+    _event_rows(gx, gc, same, y, 0, h0, True, d)
+    _event_rows(gx, gc, same, y, n, h0, False, dd)
+    _event_rows(gx, gc, same, acc, 0, h0, False, d2)
+    if mv_e.size > 0:
+        add_moving(t, gr, mv_e, mv_w, d, dd, d2)
 
 
 @njit(cache=True)
@@ -335,23 +381,3 @@ def _friction(g_new, gam, centre_map, acc, masses, normal_forces, friction):
         fr = abs(shear) / (normal_forces[i] * gam)
         if fr > friction[i]:
             friction[i] = fr
-
-
-@njit(cache=True)
-def _emit_rest(t_stop, samples, n_out, next_out, dt):
-    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
-        samples[n_out, 0] = next_out
-        samples[n_out, 1:] = 0.0
-        n_out += 1
-        next_out += dt
-    return n_out, next_out
-
-
-@njit(cache=True)
-def _emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
-    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
-        samples[n_out, 0] = next_out
-        _dense_eval(mc, next_out, t_old, h, y_old, F, samples[n_out, 1:])
-        n_out += 1
-        next_out += dt
-    return n_out, next_out

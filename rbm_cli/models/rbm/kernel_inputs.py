@@ -73,6 +73,8 @@ class ModelArrays(NamedTuple):
     mg: np.ndarray  #: minv @ gravity (n, n)
     track: np.ndarray  #: tracked ratios: the n collapse rows, then the top (n + 1, n)
     es: np.ndarray  #: -minv @ ground_load (n,)
+    slope_parts: np.ndarray  #: weight and elastic parts of the slopes (2, n, max edges + 1)
+    edge_w: np.ndarray  #: weight share of each kink, 1: fixed (n, max edges), padded with 1
 
 
 class Excitation(NamedTuple):
@@ -211,6 +213,7 @@ def model_arrays(model: Model) -> ModelArrays:
         rest_rate=float(rest_rate), barrier=float(barrier), event_rows=event_rows,
         gx=event_rows[:n], gc=event_rows[3 * n :],
         same=bool(same), md=md, mg=mg, track=track, es=es,
+        slope_parts=np.stack(model.slope_parts), edge_w=model.edge_weight_shares,
     )  # fmt: skip
 
 

@@ -79,27 +79,35 @@ def _rhs(t, y, n, As, cs, es, gr, out):
                 s += As[i, j] * y[j]
             out[n + i] = s
         return
-    # a vertical record: every weight (the law and gravity, As and cs) times (g + a_v) / g
+    # a vertical record: every weight (the law's weight part and gravity, As[:, :n] and cs)
+    # times (g + a_v) / g; the joints' stiffness (As[:, n:], kernel_events._system) not
     gam = _gravity(t, gr)
     for i in range(n):
         out[i] = y[n + i]
         s = cs[i]
+        el = 0.0
         for j in range(n):
             s += As[i, j] * y[j]
-        out[n + i] = gam * s + es[i] * g
+            el += As[i, n + j] * y[j]
+        out[n + i] = gam * s + el + es[i] * g
 
 
 @njit(cache=True, inline="always")
 def _acc_of(t, y, n, As, cs, es, gr, acc):
     """Angular accelerations theta'' at (t, y) into acc [rad/s^2]; returns a_g(t) [m/s^2]
-    and (g + a_v(t)) / g [-]. (gam * x + e g is x + e g to the bit when gam = 1.)"""
+    and (g + a_v(t)) / g [-]. (gam * x + e g is x + e g to the bit when gam = 1; the
+    elastic part As[:, n:] is read with a vertical record only, as _rhs reads it.)"""
     g = _ground(t, gr)
     gam = _gravity(t, gr)
+    vert = gr[6] != 0.0
     for i in range(n):
         d = cs[i]
+        el = 0.0
         for j in range(n):
             d += As[i, j] * y[j]
-        acc[i] = gam * d + es[i] * g
+            if vert:
+                el += As[i, n + j] * y[j]
+        acc[i] = (gam * d + el + es[i] * g) if vert else (gam * d + es[i] * g)
     return g, gam
 
 
@@ -248,3 +256,23 @@ def _dense_eval(mc, t, t_old, h, y_old, F, out):
             p *= x
             v += F[r, i] * p
         out[i] = y_old[i] + v
+
+
+@njit(cache=True)
+def _emit_rest(t_stop, samples, n_out, next_out, dt):
+    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
+        samples[n_out, 0] = next_out
+        samples[n_out, 1:] = 0.0
+        n_out += 1
+        next_out += dt
+    return n_out, next_out
+
+
+@njit(cache=True)
+def _emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
+    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
+        samples[n_out, 0] = next_out
+        _dense_eval(mc, next_out, t_old, h, y_old, F, samples[n_out, 1:])
+        n_out += 1
+        next_out += dt
+    return n_out, next_out

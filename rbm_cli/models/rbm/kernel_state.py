@@ -77,3 +77,22 @@ def switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
             y[j] = 0.0
         return REST
     return IMPACT
+
+
+@njit(cache=True, inline="always")
+def _settle(awaiting, argmap, y, side):
+    """events.Pieces.settle in the kernel: the silent impacts (interfaces back on their
+    first piece whose argument changed sign) counted and their sides flipped; returns how
+    many."""
+    n = side.size
+    hits = 0
+    for i in range(n):
+        if awaiting[i]:
+            x_i = 0.0
+            for j in range(n):
+                x_i += argmap[i, j] * y[j]
+            if side[i] * x_i < 0.0:
+                side[i] = -side[i]
+                awaiting[i] = False
+                hits += 1
+    return hits

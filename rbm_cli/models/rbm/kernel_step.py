@@ -15,15 +15,13 @@ from rbm_cli.models.rbm.kernel_events import (
     _affine,
     _bounds,
     _brentq,
-    _emit,
-    _emit_rest,
     _energy1,
-    _event_rows,
     _first_crossing,
     _friction,
     _n_below,
     _poly_val,
     _row_poly,
+    _surfaces,
     _system,
     _within_reach,
 )
@@ -49,12 +47,15 @@ from rbm_cli.models.rbm.kernel_rk import (
     _acc_of,
     _dense_eval,
     _dense_prepare,
+    _emit,
+    _emit_rest,
     _error_norm,
     _initial_step,
     _rhs,
     _rk_attempt,
 )
-from rbm_cli.models.rbm.kernel_state import IMPACT, REST, UPLIFT, switch
+from rbm_cli.models.rbm.kernel_state import IMPACT, REST, UPLIFT, _settle, switch
+from rbm_cli.models.rbm.kernel_vertical import bound_now, moving_rows
 
 
 @njit(cache=True)
@@ -82,6 +83,7 @@ def run_kernel(model, motion, solver, task):
     solver, task = SolverSettings(*solver), RunTask(*task)
     mass, argmap, gravity = model.mass, model.argmap, model.gravity
     edges, nedges, intercepts, slopes = model.edges, model.nedges, model.intercepts, model.slopes
+    parts, edge_w = model.slope_parts, model.edge_w
     rigid, silent, tu, c_ratio = model.rigid, model.silent, model.tu, model.c_ratio
     centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
     uplift_level, barrier = model.uplift_level, model.barrier
@@ -121,7 +123,9 @@ def run_kernel(model, motion, solver, task):
     event_rows, gx, gc, same = model.event_rows, model.gx, model.gc, model.same
     md, mg, track, es = model.md, model.mg, model.track, model.es
     peaks = np.zeros(nt)
-    As, cs = np.empty((n, n)), np.empty(n)
+    As, cs = np.empty((n, 2 * n)), np.empty(n)  # As[:, n:]: the joints' (kernel_events._system)
+    vert = vertical.size > 0  # a vertical record: kinks that move with it (kernel_vertical)
+    mv_e, mv_w = np.zeros(2 * n if vert else 0), np.ones(2 * n if vert else 0)
     h0 = np.empty(4 * n)
     K = np.empty((_NS_MAX, m))
     F = np.empty((8, m))
@@ -203,13 +207,15 @@ def run_kernel(model, motion, solver, task):
                 n_upl += 1
                 h_carry = -1.0
 
-            _system(side, k, intercepts, slopes, md, mg, argmap, As, cs)
+            _system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs)
             for i in range(n):
                 _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi)
                 h0[i] = min(-lo[i] / tu[i], BIG) + EVENT_EPS
                 h0[n + i] = min(hi[i] / tu[i], BIG) + EVENT_EPS
                 h0[2 * n + i] = c_ratio + EVENT_EPS
                 h0[3 * n + i] = c_ratio + EVENT_EPS
+            if vert:
+                moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv_w)
 
             # a new stepper from (t, y)
             t_bound = seg_end
@@ -225,10 +231,8 @@ def run_kernel(model, motion, solver, task):
                 n_rhs += 2
             _affine(track, y, 0, no_offset, z_old)
             _affine(track, y, n, no_offset, dz_old)
-            _event_rows(gx, gc, same, y, 0, h0, True, d_old)
-            _event_rows(gx, gc, same, y, n, h0, False, dd_old)
             _acc_of(t, y, n, As, cs, es, gr, acc)
-            _event_rows(gx, gc, same, acc, 0, h0, False, d2_old)
+            _surfaces(gx, gc, same, y, acc, h0, d_old, dd_old, d2_old, t, gr, mv_e, mv_w)
             event = False
             running = True
             while running:
@@ -282,11 +286,10 @@ def run_kernel(model, motion, solver, task):
                 t_old = t
                 y_old = y
                 y_new[:] = ynew
-                _event_rows(gx, gc, same, y_new, 0, h0, True, d_new)
-                _event_rows(gx, gc, same, y_new, n, h0, False, dd_new)
                 dense_ready = False
                 g_new, gam_new = _acc_of(t_new, y_new, n, As, cs, es, gr, acc)
-                _event_rows(gx, gc, same, acc, 0, h0, False, d2_new)
+                _surfaces(gx, gc, same, y_new, acc, h0, d_new, dd_new, d2_new, t_new, gr, mv_e,
+                          mv_w)  # fmt: skip
                 event_row = -1
                 t_e = t_new
                 if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
@@ -295,7 +298,7 @@ def run_kernel(model, motion, solver, task):
                     dense_ready = True
                     t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, event_rows, h0,
                                                      n, Dq, Rq, dc0, dc1, rc0, rc1, near, CP,
-                                                     BP, CR, BR)  # fmt: skip
+                                                     BP, CR, BR, gr, mv_e, mv_w)  # fmt: skip
                 if event_row >= 0:
                     _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e
@@ -312,15 +315,7 @@ def run_kernel(model, motion, solver, task):
                     n_out, next_out = _emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
                                             next_out, output_dt)  # fmt: skip
                 if any_silent:
-                    for i in range(n):
-                        if awaiting[i]:
-                            x_i = 0.0
-                            for j in range(n):
-                                x_i += argmap[i, j] * y_new[j]
-                            if side[i] * x_i < 0.0:
-                                side[i] = -side[i]
-                                awaiting[i] = False
-                                n_imp += 1
+                    n_imp += _settle(awaiting, argmap, y_new, side)
                 # peaks and friction demand over [t_old, t_new]
                 _affine(track, y_new, 0, no_offset, z_new)
                 _affine(track, y_new, n, no_offset, dz_new)
@@ -338,7 +333,7 @@ def run_kernel(model, motion, solver, task):
                                                     As, cs, es, gr)  # fmt: skip
                             dense_ready = True
                         base = _row_poly(mc, F, y_old, track, r, zero_t, n, True, coef)
-                        t_pk = _brentq(mc, t_old, t_new, t_old, h, coef, base)
+                        t_pk = _brentq(mc, t_old, t_new, t_old, h, coef, base, (0.0, 1.0, gr))
                         base = _row_poly(mc, F, y_old, track, r, zero_t, n, False, coef)
                         v = max(v, abs(_poly_val(mc, t_pk, t_old, h, coef, base)))
                     if v > peaks[r]:
@@ -383,7 +378,8 @@ def run_kernel(model, motion, solver, task):
                 return (COLLAPSED, t, t_col, c_if, max_ratio, max_top, friction,
                         n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
             going_up = which == 1
-            bound = hi[i] if going_up else lo[i]
+            bound = bound_now(i, going_up, n, lo, hi, tu, t, gr, mv_e, mv_w) if vert else (
+                hi[i] if going_up else lo[i])  # fmt: skip
             what = switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
             if what == UPLIFT:
                 n_upl += 1

@@ -45,6 +45,7 @@ from rbm_cli.models.rbm.python_steps import (
     leave_rest,
     step_to_event,
 )
+from rbm_cli.models.rbm.python_vertical import VerticalPiece
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -135,7 +136,10 @@ def _run_segment(
                 return run.out
             if kind == "segment":
                 return None
-        piece = SmoothPiece(run, ag, gam)
+        if gam is None:
+            piece = SmoothPiece(run, ag)
+        else:
+            piece = VerticalPiece(run, ag, gam, motion.vertical)
         integ = _start_stepper(run, piece, seg_end)
         event = step_to_event(run, piece, integ, can_stop)
         if isinstance(event, Outcome):

@@ -164,8 +164,7 @@ class RunState:
 class SmoothPiece:
     """The linear system of the current law pieces, theta'' = A theta + c + e a_g(t), and
     the distances to its event surfaces, linear in theta: d = G theta + h0 (>= 0 inside).
-    With a vertical record (gam(t) = (g + a_v(t)) / g, rigid laws only, whose A and c are
-    all weight): theta'' = gam(t) (A theta + c) + e a_g(t)."""
+    With a vertical record, python_vertical.VerticalPiece."""
 
     def __init__(self, run: RunState, ag, gam=None):
         self.n = run.n
@@ -192,14 +191,21 @@ class SmoothPiece:
     def acc(self, tt, yy) -> np.ndarray:
         """Angular accelerations theta'' at (tt [s], yy) [rad/s^2]."""
         n = self.n
-        if self.gam is None:
-            return self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)
-        return self.gam(tt) * (self.A @ yy[:n] + self.cvec) + self.evec * self.ag(tt)
+        return self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)
 
-    def distances(self, yy) -> tuple[np.ndarray, np.ndarray]:
-        """Event distances and their rates at the state yy."""
+    def distances(self, yy, t=None, t_piece=None) -> tuple[np.ndarray, np.ndarray]:
+        """Event distances and their rates at the state yy (at t [s]; the rate of gam(t) of
+        the ground piece a step from t_piece runs on: VerticalPiece's)."""
         n = self.n
         return self.g_rows @ yy[:n] + self.h0, self.g_rows @ yy[n:]
+
+    def curvature(self, acc, t=None, t_piece=None) -> np.ndarray:
+        """Second time derivatives of the event distances for accelerations acc [rad/s^2]."""
+        return self.g_rows @ acc
+
+    def bound(self, i: int, going_up: bool, t: float) -> float:
+        """The bound [rad] interface i's argument reached at its event at t [s]."""
+        return float(self.hi[i] if going_up else self.lo[i])
 
     def dist(self, dense, ts):
         """Event distances and rates on the dense output at the times ts, (rows, m)."""
@@ -241,9 +247,9 @@ def end_of_step(run: RunState, piece: SmoothPiece, integ, surfaces: tuple) -> St
     row), when the step comes within reach of one. surfaces: (d, d', d'') at its start."""
     t_old = integ.t_old
     t_new, y_new = integ.t, integ.y
-    d_new, dd_new = piece.distances(y_new)
+    d_new, dd_new = piece.distances(y_new, t_new, t_old)
     acc = piece.acc(t_new, y_new)
-    d2_new = run.g_rows @ acc
+    d2_new = piece.curvature(acc, t_new, t_old)
     hit = None
     dense = None
     d_old, dd_old, d2_old = surfaces
@@ -295,8 +301,8 @@ def step_to_event(run: RunState, piece: SmoothPiece, integ, can_stop: bool):
     y = run.y
     z_old = track @ y[:n]
     dz_old = track @ y[n:]
-    d_old, dd_old = piece.distances(y)
-    surfaces = (d_old, dd_old, run.g_rows @ piece.acc(run.t, y))
+    d_old, dd_old = piece.distances(y, run.t)
+    surfaces = (d_old, dd_old, piece.curvature(piece.acc(run.t, y), run.t))
     while integ.status == "running":
         stop = take_step(run, integ)
         if stop is not None:
@@ -347,7 +353,7 @@ def handle_event(run: RunState, piece: SmoothPiece, event_row: int) -> Outcome |
     # put the argument exactly on the surface it crossed (the event is
     # located EVENT_EPS beyond it); removes the energy that repeated
     # overshoots would pump into chattering impacts
-    bound = piece.hi[i] if going_up else piece.lo[i]
+    bound = piece.bound(i, going_up, t)
     x_i = float(run.argmap[i] @ run.y[:n])
     y = run.y.copy()
     y[:n] += run.arg_inv[:, i] * (bound - x_i)

@@ -10,7 +10,7 @@ from functools import partial
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import Config, SolverConfig
+from rbm_cli.config.types import Config, G, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.result import history_from_samples
@@ -21,6 +21,35 @@ from rbm_cli.physics.restitution import column_restitution, resolve
 
 #: What a numerical failure of the integrator raises; the run ends `failed`, with the reason.
 NUMERICAL_FAILURES = (FloatingPointError, np.linalg.LinAlgError, ValueError, ZeroDivisionError)
+
+
+#: Why a run stops where g + a_v(t) changes the order of a law's pieces (shape_change).
+SHAPE_CHANGE = (
+    "g + a_v(t) changes the order of a joint law's pieces (the elastic end xi gam M_u / K_M"
+    " passes the cap's end theta_u (1 - xi)), which this version does not integrate"
+    " (excitation.vertical)"
+)
+
+
+def shape_change(model: Model, motion: GroundMotion) -> float | None:
+    """First time [s] gam = (g + a_v(t)) / g leaves Model.shape_range() (the pieces of
+    every law keep their order inside it), or None. a_v is linear between the knots."""
+    if motion.vertical is None:
+        return None
+    lo, hi = model.shape_range()
+    if lo <= 0.0 and hi == math.inf:
+        return None
+    gam = 1.0 + np.asarray(motion.vertical) / G
+    bad = (gam < lo) | (gam > hi)
+    if not bad.any():
+        return None
+    k = int(np.argmax(bad))
+    knots = motion.knots
+    if k == 0 or knots[k] == knots[k - 1]:
+        return float(knots[k])
+    limit = lo if gam[k] < lo else hi
+    frac = (limit - gam[k - 1]) / (gam[k] - gam[k - 1])
+    return float(knots[k - 1] + (knots[k] - knots[k - 1]) * frac)
 
 
 def model_from_config(config: Config, column: Column | None = None) -> Model:
@@ -146,8 +175,12 @@ class RbmRunner:
             )
         n = self.model.n
         t_lift = motion.lift_off  # a vertical record dropping faster than gravity
-        if t_lift is not None:
-            motion = motion.until(t_lift)
+        t_shape = shape_change(self.model, motion)  # or changing the order of a law's pieces
+        if t_shape is not None and t_lift is not None:  # the earlier one ends the run
+            t_lift, t_shape = (None, t_shape) if t_shape < t_lift else (t_lift, None)
+        t_stop = t_lift if t_lift is not None else t_shape
+        if t_stop is not None:
+            motion = motion.until(t_stop)
         try:
             out = integrator(
                 self.model,
@@ -160,6 +193,8 @@ class RbmRunner:
                 early_stop=early_stop,
             )
             out.lifted_off(t_lift)
+            if t_shape is not None and out.status == "survived":
+                out.stop("failed", SHAPE_CHANGE, t_shape)
         except NUMERICAL_FAILURES as exc:
             out = Outcome(status="failed", message=f"numerical failure: {exc}")
             out.max_ratio = np.full(n, np.nan)

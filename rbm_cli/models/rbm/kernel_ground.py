@@ -93,7 +93,8 @@ def _record_piece(t, knots, values, vertical, gain, seg_end):
     """The straight piece of a record a step from t [s] runs on, as a ground tuple, and
     the time that step ends at: the first sample past t + the smallest step (10 ulp of
     t, as python.Stepper takes it), or seg_end if sooner. Before the first sample and
-    after the last the ground rests (gain 0). vertical: a_v at the knots (or empty)."""
+    after the last the ground rests (gain 0). vertical: a_v at the knots (or empty; if not,
+    the tuple says so even where a_v = 0, since the laws are then split, _rhs)."""
     min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
     j = _first_after(knots, t + min_step)
     n = knots.size
@@ -104,8 +105,8 @@ def _record_piece(t, knots, values, vertical, gain, seg_end):
             vf, va, vd = 1.0, vertical[j - 1], vertical[j] - vertical[j - 1]
         gr = (LINE, gain, values[j] - values[j - 1], values[j - 1], knots[j - 1],
               knots[j] - knots[j - 1], vf, va, vd)  # fmt: skip
-    else:
-        gr = (LINE, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+    else:  # with a vertical record, a_v = 0 still read as one (its split laws: kernel_vertical)
+        gr = (LINE, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0 if vertical.size > 0 else 0.0, 0.0, 0.0)
     return gr, bound
 
 

@@ -88,8 +88,10 @@ class VerticalPiece(SmoothPiece):
 
     def acc(self, tt, yy) -> np.ndarray:
         n = self.n
-        out = self.gam(tt) * (self.A @ yy[:n] + self.cvec) + self.evec * self.ag(tt)
-        return out if self.Ae is None else out + self.Ae @ yy[:n]
+        weight = self.gam(tt) * (self.A @ yy[:n] + self.cvec)
+        if self.Ae is None:
+            return weight + self.evec * self.ag(tt)
+        return weight + self.Ae @ yy[:n] + self.evec * self.ag(tt)  # the kernel's order
 
     def _parts(self, t: float, t_piece: float | None = None):
         """The moving rows' parts at t [s]: value, rate, second derivative (2n each); the

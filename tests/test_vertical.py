@@ -147,7 +147,6 @@ def test_segments_restart_at_the_jumps(tmp_path):
     "data, needle",
     [
         ({"model": "rbm", "interface": {"stiffness": {"normal": 5e9}}}, "needs a rigid block"),
-        ({"model": "bullet"}, "needs a rigid block"),
         ({"excitation": {"type": "harmonic", "vertical": "v.csv"}}, "applies only to type record"),
         ({"excitation": {"type": "record", "file": "h.csv", "vertical": "nope.csv"}},
          "excitation.vertical: "),

@@ -295,12 +295,12 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
 def check_vertical(excitation: ExcitationConfig, model: str, stiffness_kind: str) -> None:
     """excitation.vertical is integrated by rigid blocks only: the rigid RBM (whose joint
     law scales with the weight as a whole) and housner / housner-linear. With a finite
-    joint stiffness the kinks of the law move with g + a_v(t) (not implemented), and the
-    contact engine does not take it."""
+    joint stiffness the kinks of the law move with g + a_v(t) (not implemented). The
+    contact engine (bullet) takes it as its gravity, -(g + a_v(t)), in the ground's frame."""
     if excitation.vertical is None:
         return
-    if model == "bullet" or (model == "rbm" and stiffness_kind != "rigid"):
-        what = "model bullet" if model == "bullet" else f"interface.stiffness {stiffness_kind}"
+    if model == "rbm" and stiffness_kind != "rigid":
+        what = f"interface.stiffness {stiffness_kind}"
         raise ConfigError(
             f"excitation.vertical needs a rigid block (model rbm with interface.stiffness:"
             f" rigid, or housner, housner-linear), not {what}: with a finite joint"

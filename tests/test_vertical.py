@@ -146,7 +146,6 @@ def test_segments_restart_at_the_jumps(tmp_path):
 @pytest.mark.parametrize(
     "data, needle",
     [
-        ({"model": "bullet"}, "not model bullet"),
         ({"excitation": {"type": "harmonic", "vertical": "v.csv"}}, "applies only to type record"),
         ({"excitation": {"type": "record", "file": "h.csv", "vertical": "nope.csv"}},
          "excitation.vertical: "),

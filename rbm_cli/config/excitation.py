@@ -16,8 +16,7 @@ Keys, by excitation type (a key of another type is refused, naming it):
   :data:`~rbm_cli.config.types.DEFAULT_FREE_TIME`, 5 s), ``scale`` (``pga``, default: the
   grid's amplitude [g] is the scaled record's PGA; ``factor``: a plain scale factor),
   ``vertical`` (a second file, same formats and units: the upward ground acceleration,
-  scaled by the same factor as the horizontal record; not for model bullet,
-  :func:`check_vertical`).
+  scaled by the same factor as the horizontal record; every model takes it).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
   sets ``ExcitationConfig.duration`` to that.
 
@@ -65,7 +64,6 @@ from rbm_cli.config.validate import one_line as _one_line
 
 __all__ = [
     "RecordFile",
-    "check_vertical",
     "excitation_section",
     "record_file",
     "resolve_record_path",
@@ -290,20 +288,6 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
         free_time=free_time,
         duration=_record_duration(end, free_time, "excitation.file"),
     )
-
-
-def check_vertical(excitation: ExcitationConfig, model: str, stiffness_kind: str) -> None:
-    """excitation.vertical is integrated by the RBM, rigid or with elastic joints (the
-    weight part of its laws scales with g + a_v(t), the joint stiffness does not, and the
-    kinks between them move: SPEC "Vertical shaking"), and by housner / housner-linear; the
-    contact engine does not take it. stiffness_kind: any (kept for the callers)."""
-    if excitation.vertical is None:
-        return
-    if model == "bullet":
-        raise ConfigError(
-            "excitation.vertical needs model rbm, housner or housner-linear, not model"
-            " bullet: the contact engine does not integrate g + a_v(t)"
-        )
 
 
 def _mp_fields(e: dict) -> dict:

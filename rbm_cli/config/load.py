@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
-from rbm_cli.config.excitation import check_vertical, excitation_section
+from rbm_cli.config.excitation import excitation_section
 from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, hoist_suite, parse_grid
 from rbm_cli.config.interface import interface_section
 from rbm_cli.config.points import expand
@@ -195,7 +195,6 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         raise ConfigError(f"model {model!r} needs a monolithic column (drums: 1), got {n} drums")
     interface = interface_section(top.get("interface"), n, model)
     excitation = excitation_section(top.get("excitation"), n, base_dir)
-    check_vertical(excitation, model, interface.stiffness.kind)
     return Config(
         name=name,
         column=column,

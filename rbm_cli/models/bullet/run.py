@@ -8,7 +8,10 @@ The engine is PyBullet (Bullet Physics), driven without a GUI.
 
 The scene is the ground's own frame. The ground motion enters exactly as the
 inertial force it produces there: the gravity vector is set to
-(-a_g(t), 0, -g) at every step, so there is no drift of the ground.
+(-a_g(t), 0, -(g + a_v(t))) at every step (a_v the upward ground acceleration of
+``excitation.vertical``, else 0), so there is no drift of the ground, horizontal
+or vertical. When g + a_v(t) reaches 0 the stack would leave the ground: the run
+ends there `failed` (GroundMotion.lift_off), as in the other models.
 
 Engine settings (fixed, see :class:`EngineSettings`): time step 1e-4 s (the
 config's ``solver.time_step``), 100 solver iterations, restitution 0 with a
@@ -35,6 +38,7 @@ References
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -79,10 +83,12 @@ __all__ = [
     "PhysicsClient",
     "bullet_run",
     "engine_uplift_g",
+    "ground_friction_demand",
     "impact_rate_ratios",
     "measure_restitution",
     "settings_from_config",
     "uplift_level",
+    "upward_accel",
 ]
 
 
@@ -100,6 +106,27 @@ def engine_uplift_g(config: Config) -> float:
     return uplift_level(drum_solids(config.column), config.interface.friction) / G
 
 
+def upward_accel(motion: GroundMotion, t: np.ndarray) -> np.ndarray | None:
+    """The upward ground acceleration a_v(t) [m/s^2] at times t [s] (linear between the
+    knots, 0 outside them: GroundMotion.gravity's values times g, less g), or None
+    without excitation.vertical."""
+    if not motion.has_vertical:
+        return None
+    return np.interp(t, motion.knots, motion.vertical, left=0.0, right=0.0)
+
+
+def ground_friction_demand(motion: GroundMotion) -> float:
+    """max over t of |a_g(t)| / (g + a_v(t)) [-]: the friction a stack moving with the
+    ground needs (inf where g + a_v reaches 0). With a vertical record both are linear
+    between the same knots, so the ratio is monotone there and its maximum is at a knot."""
+    if not motion.has_vertical:
+        return motion.amplitude / G
+    weight = G + np.asarray(motion.vertical)
+    if np.any(weight <= 0.0):
+        return math.inf
+    return float(np.max(np.abs(motion.values) / weight))
+
+
 def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, observe):
     """Step the engine from t = 0 to the motion's end or a stop, checking the stack
     every CHECK_DT (and at every sample); fills `out`. Returns (samples, watch)."""
@@ -108,15 +135,18 @@ def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, o
     n_steps = int(round(motion.t_end / dt))
     check = max(1, int(round(CHECK_DT / dt)))
     set_gravity, step = p.setGravity, p.stepSimulation
-    # a_g at every mid-step, at once (the same numbers as one call per step)
-    accel_array = np.asarray(motion.accel((np.arange(n_steps) + 0.5) * dt), dtype=float)
+    # a_g and a_v at every mid-step, at once (the same numbers as one call per step)
+    mid = (np.arange(n_steps) + 0.5) * dt
+    accel_array = np.asarray(motion.accel(mid), dtype=float)
     accel = accel_array.tolist()
+    upward = upward_accel(motion, mid)
+    down = (-(G + upward)).tolist() if upward is not None else [-G] * n_steps
     frame = read_frame(p, cid, bodies)
-    watch = RunWatch(solids, alpha, limit, dt, accel_array, frame)
+    watch = RunWatch(solids, alpha, limit, dt, accel_array, frame, upward)
     samples = [_sample(0.0, frame, watch.joints(frame))] if sample else []
     k = 0
     while k < n_steps:
-        set_gravity(-accel[k], 0.0, -G, physicsClientId=cid)
+        set_gravity(-accel[k], 0.0, down[k], physicsClientId=cid)
         step(physicsClientId=cid)
         k += 1
         if observe is not None:
@@ -154,7 +184,7 @@ def bullet_run(
     config : Config  Column geometry, interface.friction, collapse.ratio,
         solver.time_step, excitation.initial (a rigid stack only: one rotation
         [rad] and rate [rad/s] shared by every drum)
-    motion : GroundMotion  a_g(t) [m/s^2], simulated time [s]
+    motion : GroundMotion  a_g(t) [m/s^2], a_v(t) [m/s^2] if any, simulated time [s]
     record : bool  Keep a history sampled every output_dt [s]
     early_stop : bool  After a half-sine pulse (or in free motion), stop once
         the stack has been at rest for REST_TIME
@@ -177,20 +207,25 @@ def bullet_run(
         largest mobilised friction |T| / N of the joint's mean force over each
         FRICTION_DT interval (:func:`rbm_cli.models.bullet.scene.joint_friction`; nan
         if never loaded);
-        the message gives the largest slips.
+        the message gives the largest slips. A vertical record reaching -g ends
+        the run there, 'failed' (unless it collapsed before).
     """
     solids = drum_solids(config.column)
     n = len(solids)
     settings = settings or settings_from_config(config)
     tilt, rate = _initial(config)
+    t_lift = motion.lift_off  # a vertical record dropping faster than gravity
+    if t_lift is not None:
+        motion = motion.until(t_lift)
     out = Outcome()
     out.max_ratio = np.zeros(n)
-    level = uplift_level(solids, settings.friction)
-    if not record and tilt == 0.0 and rate == 0.0 and motion.amplitude < level * (1 - 1e-9):
-        # the stack moves with the ground: every joint carries m_above a_g on m_above g
-        out.friction = np.full(n, motion.amplitude / G)
+    demand = ground_friction_demand(motion)
+    level = uplift_level(solids, settings.friction) / G
+    if not record and tilt == 0.0 and rate == 0.0 and demand < level * (1 - 1e-9):
+        # the stack moves with the ground: every joint carries m_above a_g on m_above (g + a_v)
+        out.friction = np.full(n, demand)
         out.message = "at rest: ground acceleration below the uplift and sliding levels"
-        return out.stop("survived", out.message, motion.t_end), None
+        return out.stop("survived", out.message, motion.t_end).lifted_off(t_lift), None
 
     dt = settings.time_step
     sample = max(1, int(round(output_dt / dt))) if record else 0
@@ -201,7 +236,7 @@ def bullet_run(
     samples, watch = _drive(
         client, bodies, solids, config.collapse.ratio, dt, motion, out, sample, early_stop, observe
     )
-    out.message += "; " + _slip_text(watch.max_slip)
+    out.lifted_off(t_lift).message += "; " + _slip_text(watch.max_slip)
     history = _history(samples, motion) if record else None
     return out, history
 

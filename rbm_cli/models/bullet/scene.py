@@ -292,6 +292,7 @@ def joint_friction(
     duration: float,
     mean_accel: float,
     tilt_range: tuple[np.ndarray, np.ndarray] | None = None,
+    mean_up: float = 0.0,
 ) -> np.ndarray:
     """Mobilised friction of every joint over an interval: the least |T| / N of the
     joint's mean force, from the momentum balance of the drums above it, over the
@@ -304,14 +305,16 @@ def joint_friction(
     mean_accel : float  Mean ground acceleration a_g over it, as the engine applied it [m/s^2]
     tilt_range : (lo, hi), optional  Range of each drum's tilt over the interval [rad]
         (every frame read); by default that of its two ends.
+    mean_up : float  Mean upward ground acceleration a_v over it, as the engine applied
+        it [m/s^2] (excitation.vertical; 0 without)
 
     Notes
     -----
     The drums i..n touch the rest only through joint i, so the joint's mean force
     over the interval is, exactly (Newton, in the ground's frame where gravity is
-    (-a_g, 0, -g)),
+    (-a_g, 0, -(g + a_v))),
 
-    .. math:: F_i = \\frac{\\Delta P_i}{\\Delta t} + M_i (\\bar a_g, 0, g),
+    .. math:: F_i = \\frac{\\Delta P_i}{\\Delta t} + M_i (\\bar a_g, 0, g + \\bar a_v),
 
     P_i the momentum of drums i..n, M_i their mass. At angle psi in the plane
     and a contact normal at angle phi, T / N = tan(psi - phi). Where an open
@@ -332,7 +335,8 @@ def joint_friction(
     n = len(stack.masses)
     momentum = stack.masses[:, None] * (after.velocities - before.velocities)
     above = np.cumsum(momentum[::-1], axis=0)[::-1]
-    force = above / duration + stack.mass_above[:, None] * np.array([mean_accel, 0.0, G])
+    inertial = np.array([mean_accel, 0.0, G + mean_up])
+    force = above / duration + stack.mass_above[:, None] * inertial
     if tilt_range is None:
         tilt_range = (np.minimum(before.tilts, after.tilts), np.maximum(before.tilts, after.tilts))
     lo, hi = joint_normal_range(*tilt_range)

@@ -50,9 +50,13 @@ class RunWatch:
     dt : float  Engine time step [s]
     accel : (n_steps,) array  a_g at every mid-step, as the engine applies it [m/s^2]
     frame : Frame  The stack at t = 0
+    upward : (n_steps,) array or None  a_v at every mid-step, as the engine applies it
+        [m/s^2] (excitation.vertical; None: 0)
     """
 
-    def __init__(self, solids, alpha, limit: float, dt: float, accel, frame: Frame) -> None:
+    def __init__(
+        self, solids, alpha, limit: float, dt: float, accel, frame: Frame, upward=None
+    ) -> None:
         n = len(solids)
         self.stack = StackGeometry.of(solids)
         self.alpha = alpha
@@ -66,6 +70,7 @@ class RunWatch:
         self.last_sign = np.zeros(n)
         self.prev_ratio, self.prev_t, self.quiet_since = 0.0, 0.0, None
         self.accel_sum = np.concatenate([[0.0], np.cumsum(accel)])  # for the mean over a window
+        self.up_sum = None if upward is None else np.concatenate([[0.0], np.cumsum(upward)])
         self.friction_steps = max(1, int(round(FRICTION_DT / dt)))
         self.k_prev = 0
         self.frame_prev = frame
@@ -112,6 +117,8 @@ class RunWatch:
         """Close the friction window at step k: the joints' mean-force demand over it."""
         k_prev = self.k_prev
         mean_accel = (self.accel_sum[k] - self.accel_sum[k_prev]) / (k - k_prev)
+        up_sum = self.up_sum
+        mean_up = 0.0 if up_sum is None else (up_sum[k] - up_sum[k_prev]) / (k - k_prev)
         demand = joint_friction(
             self.frame_prev,
             frame,
@@ -119,6 +126,7 @@ class RunWatch:
             (k - k_prev) * self.dt,
             mean_accel,
             (self.tilt_lo, self.tilt_hi),
+            mean_up,
         )
         out.friction = np.fmax(out.friction, demand)
         self.frame_prev, self.k_prev = frame, k

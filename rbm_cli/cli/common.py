@@ -9,6 +9,8 @@ options) end in one line ``Error: ...`` on stderr and exit status 2.
 
 from __future__ import annotations
 
+import dataclasses
+
 import click
 
 from rbm_cli import __version__
@@ -62,12 +64,47 @@ def load(config_path: str):
 
 
 def compile_notice(cfg) -> None:
-    """One line on stderr before a run that will compile the kernel (first use)."""
+    """One line on stderr before a sweep that will compile the kernel (first use), or wait
+    for the compile that an earlier ``rbm run`` started in the background."""
     if cfg.model == "rbm" and cfg.solver.implementation == "compiled":
+        from rbm_cli.models.rbm.compile_ahead import compiling_elsewhere
         from rbm_cli.models.rbm.kernel import needs_compile
 
-        if needs_compile():
+        if compiling_elsewhere():
+            click.echo(
+                "note: waiting for the integrator's compile, started by an earlier run"
+                " (first use only)",
+                err=True,
+            )
+        elif needs_compile():
             click.echo("note: compiling the integrator (first use only, about 20 s)", err=True)
+
+
+def first_use(cfg):
+    """The config one run is integrated with. On a first use (the compiled kernel not in
+    numba's cache) the kernel compiles in a background process and this run is integrated
+    by the Python loop, the same method and tolerances (the returned config says
+    ``solver.implementation: python``, so the run's summary does too); with
+    RBM_BACKGROUND_COMPILE=0, or when no background compile can start, the kernel
+    compiles here first, as a note says."""
+    if not (cfg.model == "rbm" and cfg.solver.implementation == "compiled"):
+        return cfg
+    from rbm_cli.models.rbm import compile_ahead
+    from rbm_cli.models.rbm.kernel import needs_compile
+
+    if not (compile_ahead.compiling_elsewhere() or needs_compile()):
+        return cfg
+    if compile_ahead.start():
+        click.echo(
+            "note: the compiled integrator is compiling in the background (first use only,"
+            " about 20 s); this run uses the Python integrator (the same method and"
+            " tolerances)",
+            err=True,
+        )
+        solver = dataclasses.replace(cfg.solver, implementation="python")
+        return dataclasses.replace(cfg, solver=solver)
+    click.echo("note: compiling the integrator (first use only, about 20 s)", err=True)
+    return cfg
 
 
 def one_line(exc: BaseException) -> str:

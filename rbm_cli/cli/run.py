@@ -15,7 +15,7 @@ from rbm_cli.cli.common import (
     Interrupted,
     UserError,
     cli,
-    compile_notice,
+    first_use,
     config_argument,
     load,
     one_line,
@@ -148,7 +148,7 @@ def run(
     try:
         check_writable_dir(Path(output) / cfg.name)
         column = build_column(cfg.column, cfg.interface)
-        compile_notice(cfg)
+        cfg = first_use(cfg)
         result = run_cell(cfg, amplitude_g, frequency_hz, output_dt=output_dt).result
         summary = run_summary(
             result,

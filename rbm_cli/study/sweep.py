@@ -363,14 +363,17 @@ def _finished_summary(folder: Path, n_cells: int) -> SweepSummary:
 
 def _warm_up(points: list[GridPoint], todo: list) -> float:
     """Compile (or load) the kernel once here, so the workers load it from numba's
-    cache; its time [s], which the sweep's wall time and ETA leave out."""
+    cache (after the background compile of an earlier `rbm run`, if one runs); its time
+    [s], which the sweep's wall time and ETA leave out."""
     compiled = any(
         p.config.model == "rbm" and p.config.solver.implementation == "compiled" for p in points
     )
     if not (todo and compiled):
         return 0.0
+    from rbm_cli.models.rbm.compile_ahead import wait
     from rbm_cli.models.rbm.kernel import warm_up
 
     start = time.perf_counter()
+    wait()  # a compile an earlier `rbm run` started in the background: not a second one
     warm_up()
     return time.perf_counter() - start

@@ -24,7 +24,6 @@ import math
 import numpy as np
 import pytest
 
-from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
 from rbm_cli.models.rbm.kernel import integrate_compiled
@@ -246,13 +245,3 @@ def test_a_vertical_that_reorders_the_law_fails_the_run(tmp_path, impl):
     assert out.status == "failed"
     assert out.t_end == pytest.approx(1.0, abs=1e-9)
     assert SHAPE_CHANGE in out.message and "\n" not in out.message
-
-
-def test_bullet_still_refuses_a_vertical_record(tmp_path):
-    write_csv(tmp_path / "h.csv", (np.array([0.0, 1.0]), np.array([0.1, 0.1]) * G))
-    write_csv(tmp_path / "v.csv", (np.array([0.0, 1.0]), np.array([0.1, 0.1]) * G))
-    exc = {"type": "record", "file": "h.csv", "vertical": "v.csv"}
-    data = {"name": "b", "model": "bullet", "column": _column(1), "excitation": exc}
-    with pytest.raises(ConfigError) as err:
-        parse_config(data, "c.yaml", tmp_path)
-    assert "not model bullet" in str(err.value) and "\n" not in str(err.value)

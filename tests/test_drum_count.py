@@ -34,7 +34,9 @@ def test_the_axis_is_the_drum_count(study):
         assert sum(heights) == pytest.approx(5.0) and len(set(heights)) == 1
 
 
-@pytest.mark.parametrize(("drums", "stored"), [(1, "harmonic_monolithic"), (8, "harmonic_multidrum")])
+@pytest.mark.parametrize(
+    ("drums", "stored"), [(1, "harmonic_monolithic"), (8, "harmonic_multidrum")]
+)
 def test_a_point_equals_the_column_swept_on_its_own(study, drums, stored):
     other = read_domain(RESULTS / stored / "domain.csv")
     mine = study[study["column.drums"] == drums]

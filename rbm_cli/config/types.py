@@ -16,7 +16,7 @@ G = 9.81
 SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
 EXCITATIONS = ("harmonic", "half-sine", "free")
-METHODS = ("DOP853", "RK45", "RK23")
+METHODS = ("DOP853", "RK45", "RK23", "exact")
 IMPLEMENTATIONS = ("compiled", "python")
 
 
@@ -161,7 +161,9 @@ class CollapseConfig:
 class SolverConfig:
     """Integrator settings.
 
-    method : str  Runge-Kutta pair of scipy.integrate.solve_ivp
+    method : str  Runge-Kutta pair of scipy.integrate.solve_ivp, or 'exact' (model rbm:
+        closed-form integration of the linear pieces, rbm_cli.models.rbm.exact; its
+        tolerances do not apply)
     rtol, atol : float  Tolerances (atol relative to the rotation scale theta_u)
     max_steps : int  Step budget of one run; beyond it the run is 'failed'
     max_events : int  Budget of events (kinks, impacts) of one run

@@ -1,0 +1,242 @@
+"""Where the exact integrator samples a piece, and how it finds events and peaks that no
+sampling can miss.
+
+An interval [a, b] of a piece is *certified* for an event row when a lower bound of the
+row's distance over the whole interval is positive (rbm_cli.models.rbm.exact_piece
+module docstring: a slow part bounded by curvature, fast oscillations by their envelope):
+
+    lower = max(min(s_a, s_b) - C h^2 / 8,                 (linear interpolation)
+                min(s_a, s_a + s'_a h - C h^2 / 2),        (Taylor from a)
+                min(s_b, s_b - s'_b h - C h^2 / 2)) - E    (Taylor from b)
+
+with s the slow part, C the bound of its second derivative and E the envelope of the fast
+modes (the same with every mode in C and E = 0 is also tried). No crossing can hide in a
+certified interval. The integrator advances by certified intervals, doubling the interval
+after a success and halving it after a failure; an interval where some rows end below zero
+and every other row is certified holds the first event, provided each such row's distance
+is monotone there (its rate cannot reach zero: d'_a + C_full h < 0 or d'_b + C_full h < 0,
+so the root is unique), and Brent's method finds it. Below MIN_STEP the interval is taken
+as it is (a graze deeper than C MIN_STEP^2 cannot hide there).
+
+Peaks of the tracked quantities (collapse ratios, top displacement) use the same bounds
+from above: an interval whose upper bound of |z| does not exceed the running maximum is
+done, and so is one where z' keeps its sign (a lower bound of +-z' from the ends' z', z''
+and a bound of |z'''|): |z| peaks at an end. Otherwise the interval is split at the root
+of z' (Brent) when z' changes sign, else in halves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from rbm_cli.models.rbm.exact_bounds import ModeBounds, mode_bounds
+from rbm_cli.models.rbm.exact_piece import LinearPiece
+
+#: Shortest interval the search splits down to, relative to max(1, t) [s].
+MIN_STEP = 1e-13
+#: Absolute tolerance of Brent's method on event times and peak times [s].
+ROOT_XTOL = 1e-15
+#: Relative tolerance of the peaks (running maxima of |z|).
+PEAK_RTOL = 1e-12
+#: A root of z' closer than this fraction of its interval to an end is taken as that end;
+#: a rate below this fraction of the interval's end rates is a stationary point.
+STATIONARY_GAP = 1e-9
+
+
+@dataclass
+class Point:
+    """The piece's state at time t [s]: modal (q, v), event distances d and rates dd,
+    tracked quantities z and their first and second derivatives dz, zz."""
+
+    t: float
+    q: np.ndarray
+    v: np.ndarray
+    d: np.ndarray
+    dd: np.ndarray
+    z: np.ndarray
+    dz: np.ndarray
+    zz: np.ndarray
+
+
+class Evaluator:
+    """Evaluations of a piece, counted (n_evals)."""
+
+    def __init__(self, piece: LinearPiece) -> None:
+        self.piece = piece
+        self.n_evals = 0
+
+    def start(self, t: float, q: np.ndarray, v: np.ndarray) -> Point:
+        d, dd = self.piece.distances(q, v)
+        z, dz = self.piece.peaks(q, v)
+        zz = self.piece.track @ self.piece.modal_accel(t, q)
+        return Point(t, q, v, d, dd, z, dz, zz)
+
+    def point(self, a: Point, tau: float) -> Point:
+        """The point tau [s] after a."""
+        self.n_evals += 1
+        q, v = self.piece.at(a.t, a.q, a.v, tau)
+        return self.start(a.t + tau, q, v)
+
+    def bounds(self, a: Point, b: Point) -> ModeBounds:
+        return mode_bounds(self.piece, a.t, a.q, a.v, b.t - a.t, b.q, b.v)
+
+
+def _lower(vals_a, vals_b, rate_a, rate_b, curv, h):
+    """Lower bound over the interval of functions with these end values and rates and
+    |second derivative| <= curv."""
+    interp = np.minimum(vals_a, vals_b) - curv * (h * h / 8.0)
+    left = np.minimum(vals_a, vals_a + rate_a * h - curv * (h * h / 2.0))
+    right = np.minimum(vals_b, vals_b - rate_b * h - curv * (h * h / 2.0))
+    return np.maximum(interp, np.maximum(left, right))
+
+
+def _upper_abs(vals_a, vals_b, rate_a, rate_b, curv, h):
+    """Upper bound of |value| over the interval (same data as _lower)."""
+    ends = np.maximum(np.abs(vals_a), np.abs(vals_b))
+    interp = ends + curv * (h * h / 8.0)
+    left = np.maximum(np.abs(vals_a), np.abs(vals_a + rate_a * h)) + curv * (h * h / 2.0)
+    right = np.maximum(np.abs(vals_b), np.abs(vals_b - rate_b * h)) + curv * (h * h / 2.0)
+    return np.minimum(interp, np.minimum(left, right))
+
+
+def _slow(rows, mb: ModeBounds, a: Point, b: Point, va, vb, ra, rb):
+    """End values and rates of the rows' slow parts (the fast oscillations taken out)."""
+    if not mb.fast.any():
+        return va, vb, ra, rb
+    return va - rows @ mb.osc_a, vb - rows @ mb.osc_b, ra - rows @ mb.rate_a, rb - rows @ mb.rate_b
+
+
+def row_lower(piece: LinearPiece, a: Point, b: Point, mb: ModeBounds) -> np.ndarray:
+    """Lower bounds of the event distances over [a.t, b.t]."""
+    h = b.t - a.t
+    rows, absr = piece.rows, piece.abs_rows
+    full = _lower(a.d, b.d, a.dd, b.dd, absr @ mb.full, h)
+    if not mb.fast.any():
+        return full
+    sa, sb, ra, rb = _slow(rows, mb, a, b, a.d, b.d, a.dd, b.dd)
+    split = _lower(sa, sb, ra, rb, absr @ mb.curv, h) - absr @ mb.env
+    return np.maximum(full, split)
+
+
+def track_upper(piece: LinearPiece, a: Point, b: Point, mb: ModeBounds) -> np.ndarray:
+    """Upper bounds of |z| (tracked quantities) over [a.t, b.t]."""
+    h = b.t - a.t
+    rows, absr = piece.track, piece.abs_track
+    full = _upper_abs(a.z, b.z, a.dz, b.dz, absr @ mb.full, h)
+    if not mb.fast.any():
+        return full
+    sa, sb, ra, rb = _slow(rows, mb, a, b, a.z, b.z, a.dz, b.dz)
+    split = _upper_abs(sa, sb, ra, rb, absr @ mb.curv, h) + absr @ mb.env
+    return np.minimum(full, split)
+
+
+def _bracketed(fun, h: float, f0: float, fh: float) -> float:
+    """Brent's root of fun in [0, h] [s], with the end values known (f0 fh < 0): the ends
+    are not evaluated again (a re-evaluation may round to the other sign)."""
+
+    def wrapped(tau):
+        if tau == 0.0:
+            return f0
+        if tau == h:
+            return fh
+        return fun(tau)
+
+    return brentq(wrapped, 0.0, h, xtol=ROOT_XTOL)
+
+
+def _root(ev: Evaluator, a: Point, b: Point, r: int) -> float:
+    """Time after a [s] where event row r crosses zero in (0, b.t - a.t]."""
+    piece = ev.piece
+
+    def dist(tau):
+        ev.n_evals += 1
+        q, _ = piece.at(a.t, a.q, a.v, tau)
+        return float(piece.rows[r] @ q + piece.h0[r])
+
+    return _bracketed(dist, b.t - a.t, float(a.d[r]), float(b.d[r]))
+
+
+def next_point(ev: Evaluator, a: Point, h: float, t_stop: float) -> tuple[Point, int | None, float]:
+    """The next sample point after a: the end of a certified interval of length <= h
+    [s] (or t_stop), or the first event. Returns (point, event row or None, the
+    interval length to try next [s])."""
+    piece = ev.piece
+    h_min = MIN_STEP * max(1.0, abs(a.t))
+    h = min(h, t_stop - a.t)
+    while True:
+        at_stop = h >= t_stop - a.t
+        b = ev.point(a, t_stop - a.t if at_stop else h)
+        if at_stop:
+            b.t = t_stop
+        mb = ev.bounds(a, b)
+        bad = ~(row_lower(piece, a, b, mb) > 0.0)  # NaN: no bound
+        if not bad.any():
+            return b, None, 2.0 * h
+        crossed = b.d < 0.0
+        small = h <= h_min
+        if crossed.any() and (small or not (bad & ~crossed).any()):
+            rows = np.nonzero(crossed)[0]
+            cfull = piece.abs_rows[rows] @ mb.full * (b.t - a.t)
+            mono = (a.dd[rows] + cfull < 0.0) | (b.dd[rows] + cfull < 0.0)
+            if small or mono.all():
+                hits = [(_root(ev, a, b, int(r)), int(r)) for r in rows]
+                tau, r = min(hits)
+                return ev.point(a, tau), r, h
+        if small:
+            return b, None, h
+        h = 0.5 * h
+
+
+def refine_peaks(ev: Evaluator, a: Point, b: Point, maxima: np.ndarray) -> None:
+    """Raise the running maxima of |z| to the peaks inside [a.t, b.t]: split the interval
+    at roots of z' (Brent) and in halves until, for every row, each part is below the
+    running maximum or has a monotone z (module docstring)."""
+    piece = ev.piece
+    stack = [(a, b, None)]
+    while stack:
+        a, b, need = stack.pop()
+        np.maximum(maxima, np.maximum(np.abs(a.z), np.abs(b.z)), out=maxima)
+        h = b.t - a.t
+        mb = ev.bounds(a, b)
+        rows = ~(track_upper(piece, a, b, mb) <= maxima)  # NaN: no bound
+        if need is not None:
+            rows &= need
+        if not rows.any() or h <= MIN_STEP * max(1.0, abs(a.t)):
+            continue
+        rows &= ~_monotone(a, b, piece.abs_track @ mb.third, PEAK_RTOL * maxima / h)
+        if not rows.any():
+            continue
+        flips = np.nonzero(rows & (a.dz * b.dz < 0.0))[0]
+        if flips.size:
+            r = int(flips[0])
+
+            def rate(tau, a=a, r=r):
+                ev.n_evals += 1
+                _, v = piece.at(a.t, a.q, a.v, tau)
+                return float(piece.track[r] @ v)
+
+            tau = _bracketed(rate, h, float(a.dz[r]), float(b.dz[r]))
+            if not STATIONARY_GAP * h < tau < (1.0 - STATIONARY_GAP) * h:
+                tau = 0.5 * h  # an end is stationary already: split in halves
+            c = ev.point(a, tau)
+            # stationary rows at c (r, and rows proportional to it): no sign change there
+            still = np.abs(c.dz) <= STATIONARY_GAP * (np.abs(a.dz) + np.abs(b.dz))
+            c.dz[r] = 0.0
+            c.dz[still] = 0.0
+        else:
+            c = ev.point(a, 0.5 * h)
+        np.maximum(maxima, np.abs(c.z), out=maxima)
+        stack += [(c, b, rows), (a, c, rows)]
+
+
+def _monotone(a: Point, b: Point, third: np.ndarray, slack: np.ndarray) -> np.ndarray:
+    """Rows whose z' keeps one sign on [a.t, b.t], so |z| peaks at an end: a lower bound of
+    s z' (s = +-1) over the interval, from the ends' z' and z'' and the bound `third` of
+    the third derivative, is above -slack (a Brent root of z' is not exactly zero)."""
+    h = b.t - a.t
+    up = _lower(a.dz, b.dz, a.zz, b.zz, third, h) >= -slack
+    down = _lower(-a.dz, -b.dz, -a.zz, -b.zz, third, h) >= -slack
+    return up | down

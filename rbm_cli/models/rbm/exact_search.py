@@ -15,14 +15,14 @@ certified interval. The integrator advances by certified intervals, doubling the
 after a success and halving it after a failure; an interval where some rows end below zero
 and every other row is certified holds the first event, provided each such row's distance
 is monotone there (its rate cannot reach zero: d'_a + C_full h < 0 or d'_b + C_full h < 0,
-so the root is unique), and Brent's method finds it. Below MIN_STEP the interval is taken
-as it is (a graze deeper than C MIN_STEP^2 cannot hide there).
+so the root is unique), and a safeguarded Newton method finds it. Below MIN_STEP the
+interval is taken as it is (a graze deeper than C MIN_STEP^2 cannot hide there).
 
 Peaks of the tracked quantities (collapse ratios, top displacement) use the same bounds
 from above: an interval whose upper bound of |z| does not exceed the running maximum is
 done, and so is one where z' keeps its sign (a lower bound of +-z' from the ends' z', z''
 and a bound of |z'''|): |z| peaks at an end. Otherwise the interval is split at the root
-of z' (Brent) when z' changes sign, else in halves.
+of z' (safeguarded Newton) when z' changes sign, else in halves.
 """
 
 from __future__ import annotations
@@ -30,14 +30,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from rbm_cli.models.rbm.exact_bounds import ModeBounds, mode_bounds
 from rbm_cli.models.rbm.exact_piece import LinearPiece
 
 #: Shortest interval the search splits down to, relative to max(1, t) [s].
 MIN_STEP = 1e-13
-#: Absolute tolerance of Brent's method on event times and peak times [s].
+#: Absolute tolerance of the root finding on event times and peak times [s].
 ROOT_XTOL = 1e-15
 #: Relative tolerance of the peaks (running maxima of |z|).
 PEAK_RTOL = 1e-12
@@ -133,18 +132,33 @@ def track_upper(piece: LinearPiece, a: Point, b: Point, mb: ModeBounds) -> np.nd
     return np.minimum(full, split)
 
 
-def _bracketed(fun, h: float, f0: float, fh: float) -> float:
-    """Brent's root of fun in [0, h] [s], with the end values known (f0 fh < 0): the ends
-    are not evaluated again (a re-evaluation may round to the other sign)."""
-
-    def wrapped(tau):
-        if tau == 0.0:
-            return f0
-        if tau == h:
-            return fh
-        return fun(tau)
-
-    return brentq(wrapped, 0.0, h, xtol=ROOT_XTOL)
+def _safe_newton(fun, h: float, f0: float, fh: float) -> float:
+    """Root in [0, h] [s] of fun (tau -> (value, derivative)), f0 fh < 0 the values at the
+    ends (not evaluated again: a re-evaluation may round to the other sign): Newton's
+    method kept inside the bracket, bisecting when a Newton step would leave it or
+    converge slowly (rtsafe), to ROOT_XTOL."""
+    lo, hi = (0.0, h) if f0 < 0.0 else (h, 0.0)  # fun(lo) < 0 < fun(hi)
+    x = h * f0 / (f0 - fh)  # the secant's root
+    step = step_old = h
+    f, df = fun(x)
+    for _ in range(200):
+        if f == 0.0:
+            return x
+        if f < 0.0:
+            lo = x
+        else:
+            hi = x
+        newton_out = ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0
+        if newton_out or abs(2.0 * f) > abs(step_old * df):
+            step_old, step = step, 0.5 * (hi - lo)
+            x = lo + step
+        else:
+            step_old, step = step, f / df
+            x -= step
+        if abs(step) < ROOT_XTOL:
+            return x
+        f, df = fun(x)
+    return x
 
 
 def _root(ev: Evaluator, a: Point, b: Point, r: int) -> float:
@@ -153,16 +167,16 @@ def _root(ev: Evaluator, a: Point, b: Point, r: int) -> float:
 
     def dist(tau):
         ev.n_evals += 1
-        q, _ = piece.at(a.t, a.q, a.v, tau)
-        return float(piece.rows[r] @ q + piece.h0[r])
+        q, v = piece.at(a.t, a.q, a.v, tau)
+        return float(piece.rows[r] @ q + piece.h0[r]), float(piece.rows[r] @ v)
 
-    return _bracketed(dist, b.t - a.t, float(a.d[r]), float(b.d[r]))
+    return _safe_newton(dist, b.t - a.t, float(a.d[r]), float(b.d[r]))
 
 
 def next_point(ev: Evaluator, a: Point, h: float, t_stop: float) -> tuple[Point, int | None, float]:
     """The next sample point after a: the end of a certified interval of length <= h
     [s] (or t_stop), or the first event. Returns (point, event row or None, the
-    interval length to try next [s])."""
+    interval length to try next [s]: twice a certified one)."""
     piece = ev.piece
     h_min = MIN_STEP * max(1.0, abs(a.t))
     h = min(h, t_stop - a.t)
@@ -192,7 +206,7 @@ def next_point(ev: Evaluator, a: Point, h: float, t_stop: float) -> tuple[Point,
 
 def refine_peaks(ev: Evaluator, a: Point, b: Point, maxima: np.ndarray) -> None:
     """Raise the running maxima of |z| to the peaks inside [a.t, b.t]: split the interval
-    at roots of z' (Brent) and in halves until, for every row, each part is below the
+    at roots of z' and in halves until, for every row, each part is below the
     running maximum or has a monotone z (module docstring)."""
     piece = ev.piece
     stack = [(a, b, None)]
@@ -215,10 +229,12 @@ def refine_peaks(ev: Evaluator, a: Point, b: Point, maxima: np.ndarray) -> None:
 
             def rate(tau, a=a, r=r):
                 ev.n_evals += 1
-                _, v = piece.at(a.t, a.q, a.v, tau)
-                return float(piece.track[r] @ v)
+                q, v = piece.at(a.t, a.q, a.v, tau)
+                return float(piece.track[r] @ v), float(
+                    piece.track[r] @ piece.modal_accel(a.t + tau, q)
+                )
 
-            tau = _bracketed(rate, h, float(a.dz[r]), float(b.dz[r]))
+            tau = _safe_newton(rate, h, float(a.dz[r]), float(b.dz[r]))
             if not STATIONARY_GAP * h < tau < (1.0 - STATIONARY_GAP) * h:
                 tau = 0.5 * h  # an end is stationary already: split in halves
             c = ev.point(a, tau)
@@ -235,7 +251,7 @@ def refine_peaks(ev: Evaluator, a: Point, b: Point, maxima: np.ndarray) -> None:
 def _monotone(a: Point, b: Point, third: np.ndarray, slack: np.ndarray) -> np.ndarray:
     """Rows whose z' keeps one sign on [a.t, b.t], so |z| peaks at an end: a lower bound of
     s z' (s = +-1) over the interval, from the ends' z' and z'' and the bound `third` of
-    the third derivative, is above -slack (a Brent root of z' is not exactly zero)."""
+    the third derivative, is above -slack (a computed root of z' is not exactly zero)."""
     h = b.t - a.t
     up = _lower(a.dz, b.dz, a.zz, b.zz, third, h) >= -slack
     down = _lower(-a.dz, -b.dz, -a.zz, -b.zz, third, h) >= -slack

@@ -30,55 +30,19 @@ piecewise linear in time and the closed form takes it exactly per sample interva
 from __future__ import annotations
 
 import time
-from functools import partial
 
 import numpy as np
 
-from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import SolverConfig
 from rbm_cli.models.events import REST_RATE, Pieces
 from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
 from rbm_cli.models.rbm.exact_modal import Forcing
+from rbm_cli.models.rbm.exact_motion import check_exact, forcing_segments
 from rbm_cli.models.rbm.exact_piece import LinearPiece, ModalSystem
 from rbm_cli.models.rbm.exact_search import Evaluator, Point, next_point, refine_peaks
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
-
-#: Ground motions the exact integrator takes.
-EXACT_KINDS = ("harmonic", "half-sine", "free")
-#: First interval tried at the start of a run [s].
-FIRST_STEP = 1e-3
-
-
-def forcing_segments(motion: GroundMotion) -> list[tuple[float, float, Forcing]]:
-    """(start [s], end [s], forcing) of the motion's smooth segments."""
-    out = []
-    for start, end in motion.segments():
-        if motion.forced(start):
-            forcing = Forcing("harmonic", motion.amplitude, motion.omega, motion.phase)
-        else:
-            forcing = Forcing("zero")
-        out.append((start, end, forcing))
-    return out
-
-
-def check_exact(model: Model, kind: str) -> None:
-    """Raise RbmError (one line) unless the exact method takes this model and excitation."""
-    if model.formulation == "absolute":
-        raise RbmError(
-            "solver.method exact needs interface.formulation relative or geometric (absolute"
-            " is not symmetric): use a Runge-Kutta method (DOP853) for absolute"
-        )
-    if kind not in EXACT_KINDS:
-        raise RbmError(
-            f"solver.method exact takes harmonic, half-sine and free excitations, not {kind}"
-        )
-
-
-def exact_integrator(model: Model, implementation: str):
-    """The exact integrator of a model (its modes cached across runs)."""
-    check_exact(model, "free")
-    return partial(integrate_exact, system=ModalSystem(model))
 
 
 class ExactRun:

@@ -7,7 +7,8 @@ For each mode q'' + lam q = f + g a_g(t) on [a, a + h], from its state (q_a, v_a
   |q| <= |q_a| C + |v_a| S + F S2 and |q'| <= |q_a| k^2 S + |v_a| C + F S (hyperbolic C,
   S, S2 of k at h), so |q''| <= |lam| max|q| + F and |q'''| <= |lam| max|q'| + max|g a_g'|;
 - for lam > 0, the energy E = v^2 + lam q^2 grows at most as sqrt(E) <= sqrt(E_a) + h F,
-  which bounds |q'| and |q| for any h (the smaller of the two bounds is kept);
+  which bounds |q'| and |q| for any h (the smaller of the two bounds is kept; the
+  hyperbolic one only while lam h^2 < HYPERBOLIC_LIMIT, beyond which it is the larger);
 - for an oscillatory mode away from resonance (lam > 0, and for a harmonic forcing
   lam >= 4 omega^2: "eligible"), the free oscillation o = q - p, p the particular solution,
   has the constant amplitude R = sqrt(o^2 + o'^2 / lam) over the whole piece, so
@@ -32,6 +33,22 @@ from rbm_cli.models.rbm.exact_modal import basis
 SAFETY = 1.0 + 1e-9
 #: A mode is treated by its envelope on an interval when lam h^2 exceeds this.
 ENVELOPE_RATIO = 8.0
+#: For lam > 0 the hyperbolic majorant is used only while lam h^2 is below this (beyond,
+#: the energy bound is the smaller).
+HYPERBOLIC_LIMIT = 4.0
+
+# the search's settings (rbm_cli.models.rbm.exact_search)
+#: Shortest interval the search splits down to, relative to max(1, t) [s].
+MIN_STEP = 1e-13
+#: Absolute tolerance of the root finding on event times and peak times [s].
+ROOT_XTOL = 1e-15
+#: Relative tolerance of the peaks (running maxima of |z|).
+PEAK_RTOL = 1e-12
+#: A root of z' closer than this fraction of its interval to an end is taken as that end;
+#: a rate below this fraction of the interval's end rates is a stationary point.
+STATIONARY_GAP = 1e-9
+#: First interval tried at the start of a run and of a segment [s].
+FIRST_STEP = 1e-3
 
 
 @dataclass
@@ -114,6 +131,8 @@ def _majorants(lam, q, v, h, big):
         qmax = np.nan_to_num(aq * c + av * s + big * s2, nan=np.inf)  # 0 * inf: no bound
         vmax = np.nan_to_num(aq * alam * s + av * c + big * s, nan=np.inf)
     pos = lam > 0.0
+    far = pos & (lam * h * h >= HYPERBOLIC_LIMIT)
+    qmax, vmax = np.where(far, np.inf, qmax), np.where(far, np.inf, vmax)
     energy = np.sqrt(v * v + np.maximum(lam, 0.0) * q * q) + h * big
     alt = np.minimum(aq + h * energy, energy / np.sqrt(np.where(pos, lam, 1.0)))
     return np.where(pos, np.minimum(qmax, alt), qmax), np.where(pos, np.minimum(vmax, energy), vmax)

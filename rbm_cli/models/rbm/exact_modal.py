@@ -19,14 +19,16 @@ with the fundamental functions, continuous in lam through lam = 0,
     S2 = int_0^tau S = (1 - C) / lam      (tau^2 / 2 at lam = 0)
     S3 = int_0^tau S2 = (tau - S) / lam   (tau^3 / 6 at lam = 0)
 
-(power series for |lam| tau^2 < 1, so no cancellation near lam = 0), and Y the response
+(power series for |lam| tau^2 < 1, so no cancellation near lam = 0; beyond it the
+differences lose at most an absolute eps / |lam|), and Y the response
 from rest to the ground acceleration:
 
-- harmonic, a_g = A sin(Om tau + phi):
-  lam > 0: Y = A [cos(phi) S - tau cos(sig tau / 2 + phi) sinc(del tau / 2)] / (w + Om),
+- harmonic, a_g = A sin(Om tau + phi): Y = A [sin(Om tau + phi) - sin(phi) C
+  - Om cos(phi) S] / (lam - Om^2), except near resonance (lam > 0, |w - Om| <
+  RESONANCE_BAND Om), where the same function is written
+  Y = A [cos(phi) S - tau cos(sig tau / 2 + phi) sinc(del tau / 2)] / (w + Om),
   sig = w + Om, del = w - Om: exact at resonance (w = Om gives the tau cos term) and
-  without cancellation near it; lam <= 0: Y = A [sin(Om tau + phi) - sin(phi) C
-  - Om cos(phi) S] / (lam - Om^2) (never resonant);
+  without cancellation near it;
 - piecewise linear, a_g = a0 + a1 tau (a sampled record, exact on each sample interval
   as in Nigam and Jennings' response spectra): Y = a0 S2 + a1 S3.
 
@@ -43,6 +45,9 @@ import numpy as np
 #: Terms of the power series of C, S, S2, S3 (used for |lam| tau^2 < 1: the last term is
 #: below 1e-26 of the first).
 SERIES_TERMS = 14
+#: The harmonic response uses its resonance-stable form for modes with
+#: |w - omega| < RESONANCE_BAND omega, the plain particular-solution form elsewhere.
+RESONANCE_BAND = 0.5
 
 
 @dataclass(frozen=True)
@@ -113,18 +118,16 @@ def basis(lam: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarr
     pos = ~small & (lam > 0.0)
     if pos.any():
         w = np.sqrt(lam[pos])
-        half = np.sin(0.5 * w * tau)
         c[pos] = np.cos(w * tau)
         s[pos] = np.sin(w * tau) / w
-        s2[pos] = 2.0 * half * half / lam[pos]
+        s2[pos] = (1.0 - c[pos]) / lam[pos]
         s3[pos] = (tau - s[pos]) / lam[pos]
     neg = ~small & (lam < 0.0)
     if neg.any():
         k = np.sqrt(-lam[neg])
-        half = np.sinh(0.5 * k * tau)
         c[neg] = np.cosh(k * tau)
         s[neg] = np.sinh(k * tau) / k
-        s2[neg] = 2.0 * half * half / (k * k)
+        s2[neg] = (c[neg] - 1.0) / (k * k)
         s3[neg] = (s[neg] - tau) / (k * k)
     return c, s, s2, s3
 
@@ -136,25 +139,24 @@ def harmonic_response(
     given C and S of the same tau (basis). Exact at resonance, stable near it."""
     y = np.empty_like(lam)
     dy = np.empty_like(lam)
-    pos = lam > 0.0
-    if pos.any():
-        w = np.sqrt(lam[pos])
+    near = (lam > 0.0) & (np.abs(np.sqrt(np.abs(lam)) - omega) < RESONANCE_BAND * omega)
+    if near.any():
+        w = np.sqrt(lam[near])
         sig, dlt = w + omega, w - omega
         arg = 0.5 * sig * tau + phase
         half = 0.5 * dlt * tau
         sinc = np.sinc(half / math.pi)  # sin(half) / half
         ca, sa = np.cos(arg), np.sin(arg)
         cph = math.cos(phase)
-        y[pos] = (cph * s[pos] - tau * ca * sinc) / sig
-        dy[pos] = (cph * c[pos] + sig * sa * 0.5 * tau * sinc - ca * np.cos(half)) / sig
-    neg = ~pos
-    if neg.any():
-        den = lam[neg] - omega * omega
+        y[near] = (cph * s[near] - tau * ca * sinc) / sig
+        dy[near] = (cph * c[near] + sig * sa * 0.5 * tau * sinc - ca * np.cos(half)) / sig
+    far = ~near
+    if far.any():
+        den = lam[far] - omega * omega
         sph, cph = math.sin(phase), math.cos(phase)
-        y[neg] = (math.sin(omega * tau + phase) - sph * c[neg] - omega * cph * s[neg]) / den
-        dy[neg] = (
-            omega * math.cos(omega * tau + phase) + lam[neg] * sph * s[neg] - omega * cph * c[neg]
-        ) / den
+        sw, cw = math.sin(omega * tau + phase), math.cos(omega * tau + phase)
+        y[far] = (sw - sph * c[far] - omega * cph * s[far]) / den
+        dy[far] = (omega * cw + lam[far] * sph * s[far] - omega * cph * c[far]) / den
     return y, dy
 
 

@@ -31,18 +31,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rbm_cli.models.rbm.exact_bounds import ModeBounds, mode_bounds
+from rbm_cli.models.rbm.exact_bounds import (
+    MIN_STEP,
+    PEAK_RTOL,
+    ROOT_XTOL,
+    STATIONARY_GAP,
+    ModeBounds,
+    mode_bounds,
+)
 from rbm_cli.models.rbm.exact_piece import LinearPiece
-
-#: Shortest interval the search splits down to, relative to max(1, t) [s].
-MIN_STEP = 1e-13
-#: Absolute tolerance of the root finding on event times and peak times [s].
-ROOT_XTOL = 1e-15
-#: Relative tolerance of the peaks (running maxima of |z|).
-PEAK_RTOL = 1e-12
-#: A root of z' closer than this fraction of its interval to an end is taken as that end;
-#: a rate below this fraction of the interval's end rates is a stationary point.
-STATIONARY_GAP = 1e-9
 
 
 @dataclass
@@ -161,25 +158,41 @@ def _safe_newton(fun, h: float, f0: float, fh: float) -> float:
     return x
 
 
-def _root(ev: Evaluator, a: Point, b: Point, r: int) -> float:
-    """Time after a [s] where event row r crosses zero in (0, b.t - a.t]."""
+def _earliest(ev: Evaluator, a: Point, b: Point, rows: np.ndarray) -> tuple[float, int]:
+    """(time after a [s], row) of the earliest root among rows, each crossing zero once in
+    (0, b.t - a.t]: a row whose distance is still positive at the earliest root so far
+    crosses later and is not solved."""
     piece = ev.piece
+    best, best_r, f_best = b.t - a.t, -1, 0.0
+    for r in rows:
 
-    def dist(tau):
-        ev.n_evals += 1
-        q, v = piece.at(a.t, a.q, a.v, tau)
-        return float(piece.rows[r] @ q + piece.h0[r]), float(piece.rows[r] @ v)
+        def dist(tau, r=r):
+            ev.n_evals += 1
+            q, v = piece.at(a.t, a.q, a.v, tau)
+            return float(piece.rows[r] @ q + piece.h0[r]), float(piece.rows[r] @ v)
 
-    return _safe_newton(dist, b.t - a.t, float(a.d[r]), float(b.d[r]))
+        if best_r < 0:
+            f_best = float(b.d[r])
+        else:
+            f_best = dist(best)[0]
+            if f_best > 0.0:
+                continue
+        if f_best == 0.0:
+            best_r = int(r)
+            continue
+        best, best_r = _safe_newton(dist, best, float(a.d[r]), f_best), int(r)
+    return best, best_r
 
 
 def next_point(ev: Evaluator, a: Point, h: float, t_stop: float) -> tuple[Point, int | None, float]:
     """The next sample point after a: the end of a certified interval of length <= h
     [s] (or t_stop), or the first event. Returns (point, event row or None, the
-    interval length to try next [s]: twice a certified one)."""
+    interval length to try next [s]: twice the certified one if certified at the first
+    try, else the same)."""
     piece = ev.piece
     h_min = MIN_STEP * max(1.0, abs(a.t))
     h = min(h, t_stop - a.t)
+    first = True
     while True:
         at_stop = h >= t_stop - a.t
         b = ev.point(a, t_stop - a.t if at_stop else h)
@@ -188,7 +201,7 @@ def next_point(ev: Evaluator, a: Point, h: float, t_stop: float) -> tuple[Point,
         mb = ev.bounds(a, b)
         bad = ~(row_lower(piece, a, b, mb) > 0.0)  # NaN: no bound
         if not bad.any():
-            return b, None, 2.0 * h
+            return b, None, 2.0 * h if first else h
         crossed = b.d < 0.0
         small = h <= h_min
         if crossed.any() and (small or not (bad & ~crossed).any()):
@@ -196,12 +209,12 @@ def next_point(ev: Evaluator, a: Point, h: float, t_stop: float) -> tuple[Point,
             cfull = piece.abs_rows[rows] @ mb.full * (b.t - a.t)
             mono = (a.dd[rows] + cfull < 0.0) | (b.dd[rows] + cfull < 0.0)
             if small or mono.all():
-                hits = [(_root(ev, a, b, int(r)), int(r)) for r in rows]
-                tau, r = min(hits)
+                tau, r = _earliest(ev, a, b, rows)
                 return ev.point(a, tau), r, h
         if small:
             return b, None, h
         h = 0.5 * h
+        first = False
 
 
 def refine_peaks(ev: Evaluator, a: Point, b: Point, maxima: np.ndarray) -> None:

@@ -120,17 +120,22 @@ class RbmRunner:
         self.rate0 = np.zeros(n) if not init.velocities else np.asarray(init.velocities, float)
         self._integrators: dict = {}  # (exact, implementation) -> integrator, on first use
         if config.solver.method == "exact":
-            from rbm_cli.models.rbm.exact import check_exact
+            from rbm_cli.models.rbm.exact_motion import check_exact
 
             check_exact(self.model, config.excitation.type)
 
     def _integrator(self, method: str, implementation: str):
         """The integrator of a method and implementation, imported only when a run needs
         it; the compiled one with this column's kernel inputs, prepared once."""
-        if method == "exact":
-            from rbm_cli.models.rbm.exact import exact_integrator
+        if method == "exact" and implementation == "compiled":
+            from rbm_cli.models.rbm.exact_jit import integrate_exact_compiled, prepare_exact
 
-            return exact_integrator(self.model, implementation)
+            return partial(integrate_exact_compiled, prepared=prepare_exact(self.model))
+        if method == "exact":
+            from rbm_cli.models.rbm.exact import integrate_exact
+            from rbm_cli.models.rbm.exact_piece import ModalSystem
+
+            return partial(integrate_exact, system=ModalSystem(self.model))
         if implementation == "compiled":
             from rbm_cli.models.rbm.kernel import integrate_compiled, prepare_kernel
 

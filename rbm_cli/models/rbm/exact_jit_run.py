@@ -3,9 +3,9 @@ algorithm, statement for statement, in one compiled call per run.
 
 Mutable scalars live in small arrays: st = [t, h, next_out, t_collapse, at_rest, n_out]
 (floats) and cnt = [n_uplifts, n_impacts, n_steps, n_rhs, n_events, collapse interface,
-the part of n_rhs spent on peaks] (ints). A motion is mo = [half-sine (0/1), amplitude,
-omega, phase, pulse_end, t_end] and its segments (start, end) with their forcings
-(exact_jit_modal); settings are
+the part of n_rhs spent on peaks, the current segment] (ints). A motion is
+mo = [half-sine (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
+(start, end) with their forcings (exact_jit_modal); settings are
 se = [max_steps, max_events, deadline, early_stop, record, output_dt].
 """
 
@@ -19,6 +19,7 @@ from numba import njit
 
 from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
 from rbm_cli.models.rbm.exact_jit_modal import ZERO, f_accel
+from rbm_cli.models.rbm.exact_jit_peaks import NOTES, new_notes, note_interval, settle_peaks
 from rbm_cli.models.rbm.exact_jit_piece import (
     cross,
     eval_point,
@@ -28,19 +29,19 @@ from rbm_cli.models.rbm.exact_jit_piece import (
     row_at,
     set_point,
 )
-from rbm_cli.models.rbm.exact_jit_search import SCRATCH, next_point, refine_peaks
+from rbm_cli.models.rbm.exact_jit_search import SCRATCH, next_point
 from rbm_cli.models.rbm.exact_jit_state import clock, energy1, friction, next_exceedance
 
 GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
 FAILED_STEPS, FAILED_EVENTS, FAILED_WALL = 5, 6, 7
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
-UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS = range(7)
+UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
 #: Steps between two readings of the wall clock.
 CLOCK_EVERY = 64
 
 #: Work arrays of a run: the point pool, mode and family bounds, the peak refinement's
-#: reference counts, free list and stack.
-Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows")
+#: reference counts, free list and stack, and the noted intervals (exact_jit_peaks).
+Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes")
 #: The moving state: rotations, rates, law pieces (side, k, pending, awaiting), maxima of
 #: the tracked quantities, friction demand.
 State = namedtuple("State", "theta rate side k pending awaiting maxima fric st cnt")
@@ -122,8 +123,8 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
             return -code
         row, s.st[H], ev, fresh = next_point(pc, pts, s.st[H], seg_end, wk.mb, wk.fb)
         s.cnt[RHS] += ev
-        ev = refine_peaks(pc, pts, s.maxima, wk.mb, wk.fb, wk.refs, wk.free, wk.st_ab,
-                          wk.st_rows, fresh)  # fmt: skip
+        ev = note_interval(pc, pts, s.maxima, wk.mb, wk.fb, fresh, wk.notes, s.side, s.k,
+                           s.cnt[SEG], wk)  # fmt: skip
         s.cnt[RHS] += ev
         s.cnt[RHS_PEAKS] += ev
         if se[4] != 0.0:
@@ -246,21 +247,25 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
         st[AT_REST] = 1.0
     s = State(theta, rate, side, k, pending, awaiting, np.zeros(n + 1), np.zeros(n), st,
-              np.zeros(7, dtype=np.int64))  # fmt: skip
+              np.zeros(8, dtype=np.int64))  # fmt: skip
     nf = 2 * n + 1
     wk = Work(np.zeros((pool, 1 + 2 * n + 3 * nf)), np.zeros((9, n)), np.zeros((8, nf)),
               np.zeros(pool, dtype=np.int64), np.zeros(pool - 3, dtype=np.int64),
               np.zeros((stack, 2), dtype=np.int64),
-              np.zeros((stack, n + 1), dtype=np.bool_))  # fmt: skip
+              np.zeros((stack, n + 1), dtype=np.bool_), new_notes(n, NOTES))  # fmt: skip
     code = GOING
     for i in range(seg_t.shape[0]):
         if s.st[T] >= seg_t[i, 1]:
             continue
         s.st[H] = min(s.st[H], FIRST_STEP)
         can_stop = se[3] != 0.0 and int(seg_fc[i, 0]) == ZERO and mo[0] != 0.0
+        s.cnt[SEG] = i
         code = _segment(mdl, cache, wk, s, mo, se, seg_fc[i], seg_t[i, 1], can_stop, samples)
         if code != GOING:
             break
     if code == GOING:
         code = SURVIVED
+    ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)
+    s.cnt[RHS] += ev
+    s.cnt[RHS_PEAKS] += ev
     return code, s.st, s.cnt, s.maxima, s.fric

@@ -310,3 +310,11 @@ def test_absolute_formulation_is_refused_in_one_line():
     with pytest.raises(RbmError) as err:
         make_runner(cfg)
     assert "\n" not in str(err.value) and "absolute" in str(err.value)
+
+
+def test_housner_model_refuses_exact_in_one_line():
+    """Housner's large-rotation block is not piecewise linear: its runner says so."""
+    cfg = exact_config("spanos_koh_slender_housner")
+    with pytest.raises(RbmError) as err:
+        make_runner(cfg)
+    assert "\n" not in str(err.value) and "housner" in str(err.value)

@@ -161,3 +161,25 @@ def mode_bounds(piece, t: float, q, v, h: float, qb, vb) -> ModeBounds:
         np.where(fast, osc_a, 0.0), np.where(fast, qb - p_b, 0.0),
         np.where(fast, rate_a, 0.0), np.where(fast, vb - dp_b, 0.0),
     )  # fmt: skip
+
+
+def hermite_root(f0: float, d0: float, fh: float, dh: float, h: float) -> float:
+    """Start for the root finding in [0, h] [s] of a function with values f0, fh (f0 fh < 0)
+    and rates d0, dh at the ends: the root of their cubic Hermite interpolant (Newton on the
+    cubic from the secant's root, kept inside the interval). Plain arithmetic, compiled as
+    is by rbm_cli.models.rbm.exact_jit_search."""
+    m0, m1 = d0 * h, dh * h
+    s = f0 / (f0 - fh)
+    for _ in range(6):
+        s2 = s * s
+        p = (2 * s2 * s - 3 * s2 + 1) * f0 + (s2 * s - 2 * s2 + s) * m0
+        p += (-2 * s2 * s + 3 * s2) * fh + (s2 * s - s2) * m1
+        dp = (6 * s2 - 6 * s) * f0 + (3 * s2 - 4 * s + 1) * m0
+        dp += (-6 * s2 + 6 * s) * fh + (3 * s2 - 2 * s) * m1
+        if dp == 0.0:
+            break
+        s_new = s - p / dp
+        if not 0.0 < s_new < 1.0:
+            break
+        s = s_new
+    return s * h

@@ -8,9 +8,17 @@ the slots above, with reference counts.
 
 from __future__ import annotations
 
+import math
+
 from numba import njit
 
-from rbm_cli.models.rbm.exact_bounds import MIN_STEP, PEAK_RTOL, ROOT_XTOL, STATIONARY_GAP
+from rbm_cli.models.rbm.exact_bounds import (
+    MIN_STEP,
+    PEAK_RTOL,
+    ROOT_XTOL,
+    STATIONARY_GAP,
+    hermite_root,
+)
 from rbm_cli.models.rbm.exact_jit_bounds import (
     family_bounds,
     lower2,
@@ -48,16 +56,19 @@ def _value(pc, pts, ia, x, r, kind):
     return dv, ff
 
 
+_hermite_root = njit(cache=True)(hermite_root)
+
+
 @njit(cache=True)
-def _newton(pc, pts, ia, h, f0, fh, r, kind):
+def _newton(pc, pts, ia, h, f0, fh, r, kind, x0):
     """Root in [0, h] [s] after point ia of event row r (kind 0) or of the rate of family
-    r (kind 1), f0 fh < 0 the values at the ends (exact_search._safe_newton). Returns
-    (root, evaluations)."""
+    r (kind 1), f0 fh < 0 the values at the ends, from x0 (NaN: the secant's root)
+    (exact_search._safe_newton). Returns (root, evaluations)."""
     if f0 < 0.0:
         lo, hi = 0.0, h
     else:
         lo, hi = h, 0.0
-    x = h * f0 / (f0 - fh)
+    x = h * f0 / (f0 - fh) if math.isnan(x0) else x0
     step = step_old = h
     evals = 1
     f, df = _value(pc, pts, ia, x, r, kind)
@@ -115,20 +126,22 @@ def _first_root(pc, pts, ia, ib, fb, h, small):
     # root so far crosses later
     best, best_r, evals = h, -1, 0
     for r in range(pc.sgn.size):
-        if not pc.sgn[r] * pts[ib, of + pc.fam[r]] + pc.off[r] < 0.0:
+        k, s = pc.fam[r], pc.sgn[r]
+        if not s * pts[ib, of + k] + pc.off[r] < 0.0:
             continue
         if best_r < 0:
-            f_best = pc.sgn[r] * pts[ib, of + pc.fam[r]] + pc.off[r]
+            f_best, d_best = s * pts[ib, of + k] + pc.off[r], s * pts[ib, of + nf + k]
         else:
-            f_best, _ = _value(pc, pts, ia, best, r, 0)
+            f_best, d_best = _value(pc, pts, ia, best, r, 0)
             evals += 1
             if f_best > 0.0:
                 continue
         if f_best == 0.0:
             best_r = r
             continue
-        f0 = pc.sgn[r] * pts[ia, of + pc.fam[r]] + pc.off[r]
-        best, ne = _newton(pc, pts, ia, best, f0, f_best, r, 0)
+        f0, d0 = s * pts[ia, of + k] + pc.off[r], s * pts[ia, of + nf + k]
+        start = _hermite_root(f0, d0, f_best, d_best, best)
+        best, ne = _newton(pc, pts, ia, best, f0, f_best, r, 0, start)
         best_r = r
         evals += ne
     return best_r, best, evals
@@ -188,7 +201,8 @@ def _split_point(pc, pts, a, b, rows, c):
     for i in range(n + 1):
         k = n + i
         if rows[i] and pts[a, of + nf + k] * pts[b, of + nf + k] < 0.0:
-            tau, evals = _newton(pc, pts, a, h, pts[a, of + nf + k], pts[b, of + nf + k], k, 1)
+            tau, evals = _newton(pc, pts, a, h, pts[a, of + nf + k], pts[b, of + nf + k], k, 1,
+                                 math.nan)  # fmt: skip
             if not STATIONARY_GAP * h < tau < (1.0 - STATIONARY_GAP) * h:
                 tau = 0.5 * h
             eval_point(pc, pts, a, tau, c)

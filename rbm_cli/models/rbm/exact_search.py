@@ -37,6 +37,7 @@ from rbm_cli.models.rbm.exact_bounds import (
     ROOT_XTOL,
     STATIONARY_GAP,
     ModeBounds,
+    hermite_root,
     mode_bounds,
 )
 from rbm_cli.models.rbm.exact_piece import LinearPiece
@@ -129,13 +130,13 @@ def track_upper(piece: LinearPiece, a: Point, b: Point, mb: ModeBounds) -> np.nd
     return np.minimum(full, split)
 
 
-def _safe_newton(fun, h: float, f0: float, fh: float) -> float:
+def _safe_newton(fun, h: float, f0: float, fh: float, x0: float | None = None) -> float:
     """Root in [0, h] [s] of fun (tau -> (value, derivative)), f0 fh < 0 the values at the
     ends (not evaluated again: a re-evaluation may round to the other sign): Newton's
-    method kept inside the bracket, bisecting when a Newton step would leave it or
-    converge slowly (rtsafe), to ROOT_XTOL."""
+    method from x0 (default: the secant's root) kept inside the bracket, bisecting when a
+    Newton step would leave it or converge slowly (rtsafe), to ROOT_XTOL."""
     lo, hi = (0.0, h) if f0 < 0.0 else (h, 0.0)  # fun(lo) < 0 < fun(hi)
-    x = h * f0 / (f0 - fh)  # the secant's root
+    x = h * f0 / (f0 - fh) if x0 is None else x0
     step = step_old = h
     f, df = fun(x)
     for _ in range(200):
@@ -163,7 +164,7 @@ def _earliest(ev: Evaluator, a: Point, b: Point, rows: np.ndarray) -> tuple[floa
     (0, b.t - a.t]: a row whose distance is still positive at the earliest root so far
     crosses later and is not solved."""
     piece = ev.piece
-    best, best_r, f_best = b.t - a.t, -1, 0.0
+    best, best_r, f_best, d_best = b.t - a.t, -1, 0.0, 0.0
     for r in rows:
 
         def dist(tau, r=r):
@@ -172,15 +173,16 @@ def _earliest(ev: Evaluator, a: Point, b: Point, rows: np.ndarray) -> tuple[floa
             return float(piece.rows[r] @ q + piece.h0[r]), float(piece.rows[r] @ v)
 
         if best_r < 0:
-            f_best = float(b.d[r])
+            f_best, d_best = float(b.d[r]), float(b.dd[r])
         else:
-            f_best = dist(best)[0]
+            f_best, d_best = dist(best)
             if f_best > 0.0:
                 continue
         if f_best == 0.0:
             best_r = int(r)
             continue
-        best, best_r = _safe_newton(dist, best, float(a.d[r]), f_best), int(r)
+        start = hermite_root(float(a.d[r]), float(a.dd[r]), f_best, d_best, best)
+        best, best_r = _safe_newton(dist, best, float(a.d[r]), f_best, start), int(r)
     return best, best_r
 
 

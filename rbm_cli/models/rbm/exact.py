@@ -38,7 +38,7 @@ from rbm_cli.models.events import REST_RATE, Pieces
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
 from rbm_cli.models.rbm.exact_modal import Forcing
-from rbm_cli.models.rbm.exact_motion import check_exact, forcing_segments
+from rbm_cli.models.rbm.exact_motion import resolve_segments
 from rbm_cli.models.rbm.exact_piece import LinearPiece, ModalSystem
 from rbm_cli.models.rbm.exact_search import Evaluator, Point, next_point, refine_peaks
 from rbm_cli.physics.equations import Model
@@ -244,17 +244,20 @@ def integrate_exact(
     output_dt: float = 0.002,
     early_stop: bool = True,
     system: ModalSystem | None = None,
+    segments: list | None = None,
 ) -> Outcome:
     """One run of the model under a ground motion, exactly (same arguments and Outcome as
     rbm_cli.models.rbm.python.integrate; solver's budgets apply, its tolerances do not).
 
     system : ModalSystem, optional  The column's modes, cached across runs (a sweep);
         made here when None.
+    segments : list of (start [s], end [s], Forcing), optional  The forcing, instead of
+        the motion's (exact_motion.resolve_segments): a sampled record as piecewise-linear
+        segments (exact_motion.sampled_segments).
     """
-    check_exact(model, motion.kind)
+    segments = resolve_segments(model, motion, segments)
     if system is None:
         system = ModalSystem(model)
-    segments = forcing_segments(motion)
     deadline = time.monotonic() + solver.max_wall_time
     run = ExactRun(model, system, motion, theta0, rate0, solver, record, output_dt, deadline)
     try:

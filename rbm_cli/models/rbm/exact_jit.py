@@ -26,7 +26,7 @@ from rbm_cli.models.rbm.exact_jit_run import (
     run_exact,
 )
 from rbm_cli.models.rbm.exact_jit_state import ExactModel, exact_model, new_cache
-from rbm_cli.models.rbm.exact_motion import check_exact, forcing_segments
+from rbm_cli.models.rbm.exact_motion import check_exact, resolve_segments
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -47,8 +47,7 @@ def prepare_exact(model: Model) -> PreparedExact:
     return PreparedExact(exact_model(model), new_cache(model.n))
 
 
-def _segments(motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:
-    segs = forcing_segments(motion)
+def _segments(segs: list) -> tuple[np.ndarray, np.ndarray]:
     seg_t = np.array([[s, e] for s, e, _ in segs], dtype=float).reshape(-1, 2)
     seg_fc = np.array([forcing_array(f) for _, _, f in segs]).reshape(-1, FORCING_SIZE)
     return seg_t, seg_fc
@@ -90,17 +89,19 @@ def integrate_exact_compiled(
     output_dt: float = 0.002,
     early_stop: bool = True,
     prepared: PreparedExact | None = None,
+    segments: list | None = None,
 ) -> Outcome:
     """rbm_cli.models.rbm.exact.integrate_exact, compiled (same arguments and Outcome).
 
     prepared : PreparedExact, optional  prepare_exact(model), made once by a caller that
         runs one model many times (a sweep); made here when None.
+    segments : list, optional  The forcing instead of the motion's (exact.integrate_exact)
     """
-    check_exact(model, motion.kind)
+    segs = resolve_segments(model, motion, segments)
     if prepared is None:
         prepared = prepare_exact(model)
     n = model.n
-    seg_t, seg_fc = _segments(motion)
+    seg_t, seg_fc = _segments(segs)
     mo = np.array([1.0 if motion.kind == "half-sine" else 0.0, motion.amplitude, motion.omega,
                    motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
     deadline = time.monotonic() + float(solver.max_wall_time)

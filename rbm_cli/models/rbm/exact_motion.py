@@ -60,3 +60,21 @@ def sampled_segments(
     if times.size and times[-1] < t_end:
         out.append((float(times[-1]), t_end, Forcing("zero")))
     return out
+
+
+def resolve_segments(model: Model, motion: GroundMotion, segments=None) -> list:
+    """The forcing segments of a run: the motion's (forcing_segments, which checks its kind),
+    or segments given by the caller (a sampled record: sampled_segments), for which the
+    motion gives only its end and kind. A rigid monolith rests until its uplift level is
+    exceeded, found from a harmonic's formula: under a given piecewise-linear forcing it
+    is not supported yet (one-line RbmError)."""
+    if segments is None:
+        check_exact(model, motion.kind)
+        return forcing_segments(motion)
+    check_exact(model, "free")
+    if model.uplift_level is not None and any(f.kind == "linear" for _, _, f in segments):
+        raise RbmError(
+            "solver.method exact: a rigid monolith under a piecewise-linear forcing is not"
+            " supported yet (its rest and uplift are found for harmonic motions only)"
+        )
+    return list(segments)

@@ -48,19 +48,26 @@ State = namedtuple("State", "theta rate side k pending awaiting maxima fric st c
 
 
 @njit(cache=True)
-def _emit(pc, pts, s, samples, t_stop, rest, dt):
-    """Record the samples due up to t_stop [s], every dt [s]: from point 0 of the piece,
-    or zeros at rest."""
+def _emit(pc, pts, s, samples, t_stop, dt):
+    """Record the samples due up to t_stop [s], every dt [s], from point 0 of the piece."""
     n = s.theta.size
     while s.st[NEXT_OUT] <= t_stop + 1e-12 and int(s.st[N_OUT]) < samples.shape[0]:
         row = int(s.st[N_OUT])
         samples[row, 0] = s.st[NEXT_OUT]
-        if rest:
-            samples[row, 1:] = 0.0
-        else:
-            eval_point(pc, pts, 0, s.st[NEXT_OUT] - pts[0, 0], SCRATCH)
-            samples[row, 1 : 1 + n] = pc.phi @ pts[SCRATCH, 1 : 1 + n]
-            samples[row, 1 + n : 1 + 2 * n] = pc.phi @ pts[SCRATCH, 1 + n : 1 + 2 * n]
+        eval_point(pc, pts, 0, s.st[NEXT_OUT] - pts[0, 0], SCRATCH)
+        samples[row, 1 : 1 + n] = pc.phi @ pts[SCRATCH, 1 : 1 + n]
+        samples[row, 1 + n : 1 + 2 * n] = pc.phi @ pts[SCRATCH, 1 + n : 1 + 2 * n]
+        s.st[N_OUT] += 1
+        s.st[NEXT_OUT] += dt
+
+
+@njit(cache=True)
+def _emit_rest(s, samples, t_stop, dt):
+    """Record zeros (a rigid block at rest) for the samples due up to t_stop [s]."""
+    while s.st[NEXT_OUT] <= t_stop + 1e-12 and int(s.st[N_OUT]) < samples.shape[0]:
+        row = int(s.st[N_OUT])
+        samples[row, 0] = s.st[NEXT_OUT]
+        samples[row, 1:] = 0.0
         s.st[N_OUT] += 1
         s.st[NEXT_OUT] += dt
 
@@ -128,7 +135,7 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
         s.cnt[RHS] += ev
         s.cnt[RHS_PEAKS] += ev
         if se[4] != 0.0:
-            _emit(pc, pts, s, samples, pts[1, 0], False, se[5])
+            _emit(pc, pts, s, samples, pts[1, 0], se[5])
         _accel_and_friction(mdl, pc, pts, 1, s.fric)
         if can_stop and _passed_peak(mdl, pc, pts):
             s.st[T] = pts[1, 0]
@@ -181,7 +188,7 @@ def _handle(mdl, pc, row, s, se):
 
 
 @njit(cache=True)
-def _leave_rest(mdl, s, mo, seg_end, forced, pc, pts, samples, dt):
+def _leave_rest(mdl, s, mo, seg_end, forced, samples, dt):
     """A rigid monolith at rest (exact._leave_rest): 0 no ground motion left (rests to
     the end), 1 the segment ends first, 2 it lifts."""
     t = s.st[T]
@@ -193,7 +200,7 @@ def _leave_rest(mdl, s, mo, seg_end, forced, pc, pts, samples, dt):
             kind, t_stop = 1, seg_end
         else:
             kind, t_stop = 2, t_up
-    _emit(pc, pts, s, samples, t_stop - (1e-15 if kind == 2 else 0.0), True, dt)
+    _emit_rest(s, samples, t_stop - (1e-15 if kind == 2 else 0.0), dt)
     s.st[T] = t_stop
     if kind != 2:
         return kind
@@ -209,17 +216,14 @@ def _leave_rest(mdl, s, mo, seg_end, forced, pc, pts, samples, dt):
 @njit(cache=True)
 def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
     """Run up to seg_end [s] under the forcing fc (exact._segment). Returns a code."""
-    n = s.theta.size
     while s.st[T] < seg_end:
-        pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)
         if s.st[AT_REST] != 0.0:
-            kind = _leave_rest(mdl, s, mo, seg_end, int(fc[0]) != ZERO, pc, wk.pts, samples,
-                               se[5])  # fmt: skip
+            kind = _leave_rest(mdl, s, mo, seg_end, int(fc[0]) != ZERO, samples, se[5])
             if kind == 0:
                 return AT_REST_END
             if kind == 1:
                 return GOING
-            pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)
+        pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)
         set_point(pc, wk.pts, 0, s.st[T], pc.tom @ s.theta, pc.tom @ s.rate)
         row = _march(mdl, pc, wk, s, se, seg_end, can_stop, samples)
         if row < -1:
@@ -228,7 +232,6 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
             code = _handle(mdl, pc, row, s, se)
             if code != GOING:
                 return code
-        _ = n
     return GOING
 
 

@@ -28,9 +28,8 @@ from rbm_cli.config.load import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ
 from rbm_cli.config.load import load_config as _load_file
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import RunResult
-from rbm_cli.physics.column import build_column
-from rbm_cli.report.domain_figure import domain_figure, uplift_level
-from rbm_cli.report.plot_domain import plot_domain as _plot_domain
+from rbm_cli.report.domain_figure import domain_figure
+from rbm_cli.report.domain_figure import draw_domain_on as _draw_domain
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import history_frame
 from rbm_cli.study.domain import read_domain
@@ -253,19 +252,18 @@ def run(
     cfg = _as_config(config)
     if cfg.excitation.type == "free":
         amplitude_g, frequency_hz = 0.0, 0.0
-    for name, value, (lo, hi), unit in (
-        ("amplitude_g", amplitude_g, AMPLITUDE_RANGE_G, "g"),
-        ("frequency_hz", frequency_hz, FREQUENCY_RANGE_HZ, "Hz"),
-    ):
+    checks = [("amplitude_g", amplitude_g, AMPLITUDE_RANGE_G, "g")]
+    if cfg.excitation.type != "record":  # a record has no frequency
+        checks.append(("frequency_hz", frequency_hz, FREQUENCY_RANGE_HZ, "Hz"))
+    for name, value, (lo, hi), unit in checks:
         if value is None:
             raise RbmError(f"{name} [{unit}] is required for excitation.type {cfg.excitation.type}")
         if cfg.excitation.type != "free" and not (_finite(value) and lo <= value <= hi):
             raise RbmError(f"{name} must be a number in [{lo:g}, {hi:g}] [{unit}], got {value!r}")
     if output_dt is not None and not (_finite(output_dt) and output_dt > 0.0):
         raise RbmError(f"output_dt must be a number > 0 [s], got {output_dt!r}")
-    result = simulate(
-        cfg, float(amplitude_g), float(frequency_hz), record=record, output_dt=output_dt
-    )
+    f = None if cfg.excitation.type == "record" else float(frequency_hz)
+    result = simulate(cfg, float(amplitude_g), f, record=record, output_dt=output_dt)
     return CellRun(config=cfg, result=result)
 
 
@@ -338,6 +336,9 @@ def plot_domain(
     df: pd.DataFrame,
     ax=None,
     config: Config | str | os.PathLike | Mapping[str, Any] | None = None,
+    *,
+    dimensionless: bool = False,
+    layout: str = "auto",
     **options,
 ):
     """Draw a safe-unsafe domain (frequency [Hz] x amplitude [g]) on a matplotlib axes.
@@ -348,28 +349,24 @@ def plot_domain(
     ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
     config : Config, path or mapping, optional  The config swept: adds the level [g] where
         the column starts to rock (B/H for a rigid monolith) and the closed forms that apply
+    dimensionless : bool  Axes omega / p and A / (g tan alpha) instead (read from the domain's
+        scale columns, or computed from ``config`` for domains written before them)
+    layout : str  A domain over more axes than amplitude and frequency: 'panels' (one per
+        point of the others), 'overlay' (each point's boundary a line) or 'auto'
+        (rbm_cli.report.domain_view: with one frequency the innermost axis goes on x)
     **options  For rbm_cli.report.plot_domain.plot_domain (compare, labels, ...)
 
     Returns
     -------
-    matplotlib Axes
+    matplotlib Axes  (panels: the list of their axes, in the place of ``ax``)
 
     Examples
     --------
     >>> import rbm
     >>> ax = rbm.plot_domain(rbm.read_domain("out/block/domain.csv"))  # doctest: +SKIP
     """
-    if config is not None:
-        cfg = _as_config(config)
-        level, label = uplift_level(cfg)
-        defaults = {
-            "column": build_column(cfg.column, cfg.interface),
-            "excitation_type": cfg.excitation.type,
-            "static_multiplier": level,
-            "static_label": label,
-        }
-        options = {**defaults, **options}
-    return _plot_domain(df, ax=ax, **options)
+    cfg = None if config is None else _as_config(config)
+    return _draw_domain(df, ax, cfg, dimensionless=dimensionless, layout=layout, **options)
 
 
 def plot_history(run: CellRun | RunResult, ax=None):

@@ -242,3 +242,18 @@ def test_dask_sweeps_axes_as_the_local_workers_do(tmp_path):
             cfg, tmp_path / "dask", jobs=2, backend="dask", scheduler=cluster.scheduler_address
         )
     assert (got.folder / "domain.csv").read_bytes() == (ref.folder / "domain.csv").read_bytes()
+
+
+def test_rbm_compare_prints_the_point_of_each_boundary_line(tmp_path):
+    from click.testing import CliRunner
+
+    from rbm_cli.cli.main import cli
+
+    cfg = config({"frequencies": [1.0], "interface.restitution": [0.9, 1.0]})
+    csv = run_sweep(cfg, tmp_path, jobs=1).folder / "domain.csv"
+    res = CliRunner().invoke(cli, ["compare", str(csv), str(csv)])
+    assert res.exit_code == 0, res.output
+    lines = res.output.splitlines()
+    header = next(line for line in lines if "frequency [Hz]" in line)
+    assert header.split()[0] == "interface.restitution"
+    assert [line.split()[0] for line in lines[lines.index(header) + 1 :]] == ["0.9", "1.0"]

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.physics import record_parsers
+from rbm_cli.config import record_files as record_parsers
 from rbm_cli.physics.records import G, Record, read_record, write_at2, write_csv
 
 HEADER = [

@@ -53,6 +53,9 @@ STUDIES = {
     # grids over config keys (issue 16): the size effect, the drum count
     "size_effect": CONFIGS / "size_effect.yaml",
     "drum_count": CONFIGS / "drum_count.yaml",
+    # record suites (issue 17): the monolith whole, the 8-drum column by its CI band
+    "suite_monolithic": CONFIGS / "suite_monolithic.yaml",
+    "suite_multidrum_ci": CONFIGS / "ci" / "suite_multidrum_ci.yaml",
 }
 
 
@@ -94,6 +97,19 @@ def test_ci_band_matches_the_full_stored_domain():
     assert cmp.n_differ == 0
     merged = full.merge(sub, on=["amplitude_g", "frequency_hz"], suffixes=("", "_ci"))
     assert (merged["robust"] == merged["robust_ci"]).all()
+
+
+def test_suite_band_matches_the_full_stored_suite():
+    """The CI band of the 8-drum suite (4 records, every intensity) is the full stored
+    suite on those cells (matched on record and intensity: the band names its files
+    relative to configs/ci/)."""
+    full = read_domain(RESULTS / "suite_multidrum" / "domain.csv")
+    sub = read_domain(RESULTS / "suite_multidrum_ci" / "domain.csv")
+    merged = full.merge(sub, on=["record", "amplitude_g"], suffixes=("", "_ci"))
+    assert len(merged) == len(sub) == 4 * full["amplitude_g"].nunique()
+    both = (merged["robust"] == 1) & (merged["robust_ci"] == 1)
+    assert both.sum() >= 0.5 * len(merged)  # mostly robust cells, or the check says little
+    assert (merged.loc[both, "collapsed"] == merged.loc[both, "collapsed_ci"]).all()
 
 
 def test_a_perturbed_model_fails_the_rule(tmp_path):

@@ -28,6 +28,10 @@ import math
 import numpy as np
 from numba import njit
 
+from rbm_cli.base.compile_cache import key_numba_cache
+
+key_numba_cache()  # numba's cache of what follows is keyed on every compiled source
+
 
 # ---------------------------------------------------------------- linear algebra
 @njit(cache=True)

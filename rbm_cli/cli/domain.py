@@ -199,17 +199,45 @@ def _resume_command(config, output, jobs, backend, scheduler, ensemble, force) -
     help="Config of the domain (for the static multiplier and closed forms); "
     "default: the meta.json beside DOMAIN.csv if any.",
 )
+@click.option(
+    "--dimensionless",
+    is_flag=True,
+    help="Axes omega/p (x) and A/(g tan alpha) (y), in which geometrically similar "
+    "columns of every size share one boundary.",
+)
+@click.option(
+    "--panels",
+    is_flag=True,
+    help="A domain over more axes: one panel per point of the others (the default).",
+)
+@click.option(
+    "--overlay",
+    is_flag=True,
+    help="A domain over more axes: one axes, each point's boundary as a line of its own.",
+)
 def plot_domain_cmd(
-    domain_csv: str, png: str | None, others: tuple[str, ...], config_path: str | None
+    domain_csv: str,
+    png: str | None,
+    others: tuple[str, ...],
+    config_path: str | None,
+    dimensionless: bool,
+    panels: bool,
+    overlay: bool,
 ) -> None:
     """Draw a safe-unsafe domain: safe (o) and unsafe (x) cells, the boundary,
     the static multiplier and, for rigid monolithic half-sine studies, Housner's
     and the exact linear closed-form curves; other domains overlaid.
 
+    A domain over axes beside amplitude and frequency (a grid over config keys) is
+    drawn as one panel per point (--panels), or as one axes with each point's boundary
+    (--overlay); with one frequency, the innermost axis goes on x instead of the
+    frequency. --dimensionless draws any domain in omega/p and A/(g tan alpha).
+
     \b
     Example:
         rbm plot-domain out/spanos_koh_slender/domain.csv -o slender.png
         rbm plot-domain out/a/domain.csv --compare results/a/domain.csv
+        rbm plot-domain out/size_effect/domain.csv --dimensionless --overlay
     """
     from matplotlib.backend_bases import FigureCanvasBase
 
@@ -219,6 +247,9 @@ def plot_domain_cmd(
 
     if png is not None and not png.strip():
         raise UserError("--output must name an image file (e.g. domain.png), got ''")
+    if panels and overlay:
+        raise UserError("--panels and --overlay exclude each other: give one")
+    layout = "panels" if panels else "overlay" if overlay else "auto"
     try:
         df = read_domain(domain_csv)
         dfs = [read_domain(p) for p in others]
@@ -231,12 +262,20 @@ def plot_domain_cmd(
                 f" (allowed: {', '.join(sorted(kinds))})"
             )
         labels = [Path(domain_csv).parent.name or "domain"] + [Path(p).parent.name for p in others]
-        save_figure_atomic(domain_figure(df, cfg, compare=dfs, labels=labels), target)
+        configs = [_config_for(p, None) for p in others] if dimensionless else None
+        fig = domain_figure(df, cfg, compare=dfs, labels=labels, dimensionless=dimensionless,
+                            layout=layout, compare_configs=configs, where=domain_csv)  # fmt: skip
+        save_figure_atomic(fig, target)
     except RbmError as exc:
-        raise UserError(one_line(exc)) from None
+        raise UserError("--" + one_line(exc) if _names_a_layout(exc) else one_line(exc)) from None
     except OSError as exc:
         raise UserError(f"cannot write {png}: {exc.strerror or exc}") from None
     click.echo(f"wrote {target}")
+
+
+def _names_a_layout(exc: RbmError) -> bool:
+    """The message starts with the layout refused (panels/overlay): the CLI names the flag."""
+    return str(exc).startswith(("panels", "overlay"))
 
 
 def _config_for(domain_csv: str, config_path: str | None):
@@ -251,6 +290,22 @@ def _config_for(domain_csv: str, config_path: str | None):
         return domain_config(domain_csv)
     except RbmError as exc:
         raise UserError(f"the config stored beside {domain_csv}: {one_line(exc)}") from None
+
+
+def _print_shifts(shifts) -> None:
+    """The boundary shifts, one line per frequency (and point of any axes over config
+    keys, whose columns come first)."""
+    from rbm_cli.study.domain import axis_columns
+
+    axes = axis_columns(shifts.columns)
+    head = "".join(f"{p:>22} " for p in axes)
+    click.echo(f"{head}{'frequency [Hz]':>15} {'A [g]':>8} {'B [g]':>8} {'shift [g]':>10}")
+    for _, r in shifts.iterrows():
+        point = "".join(f"{str(r[p]):>22} " for p in axes)
+        click.echo(
+            f"{point}{r.frequency_hz:>15.6g} {r.boundary_a_g:>8.4g} {r.boundary_b_g:>8.4g} "
+            f"{r.shift_g:>+10.4g}"
+        )
 
 
 @cli.command()
@@ -302,7 +357,8 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         first = cmp.first_missing
         raise UserError(
             f"the domains do not cover the same cells: {cmp.only_a} only in {a_csv}, "
-            f"{cmp.only_b} only in {b_csv} (first: {first[0]} g, {first[1]} Hz); compare "
+            f"{cmp.only_b} only in {b_csv} (first: {first[0]} g, {first[1] or 'no'} Hz"
+            f"{''.join(', ' + v for v in first[2:])}); compare "
             "complete domains of the same grid"
         )
     click.echo(
@@ -310,12 +366,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         f"({100 * cmp.fraction:.3g} %); only in A: {cmp.only_a}, only in B: {cmp.only_b}"
     )
     click.echo(f"largest boundary shift: {cmp.max_shift_g:.4g} g")
-    click.echo(f"{'frequency [Hz]':>15} {'A [g]':>8} {'B [g]':>8} {'shift [g]':>10}")
-    for r in cmp.shifts.itertuples():
-        click.echo(
-            f"{r.frequency_hz:>15.6g} {r.boundary_a_g:>8.4g} {r.boundary_b_g:>8.4g} "
-            f"{r.shift_g:>+10.4g}"
-        )
+    _print_shifts(cmp.shifts)
     failed = []
     if "robust" in dom_a.columns:
         from rbm_cli.study.regression import check

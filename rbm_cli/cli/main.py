@@ -14,7 +14,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # the CLI saves figures to files; only the CLI picks a backend
 
-from rbm_cli.cli import bench, domain, run  # noqa: E402, F401  (register the commands)
+from rbm_cli.cli import bench, domain, fragility, run  # noqa: E402, F401  (register the commands)
 from rbm_cli.cli.common import cli  # noqa: E402
 
 __all__ = ["cli", "main"]

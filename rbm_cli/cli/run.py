@@ -25,7 +25,8 @@ from rbm_cli.cli.common import (
 
 def _check_excitation(kind: str, amplitude: float | None, frequency: float | None):
     """Validate --amplitude [g] and --frequency [Hz] for the excitation type (the
-    grid's ranges, rbm_cli.config.load.AMPLITUDE_RANGE_G and FREQUENCY_RANGE_HZ)."""
+    grid's ranges, rbm_cli.config.load.AMPLITUDE_RANGE_G and FREQUENCY_RANGE_HZ).
+    Returns (amplitude [g], frequency [Hz] or None for a record)."""
     from rbm_cli.config.load import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ
 
     if amplitude is not None and not (math.isfinite(amplitude) and amplitude >= 0.0):
@@ -42,6 +43,8 @@ def _check_excitation(kind: str, amplitude: float | None, frequency: float | Non
         return 0.0, 0.0
     if amplitude is None:
         raise UserError(f"--amplitude [g] is required for excitation.type '{kind}'")
+    if kind == "record":
+        return float(amplitude), None
     if frequency is None:
         raise UserError(f"--frequency [Hz] is required for excitation.type '{kind}'")
     return float(amplitude), float(frequency)
@@ -80,14 +83,15 @@ def _print_summary(result, folder: Path) -> None:
     "--amplitude",
     type=float,
     default=None,
-    help="Peak ground acceleration [g], >= 0 (not used by 'free').",
+    help="Peak ground acceleration [g], >= 0 (not used by 'free'); for a 'record', its"
+    " PGA after scaling (or the scale factor with excitation.scale: factor).",
 )
 @click.option(
     "-f",
     "--frequency",
     type=float,
     default=None,
-    help="Excitation frequency [Hz], > 0 (not used by 'free').",
+    help="Excitation frequency [Hz], > 0 (not used by 'free' and 'record').",
 )
 @click.option(
     "--dt",
@@ -118,6 +122,7 @@ def run(
     Example:
         rbm run configs/spanos_koh_slender.yaml --amplitude 0.5 --frequency 1
         rbm run configs/harmonic_multidrum.yaml -a 0.3 -f 2 -o /tmp/rbm-out
+        rbm run my_record.yaml --amplitude 0.4     (excitation.type: record)
     """
     from rbm_cli.api import run as run_cell
     from rbm_cli.base.files import check_writable_dir
@@ -129,6 +134,8 @@ def run(
     amplitude_g, frequency_hz = _check_excitation(kind, amplitude, frequency)
     if kind == "free" and (amplitude is not None or frequency is not None):
         click.echo("note: excitation.type is 'free': --amplitude/--frequency are ignored", err=True)
+    if kind == "record" and frequency is not None:
+        click.echo("note: excitation.type is 'record': --frequency is ignored", err=True)
     if output_dt is not None and not (math.isfinite(output_dt) and output_dt > 0.0):
         raise UserError(f"--dt must be a finite number > 0 [s], got {output_dt:g}")
     if output_dt is not None and cfg.excitation.duration / output_dt > MAX_SAMPLES:

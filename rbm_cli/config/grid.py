@@ -19,6 +19,7 @@ Each point of the axes is a config of its own, validated as a config is (rbm_cli
 
 from __future__ import annotations
 
+import glob
 import os
 import re
 from collections.abc import Mapping
@@ -233,7 +234,7 @@ def _suite_files(value: Any, base: Path) -> list[str] | None:
     if not isinstance(value, str) or not value.strip():
         return None
     if any(c in value for c in GLOB_CHARS):
-        found = sorted(p for p in base.glob(value) if p.is_file())
+        found = sorted(Path(p) for p in glob.glob(os.path.join(base, value)) if Path(p).is_file())
         if not found:
             raise ConfigError(f"{where}: the pattern {value!r} matches no file (in {base})")
         return [_relative(p, base) for p in found]

@@ -14,7 +14,17 @@ from typing import Any
 
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.types import FORMULATIONS, InterfaceConfig, StiffnessConfig
-from rbm_cli.config.validate import choice, describe, fmt, is_number, mapping, number, number_list
+from rbm_cli.config.validate import (
+    SOUND_WHY,
+    choice,
+    describe,
+    fmt,
+    in_bounds,
+    is_number,
+    mapping,
+    number,
+    number_list,
+)
 
 INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation", "friction")
 STIFFNESS_KEYS = ("rotational", "normal")
@@ -65,15 +75,6 @@ def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
     )
 
 
-def _in_range(x: float, path: str, unit: str, bounds: tuple[float, float]) -> float:
-    if not bounds[0] <= x <= bounds[1]:
-        raise ConfigError(
-            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
-            f" the arithmetic is sound), got {fmt(x)}"
-        )
-    return x
-
-
 def stiffness_value(value: Any, n: int, *, given: bool = True) -> StiffnessConfig:
     """``rigid``, ``{rotational: K_M or [K_M,i]}`` or ``{normal: k_n}``."""
     path = "interface.stiffness"
@@ -98,7 +99,7 @@ def stiffness_value(value: Any, n: int, *, given: bool = True) -> StiffnessConfi
             return _rotational(m["rotational"], n)
         sub = f"{path}.normal"
         k_n = number(m["normal"], sub, "Pa/m", 0.0, inf_hint="use rigid for an infinite stiffness")
-        return StiffnessConfig("normal", (_in_range(k_n, sub, "Pa/m", NORMAL_RANGE),))
+        return StiffnessConfig("normal", (in_bounds(k_n, sub, "Pa/m", NORMAL_RANGE, SOUND_WHY),))
     raise ConfigError(
         f"{path} must be rigid, {BOTH_FORMS} (K_M one value or a list with one per interface),"
         f" got {describe(value)}"
@@ -111,7 +112,9 @@ def _rotational(value: Any, n: int) -> StiffnessConfig:
         per = f"one K_M per interface ({n} for {n} drum{'s' if n > 1 else ''})"
         values = number_list(value, path, "N m/rad", 0.0, length=n, length_text=per)
         for i, k in enumerate(values):
-            _in_range(k, f"{path}[{i}]", "N m/rad", ROTATIONAL_RANGE)
+            in_bounds(k, f"{path}[{i}]", "N m/rad", ROTATIONAL_RANGE, SOUND_WHY)
         return StiffnessConfig("moment", values)
     k_m = number(value, path, "N m/rad", 0.0, inf_hint="use rigid for an infinite stiffness")
-    return StiffnessConfig("moment", (_in_range(k_m, path, "N m/rad", ROTATIONAL_RANGE),))
+    return StiffnessConfig(
+        "moment", (in_bounds(k_m, path, "N m/rad", ROTATIONAL_RANGE, SOUND_WHY),)
+    )

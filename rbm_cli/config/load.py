@@ -21,11 +21,11 @@ from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
-from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, parse_grid
+from rbm_cli.config.excitation import check_vertical, excitation_section
+from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, hoist_suite, parse_grid
 from rbm_cli.config.interface import interface_section
 from rbm_cli.config.points import expand
 from rbm_cli.config.types import (
-    EXCITATIONS,
     IMPLEMENTATIONS,
     METHODS,
     MODELS,
@@ -33,14 +33,13 @@ from rbm_cli.config.types import (
     CollapseConfig,
     ColumnConfig,
     Config,
-    ExcitationConfig,
-    InitialConfig,
     SolverConfig,
 )
 from rbm_cli.config.validate import (
     choice,
     describe,
     fmt,
+    in_bounds,
     integer,
     join,
     mapping,
@@ -55,8 +54,6 @@ __all__ = ["AMPLITUDE_RANGE_G", "FREQUENCY_RANGE_HZ", "load_config", "parse_conf
 
 TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
 COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
-EXCITATION_KEYS = ("type", "duration", "phase", "initial")
-INITIAL_KEYS = ("rotations", "velocities")
 COLLAPSE_KEYS = ("ratio",)
 SOLVER_KEYS = (
     "method",
@@ -75,9 +72,6 @@ PLANNED_MODELS: tuple[str, ...] = ()
 MULTI_DRUM_MODELS = tuple(name for name, entry in MODELS.items() if entry.multi_drum)
 #: Range of solver.time_step, the contact engine's fixed step [s].
 TIME_STEP_RANGE = (1e-6, 1e-2)
-#: Default ``excitation.duration`` per type [s] (SPEC section 3).
-DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
-MAX_DURATION = 1e4  # [s]
 MAX_DRUMS = 200
 MAX_TOP_TAPER = 3.0  # top_width <= MAX_TOP_TAPER * base_width (and <= height)
 #: Heights of a column or block the tool accepts [m] [assumption]: a laboratory
@@ -89,9 +83,6 @@ HEIGHT_RANGE = (1e-3, 1e3)
 #: and reported a collapsing column as survived: issue 14).
 LENGTH_RANGE = (1e-4, 1e3)
 DENSITY_RANGE = (1.0, 1e5)
-#: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
-INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
-PHASE_MAX = 1e3
 #: Largest step and event budgets (a 64-bit count; 1e300 failed in the compiled kernel).
 MAX_BUDGET = 1_000_000_000
 #: Range of solver.max_wall_time, the wall-clock budget of one run [s].
@@ -141,19 +132,26 @@ def load_config(path: str | os.PathLike[str]) -> Config:
         raise ConfigError(
             f"cannot parse {source}: not UTF-8 text (bad byte at offset {exc.start})"
         ) from None
-    return parse_config(read_yaml(text, source), source)
+    return parse_config(read_yaml(text, source), source, base_dir=file.parent)
 
 
 # ------------------------------------------------------------------------ sections
 
 
-def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
+def parse_config(
+    data: Mapping[str, Any],
+    source: str = "<config>",
+    base_dir: str | os.PathLike[str] | None = None,
+) -> Config:
     """Validate the mapping a YAML config holds and build a :class:`Config`.
 
     Parameters
     ----------
     data : mapping  Parsed YAML or a dict (keys of SPEC section 4; numpy numbers allowed)
     source : str  Where ``data`` came from, prefixed to error messages
+    base_dir : path or None  Folder that relative paths in the config (a record's
+        ``excitation.file``) are taken from; None: the current directory.
+        :func:`load_config` passes the config file's folder.
 
     Returns
     -------
@@ -165,19 +163,21 @@ def parse_config(data: Mapping[str, Any], source: str = "<config>") -> Config:
     """
     written = plain_copy(data)  # numpy numbers (a notebook's) read as the numbers they are
     try:
-        config = dataclasses.replace(_config(written), written=written)
-        expand(config, parse_config)  # every point of the grid's axes validates, or one line
+        config = _config(written, base_dir)
+        folder = os.getcwd() if base_dir is None else os.path.abspath(base_dir)
+        config = dataclasses.replace(config, written=written, base_dir=folder)
+        expand(config, parse_config, base_dir=folder)  # every grid point validates, or one line
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
     return config
 
 
-def _config(data: Any) -> Config:
+def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
     if data is None:
         raise ConfigError("the config is empty (it needs at least name and column)")
     if isinstance(data, Mapping) and "initial" in data:
         raise ConfigError("unknown key 'initial' at top level: it goes under excitation")
-    top = mapping(data, "", TOP_KEYS)
+    top = hoist_suite(mapping(data, "", TOP_KEYS), base_dir)  # a suite: an axis of records
     if "name" not in top:
         raise ConfigError("name is required (the output folder name)")
     if "column" not in top:
@@ -193,12 +193,15 @@ def _config(data: Any) -> Config:
     n = column.n_drums
     if model not in MULTI_DRUM_MODELS and n != 1:
         raise ConfigError(f"model {model!r} needs a monolithic column (drums: 1), got {n} drums")
+    interface = interface_section(top.get("interface"), n, model)
+    excitation = excitation_section(top.get("excitation"), n, base_dir)
+    check_vertical(excitation, model, interface.stiffness.kind)
     return Config(
         name=name,
         column=column,
         model=model,
-        interface=interface_section(top.get("interface"), n, model),
-        excitation=_excitation(top.get("excitation"), n),
+        interface=interface,
+        excitation=excitation,
         grid=parse_grid(top.get("grid")),
         collapse=CollapseConfig(
             ratio=number(
@@ -278,13 +281,8 @@ def _column(raw: Any) -> ColumnConfig:
 def _bounded(
     x: float, path: str, unit: str = "m", bounds: tuple[float, float] = LENGTH_RANGE
 ) -> float:
-    """x within bounds [assumption: the range where the arithmetic is sound]."""
-    if not bounds[0] <= x <= bounds[1]:
-        raise ConfigError(
-            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
-            f" masses, inertias and moments stay finite), got {fmt(x)}"
-        )
-    return x
+    """x within bounds (validate.in_bounds, lengths by default)."""
+    return in_bounds(x, path, unit, bounds)
 
 
 def _drums(value: Any, height: float) -> tuple[float, ...]:
@@ -307,46 +305,6 @@ def _drums(value: Any, height: float) -> tuple[float, ...]:
             " (they must agree within 1e-9 relative)"
         )
     return heights
-
-
-def _excitation(raw: Any, n: int) -> ExcitationConfig:
-    e = mapping(raw, "excitation", EXCITATION_KEYS)
-    kind = choice(e.get("type", "harmonic"), "excitation.type", EXCITATIONS)
-    duration = number(
-        e.get("duration", DEFAULT_DURATION.get(kind, 10.0)),
-        "excitation.duration",
-        "s",
-        0.0,
-        MAX_DURATION,
-    )
-    phase = number(e.get("phase", 0.0), "excitation.phase", "rad")
-    phase = _bounded(phase, "excitation.phase", "rad", (-PHASE_MAX, PHASE_MAX))
-    if phase != 0.0 and kind != "harmonic":
-        raise ConfigError(
-            f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"
-        )
-    path = "excitation.initial"
-    init = mapping(e.get("initial"), path, INITIAL_KEYS)
-    per = f"one value per drum ({n})"
-    values = {
-        key: tuple(
-            _bounded(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
-            for i, x in enumerate(
-                number_list(init[key], join(path, key), unit, length=n, length_text=per)
-            )
-        )
-        if key in init
-        else ()
-        for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
-    }
-    if kind == "free" and not any(values["rotations"]) and not any(values["velocities"]):
-        raise ConfigError(
-            f"{path}: excitation type free needs a non-zero initial rotation or velocity"
-            f" ({path}.rotations or .velocities); with none the column stays at rest"
-        )
-    return ExcitationConfig(
-        type=kind, duration=duration, phase=phase, initial=InitialConfig(**values)
-    )
 
 
 def _solver(raw: Any) -> SolverConfig:

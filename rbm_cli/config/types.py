@@ -15,7 +15,19 @@ G = 9.81
 
 SECTIONS = ("rectangular", "circular")
 FORMULATIONS = ("relative", "absolute", "geometric")
-EXCITATIONS = ("harmonic", "half-sine", "free")
+#: Near-fault pulses (one cycle or wavelet, then free motion), by the rocking literature's
+#: names: amplitude [g] and frequency [Hz] from the grid, as the half-sine.
+PULSES = ("one-sine", "cycloidal", "ricker", "mavroeidis-papageorgiou")
+EXCITATIONS = ("harmonic", "half-sine", "free", *PULSES, "record")
+#: Units of a record file's accelerations (excitation.units) and how a record is scaled to
+#: the grid's amplitude (excitation.scale: its PGA [g], or a plain factor).
+RECORD_UNITS = ("g", "m/s2")
+RECORD_SCALES = ("pga", "factor")
+#: Default free motion after a record's last sample [s] (excitation.free_time)
+#: [assumption]: a few rocking half-periods of a stone column (0.5-2 s each), so a column
+#: still rocking when the shaking ends has time to collapse or settle; a monolithic
+#: column whose energy is below its collapse barrier is stopped early anyway.
+DEFAULT_FREE_TIME = 5.0
 METHODS = ("DOP853", "RK45", "RK23", "exact")
 IMPLEMENTATIONS = ("compiled", "python")
 
@@ -111,20 +123,74 @@ class InitialConfig:
     velocities: tuple[float, ...] = ()
 
 
+#: ExcitationConfig fields of type 'record' only, and those never in Config.resolved()
+#: (the absolute path of the file depends on where the checkout lives; the path as
+#: written and the file's digest identify the record).
+_RECORD_FIELDS = ("file", "file_sha256", "units", "free_time", "scale")
+_VERTICAL_FIELDS = ("vertical", "vertical_sha256")
+_MP_FIELDS = ("gamma", "nu")
+_LOCAL_FIELDS = ("file_path", "vertical_path")
+
+
 @dataclass(frozen=True)
 class ExcitationConfig:
     """Ground motion shape; amplitude and frequency come from the grid or the CLI.
 
-    type : str  'harmonic', 'half-sine' or 'free'
-    duration : float  Harmonic: length of the excitation; half-sine: maximum
-        simulated time; free: simulated time [s]
+    type : str  'harmonic', 'half-sine', 'free', a pulse ('one-sine', 'cycloidal',
+        'ricker', 'mavroeidis-papageorgiou') or 'record'
+    duration : float  Harmonic: length of the excitation; half-sine and pulses: maximum
+        simulated time; free: simulated time; record: the simulated time, set by the
+        loader to the record's last sample time plus free_time (not written by the
+        user) [s]
     phase : float  Phase of the harmonic [rad]
+    file : str or None  Record: its file (PEER NGA .AT2 or CSV) as written in the config
+    file_sha256 : str or None  Record: SHA-256 of the file's bytes (identifies the record
+        in the config's hash wherever the checkout lives)
+    units : str  Record: units of a CSV's accelerations, 'g' or 'm/s2' (an .AT2 is in g)
+    free_time : float  Record: free motion simulated after its last sample [s]
+    scale : str  Record: 'pga' (the grid's amplitude [g] is the scaled record's peak
+        ground acceleration: the record is multiplied by amplitude / its own PGA) or
+        'factor' (the amplitude is a plain scale factor [-])
+    vertical : str or None  Record: a second file, the upward ground acceleration, as
+        written (scaled by the same factor as the horizontal record)
+    vertical_sha256 : str or None  Its SHA-256
+    gamma : float or None  Mavroeidis-Papageorgiou: oscillatory character, > 1 [-]
+    nu : float or None  Mavroeidis-Papageorgiou: phase of the harmonic [rad]
+    file_path, vertical_path : str or None  Record: the files' absolute paths (resolved
+        against the config's folder); not in :meth:`resolved`, not compared
     """
 
     type: str = "harmonic"
     duration: float = 10.0
     phase: float = 0.0
     initial: InitialConfig = field(default_factory=InitialConfig)
+    file: str | None = None
+    file_sha256: str | None = None
+    units: str = "g"
+    free_time: float = DEFAULT_FREE_TIME
+    scale: str = "pga"
+    gamma: float | None = None
+    nu: float | None = None
+    vertical: str | None = None
+    vertical_sha256: str | None = None
+    file_path: str | None = field(default=None, compare=False)
+    vertical_path: str | None = field(default=None, compare=False)
+
+    def resolved(self) -> dict:
+        """The settings that define the motion, as plain data: the fields of other
+        excitation types and the absolute paths are left out (so a config that does not
+        use them has the same resolved form, and hash, as before they existed)."""
+        out = asdict(self)
+        drop = list(_LOCAL_FIELDS)
+        if self.type != "record":
+            drop += _RECORD_FIELDS
+        if self.vertical is None:
+            drop += _VERTICAL_FIELDS
+        if self.type != "mavroeidis-papageorgiou":
+            drop += _MP_FIELDS
+        for key in drop:
+            out.pop(key)
+        return out
 
 
 @dataclass(frozen=True)
@@ -191,7 +257,11 @@ class Config:
     The sections are typed and in SI (the grid in g and Hz); ``written`` is the mapping the
     user wrote (YAML or a dict), kept as given once it validated, so that a stored result
     (meta.json) can be re-read exactly as it was configured, never rebuilt from derived
-    values. It takes no part in equality, in the config's hash or in :meth:`resolved`.
+    values. It takes no part in equality, in the config's hash or in :meth:`resolved`;
+    nor does ``base_dir``, the folder relative paths in it (a record's file) were taken
+    from (the config file's folder, or the current directory of the time it was parsed),
+    so that ``written`` can be validated again as it was:
+    ``parse_config(config.written, base_dir=config.base_dir)``.
     """
 
     name: str
@@ -203,11 +273,16 @@ class Config:
     collapse: CollapseConfig = field(default_factory=CollapseConfig)
     solver: SolverConfig = field(default_factory=SolverConfig)
     written: dict | None = field(default=None, compare=False, repr=False)
+    base_dir: str | None = field(default=None, compare=False, repr=False)
 
     def resolved(self) -> dict:
-        """Every resolved setting as plain data (dataclasses.asdict without ``written``)."""
+        """Every resolved setting as plain data (dataclasses.asdict without ``written``,
+        ``base_dir`` and the excitation's fields that do not apply,
+        :meth:`ExcitationConfig.resolved`)."""
         out = asdict(self)
         out.pop("written", None)
+        out.pop("base_dir", None)
+        out["excitation"] = self.excitation.resolved()
         if not out["grid"]["axes"]:  # a plain grid resolves (and hashes) as it always did
             del out["grid"]["axes"]
         return out

@@ -147,6 +147,23 @@ def number(
     return x
 
 
+#: Why a bound is there, as range messages say it.
+FINITE_WHY = "masses, inertias and moments stay finite"
+SOUND_WHY = "the arithmetic is sound"
+
+
+def in_bounds(
+    x: float, path: str, unit: str, bounds: tuple[float, float], why: str = FINITE_WHY
+) -> float:
+    """x within the closed interval ``bounds`` [assumption: the range where ``why``]."""
+    if not bounds[0] <= x <= bounds[1]:
+        raise ConfigError(
+            f"{path} must be in [{fmt(bounds[0])}, {fmt(bounds[1])}] [{unit}] (the range where"
+            f" {why}), got {fmt(x)}"
+        )
+    return x
+
+
 def integer(value: Any, path: str, lo: int, hi: int | None = None, what: str = "") -> int:
     """An integer in [lo, hi]; a float with an integral value (``2e6``) is accepted."""
     rng = f">= {lo}" if hi is None else f"in {lo}..{hi}"

@@ -49,9 +49,12 @@ class BlockRunner:
         early_stop: bool = True,
     ) -> Outcome:
         """One run (rbm_cli.models.contract.Runner.run)."""
+        t_lift = motion.lift_off  # a vertical record dropping faster than gravity
+        if t_lift is not None:
+            motion = motion.until(t_lift)
         out = self._integrate(
             motion, solver, record=record, output_dt=output_dt, early_stop=early_stop
-        )
+        ).lifted_off(t_lift)
         if record:
             out.history = history_from_samples(self.node_map, motion, out.samples)
         return out

@@ -8,7 +8,8 @@ with the true centre of mass and the rotary inertia of the tapered solid about
 a base corner (not the RBM's mid-height lumping). Integrated by scipy's DOP853
 driven step by step, restarted at every impact and at the end of a pulse;
 impacts (theta = 0), collapse (|theta| = c alpha) and peaks (theta' = 0) are
-located by root finding on the step's dense output.
+located by root finding on the step's dense output. Under a record every step ends at
+a sample (rbm_cli.models.knots), where the acceleration has a kink.
 
 References
 ----------
@@ -38,6 +39,7 @@ from rbm_cli.models.housner_steps import (
     HousnerStep,
     peak_in_step,
 )
+from rbm_cli.models.knots import clip_at_knots
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.block import (
     BlockGeometry,
@@ -45,9 +47,21 @@ from rbm_cli.physics.block import (
     top_displacement,
 )
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.ground_forms import SINE
 from rbm_cli.physics.restitution import block_restitution, resolve
 
-_METHODS = {"DOP853": DOP853, "RK45": RK45, "RK23": RK23}
+_METHODS = {m.__name__: clip_at_knots(m) for m in (DOP853, RK45, RK23)}
+
+
+def ground_over_g(motion: GroundMotion):
+    """a_g(t) / g [-] of the motion's forced segments, t [s]: the sine as
+    amp_g sin(omega t + phase) with amp_g = A / g (the operations of the model's first
+    version, so its results keep their bits), any other form as a_g(t) / g."""
+    if motion.form == SINE:
+        amp_g, om, ph = motion.amplitude / G, motion.omega, motion.phase
+        return lambda tt: amp_g * math.sin(om * tt + ph)
+    accel = motion.scalar(True)
+    return lambda tt: accel(tt) / G
 
 
 def _start(geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, initial, events):
@@ -64,9 +78,8 @@ def _start(geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, 
         eps=EVENT_EPS * alpha,
         level=G * math.tan(alpha),
         atol=solver.atol * np.array([alpha, p * alpha]),
-        amp_g=motion.amplitude / G,
-        om=motion.omega,
-        ph=motion.phase,
+        ground=ground_over_g(motion),
+        gravity=motion.gravity(True),
         solver=solver,
         record=record,
     )
@@ -191,6 +204,7 @@ def _segment(
         )
         stepper = _METHODS[solver.method]
         integ = stepper(eqs.rhs, run.t, y, seg_end, rtol=solver.rtol, atol=blk.atol)
+        integ.knots = motion.knots if motion.clipped else None  # a record's samples
         kind = _step_to_event(blk, run, eqs, integ, stop_ok)
         if isinstance(kind, Outcome):
             return kind
@@ -229,7 +243,7 @@ def housner_run(
     record : bool  Keep samples (t [s], [theta] [rad], [rate] [rad/s]) every output_dt [s]
     output_dt : float  Sampling interval of the history [s]
     initial : (float, float)  Initial rotation [rad] and rate [rad/s]
-    early_stop : bool  After a half-sine pulse, stop at rest, or at a peak
+    early_stop : bool  After a pulse or a record, stop at rest, or at a peak
         when the energy is below the collapse barrier
     events : list or None  If a list, (t [s], kind) is appended for every
         'uplift', 'impact', 'rest' and 'collapse'

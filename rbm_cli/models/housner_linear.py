@@ -22,6 +22,7 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,7 @@ from rbm_cli.models.housner_linear_piece import LinearPiece, PieceScanner, Scan
 from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.ground_forms import gravity_factor
 
 #: Samples per scanning chunk of a closed-form piece.
 _CHUNK = 64
@@ -118,6 +120,9 @@ class _LinearBlock:
     phase: float  # ground phase [rad]
     max_pieces: int
     record: bool
+    knots: np.ndarray | None = None  # a record's sample times [s] (pieces end there)
+    values: np.ndarray | None = None  # its accelerations [m/s^2]
+    vertical: np.ndarray | None = None  # its upward accelerations a_v [m/s^2]
 
     @classmethod
     def make(cls, alpha, p, motion, restitution, collapse_ratio, max_pieces, record):
@@ -135,6 +140,9 @@ class _LinearBlock:
             phase=motion.phase,
             max_pieces=max_pieces,
             record=record,
+            knots=motion.knots if motion.clipped else None,
+            values=motion.values if motion.clipped else None,
+            vertical=motion.vertical,
         )
 
 
@@ -162,23 +170,41 @@ class _LinearRun(BlockRun):
         )
 
 
+def _start_piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: bool):
+    """The closed-form piece from the current state, and where it ends [s]: seg_end, or
+    under a record the next sample (the ground acceleration is one line up to it). With a
+    vertical record, theta'' = p^2 gam (theta - s alpha) - p^2 a_g / g, gam = (g + a_v) / g
+    taken constant on the piece at its middle: exact for a_v constant between samples (the
+    similarity test of tests/test_vertical.py), second order in the sample step otherwise."""
+    t = run.t
+    if not forced or blk.knots is None:
+        amp = blk.amp_g if forced else 0.0
+        piece = LinearPiece.start(
+            t, run.theta, run.rate, run.side, blk.alpha, blk.p, amp, blk.omega, blk.phase
+        )
+        return piece, seg_end
+    knots, values = blk.knots, blk.values
+    k = int(np.searchsorted(knots, t, side="right"))  # the first sample after t
+    end = min(float(knots[k]), seg_end) if k < knots.size else seg_end
+    q0 = q1 = 0.0  # at rest before the first sample
+    if 0 < k < knots.size:
+        q1 = (values[k] - values[k - 1]) / (knots[k] - knots[k - 1]) / G
+        q0 = values[k - 1] / G + q1 * (t - knots[k - 1])
+    p = blk.p
+    if blk.vertical is not None:  # g -> g + a_v: p^2 gam (theta - s alpha) - p^2 a_g / g
+        gam = gravity_factor(0.5 * (t + end), knots, blk.vertical)  # the piece's middle
+        p, q0, q1 = p * math.sqrt(gam), q0 / gam, q1 / gam
+    piece = LinearPiece.start_line(t, run.theta, run.rate, run.side, blk.alpha, p, q0, q1)
+    return piece, end
+
+
 def _piece(blk: _LinearBlock, run: _LinearRun, seg_end: float, forced: bool, can_stop: bool):
     """One closed-form piece from the current state up to its first event, a peak of free
-    motion below the barrier (when can_stop) or seg_end [s]. Returns the Outcome if the
-    run ends there, else None."""
+    motion below the barrier (when can_stop) or its end (seg_end [s], or a record's next
+    sample). Returns the Outcome if the run ends there, else None."""
     out, rec, t = run.out, run.rec, run.t
     alpha, p = blk.alpha, blk.p
-    piece = LinearPiece.start(
-        t,
-        run.theta,
-        run.rate,
-        run.side,
-        alpha,
-        p,
-        blk.amp_g if forced else 0.0,
-        blk.omega,
-        blk.phase,
-    )
+    piece, seg_end = _start_piece(blk, run, seg_end, forced)
     out.n_steps += 1
     sc = scan_piece(piece, seg_end - t, blk.limit)
     out.n_rhs += sc.n_evals
@@ -278,6 +304,9 @@ def housner_linear_run(
     -------
     Outcome  status 'collapsed' or 'survived' (or 'failed' past the budget);
         n_steps counts closed-form pieces, n_rhs closed-form evaluations.
+        Records: exact pieces between samples; Ricker / MP pulses sampled first
+        (GroundMotion.sampled); a vertical record's gam = (g + a_v) / g constant on each
+        piece at its middle (_start_piece).
 
     Notes
     -----
@@ -301,6 +330,7 @@ def housner_linear_run(
         raise ValueError("alpha [rad] and p [rad/s] must be > 0")
     if not 0.0 < restitution <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
+    motion = motion.sampled()  # a pulse with no closed form as a record; else itself
     blk = _LinearBlock.make(alpha, p, motion, restitution, collapse_ratio, max_pieces, record)
     run = _LinearRun.make(blk, record, output_dt, events, height, initial)
     finish = run.finish

@@ -23,7 +23,9 @@ class LinearPiece:
 
     theta(tau) = s alpha + C sin(omega tau + phi0) + c1 exp(p tau) + c2 exp(-p tau),
     tau = t - t0 [s]; C = p^2 A / (p^2 + omega^2), A the ground amplitude in g
-    (C = 0 in free motion).
+    (C = 0 in free motion). Under a straight-line ground acceleration (a record between
+    two samples), a_g / g = q0 + q1 tau, the particular solution is the line itself:
+    theta(tau) = s alpha + q0 + q1 tau + c1 exp(p tau) + c2 exp(-p tau) (C = 0).
     """
 
     t0: float
@@ -35,6 +37,8 @@ class LinearPiece:
     phi0: float
     c1: float
     c2: float
+    q0: float = 0.0  # a_g / g at t0 of a straight-line ground acceleration [-]
+    q1: float = 0.0  # its slope [1/s]
 
     @classmethod
     def start(cls, t0, theta0, rate0, side, alpha, p, amplitude_g, omega, phase):
@@ -44,6 +48,15 @@ class LinearPiece:
         x0 = theta0 - side * alpha - c * math.sin(phi0)
         v0 = rate0 - c * omega * math.cos(phi0)
         return cls(t0, side, alpha, p, c, omega, phi0, 0.5 * (x0 + v0 / p), 0.5 * (x0 - v0 / p))
+
+    @classmethod
+    def start_line(cls, t0, theta0, rate0, side, alpha, p, q0, q1):
+        """The piece through (theta0 [rad], rate0 [rad/s]) at t0 [s] under the ground
+        acceleration a_g / g = q0 + q1 (t - t0) [-]."""
+        x0 = theta0 - side * alpha - q0
+        v0 = rate0 - q1
+        c1, c2 = 0.5 * (x0 + v0 / p), 0.5 * (x0 - v0 / p)
+        return cls(t0, side, alpha, p, 0.0, 0.0, 0.0, c1, c2, q0, q1)
 
     def _exps(self, tau):
         tau = np.asarray(tau, dtype=float)
@@ -57,12 +70,16 @@ class LinearPiece:
         """Rotation theta(t0 + tau) [rad]."""
         tau, e1, e2 = self._exps(tau)
         forced = self.forced_amplitude * np.sin(self.omega * tau + self.phi0)
+        if self.q0 != 0.0 or self.q1 != 0.0:
+            forced = forced + (self.q0 + self.q1 * tau)
         return self.side * self.alpha + forced + e1 + e2
 
     def rate(self, tau):
         """Rate theta'(t0 + tau) [rad/s]."""
         tau, e1, e2 = self._exps(tau)
         forced = self.forced_amplitude * self.omega * np.cos(self.omega * tau + self.phi0)
+        if self.q1 != 0.0:
+            forced = forced + self.q1
         return forced + self.p * (e1 - e2)
 
 

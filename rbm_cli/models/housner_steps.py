@@ -5,6 +5,7 @@ record of one step, with the peak rotation found inside a step."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -29,9 +30,8 @@ class HousnerBlock:
     eps: float  # offset of the impact surface [rad]
     level: float  # uplift level g tan(alpha) [m/s^2]
     atol: np.ndarray  # absolute tolerances of theta [rad] and rate [rad/s]
-    amp_g: float  # ground amplitude [g]
-    om: float  # ground circular frequency [rad/s]
-    ph: float  # ground phase [rad]
+    ground: Callable[[float], float]  # a_g(t) / g [-] of the forced segments, t [s]
+    gravity: Callable[[float], float] | None  # (g + a_v(t)) / g [-] (None: no vertical)
     solver: SolverConfig
     record: bool
 
@@ -52,8 +52,12 @@ class HousnerSide:
         blk, s = self.blk, self.s
         alpha, p = blk.alpha, blk.p
         arg = alpha * s - yy[0]
-        a = blk.amp_g * math.sin(blk.om * tt + blk.ph) if self.forced else 0.0
-        return np.array([yy[1], -p * p * (math.sin(arg) + a * math.cos(arg))])
+        a = blk.ground(tt) if self.forced else 0.0
+        if blk.gravity is None or not self.forced:
+            return np.array([yy[1], -p * p * (math.sin(arg) + a * math.cos(arg))])
+        # g -> g + a_v: p^2 and the weight's moment scale with it, a_g / g does not
+        gam = blk.gravity(tt)
+        return np.array([yy[1], -p * p * (gam * math.sin(arg) + a * math.cos(arg))])
 
     def dist(self, yy):
         """Event distances (impact, collapse) at the state(s) yy [rad]."""

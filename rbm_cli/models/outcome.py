@@ -39,3 +39,12 @@ class Outcome:
         self.status, self.t_end = status, t
         self.message = message if status != "failed" else f"{message} at t={t:.6g} s"
         return self
+
+    def lifted_off(self, t_lift: float | None) -> Outcome:
+        """A run that reached t_lift [s], where g + a_v(t) <= 0 (the ground's upward
+        acceleration reaches -g: the column leaves the ground), ends there as 'failed'
+        unless it collapsed before; None: nothing to do."""
+        if t_lift is not None and self.status == "survived":
+            self.stop("failed", "g + a_v(t) <= 0: the ground drops faster than gravity and"
+                      " the column leaves it (excitation.vertical)", t_lift)  # fmt: skip
+        return self

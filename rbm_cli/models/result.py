@@ -69,7 +69,7 @@ class RunResult:
 
     status: str
     amplitude_g: float
-    frequency_hz: float
+    frequency_hz: float | None  # None: a record (no frequency)
     t_collapse_s: float
     collapse_interface: int | None
     max_rotation_ratio: float

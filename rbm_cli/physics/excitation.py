@@ -1,126 +1,199 @@
-"""Ground motions (SPEC section 3), SI inside: a_g [m/s^2], t [s], omega [rad/s]."""
+"""Ground motions of a config (SPEC section 3), SI inside: a_g [m/s^2], t [s], omega [rad/s].
+
+:func:`make_ground_motion` turns a config's excitation, an amplitude [g] and a frequency
+[Hz] (the grid's, at this edge only) into the :class:`~rbm_cli.physics.motion.GroundMotion`
+every model integrates: a harmonic, a half-sine or near-fault pulse (physics/pulses.py),
+or a record read from its file (physics/records.py) with its vertical record if any.
+"""
 
 from __future__ import annotations
 
+import hashlib
 import math
-from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
-from rbm_cli.config.types import ExcitationConfig, G
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import PULSES, ExcitationConfig, G
+from rbm_cli.physics.ground_forms import mp_knots, ricker_knots
+from rbm_cli.physics.motion import PULSE_KINDS, SAMPLES_PER_PERIOD, GroundMotion
+from rbm_cli.physics.pulses import (
+    mavroeidis_papageorgiou_duration,
+    mp_peak,
+    one_sine_duration,
+    ricker_duration,
+)
+from rbm_cli.physics.records import Record, read_record
+
+__all__ = [
+    "PULSE_KINDS",
+    "SAMPLES_PER_PERIOD",
+    "GroundMotion",
+    "load_record",
+    "make_ground_motion",
+    "merge_records",
+    "pulse_motion",
+    "record_motion",
+]
 
 
-@dataclass(frozen=True)
-class GroundMotion:
-    """A ground acceleration a_g(t) = amplitude * sin(omega t + phase) on [0, t_pulse_end).
+# --------------------------------------------------------------------------- records
 
-    kind : str  'harmonic', 'half-sine' or 'free'
-    amplitude : float  Peak acceleration [m/s^2]
-    omega : float  Circular frequency [rad/s]
-    phase : float  [rad]
-    pulse_end : float  Time after which a_g = 0 [s] (inf-like for harmonic: the duration)
-    t_end : float  Maximum simulated time [s]
+
+@lru_cache(maxsize=64)
+def load_record(path: str, units: str, sha256: str | None) -> Record:
+    """The record of a config's file (read once per process), checked against the
+    SHA-256 the config took when it was loaded (None: not checked).
+
+    Raises
+    ------
+    RbmError  A malformed file (one line naming the file and line), or a file that
+        changed since the config was loaded.
     """
+    record = read_record(path, units)
+    if sha256 is not None:
+        digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+        if digest != sha256:
+            raise RbmError(
+                f"{path}: the record file changed since the config was loaded (SHA-256"
+                f" {digest[:12]}..., the config has {sha256[:12]}...): load the config again"
+            )
+    return record
 
-    kind: str
-    amplitude: float
-    omega: float
-    phase: float
-    pulse_end: float
-    t_end: float
 
-    def accel(self, t: float | np.ndarray) -> np.ndarray | float:
-        """Ground acceleration a_g(t) [m/s^2]."""
-        if self.amplitude == 0.0:
-            return np.zeros_like(t) if isinstance(t, np.ndarray) else 0.0
-        a = self.amplitude * np.sin(self.omega * np.asarray(t) + self.phase)
-        if self.kind == "half-sine":
-            a = np.where(np.asarray(t) <= self.pulse_end, a, 0.0)
-        return a if isinstance(t, np.ndarray) else float(a)
+def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMotion:
+    """The ground motion of a record excitation at amplitude [g] (its PGA after scaling
+    with scale 'pga', a plain factor [-] with scale 'factor'): the scaled record (and its
+    vertical record, scaled by the same factor), then free motion for
+    excitation.free_time [s]."""
+    path = excitation.file_path or excitation.file
+    if path is None:
+        raise RbmError("excitation.file is required for type record")
+    rec = load_record(str(path), excitation.units, excitation.file_sha256)
+    if excitation.scale == "pga":
+        factor = amplitude_g * G / rec.pga
+    else:
+        factor = float(amplitude_g)
+    knots, values, vertical = rec.t, rec.acceleration * factor, None
+    end = rec.duration
+    if excitation.vertical is not None:
+        path = excitation.vertical_path or excitation.vertical
+        ver = load_record(str(path), excitation.units, excitation.vertical_sha256)
+        knots, values, vertical = merge_records(rec.t, values, ver.t, ver.acceleration * factor)
+        end = max(end, ver.duration)
+        vertical.setflags(write=False)
+    values.setflags(write=False)
+    peak = float(np.max(np.abs(values)))
+    return GroundMotion(
+        "record",
+        peak,
+        0.0,
+        0.0,
+        end,
+        end + excitation.free_time,
+        gain=1.0,
+        knots=knots,
+        values=values,
+        name=rec.name,
+        vertical=vertical,
+    )
 
-    def displacement(self, t: np.ndarray) -> np.ndarray:
-        """Ground displacement u_g(t) [m] (for plots; the dynamics see only a_g).
 
-        Harmonic: the steady form -a_g / omega^2. Half-sine: integrated from rest,
-        so the ground keeps the pulse's velocity 2 A / omega after the pulse.
-        """
-        t = np.asarray(t, dtype=float)
-        if self.amplitude == 0.0:
-            return np.zeros_like(t)
-        A, w = self.amplitude, self.omega
-        if self.kind == "harmonic":
-            return -A / w**2 * np.sin(w * t + self.phase)
-        tp = np.minimum(t, self.pulse_end)
-        u = A / w * tp - A / w**2 * np.sin(w * tp)
-        return u + 2.0 * A / w * np.maximum(t - self.pulse_end, 0.0) * (t > self.pulse_end)
+def _limits(t: float, ts: np.ndarray, vs: np.ndarray) -> tuple[float, float]:
+    """(value just before t, value just after t) of a record (ts [s], vs), linear
+    between its samples and 0 outside them."""
+    inside = float(np.interp(t, ts, vs))
+    before = inside if ts[0] < t <= ts[-1] else 0.0
+    after = inside if ts[0] <= t < ts[-1] else 0.0
+    return before, after
 
-    def segments(self) -> list[tuple[float, float]]:
-        """Intervals on which a_g is smooth (the integrator restarts between them)."""
-        if self.kind == "half-sine" and self.pulse_end < self.t_end:
-            return [(0.0, self.pulse_end), (self.pulse_end, self.t_end)]
-        return [(0.0, self.t_end)]
 
-    def after_pulse(self, seg_start: float) -> bool:
-        """Whether the segment starting at seg_start [s] is the free motion after a half-sine."""
-        return self.kind == "half-sine" and seg_start >= self.pulse_end
+def merge_records(
+    th: np.ndarray, ah: np.ndarray, tv: np.ndarray, av: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Two records (times [s], values), each linear between its samples and 0 outside them,
+    on one set of knots: (knots, horizontal, vertical). Both are linear between the union
+    of their sample times; where either jumps (its first or last value not 0, inside the
+    run) the time is written twice, the values before then after. At the first knot the
+    values after it are kept (the ground rests before), at the last those before it."""
+    times = np.union1d(th, tv)
+    knots: list[float] = []
+    hs: list[float] = []
+    vs: list[float] = []
+    for i, t in enumerate(times):
+        hb, ha = _limits(t, th, ah)
+        vb, va = _limits(t, tv, av)
+        if i == len(times) - 1:
+            ha, va = hb, vb
+        if 0 < i < len(times) - 1 and (hb != ha or vb != va):
+            knots += [t, t]
+            hs += [hb, ha]
+            vs += [vb, va]
+        else:
+            knots.append(t)
+            hs.append(ha)
+            vs.append(va)
+    return np.array(knots), np.array(hs), np.array(vs)
 
-    def forced(self, seg_start: float) -> bool:
-        """Whether a_g is non-zero on the segment starting at seg_start [s]."""
-        return self.amplitude > 0.0 and not self.after_pulse(seg_start)
 
-    def next_exceedance(self, t0: float, level: float) -> float | None:
-        """First time t >= t0 with |a_g(t)| > level, or None before t_end.
+def pulse_motion(excitation: ExcitationConfig, amplitude: float, frequency_hz: float):
+    """A near-fault pulse of peak acceleration amplitude [m/s^2] and frequency f_p [Hz]
+    (physics/pulses.py), then free motion up to excitation.duration [s] (the whole pulse
+    is always simulated):
 
-        Exact for the sine: |sin(psi)| > s with s = level / amplitude holds on
-        (asin(s) + k pi, pi - asin(s) + k pi). The returned time is where
-        |a_g| = level and rising (or t0 itself when already above).
-        """
-        if self.amplitude <= level:
-            return None
-        last = min(self.pulse_end, self.t_end)
-        if t0 >= last:
-            return None
-        s = level / self.amplitude
-        psi0 = self.omega * t0 + self.phase
-        if abs(math.sin(psi0)) > s:
-            return t0
-        lo = math.asin(s)
-        k = math.ceil((psi0 - lo) / math.pi)
-        psi = lo + k * math.pi
-        if psi < psi0:
-            psi += math.pi
-        t = (psi - self.phase) / self.omega
-        if t >= last:
-            return None
-        return t
-
-    def rest_end(self, t: float, seg_end: float, level: float, forced: bool) -> tuple[str, float]:
-        """How the rest of a rigid block, at rest at time t, ends.
-
-        Returns ('end', t_end) when no ground motion is left (it rests to the end
-        of the run), ('segment', seg_end) when |a_g| stays below `level`
-        [m/s^2] in the current segment, or ('uplift', t_up) when it exceeds it.
-        """
-        if not forced:
-            return "end", self.t_end
-        t_up = self.next_exceedance(t, level)
-        if t_up is None or t_up >= seg_end:
-            return "segment", seg_end
-        return "uplift", t_up
-
-    def uplift_side(self, t: float) -> int:
-        """Side (sign of theta) a block lifts on at time t: away from a_g."""
-        return -1 if self.accel(t) > 0.0 else 1
+    - one-sine: A sin(w t) on [0, 1/f_p] (Zhang and Makris's cycloidal type A);
+    - cycloidal: A cos(w t) on [0, 1/f_p] (type B; a sine of phase pi/2), whose ground
+      velocity and displacement return to 0;
+    - ricker: A (1 - 2 u^2) exp(-u^2), u = pi f_p (t - t0), on [0, 2 t0], t0 = 1.5 / f_p;
+    - mavroeidis-papageorgiou: MP's acceleration pulse of gamma, nu on [0, gamma / f_p],
+      scaled to the peak A.
+    """
+    kind, f = excitation.type, frequency_hz
+    omega = 2.0 * math.pi * f
+    if kind in ("one-sine", "cycloidal"):
+        end = one_sine_duration(f)
+        phase = 0.0 if kind == "one-sine" else 0.5 * math.pi
+        return GroundMotion(kind, amplitude, omega, phase, end, max(excitation.duration, end))
+    if kind == "ricker":
+        end = ricker_duration(f)
+        center = 0.5 * end
+        knots = ricker_knots(omega, center)
+        t_end = max(excitation.duration, end)
+        return GroundMotion(kind, amplitude, omega, 0.0, end, t_end, center=center, knots=knots)
+    gamma, nu = float(excitation.gamma), float(excitation.nu)
+    end = mavroeidis_papageorgiou_duration(f, gamma)
+    return GroundMotion(
+        kind,
+        amplitude,
+        omega,
+        nu,
+        end,
+        max(excitation.duration, end),
+        gain=amplitude / mp_peak(gamma, nu),
+        center=0.5 * end,
+        gamma=gamma,
+        knots=mp_knots(f, gamma, nu),
+    )
 
 
 def make_ground_motion(
-    excitation: ExcitationConfig, amplitude_g: float, frequency_hz: float
+    excitation: ExcitationConfig, amplitude_g: float, frequency_hz: float | None = None
 ) -> GroundMotion:
-    """Ground motion of a run; amplitude in g and frequency in Hz at this edge only."""
+    """Ground motion of a run; amplitude in g and frequency in Hz at this edge only.
+
+    frequency_hz is not used by 'free' and 'record' (None is accepted there)."""
     if excitation.type == "free":
         return GroundMotion("free", 0.0, 1.0, 0.0, 0.0, excitation.duration)
+    if excitation.type == "record":
+        return record_motion(excitation, amplitude_g)
+    if frequency_hz is None:
+        raise RbmError(f"a frequency [Hz] is required for excitation type {excitation.type}")
     omega = 2.0 * math.pi * frequency_hz
     amplitude = amplitude_g * G
+    if excitation.type in PULSES:
+        return pulse_motion(excitation, amplitude, frequency_hz)
     if excitation.type == "half-sine":
         pulse_end = 0.5 / frequency_hz
         # the whole pulse is always simulated, then free motion up to `duration`

@@ -263,6 +263,13 @@ def _mp_peak(gamma: float, nu: float) -> float:
     return max(float(values[k]), -float(best.fun))
 
 
+def mp_peak(gamma: float, nu: float) -> float:
+    """max |a| of the Mavroeidis-Papageorgiou shape for a unit velocity amplitude, over
+    f_p [-]: the pulse of peak A has V = A / (f_p mp_peak) (checked gamma > 1)."""
+    _, g, nu = _mp_check(1.0, gamma, nu)
+    return _mp_peak(g, nu)
+
+
 def mavroeidis_papageorgiou(t, amplitude: float, frequency_hz: float, gamma: float, nu: float):
     """Mavroeidis-Papageorgiou (2003) near-fault pulse, scaled to peak acceleration A.
 

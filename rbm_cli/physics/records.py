@@ -16,7 +16,7 @@ strictly increasing sample times t [s]. Its conventions, which the integrator re
 
 Reading is strict: every malformed file is refused with an :class:`~rbm_cli.base.errors.RbmError`
 whose one-line message names the file and, where there is one, the line. Files are parsed
-in blocks of lines with numpy (:mod:`rbm_cli.physics.record_parsers`), so memory stays bounded;
+in blocks of lines with numpy (:mod:`rbm_cli.config.record_files`), so memory stays bounded;
 files of more than 10^7 samples or 512 MiB are refused before they are read.
 
 References
@@ -35,10 +35,10 @@ from pathlib import Path
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config import record_files as record_parsers
 from rbm_cli.config.types import G  # gravity [m/s^2], the one definition
-from rbm_cli.physics import record_parsers
 
-_UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0}
+_UNITS = record_parsers.UNITS
 
 
 @dataclass(frozen=True, eq=False)
@@ -198,19 +198,8 @@ def read_record(path: str | os.PathLike, units: str = "g", fmt: str | None = Non
     0.31
     """
     path = Path(path)
-    kind = (fmt or path.suffix.lstrip(".")).lower()
-    if kind not in ("at2", "csv"):
-        raise RbmError(f"{path}: unknown record format {kind!r} (expected .AT2 or .csv)")
-    if units not in _UNITS:
-        raise RbmError(f"{path}: units must be 'g' or 'm/s2', got {units!r}")
-    record_parsers.check_file(path)
-    if kind == "at2":
-        if _UNITS[units] != G:
-            raise RbmError(f"{path}: an .AT2 file is in g; units {units!r} do not apply")
-        t, values_g, title = record_parsers.read_at2(path)
-        return Record(t, values_g * G, path.stem, str(path), title)
-    t, values = record_parsers.read_csv(path)
-    return Record(t, values * _UNITS[units], path.stem, str(path))
+    t, values, title = record_parsers.read_file(path, units, fmt)
+    return Record(t, values, path.stem, str(path), title)
 
 
 # --------------------------------------------------------------------------- writing

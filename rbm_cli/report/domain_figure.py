@@ -1,28 +1,132 @@
 """The figure of a domain (domain.png): the domain in the frequency x amplitude plane with the
 level at which the column starts to rock (the RBM's static multiplier, or the engine's own
-uplift level for `bullet`) and the closed forms that apply."""
+uplift level for `bullet`) and the closed forms that apply; a domain over more axes as
+panels or an overlay, and any domain in dimensionless axes (rbm_cli.report.domain_view
+states the layout rule, rbm_cli.report.plot_axes what is drawn)."""
 
 from __future__ import annotations
 
+import math
+import numbers
 from collections.abc import Sequence
 
 import pandas as pd
 from matplotlib.figure import Figure
 
+from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.physics.column import build_column
-from rbm_cli.report.plot_domain import plot_domain
+from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
+from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
+from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
+from rbm_cli.study.domain import axis_columns
+
+__all__ = ["domain_figure", "draw_domain_on", "uplift_level"]
 
 
-def uplift_level(config: Config) -> tuple[float, str]:
-    """(level [g], label) at which the config's column starts to rock: the RBM's static
-    multiplier, or for `bullet` the engine's own level from its true solids."""
-    if config.model == "bullet":
-        from rbm_cli.models.bullet.run import engine_uplift_g
+def _plain(df: pd.DataFrame, dimensionless: bool, layout: str) -> bool:
+    """Today's plot: physical axes, a domain with no axis beside amplitude and frequency."""
+    return not dimensionless and layout == "auto" and not axis_columns(df.columns)
 
-        return engine_uplift_g(config), "engine uplift level"
-    column = build_column(config.column, config.interface)
-    return column.static_multiplier, "static multiplier"
+
+def _config_options(config: Config | None) -> dict:
+    """plot_domain's column, excitation type and uplift level of a config."""
+    if config is None:
+        return {}
+    level, label = uplift_level(config)
+    return {
+        "column": build_column(config.column, config.interface),
+        "excitation_type": config.excitation.type,
+        "static_multiplier": level,
+        "static_label": label,
+    }
+
+
+def _compared(view: DomainView, compare, labels, compare_configs, where):
+    """The compared domains in the view's columns: all of each for one plane, per point for
+    panels (a list per point); an overlay draws none."""
+    compare = list(compare)
+    if not compare:
+        return []
+    if view.layout == "overlay":
+        raise RbmError(f"overlay draws one line per point of {where}: compare domains in panels")
+    names = list(labels[1:]) if labels else [f"domain {k + 2}" for k in range(len(compare))]
+    configs = list(compare_configs) if compare_configs else [None] * len(compare)
+    if view.dimensionless:
+        compare = [with_scales(c, cfg, name) for c, cfg, name in zip(compare, configs, names,
+                                                                      strict=True)]  # fmt: skip
+    for c, name in zip(compare, names, strict=True):
+        missing = [col for col in (view.x, view.y) if col not in c.columns]
+        if missing:
+            raise RbmError(f"{name} has no column {missing[0]}: it cannot be drawn over {where}")
+    if view.layout == "single":
+        return compare
+    return [[view.at_point(c, p, n) for c, n in zip(compare, names, strict=True)]
+            for p in view.points]  # fmt: skip
+
+
+def draw_domain_on(
+    df: pd.DataFrame,
+    ax=None,
+    config: Config | None = None,
+    *,
+    dimensionless: bool = False,
+    layout: str = "auto",
+    compare: Sequence[pd.DataFrame] = (),
+    labels: Sequence[str] | None = None,
+    compare_configs: Sequence[Config | None] | None = None,
+    where: str = "the domain",
+    colorbar: bool = True,
+    **options,
+):
+    """Draw a domain on an axes (a new Figure's when None), as domain_view lays it out.
+
+    Returns the axes, or for panels the list of the panels' axes (they take the place of
+    ``ax`` in its figure). ``options`` (column, excitation_type, static_multiplier,
+    static_label of rbm_cli.report.plot_domain.plot_domain) apply to the plain plot only;
+    ``config`` gives them otherwise. ``compare_configs``: the compared domains' configs,
+    for dimensionless axes of domains written without their scale columns; ``colorbar``
+    False: panels of an ensemble leave their colour bar to the caller."""
+    if _plain(df, dimensionless, layout):
+        options = {**_config_options(config), **options}
+        return plot_domain(df, ax=ax, compare=compare, labels=labels, **options)
+    if options:
+        raise RbmError(
+            f"{', '.join(options)}: for the plain plot only; with dimensionless axes or"
+            " more axes the config gives the column and its levels"
+        )
+    view = domain_view(df, config, dimensionless, layout, where)
+    others = _compared(view, compare, labels, compare_configs, where)
+    if ax is None:
+        ax = Figure(figsize=figure_size(view)).add_subplot()
+    if view.layout == "panels":
+        fig, spec = ax.figure, ax.get_subplotspec()
+        if spec is None:
+            raise RbmError("panels take the place of an axes on a grid: pass ax=None or a subplot")
+        ax.remove()
+        return draw_panels(fig, view, spec, others, labels, colorbar)
+    if view.layout == "overlay":
+        draw_overlay(ax, view, numeric=_numeric(view))
+    else:
+        draw_plane(ax, view, view.points[0], others, labels)
+    return ax
+
+
+def _numeric(view: DomainView) -> bool:
+    """The overlaid points are the values of one numeric axis (linked ones count as one:
+    the first value names the point), drawn in ordered colours."""
+    first = [p.values[0] for p in view.points]
+    numeric = all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in first)
+    return numeric and len(set(first)) == len(first)
+
+
+def figure_size(view: DomainView) -> tuple[float, float]:
+    """Width and height [in] of a view's figure: panels 3.4 x 2.7 each, legend beside."""
+    if view.layout != "panels":
+        return (9.5, 5.0)
+    n = len(view.points)
+    ncols = min(4, math.ceil(math.sqrt(n)))
+    return (3.4 * ncols + 3.2, 2.7 * math.ceil(n / ncols) + 0.8)
 
 
 def domain_figure(
@@ -30,6 +134,11 @@ def domain_figure(
     config: Config | None,
     compare: Sequence[pd.DataFrame] = (),
     labels: Sequence[str] | None = None,
+    *,
+    dimensionless: bool = False,
+    layout: str = "auto",
+    compare_configs: Sequence[Config | None] | None = None,
+    where: str = "the domain",
 ) -> Figure:
     """The figure of domain.png (a Figure of its own, not held by pyplot).
 
@@ -39,7 +148,55 @@ def domain_figure(
     config : Config or None  The config it was swept with (None: the cells and boundaries only)
     compare : sequence of DataFrame  Other domains whose boundaries are drawn over it
     labels : sequence of str  Their legend labels
+    dimensionless : bool  A / (g tan alpha) against omega / p (rbm_cli.physics.similarity)
+    layout : str  'auto', 'panels' or 'overlay' for a domain over more axes than amplitude
+        and frequency (rbm_cli.report.domain_view: the rule of 'auto')
+    compare_configs : sequence  The configs of ``compare`` (dimensionless axes of old domains)
+    where : str  How messages name the domain (its file)
     """
+    if _plain(df, dimensionless, layout):
+        return _plain_figure(df, config, compare, labels)
+    view = domain_view(df, config, dimensionless, layout, where)
+    fig = Figure(figsize=figure_size(view))
+    ax = fig.add_subplot()
+    drawn = draw_domain_on(df, ax, config, dimensionless=dimensionless, layout=layout,
+                           compare=compare, labels=labels, compare_configs=compare_configs,
+                           where=where, colorbar=False)  # fmt: skip
+    name = config.name if config is not None else (labels[0] if labels else "")
+    kind = f" ({config.excitation.type})" if config is not None else ""
+    title = f"{name}: safe-unsafe domain{kind}" + (", dimensionless" if dimensionless else "")
+    freqs = df["frequency_hz"].dropna().unique()
+    if view.line != "frequency_hz" and len(freqs) == 1:
+        title += f", at {freqs[0]:g} Hz"
+    if isinstance(drawn, list):
+        fig.suptitle(title)
+    else:
+        drawn.set_title(title)
+    fig.tight_layout()
+    if isinstance(drawn, list) and "collapse_fraction" in df.columns:
+        _colorbar_below(fig, drawn)
+    return fig
+
+
+def _colorbar_below(fig, axes: list) -> None:
+    """The collapse fraction's colour bar in a band added below the panels (after the
+    tight layout, which cannot place a colour bar shared by several axes)."""
+    width, old = fig.get_size_inches()
+    band = 0.85  # [in]: the bar, its ticks and label, under the panels' own margin
+    height = old + band
+    fig.set_size_inches(width, height)
+    pars = fig.subplotpars
+    top = 1.0 - (1.0 - pars.top) * old / height  # the margins keep their inches
+    fig.subplots_adjust(bottom=(pars.bottom * old + band) / height, top=top)
+    fig._suptitle.set_y(1.0 - (1.0 - fig._suptitle.get_position()[1]) * old / height)
+    x0 = min(ax.get_position().x0 for ax in axes)
+    x1 = max(ax.get_position().x1 for ax in axes)
+    cax = fig.add_axes((x0, 0.45 / height, x1 - x0, 0.12 / height))
+    fraction_colorbar(fig, None, cax=cax)
+
+
+def _plain_figure(df, config, compare, labels) -> Figure:
+    """A domain over amplitude and frequency only, in physical axes (as it always was)."""
     fig = Figure(figsize=(9.5, 5))
     ax = fig.add_subplot()
     if config is None:  # a domain without its config: no column, no curves of it
@@ -48,18 +205,7 @@ def domain_figure(
             ax.set_title(f"{labels[0]}: safe-unsafe domain")
         fig.tight_layout()
         return fig
-    column = build_column(config.column, config.interface)
-    level, level_label = uplift_level(config)
-    plot_domain(
-        df,
-        ax=ax,
-        compare=compare,
-        labels=labels,
-        column=column,
-        excitation_type=config.excitation.type,
-        static_multiplier=level,
-        static_label=level_label,
-    )
+    plot_domain(df, ax=ax, compare=compare, labels=labels, **_config_options(config))
     ax.set_title(f"{config.name}: safe-unsafe domain ({config.excitation.type})")
     fig.tight_layout()
     return fig

@@ -12,28 +12,17 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from pathlib import Path
 
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.base.files import publish_files_atomic
 from rbm_cli.study.fragility import METHOD, FragilityResult
 from rbm_cli.study.outcomes import intensity_column as find_intensity_column
 
 #: Float format of the CSV files (12 significant digits, as domain.csv).
 FLOAT_FORMAT = "%.12g"
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _number(x: float) -> float | None:
@@ -64,6 +53,21 @@ def fragility_summary(result: FragilityResult) -> dict:
     }
 
 
+def fragility_texts(result: FragilityResult, extra: dict | None = None) -> dict[str, str]:
+    """The text of ``fragility.csv``, ``fragility_curve.csv`` and ``fragility.json``, by
+    name; ``extra`` entries (JSON values, e.g. the domain's path) are added to the JSON."""
+    summary = fragility_summary(result) | (extra or {})
+    return {
+        "fragility.csv": _csv(result.table),
+        "fragility_curve.csv": _csv(result.curve),
+        "fragility.json": json.dumps(summary, indent=2, allow_nan=False) + "\n",
+    }
+
+
+def _csv(frame: pd.DataFrame) -> str:
+    return frame.to_csv(index=False, float_format=FLOAT_FORMAT, lineterminator="\n")
+
+
 def write_fragility(result: FragilityResult, folder: str | os.PathLike) -> list[Path]:
     """Write ``fragility.csv``, ``fragility_curve.csv`` and ``fragility.json`` into ``folder``.
 
@@ -72,7 +76,8 @@ def write_fragility(result: FragilityResult, folder: str | os.PathLike) -> list[
     result : FragilityResult
         From :func:`rbm_cli.study.fragility.fragility`
     folder : str or os.PathLike
-        Created if missing; files are replaced atomically
+        Created if missing; the three files are staged in full, then moved into place
+        together (:func:`rbm_cli.base.files.publish_files_atomic`)
 
     Returns
     -------
@@ -90,15 +95,10 @@ def write_fragility(result: FragilityResult, folder: str | os.PathLike) -> list[
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise RbmError(f"{folder}: cannot create the output folder ({exc.strerror})") from None
-    paths = [folder / "fragility.csv", folder / "fragility_curve.csv", folder / "fragility.json"]
     try:
-        _write_atomic(paths[0], result.table.to_csv(index=False, float_format=FLOAT_FORMAT))
-        _write_atomic(paths[1], result.curve.to_csv(index=False, float_format=FLOAT_FORMAT))
-        text = json.dumps(fragility_summary(result), indent=2, allow_nan=False)
-        _write_atomic(paths[2], text + "\n")
+        return publish_files_atomic(folder, fragility_texts(result))
     except OSError as exc:
         raise RbmError(f"{folder}: cannot write the fragility files ({exc.strerror})") from None
-    return paths
 
 
 # --------------------------------------------------------------------------- figures

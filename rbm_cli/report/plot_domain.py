@@ -18,7 +18,16 @@ from rbm_cli.physics.closed_forms import halfsine_threshold_curves
 from rbm_cli.physics.column import Column
 from rbm_cli.study.domain import boundary
 
-__all__ = ["boundary", "plot_domain"]
+__all__ = [
+    "boundary",
+    "draw_cells",
+    "draw_domain",
+    "finish_axes",
+    "fraction_colorbar",
+    "legend_beside",
+    "plot_domain",
+    "plot_levels",
+]
 
 #: Colours of compared domains' boundaries (the main boundary is black).
 COMPARE_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")
@@ -86,12 +95,14 @@ def _masks(df: pd.DataFrame):
     return ~unsafe & ~failed, unsafe, failed
 
 
-def _plot_cells(ax, df: pd.DataFrame) -> None:
-    """Safe cells as open circles, unsafe as crosses, failed as grey squares, above the lines."""
+def _plot_cells(ax, df: pd.DataFrame, size: float | None = None) -> None:
+    """Safe cells as open circles, unsafe as crosses, failed as grey squares, above the
+    lines; ``size`` [points] defaults to :func:`marker_size`."""
     f = df["frequency_hz"].to_numpy(float)
     a = df["amplitude_g"].to_numpy(float)
     safe, unsafe, failed = _masks(df)
-    style = dict(linestyle="none", markersize=marker_size(ax, df), zorder=CELL_Z)
+    size = marker_size(ax, df) if size is None else size
+    style = dict(linestyle="none", markersize=size, zorder=CELL_Z)
     ax.plot(f[safe], a[safe], marker="o", markerfacecolor="none", color="tab:green",
             label="safe (survived)", gid="safe", **style)  # fmt: skip
     ax.plot(f[unsafe], a[unsafe], marker="x", color="tab:red", label="unsafe (collapsed)",
@@ -101,12 +112,12 @@ def _plot_cells(ax, df: pd.DataFrame) -> None:
                 gid="failed", **style)  # fmt: skip
 
 
-def _plot_fraction_cells(ax, df: pd.DataFrame) -> list:
+def _plot_fraction_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None) -> list:
     """Cells of an ensemble domain: the marker is member 0's outcome (the domain's row),
-    the colour the fraction of members that collapsed, with a colour bar.
+    the colour the fraction of members that collapsed, with a colour bar (unless
+    ``colorbar`` is False: panels share one, :func:`fraction_colorbar`).
 
     Returns dark legend proxies of the markers (the points' colours vary)."""
-    from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
     from matplotlib.lines import Line2D
 
@@ -116,7 +127,7 @@ def _plot_fraction_cells(ax, df: pd.DataFrame) -> list:
     frac = df["collapse_fraction"].to_numpy(float)
     safe, unsafe, failed = _masks(df)
     colours = cmap(norm(np.nan_to_num(frac, nan=0.0)))
-    size = marker_size(ax, df)
+    size = marker_size(ax, df) if size is None else size
     width = max(0.6, size / 4.0)
     ax.scatter(f[safe], a[safe], marker="o", facecolors="none", edgecolors=colours[safe],
                s=size**2, linewidths=width, gid="safe", zorder=CELL_Z)  # fmt: skip
@@ -131,10 +142,23 @@ def _plot_fraction_cells(ax, df: pd.DataFrame) -> list:
         ax.scatter(f[failed], a[failed], marker="s", c="0.45", s=(0.8 * size) ** 2,
                    gid="failed", zorder=CELL_Z)  # fmt: skip
         handles.append(Line2D([], [], marker="s", label="failed run", **{**proxy, "color": "0.45"}))
-    # below the axes: the legend sits beside them
-    ax.figure.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, label=FRACTION_LABEL,
-                       location="bottom", pad=0.16, fraction=0.06, aspect=40)  # fmt: skip
+    if colorbar:
+        fraction_colorbar(ax.figure, ax)
     return handles
+
+
+def fraction_colorbar(fig, axes, cax=None) -> None:
+    """The colour bar of the collapse fraction, below ``axes`` (one or a list; the legend
+    sits beside them), or in ``cax``."""
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    mappable = ScalarMappable(norm=Normalize(0.0, 1.0), cmap=_fraction_cmap())
+    if cax is not None:
+        fig.colorbar(mappable, cax=cax, label=FRACTION_LABEL, orientation="horizontal")
+        return
+    fig.colorbar(mappable, ax=axes, label=FRACTION_LABEL, location="bottom", pad=0.16,
+                 fraction=0.06, aspect=40)  # fmt: skip
 
 
 def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str) -> None:
@@ -186,17 +210,35 @@ def _labels(labels: Sequence[str] | None, n_compare: int) -> list[str]:
     return [f"{name}: boundary" for name in labels]
 
 
-def _finish_axes(ax, domains: list, static_multiplier: float | None, proxies: list) -> None:
-    """Amplitude range, axis labels, grid and the legend beside the axes."""
+def finish_axes(
+    ax,
+    domains: list,
+    static_multiplier: float | None,
+    proxies: list,
+    labels: tuple[str, str] = ("frequency [Hz]", "amplitude [g]"),
+    legend: bool = True,
+) -> None:
+    """Amplitude range (from 0 to just above the largest amplitude or level), the axis
+    ``labels`` (x, y), grid and (if ``legend``) the legend beside the axes."""
     amplitudes = np.concatenate([d["amplitude_g"].to_numpy(float) for d in domains])
     top = max([float(np.nanmax(amplitudes))] if len(amplitudes) else [1.0])
     if static_multiplier is not None:
         top = max(top, float(static_multiplier))
     ax.set_ylim(0.0, 1.06 * top)
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("amplitude [g]")
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
     ax.grid(True, alpha=0.3)
-    handles, texts = ax.get_legend_handles_labels()
+    if legend:
+        legend_beside(ax, proxies)
+
+
+def legend_beside(ax, proxies: list = (), handles=None) -> None:
+    """The legend beside the axes (never over the cells): ``proxies`` (an ensemble's
+    markers, under its title) first, then ``handles`` (default: the axes' labelled artists)."""
+    proxies = list(proxies)
+    if handles is None:
+        handles, _ = ax.get_legend_handles_labels()
+    texts = [h.get_label() for h in handles]
     ax.legend(
         title=FRACTION_TITLE if proxies else None,
         title_fontsize="small",
@@ -209,7 +251,7 @@ def _finish_axes(ax, domains: list, static_multiplier: float | None, proxies: li
     )
 
 
-def _plot_levels(ax, domains, column, excitation_type, static_multiplier, static_label):
+def plot_levels(ax, domains, column, excitation_type, static_multiplier, static_label):
     """The static multiplier (or the level given) and, for a rigid monolith under a
     half-sine, the closed-form thresholds; returns the level drawn [g] (or None)."""
     if static_multiplier is None and column is not None:
@@ -235,6 +277,30 @@ def _plot_levels(ax, domains, column, excitation_type, static_multiplier, static
         _plot_closed_forms(ax, column, frequencies)
 
     return static_multiplier
+
+
+def draw_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None) -> list:
+    """The cells of ``df`` (see :func:`plot_domain`) at its frequency_hz (x) and
+    amplitude_g (y); returns the ensemble's legend proxies ([] for a plain domain)."""
+    if "collapse_fraction" in df.columns:
+        return _plot_fraction_cells(ax, df, colorbar, size)
+    _plot_cells(ax, df, size)
+    return []
+
+
+def draw_domain(
+    ax, df: pd.DataFrame, compare=(), labels=None, colorbar: bool = True, size=None
+) -> list:
+    """Cells of ``df`` and the boundaries of it and of ``compare`` (see :func:`plot_domain`),
+    from its amplitude_g and frequency_hz columns; returns the ensemble's legend proxies."""
+    compare = list(compare)
+    labels = _labels(labels, len(compare))
+    proxies = draw_cells(ax, df, colorbar, size)
+    _plot_boundary(ax, df, "black", labels[0], "boundary")
+    for k, (other, label) in enumerate(zip(compare, labels[1:], strict=True)):
+        colour = COMPARE_COLOURS[k % len(COMPARE_COLOURS)]
+        _plot_boundary(ax, other, colour, label, f"compare-{k}")
+    return proxies
 
 
 def plot_domain(
@@ -296,21 +362,10 @@ def plot_domain(
     of the grids, so a steep closed-form curve does not squash the domain.
     """
     compare = list(compare)
-    labels = _labels(labels, len(compare))
     ax = _new_axes(ax)
-
-    proxies = []
-    if "collapse_fraction" in df.columns:
-        proxies = _plot_fraction_cells(ax, df)
-    else:
-        _plot_cells(ax, df)
-    _plot_boundary(ax, df, "black", labels[0], "boundary")
-    for k, (other, label) in enumerate(zip(compare, labels[1:], strict=True)):
-        colour = COMPARE_COLOURS[k % len(COMPARE_COLOURS)]
-        _plot_boundary(ax, other, colour, label, f"compare-{k}")
-
-    static_multiplier = _plot_levels(
+    proxies = draw_domain(ax, df, compare, labels)
+    static_multiplier = plot_levels(
         ax, [df, *compare], column, excitation_type, static_multiplier, static_label
     )
-    _finish_axes(ax, [df, *compare], static_multiplier, proxies)
+    finish_axes(ax, [df, *compare], static_multiplier, proxies)
     return ax

@@ -42,10 +42,13 @@ def format_number(x: float) -> str:
     return "0" if text == "-0" else text
 
 
-def run_folder_name(amplitude_g: float, frequency_hz: float, excitation_type: str) -> str:
-    """``run_A<A>_f<F>`` (e.g. ``run_A0.5_f1``); ``run_free`` for free motion."""
+def run_folder_name(amplitude_g: float, frequency_hz: float | None, excitation_type: str) -> str:
+    """``run_A<A>_f<F>`` (e.g. ``run_A0.5_f1``); ``run_A<A>`` for a record (no
+    frequency); ``run_free`` for free motion."""
     if excitation_type == "free":
         return "run_free"
+    if frequency_hz is None:
+        return f"run_A{format_number(amplitude_g)}"
     return f"run_A{format_number(amplitude_g)}_f{format_number(frequency_hz)}"
 
 

@@ -18,14 +18,14 @@ from rbm_cli.config.load import parse_config
 from rbm_cli.config.points import GridPoint, expand
 from rbm_cli.config.types import Config
 from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
-from rbm_cli.study.domain import cell_key
+from rbm_cli.study.domain import cell_key, row_key
 
 Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
 
 
 def grid_points(config: Config) -> list[GridPoint]:
     """The points of a config's axes over config keys, each with its validated config."""
-    return expand(config, parse_config)
+    return expand(config, parse_config, base_dir=config.base_dir)
 
 
 def frequencies(config: Config) -> tuple:
@@ -56,11 +56,6 @@ def key(cell: Cell) -> tuple[str, ...]:
     """The identity of a cell (rbm_cli.study.domain.cell_key of its values)."""
     a, f, values = cell
     return cell_key(a, f, *(v for _, v in values))
-
-
-def row_key(row: dict, paths: tuple[str, ...]) -> tuple[str, ...]:
-    """The identity of a domain row whose point is in the columns ``paths``."""
-    return cell_key(row.get("amplitude_g"), row.get("frequency_hz"), *(row.get(p) for p in paths))
 
 
 def has_records(config: Config) -> bool:

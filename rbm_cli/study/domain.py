@@ -59,6 +59,11 @@ def cell_key(amplitude_g: float, frequency_hz: float | None, *values) -> tuple[s
     return (_key_text(amplitude_g), _key_text(frequency_hz), *(_key_text(v) for v in values))
 
 
+def row_key(row, paths: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The cell identity of a domain or journal row whose point is in the columns ``paths``."""
+    return cell_key(row.get("amplitude_g"), row.get("frequency_hz"), *(row.get(p) for p in paths))
+
+
 def axis_columns(columns) -> tuple[str, ...]:
     """The columns of a domain that hold its point's axes: named by a dotted config path."""
     return tuple(c for c in columns if "." in str(c))
@@ -174,7 +179,11 @@ def _groups(df: pd.DataFrame):
 
 def _group_row(by: list[str], values) -> dict:
     values = values if isinstance(values, tuple) else (values,)
-    return {c: (float(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
+
+    def freq(v) -> float:
+        return math.nan if v is None else float(v)
+
+    return {c: (freq(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
 
 
 def boundary(df: pd.DataFrame) -> pd.DataFrame:
@@ -234,8 +243,7 @@ def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
             step = float(np.min(np.diff(amps))) if len(amps) > 1 else 0.0
             edge = float(amps[-1]) + step
         row = _group_row(by, values)
-        keys = [row[c] for c in by]
-        out[cell_key(0.0, keys[-1], *keys[:-1])[1:]] = (row, edge)
+        out[tuple(_key_text(row[c]) for c in by)] = (row, edge)
     return by, out
 
 
@@ -304,9 +312,11 @@ def domain_config(domain_csv: str | Path) -> Config | None:
 
     meta = Path(domain_csv).with_name("meta.json")
     try:
-        written = json.loads(meta.read_text(encoding="utf-8")).get("config_written")
+        stored = json.loads(meta.read_text(encoding="utf-8"))
+        written, where = stored.get("config_written"), stored.get("config_dir")
     except (OSError, ValueError, AttributeError):
         return None
     if not isinstance(written, dict):
         return None
-    return parse_config(written, source=str(meta))
+    base = meta.parent / where if isinstance(where, str) else None  # relative record paths
+    return parse_config(written, source=str(meta), base_dir=base)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 from rbm_cli.models.result import STATUSES
-from rbm_cli.study.domain import cell_key
+from rbm_cli.study.domain import row_key
 
 COUNT_FIELDS = ("n_uplifts", "n_impacts", "n_steps", "n_rhs")
 
@@ -49,7 +49,7 @@ def validate_row(
         return f"amplitude_g must be a finite number >= 0, got {a!r}"
     if not (f is None or (_is_number(f) and math.isfinite(f) and f > 0)):
         return f"frequency_hz must be a finite number > 0 (or empty), got {f!r}"
-    if cell_key(a, f, *(row.get(p) for p in paths)) not in grid:
+    if row_key(row, paths) not in grid:
         point = "".join(f", {p} {row.get(p)!r}" for p in paths)
         return f"the cell ({a} g, {f} Hz{point}) is not in the config's grid"
     status = row.get("status")

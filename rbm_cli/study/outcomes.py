@@ -1,4 +1,4 @@
-"""Tables of per-run outcomes (record, intensity, collapsed, status): checked and counted.
+"""Tables of per-run outcomes (record, intensity, collapsed, status): read, checked, counted.
 
 The input of a fragility analysis and of an IDA figure: one row per run of a record scaled
 to an intensity [g]. ``failed`` runs (the integrator gave up) are neither collapses nor
@@ -6,6 +6,8 @@ survivals: they are left out and counted.
 """
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -95,3 +97,50 @@ def level_table(rows: pd.DataFrame) -> pd.DataFrame:
             "fraction": fraction,
         }
     )
+
+
+def read_suite_domain(path: str | Path) -> pd.DataFrame:
+    """Read the ``domain.csv`` of a record-suite sweep (records x intensities).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path  The domain CSV (one row per run; SPEC section 5 columns
+        plus ``record``, the name of the record of each row)
+
+    Returns
+    -------
+    pandas.DataFrame  The rows as written, ``record`` as text; checked further by
+        :func:`prepare_outcomes` (intensities, collapsed, status, one run per record and
+        intensity)
+
+    Raises
+    ------
+    RbmError  One line naming the file (and the line, header = line 1): missing or
+        unreadable file, not a domain (no ``status`` column, or no rows), a domain of an
+        amplitude x frequency sweep (no ``record`` column, or every record field empty),
+        an empty record field on some line.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise RbmError(f"domain file not found: {path}")
+    try:
+        df = pd.read_csv(path, dtype={"record": str}, keep_default_na=False, na_values=[""])
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        reason = " ".join(str(exc).split())
+        raise RbmError(f"cannot read {path} as a domain CSV: {reason}") from None
+    except OSError as exc:
+        raise RbmError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if "status" not in df.columns or not isinstance(df.index, pd.RangeIndex):
+        raise RbmError(f"{path} is not a domain CSV (no status column, or ragged rows)")
+    if df.empty:
+        raise RbmError(f"{path} has no rows")
+    empty = df["record"].isna().to_numpy() if "record" in df.columns else np.ones(len(df), bool)
+    if empty.all():
+        raise RbmError(
+            f"{path} is the domain of an amplitude x frequency sweep, not of a record suite "
+            "(no record column): fragility needs a sweep over records (excitation.type: "
+            "record, excitation.file a list, a folder or a glob)"
+        )
+    if empty.any():
+        raise RbmError(f"{path}: line {int(np.argmax(empty)) + 2}: the record field is empty")
+    return df

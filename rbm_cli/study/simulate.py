@@ -26,7 +26,7 @@ __all__ = ["check_derived", "make_runner", "model_from_config", "simulate"]
 def simulate(
     config: Config,
     amplitude_g: float,
-    frequency_hz: float,
+    frequency_hz: float | None,
     *,
     record: bool = False,
     output_dt: float | None = None,
@@ -38,7 +38,7 @@ def simulate(
     ----------
     config : Config  Validated configuration (its model, excitation type and solver)
     amplitude_g : float  Peak ground acceleration [g] (ignored for `free`)
-    frequency_hz : float  Excitation frequency [Hz] (ignored for `free`)
+    frequency_hz : float or None  Excitation frequency [Hz] (ignored for `free` and `record`)
     record : bool  Keep a time history (sampled every output_dt [s])
     output_dt : float  Sampling interval of the history [s]; default 0.002 s
     runner : Runner  The model built for this column (rbm_cli.models.registry.make_runner);
@@ -58,7 +58,9 @@ def simulate(
     if config.excitation.type != "free":
         if not (math.isfinite(amplitude_g) and amplitude_g >= 0):
             raise RbmError(f"amplitude must be a number >= 0 [g], got {amplitude_g}")
-        if not (math.isfinite(frequency_hz) and frequency_hz > 0):
+        if config.excitation.type == "record":
+            frequency_hz = None  # a record has its own frequencies
+        elif frequency_hz is None or not (math.isfinite(frequency_hz) and frequency_hz > 0):
             raise RbmError(f"frequency must be a number > 0 [Hz], got {frequency_hz}")
     start = time.perf_counter()
     if runner is None:
@@ -80,7 +82,7 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
     return RunResult(
         status=out.status,
         amplitude_g=float(amplitude_g),
-        frequency_hz=float(frequency_hz),
+        frequency_hz=None if frequency_hz is None else float(frequency_hz),
         t_collapse_s=float(out.t_collapse),
         collapse_interface=out.collapse_interface,
         max_rotation_ratio=float(np.max(out.max_ratio)),

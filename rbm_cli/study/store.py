@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.study.domain import cell_key
+from rbm_cli.study.domain import row_key
 from rbm_cli.study.journal_rows import validate_row
 
 JOURNAL = "domain.partial.jsonl"
@@ -255,8 +255,7 @@ class SweepStore:
                     out.rejected += 1
                     out.first_problem = out.first_problem or f"line {number}: {problem}"
                 continue
-            key = cell_key(row["amplitude_g"], row["frequency_hz"], *(row[p] for p in paths))
-            out.rows.setdefault(key, row)
+            out.rows.setdefault(row_key(row, paths), row)
         return out
 
     # ---------------------------------------------------------------- writing

@@ -135,7 +135,10 @@ def _check_request(
     """The number of cells, once every argument is checked (before any folder exists)."""
     # counted before the cells are listed: a 10^8-cell grid is refused at once
     n_cells = count_cells(config)
-    if not n_cells or not config.grid.frequencies_hz:  # (a record needs no frequencies)
+    if config.excitation.type == "record":  # a record has no frequency
+        if not n_cells:
+            raise RbmError("the config has no grid: give grid.amplitudes (the records' PGA [g])")
+    elif not n_cells or not config.grid.frequencies_hz:
         raise RbmError("the config has no grid: give grid.amplitudes and grid.frequencies")
     if n_cells > MAX_CELLS and not force:
         raise RbmError(
@@ -240,7 +243,7 @@ def run_sweep(
         rows = [done[key(c)] for c in cells]
         df = pd.DataFrame(rows, columns=list(fields))
         counts = df["status"].value_counts().to_dict()
-        meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble)
+        meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble, folder)
         meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler,
                     compile_time_s=compile_s)  # fmt: skip
         try:

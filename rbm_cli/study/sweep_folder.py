@@ -175,12 +175,22 @@ def _versions() -> dict:
     }
 
 
-def sweep_meta(config: Config, digest: str, n_cells: int, n_run: int, counts: dict, ensemble: int):
-    """meta.json's record of a sweep (wall time, workers and compile time added after)."""
+def sweep_meta(
+    config: Config, digest: str, n_cells: int, n_run: int, counts: dict, ensemble: int,
+    folder: Path | None = None,
+):  # fmt: skip
+    """meta.json's record of a sweep (wall time, workers and compile time added after).
+    ``config_dir``: the folder the config's relative paths (records) are taken from,
+    relative to the result's ``folder``, so that the written config can be read again
+    (rbm_cli.study.domain.domain_config) wherever the checkout lives."""
+    where = None
+    if config.base_dir is not None and folder is not None:
+        where = Path(os.path.relpath(config.base_dir, Path(folder).resolve())).as_posix()
     return {
         "name": config.name,
         "config": config.resolved(),
         "config_written": config.written,
+        "config_dir": where,
         "config_hash": digest,
         "versions": _versions(),
         "wall_time_s": None,

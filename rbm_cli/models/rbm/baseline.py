@@ -17,10 +17,12 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from rbm_cli.base.errors import RbmError
 from rbm_cli.models.events import REST_RATE, Pieces
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.ground_forms import SINE
 
 #: Tolerances of the baseline (the issue's: RK45, rtol 1e-6); atol in units of
 #: theta_u for rotations and 10 theta_u for rates, as rbm's own solver.
@@ -109,7 +111,10 @@ def _outcome(status: str, t_collapse: float, peak: float, message: str = "") -> 
 
 def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) -> Outcome:
     """One run of the baseline (an Outcome, the one result type of the models). A run
-    longer than budget_s [s] of wall time stops as 'failed'."""
+    longer than budget_s [s] of wall time stops as 'failed'. Sine motions only (the
+    benchmark's harmonic and half-sine)."""
+    if motion.form != SINE:
+        raise RbmError(f"the baseline integrates sine motions only, not {motion.kind!r}")
     start = time.perf_counter()
     n = model.n
     tu = model.column.rotation_capacity

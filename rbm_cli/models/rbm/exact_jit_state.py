@@ -72,7 +72,7 @@ def new_cache(n: int) -> tuple:
 @njit(cache=True)
 def friction(mdl, acc, ag, out):
     """Raise out (n) to the friction demand |T_i / N_i| for drum accelerations acc
-    [rad/s^2] and ground acceleration ag [m/s^2] (Model.shear_ratios)."""
+    [rad/s^2] and ground acceleration ag [m/s^2] (the shear ratios of physics/equations)."""
     n = acc.size
     shear = 0.0
     for i in range(n - 1, -1, -1):
@@ -101,7 +101,7 @@ def _potential(mdl, i, x):
 
 @njit(cache=True)
 def energy1(mdl, theta, rate):
-    """Energy [J] of a monolith (Model.energy, n = 1)."""
+    """Energy [J] of a monolith (the energy of physics/equations, n = 1)."""
     x = mdl.argmap[0, 0] * theta
     return (0.5 * mdl.mass[0, 0] * rate * rate + _potential(mdl, 0, x)
             - 0.5 * mdl.gravity[0, 0] * theta * theta)  # fmt: skip

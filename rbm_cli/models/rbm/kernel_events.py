@@ -1,7 +1,7 @@
 """Event search and law bookkeeping for the compiled kernel (numba): the
 transcriptions of rbm_cli.models.events (earliest crossing on the dense output,
-cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces), plus the exact
-uplift time of a rigid block at rest and time-history sampling."""
+cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces), plus time-history
+sampling (the exact uplift time of a rigid block at rest is in kernel_ground)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
-from rbm_cli.base.detmath import asin as dasin
 from rbm_cli.base.detmath import dot, matvec
-from rbm_cli.base.detmath import sin as dsin
 from rbm_cli.models.rbm.kernel_rk import TAB_NP, _dense_eval
 
 
@@ -322,24 +320,21 @@ def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slop
     return e
 
 
-@njit(cache=True)
-def _next_exceedance(t0, level, amp, om, ph, last):
-    """GroundMotion.next_exceedance; -1 for none before `last`."""
-    if amp <= level or t0 >= last:
-        return -1.0
-    s = level / amp
-    psi0 = om * t0 + ph
-    if abs(dsin(psi0)) > s:
-        return t0
-    lo = dasin(s)
-    kk = math.ceil((psi0 - lo) / math.pi)
-    psi = lo + kk * math.pi
-    if psi < psi0:
-        psi += math.pi
-    t = (psi - ph) / om
-    if t >= last:
-        return -1.0
-    return t
+@njit(cache=True, inline="always")
+def _friction(g_new, gam, centre_map, acc, masses, normal_forces, friction):
+    """Friction demand |T_i| / N_i at each interface at the step's end, kept in friction
+    if larger: the shear from the drums above, their absolute accelerations g_new [m/s^2]
+    (the ground) + centre_map @ acc (theta'' [rad/s^2]); N_i times gam = (g + a_v) / g."""
+    n = acc.size
+    shear = 0.0
+    for i in range(n - 1, -1, -1):
+        a_abs = g_new
+        for j in range(n):
+            a_abs += centre_map[i, j] * acc[j]
+        shear += a_abs * masses[i]
+        fr = abs(shear) / (normal_forces[i] * gam)
+        if fr > friction[i]:
+            friction[i] = fr
 
 
 @njit(cache=True)

@@ -28,7 +28,16 @@ from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
 #: excitation kind -> code in the kernel
-KIND_CODES = {"harmonic": 0, "half-sine": 1, "free": 2}
+KIND_CODES = {
+    "harmonic": 0,
+    "half-sine": 1,
+    "free": 2,
+    "one-sine": 3,
+    "cycloidal": 4,
+    "ricker": 5,
+    "mavroeidis-papageorgiou": 6,
+    "record": 7,
+}
 
 
 class ModelArrays(NamedTuple):
@@ -67,14 +76,26 @@ class ModelArrays(NamedTuple):
 
 
 class Excitation(NamedTuple):
-    """The ground motion of one run (rbm_cli.physics.excitation.GroundMotion)."""
+    """The ground motion of one run (rbm_cli.physics.excitation.GroundMotion; its form's
+    numbers as rbm_cli.physics.ground_forms and kernel_ground read them)."""
 
     kind: int  #: KIND_CODES
-    amplitude: float  #: [m/s^2]
+    amplitude: float  #: peak |a_g| [m/s^2]
     omega: float  #: circular frequency [rad/s]
     phase: float  #: [rad]
-    pulse_end: float  #: end of a half-sine pulse [s]
+    pulse_end: float  #: end of a pulse or record [s]
     t_end: float  #: end of the run [s]
+    form: int  #: ground_forms: SINE, RICKER, MP or SAMPLED
+    gain: float  #: multiplier of the form [m/s^2]
+    center: float  #: centre of a Ricker or MP pulse [s]
+    gamma: float  #: MP's gamma [-]
+    knots: np.ndarray  #: times a_g is monotone between [s] (a record's samples)
+    values: np.ndarray  #: a record's a_g at its samples [m/s^2] (gain 1)
+    vertical: np.ndarray  #: its upward a_v at the samples [m/s^2] (empty: none)
+    clipped: bool  #: steps end at every knot (a record)
+    bounds: np.ndarray  #: segment boundaries, from 0 to t_end [s]
+    forced: np.ndarray  #: whether a_g acts on each segment (bool)
+    pulse: bool  #: free motion after a pulse or record (may stop early)
 
 
 class SolverSettings(NamedTuple):
@@ -212,10 +233,22 @@ def prepare_kernel(model: Model) -> PreparedModel:
     return PreparedModel(arrays=arrays, packed=tuple(arrays), atol_scale=atol_scale)
 
 
+def _array(x) -> np.ndarray:
+    """A writable float64 copy (numba types read-only arrays apart: one more compile)."""
+    return np.array(() if x is None else x, dtype=np.float64)
+
+
 def excitation(motion: GroundMotion) -> tuple:
     """The kernel's Excitation of a ground motion, as the plain tuple run_kernel takes."""
+    segments = motion.segments()
+    bounds = _array([0.0] + [end for _, end in segments])
+    forced = np.array([motion.forced(start) for start, _ in segments], dtype=np.bool_)
     return (KIND_CODES[motion.kind], float(motion.amplitude), float(motion.omega),
-            float(motion.phase), float(motion.pulse_end), float(motion.t_end))  # fmt: skip
+            float(motion.phase), float(motion.pulse_end), float(motion.t_end),
+            int(motion.form), float(motion.shape_gain), float(motion.center),
+            float(motion.gamma), _array(motion.knots), _array(motion.values),
+            _array(motion.vertical), bool(motion.clipped), bounds, forced,
+            bool(motion.is_pulse))  # fmt: skip
 
 
 def solver_settings(solver, atol_scale: np.ndarray, deadline: float) -> tuple:

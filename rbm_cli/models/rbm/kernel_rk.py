@@ -13,7 +13,7 @@ from scipy.integrate._ivp.rk import RK23 as _RK23
 from scipy.integrate._ivp.rk import RK45 as _RK45
 
 from rbm_cli.base.detmath import pow_pos
-from rbm_cli.base.detmath import sin as dsin
+from rbm_cli.models.rbm.kernel_ground import _gravity, _ground
 
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
@@ -69,21 +69,38 @@ _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 
 # ---------------------------------------------------------------- small pieces
 @njit(cache=True, inline="always")
-def _ground(t, amp, om, ph):
-    if amp == 0.0:
-        return 0.0
-    return amp * dsin(om * t + ph)
+def _rhs(t, y, n, As, cs, es, gr, out):
+    g = _ground(t, gr)
+    if gr[6] == 0.0:
+        for i in range(n):
+            out[i] = y[n + i]
+            s = cs[i] + es[i] * g
+            for j in range(n):
+                s += As[i, j] * y[j]
+            out[n + i] = s
+        return
+    # a vertical record: every weight (the law and gravity, As and cs) times (g + a_v) / g
+    gam = _gravity(t, gr)
+    for i in range(n):
+        out[i] = y[n + i]
+        s = cs[i]
+        for j in range(n):
+            s += As[i, j] * y[j]
+        out[n + i] = gam * s + es[i] * g
 
 
 @njit(cache=True, inline="always")
-def _rhs(t, y, n, As, cs, es, amp, om, ph, out):
-    g = _ground(t, amp, om, ph)
+def _acc_of(t, y, n, As, cs, es, gr, acc):
+    """Angular accelerations theta'' at (t, y) into acc [rad/s^2]; returns a_g(t) [m/s^2]
+    and (g + a_v(t)) / g [-]. (gam * x + e g is x + e g to the bit when gam = 1.)"""
+    g = _ground(t, gr)
+    gam = _gravity(t, gr)
     for i in range(n):
-        out[i] = y[n + i]
-        s = cs[i] + es[i] * g
+        d = cs[i]
         for j in range(n):
-            s += As[i, j] * y[j]
-        out[n + i] = s
+            d += As[i, j] * y[j]
+        acc[i] = gam * d + es[i] * g
+    return g, gam
 
 
 @njit(cache=True)
@@ -95,7 +112,7 @@ def _rms(v):
 
 
 @njit(cache=True)
-def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, amp, om, ph, work):
+def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, work):
     """scipy.integrate._ivp.common.select_initial_step (max_step = inf)."""
     interval = abs(t_bound - t0)
     if interval == 0.0:
@@ -109,7 +126,7 @@ def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, amp, om
     y1 = np.empty(m)
     for i in range(m):
         y1[i] = y0[i] + h0 * f0[i]
-    _rhs(t0 + h0, y1, n, As, cs, es, amp, om, ph, work)
+    _rhs(t0 + h0, y1, n, As, cs, es, gr, work)
     d2 = _rms((work - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -118,33 +135,35 @@ def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, amp, om
     return min(100.0 * h0, h1, interval)
 
 
-@njit(cache=True)
-def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, amp, om, ph):
-    """Stage s from the stages before it: K[s] = f(t + c_s h, y + h sum_j a_sj K_j)."""
+@njit(cache=True, inline="always")
+def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr):
+    """Stage s from the stages before it: K[s] = f(t + c_s h, y + h sum_j a_sj K_j).
+    Inlined (as detmath.sin is): a call costs a reference count of every array it takes
+    (the ground's knots and values included), 12 times a step."""
     A = TAB_A[mc]
     for i in range(y.size):
         acc = 0.0
         for j in range(s):
             acc += A[s, j] * K[j, i]
         tmp[i] = y[i] + h * acc
-    _rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, amp, om, ph, K[s])
+    _rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, gr, K[s])
 
 
 @njit(cache=True)
-def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, amp, om, ph):
+def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     """One Runge-Kutta step of size h; stages in K (row ns = f(t + h, y_new))."""
     B = TAB_B[mc]
     ns = TAB_NS[mc]
     m = y.size
     K[0, :] = f
     for s in range(1, ns):
-        _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, amp, om, ph)
+        _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr)
     for i in range(m):
         acc = 0.0
         for j in range(ns):
             acc += B[j] * K[j, i]
         ynew[i] = y[i] + h * acc
-    _rhs(t + h, ynew, n, As, cs, es, amp, om, ph, K[ns])
+    _rhs(t + h, ynew, n, As, cs, es, gr, K[ns])
 
 
 @njit(cache=True)
@@ -180,14 +199,14 @@ def _error_norm(mc, K, h, y, ynew, atol, rtol, scale):
 
 
 @njit(cache=True)
-def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, amp, om, ph):
+def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
     """Coefficients F of the step's interpolant (DOP853: extra stages)."""
     m = y_old.size
     ns = TAB_NS[mc]
     P = TAB_P[mc]
     if mc == 2:
         for s in range(ns + 1, _NS_MAX):
-            _stage(mc, s, t_old, y_old, h, K, tmp, n, As, cs, es, amp, om, ph)
+            _stage(mc, s, t_old, y_old, h, K, tmp, n, As, cs, es, gr)
         for i in range(m):
             dy = y_new[i] - y_old[i]
             F[0, i] = dy

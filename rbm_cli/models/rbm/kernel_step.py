@@ -20,13 +20,14 @@ from rbm_cli.models.rbm.kernel_events import (
     _energy1,
     _event_rows,
     _first_crossing,
+    _friction,
     _n_below,
-    _next_exceedance,
     _poly_val,
     _row_poly,
     _system,
     _within_reach,
 )
+from rbm_cli.models.rbm.kernel_ground import _ground_at, _next_uplift, _record_piece
 from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, POLL_STEPS, poll
 from rbm_cli.models.rbm.kernel_inputs import Excitation, ModelArrays, RunTask, SolverSettings
 from rbm_cli.models.rbm.kernel_rk import (
@@ -45,10 +46,10 @@ from rbm_cli.models.rbm.kernel_rk import (
     SURVIVED,
     TAB_EST,
     TAB_NS,
+    _acc_of,
     _dense_eval,
     _dense_prepare,
     _error_norm,
-    _ground,
     _initial_step,
     _rhs,
     _rk_attempt,
@@ -84,8 +85,15 @@ def run_kernel(model, motion, solver, task):
     rigid, silent, tu, c_ratio = model.rigid, model.silent, model.tu, model.c_ratio
     centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
     uplift_level, barrier = model.uplift_level, model.barrier
-    kind, amplitude, omega, phase = motion.kind, motion.amplitude, motion.omega, motion.phase
-    pulse_end, t_end = motion.pulse_end, motion.t_end
+    amplitude, pulse_end, t_end = motion.amplitude, motion.pulse_end, motion.t_end
+    knots, values, vertical, clipped = motion.knots, motion.values, motion.vertical, motion.clipped
+    bounds, forced = motion.bounds, motion.forced
+    # the ground (kernel_ground): of the motion, and nothing (a free segment); a record
+    # one straight piece a step (_record_piece)
+    gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
+               motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip
+    gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center, motion.gamma,
+               0.0, 0.0, 0.0)  # fmt: skip
     mc, rtol, atol, deadline = solver.mc, solver.rtol, solver.atol, solver.deadline
     max_steps, max_events = solver.max_steps, solver.max_events
     theta0, rate0, early_stop = task.theta0, task.rate0, task.early_stop
@@ -160,15 +168,14 @@ def run_kernel(model, motion, solver, task):
         k[i] = _n_below(edges[i], nedges[i], abs(x0[i]))
         pending[i] = k[i] > 0 and not rigid[i]
 
-    n_seg = 2 if (kind == 1 and pulse_end < t_end) else 1
-    for seg in range(n_seg):
-        seg_start = 0.0 if seg == 0 else pulse_end
-        seg_end = t_end if (seg == n_seg - 1) else pulse_end
+    for seg in range(bounds.size - 1):
+        seg_end = bounds[seg + 1]
         if t >= seg_end:
             continue
-        free_seg = amplitude == 0.0 or (kind == 1 and seg_start >= pulse_end)
-        amp = 0.0 if free_seg else amplitude
-        can_stop = early_stop and free_seg and kind == 1 and n == 1
+        free_seg = not forced[seg]
+        gr = gr_free if free_seg else gr_full
+        seg_gain = gr[1]
+        can_stop = early_stop and free_seg and motion.pulse and n == 1
         h_carry = -1.0  # the step size proposed before an event, carried over it
         while t < seg_end:
             if at_rest:
@@ -178,7 +185,8 @@ def run_kernel(model, motion, solver, task):
                     return (status, t_end, t_col, c_if, max_ratio, max_top, friction,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 last = min(pulse_end, t_end)
-                t_up = _next_exceedance(t, uplift_level, amplitude, omega, phase, last)
+                t_up = _next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical,
+                                    last)  # fmt: skip
                 if t_up < 0.0 or t_up >= seg_end:
                     if record:
                         n_out, next_out = _emit_rest(seg_end, samples, n_out, next_out, output_dt)
@@ -189,7 +197,7 @@ def run_kernel(model, motion, solver, task):
                 t = t_up
                 for i in range(m):
                     y[i] = 0.0
-                side[0] = -1 if _ground(t, amplitude, omega, phase) > 0.0 else 1
+                side[0] = -1 if _ground_at(t, gr_full, knots, values) > 0.0 else 1
                 k[0] = 0
                 at_rest = False
                 n_upl += 1
@@ -204,22 +212,22 @@ def run_kernel(model, motion, solver, task):
                 h0[3 * n + i] = c_ratio + EVENT_EPS
 
             # a new stepper from (t, y)
-            _rhs(t, y, n, As, cs, es, amp, omega, phase, f)
+            t_bound = seg_end
+            if clipped:
+                gr, t_bound = _record_piece(t, knots, values, vertical, seg_gain, seg_end)
+            _rhs(t, y, n, As, cs, es, gr, f)
             if h_carry > 0.0:
                 h_abs = min(h_carry, seg_end - t)
                 n_rhs += 1
             else:
-                h_abs = _initial_step(t, y, f, seg_end, est_order, rtol, atol, n, As, cs, es,
-                                      amp, omega, phase, work)  # fmt: skip
+                h_abs = _initial_step(t, y, f, t_bound, est_order, rtol, atol, n, As, cs, es,
+                                      gr, work)  # fmt: skip
                 n_rhs += 2
             _affine(track, y, 0, no_offset, z_old)
             _affine(track, y, n, no_offset, dz_old)
             _event_rows(gx, gc, same, y, 0, h0, True, d_old)
             _event_rows(gx, gc, same, y, n, h0, False, dd_old)
-            g0 = _ground(t, amp, omega, phase)
-            _affine(As, y, 0, cs, acc)
-            for i in range(n):
-                acc[i] += es[i] * g0
+            _acc_of(t, y, n, As, cs, es, gr, acc)
             _event_rows(gx, gc, same, acc, 0, h0, False, d2_old)
             event = False
             running = True
@@ -228,6 +236,9 @@ def run_kernel(model, motion, solver, task):
                 min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
                 if h_abs < min_step:
                     h_abs = min_step
+                bound = seg_end  # a record's steps end at its samples (python.Stepper's)
+                if clipped:
+                    gr, bound = _record_piece(t, knots, values, vertical, seg_gain, seg_end)
                 rejected = False
                 while True:
                     if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
@@ -235,11 +246,11 @@ def run_kernel(model, motion, solver, task):
                         return (FAILED_STEP, t_fail, t_col, c_if, max_ratio, max_top, friction,
                                 n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                     t_new = t + h_abs
-                    if t_new - seg_end > 0:
-                        t_new = seg_end
+                    if t_new - bound > 0:
+                        t_new = bound
                     h = t_new - t
                     h_abs = abs(h)
-                    _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, amp, omega, phase)
+                    _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr)
                     n_rhs += stage_rhs
                     err = _error_norm(mc, K, h, y, ynew, atol, rtol, scale)
                     if not (err == err and abs(err) < math.inf):  # NaN or inf state
@@ -274,16 +285,13 @@ def run_kernel(model, motion, solver, task):
                 _event_rows(gx, gc, same, y_new, 0, h0, True, d_new)
                 _event_rows(gx, gc, same, y_new, n, h0, False, dd_new)
                 dense_ready = False
-                g_new = _ground(t_new, amp, omega, phase)
-                _affine(As, y_new, 0, cs, acc)
-                for i in range(n):
-                    acc[i] += es[i] * g_new
+                g_new, gam_new = _acc_of(t_new, y_new, n, As, cs, es, gr, acc)
                 _event_rows(gx, gc, same, acc, 0, h0, False, d2_new)
                 event_row = -1
                 t_e = t_new
                 if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
                     n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
-                                            cs, es, amp, omega, phase)  # fmt: skip
+                                            cs, es, gr)  # fmt: skip
                     dense_ready = True
                     t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, event_rows, h0,
                                                      n, Dq, Rq, dc0, dc1, rc0, rc1, near, CP,
@@ -292,17 +300,14 @@ def run_kernel(model, motion, solver, task):
                     _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e
                     event = True
-                    g_new = _ground(t_new, amp, omega, phase)
-                    _affine(As, y_new, 0, cs, acc)
-                    for i in range(n):
-                        acc[i] += es[i] * g_new
+                    g_new, gam_new = _acc_of(t_new, y_new, n, As, cs, es, gr, acc)
                     if record:
                         n_out, next_out = _emit(mc, t_e, t_old, h, y_old, F, samples, n_out,
                                                 next_out, output_dt)  # fmt: skip
                 elif record:
                     if not dense_ready:
                         n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
-                                                cs, es, amp, omega, phase)  # fmt: skip
+                                                cs, es, gr)  # fmt: skip
                         dense_ready = True
                     n_out, next_out = _emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
                                             next_out, output_dt)  # fmt: skip
@@ -330,7 +335,7 @@ def run_kernel(model, motion, solver, task):
                     if dz_old[r] * dz_new[r] < 0.0 and reach > peaks[r]:
                         if not dense_ready:
                             n_rhs += _dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
-                                                    As, cs, es, amp, omega, phase)  # fmt: skip
+                                                    As, cs, es, gr)  # fmt: skip
                             dense_ready = True
                         base = _row_poly(mc, F, y_old, track, r, zero_t, n, True, coef)
                         t_pk = _brentq(mc, t_old, t_new, t_old, h, coef, base)
@@ -343,15 +348,7 @@ def run_kernel(model, motion, solver, task):
                         max_ratio[i] = peaks[i]
                 if peaks[n] > max_top:
                     max_top = peaks[n]
-                shear = 0.0
-                for i in range(n - 1, -1, -1):
-                    a_abs = g_new
-                    for j in range(n):
-                        a_abs += centre_map[i, j] * acc[j]
-                    shear += a_abs * masses[i]
-                    fr = abs(shear) / normal_forces[i]
-                    if fr > friction[i]:
-                        friction[i] = fr
+                _friction(g_new, gam_new, centre_map, acc, masses, normal_forces, friction)
                 z_prev, z_old, z_new = z_old, z_new, z_prev
                 dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
                 d_old, d_new = d_new, d_old

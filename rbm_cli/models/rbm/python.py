@@ -36,11 +36,11 @@ from scipy.integrate import DOP853, RK23, RK45
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.config.types import SolverConfig
 from rbm_cli.models.events import BIG, EVENT_EPS, REST_RATE, Pieces  # noqa: F401 (kernel's)
+from rbm_cli.models.knots import clip_at_knots, next_knot
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.python_steps import (
     RunState,
     SmoothPiece,
-    ground_acceleration,
     handle_event,
     leave_rest,
     step_to_event,
@@ -61,7 +61,7 @@ class _ErrorNorm(float):
 
 
 def _with_kernel_power(method):
-    class Stepper(method):
+    class Stepper(clip_at_knots(method)):
         def _estimate_error_norm(self, K, h, scale):
             return _ErrorNorm(super()._estimate_error_norm(K, h, scale))
 
@@ -104,14 +104,20 @@ def _start_stepper(run: RunState, piece: SmoothPiece, seg_end: float):
     stepper = _METHODS[solver.method]
     if run.h_carry is None:  # counted as scipy counts it: its own f0, then one call
         f0 = piece.rhs(run.t, run.y, counted=False)
+        bound = seg_end  # a record: its guess stays on the straight piece (the kernel's)
+        if run.knots is not None:
+            t = run.t
+            bound = next_knot(run.knots, t + 10 * abs(np.nextafter(t, np.inf) - t), seg_end)
         first = initial_step(
-            piece.rhs, run.t, run.y, f0, seg_end, stepper.order, solver.rtol, run.atol
+            piece.rhs, run.t, run.y, f0, bound, stepper.order, solver.rtol, run.atol
         )
     else:
         first = min(run.h_carry, seg_end - run.t)
-    return stepper(
+    integ = stepper(
         piece.rhs, run.t, run.y, seg_end, rtol=solver.rtol, atol=run.atol, first_step=first
     )
+    integ.knots = run.knots
+    return integ
 
 
 def _run_segment(
@@ -120,7 +126,7 @@ def _run_segment(
     """Integrate up to seg_end [s], the end of a segment of the motion (forced, or free
     when free_seg), piece by piece and event by event. Returns the Outcome if the run
     ends inside the segment, else None."""
-    ag = ground_acceleration(motion, free_seg)
+    ag, gam = motion.scalar(not free_seg), motion.gravity(not free_seg)
     while run.t < seg_end:
         if run.at_rest:
             kind = leave_rest(run, motion, seg_end, not free_seg)
@@ -129,7 +135,7 @@ def _run_segment(
                 return run.out
             if kind == "segment":
                 return None
-        piece = SmoothPiece(run, ag)
+        piece = SmoothPiece(run, ag, gam)
         integ = _start_stepper(run, piece, seg_end)
         event = step_to_event(run, piece, integ, can_stop)
         if isinstance(event, Outcome):
@@ -164,18 +170,19 @@ def integrate(
     theta0, rate0 : (n,) Initial absolute rotations [rad] and rates [rad/s]
     solver : SolverConfig  Method, tolerances and budgets
     record : bool  Keep samples every output_dt [s] for a time history
-    early_stop : bool  Stop a free motion (after a half-sine pulse) whose
+    early_stop : bool  Stop a free motion (after a pulse or a record) whose
         energy is below the lowest collapse barrier (`relative` only)
     """
     deadline = time.monotonic() + solver.max_wall_time
     pieces = Pieces(model, silent=True)
     run = RunState.start(model, pieces, theta0, rate0, solver, record, output_dt, deadline)
+    run.knots = motion.knots if motion.clipped else None  # a record: steps end at samples
     for seg_start, seg_end in motion.segments():
         if run.t >= seg_end:
             continue
         run.h_carry = None  # the step size proposed before an event, carried over it
         free_seg = not motion.forced(seg_start)
-        can_stop = early_stop and free_seg and motion.kind == "half-sine"
+        can_stop = early_stop and free_seg and motion.is_pulse
         stop = _run_segment(run, motion, seg_end, free_seg, can_stop)
         if stop is not None:
             return stop

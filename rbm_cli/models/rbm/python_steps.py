@@ -15,7 +15,6 @@ rbm_cli.models.rbm.python describes.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 from functools import partial
@@ -49,6 +48,7 @@ class RunState:
     at_rest : bool  A rigid monolithic column resting (no integration)
     next_out : float  Time of the next recorded sample [s]
     h_carry : float or None  Step size proposed before the last event, carried over it [s]
+    knots : ndarray or None  Times every step ends at (a record's samples) [s]
     track : (n + 1, n) ndarray  Collapse quantities over their limits [-], then the top
         displacement [m]
     g_rows : (4n, n) ndarray  Event surfaces (law bounds over theta_u, collapse)
@@ -82,6 +82,7 @@ class RunState:
     at_rest: bool
     next_out: float = 0.0
     h_carry: float | None = None
+    knots: np.ndarray | None = None  # times steps end at (a record's samples) [s]
 
     @classmethod
     def start(
@@ -160,29 +161,17 @@ class RunState:
             self.next_out += self.output_dt
 
 
-def ground_acceleration(motion: GroundMotion, free: bool):
-    """a_g(t) [m/s^2] over one segment of the motion: zero in free motion, else the harmonic."""
-    if free:
-
-        def ag(tt):
-            return 0.0
-    else:
-        amp, om, ph = motion.amplitude, motion.omega, motion.phase
-
-        def ag(tt, amp=amp, om=om, ph=ph):
-            return amp * math.sin(om * tt + ph)
-
-    return ag
-
-
 class SmoothPiece:
     """The linear system of the current law pieces, theta'' = A theta + c + e a_g(t), and
-    the distances to its event surfaces, linear in theta: d = G theta + h0 (>= 0 inside)."""
+    the distances to its event surfaces, linear in theta: d = G theta + h0 (>= 0 inside).
+    With a vertical record (gam(t) = (g + a_v(t)) / g, rigid laws only, whose A and c are
+    all weight): theta'' = gam(t) (A theta + c) + e a_g(t)."""
 
-    def __init__(self, run: RunState, ag):
+    def __init__(self, run: RunState, ag, gam=None):
         self.n = run.n
         self.out = run.out
         self.ag = ag
+        self.gam = gam
         self.g_rows = run.g_rows
         self.A, self.cvec, self.evec = run.pieces.system()
         self.lo, self.hi = run.pieces.bounds()
@@ -198,12 +187,14 @@ class SmoothPiece:
         """dy/dt at (tt [s], yy); counted in the outcome's n_rhs unless told not."""
         n = self.n
         self.out.n_rhs += counted
-        return np.concatenate([yy[n:], self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)])
+        return np.concatenate([yy[n:], self.acc(tt, yy)])
 
     def acc(self, tt, yy) -> np.ndarray:
         """Angular accelerations theta'' at (tt [s], yy) [rad/s^2]."""
         n = self.n
-        return self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)
+        if self.gam is None:
+            return self.A @ yy[:n] + self.cvec + self.evec * self.ag(tt)
+        return self.gam(tt) * (self.A @ yy[:n] + self.cvec) + self.evec * self.ag(tt)
 
     def distances(self, yy) -> tuple[np.ndarray, np.ndarray]:
         """Event distances and their rates at the state yy."""
@@ -268,13 +259,16 @@ def end_of_step(run: RunState, piece: SmoothPiece, integ, surfaces: tuple) -> St
     return StepEnd(t_new, y_new, acc, dense, (d_new, dd_new, d2_new), event_row)
 
 
-def account(run: RunState, z_old, z_new, dz_old, dz_new, dt: float, acc, ag_new) -> None:
-    """Peaks (collapse ratios, top displacement) and friction demand over a step of dt [s]."""
+def account(
+    run: RunState, z_old, z_new, dz_old, dz_new, dt: float, acc, ag_new, gam_new=1.0
+) -> None:
+    """Peaks (collapse ratios, top displacement) and friction demand over a step of dt [s]
+    (the normal forces times gam_new = (g + a_v) / g)."""
     out, n = run.out, run.n
     peaks = hermite_peaks(z_old, z_new, dz_old, dz_new, dt)
     out.max_ratio = np.maximum(out.max_ratio, peaks[:n])
     out.max_top = max(out.max_top, peaks[n])
-    fr = run.model.shear_ratios(acc[None, :], np.array([ag_new]))[0]
+    fr = run.model.shear_ratios(acc[None, :], np.array([ag_new]))[0] / gam_new
     out.friction = np.maximum(out.friction, fr)
 
 
@@ -317,7 +311,8 @@ def step_to_event(run: RunState, piece: SmoothPiece, integ, can_stop: bool):
         # peaks and friction demand over [t_old, t_new]
         z_new = track @ y_new[:n]
         dz_new = track @ y_new[n:]
-        account(run, z_old, z_new, dz_old, dz_new, t_new - t_old, end.acc, piece.ag(t_new))
+        gam_new = 1.0 if piece.gam is None else piece.gam(t_new)
+        account(run, z_old, z_new, dz_old, dz_new, t_new - t_old, end.acc, piece.ag(t_new), gam_new)
         z_prev, dz_prev = z_old, dz_old
         z_old, dz_old = z_new, dz_new
         surfaces = end.surfaces

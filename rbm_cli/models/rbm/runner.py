@@ -161,6 +161,9 @@ class RbmRunner:
                 solver.method, solver.implementation
             )
         n = self.model.n
+        t_lift = motion.lift_off  # a vertical record dropping faster than gravity
+        if t_lift is not None:
+            motion = motion.until(t_lift)
         try:
             out = integrator(
                 self.model,
@@ -172,6 +175,7 @@ class RbmRunner:
                 output_dt=output_dt,
                 early_stop=early_stop,
             )
+            out.lifted_off(t_lift)
         except NUMERICAL_FAILURES as exc:
             out = Outcome(status="failed", message=f"numerical failure: {exc}")
             out.max_ratio = np.full(n, np.nan)

@@ -1,7 +1,8 @@
 """Parsers of record files (PEER NGA ``.AT2``, CSV): strict, in blocks of lines, one-line errors.
 
-Used by :func:`rbm_cli.physics.records.read_record`, which documents the formats. Each parser
-returns
+Used by :func:`rbm_cli.physics.records.read_record`, which documents the formats, and by the
+config's ``excitation.file`` check (:mod:`rbm_cli.config.excitation`), which refuses a malformed
+record when the config is loaded (so they live here, below physics). Each parser returns
 plain arrays in the file's units; every malformed file raises an
 :class:`~rbm_cli.base.errors.RbmError` whose one-line message names the file and the line.
 Memory is bounded: about 2 x 8 bytes a sample plus one block of lines; files of more than
@@ -18,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import G  # gravity [m/s^2], the one definition
 
 #: Most samples a record may have (a larger file is refused before it is parsed).
 MAX_SAMPLES = 10_000_000
@@ -27,6 +29,34 @@ MAX_FILE_BYTES = 512 * 2**20
 
 #: Lines parsed per numpy block.
 _BLOCK_LINES = 8192
+
+
+#: Units of a record's acceleration values -> their value in m/s^2.
+UNITS = {"g": G, "m/s2": 1.0, "m/s^2": 1.0}
+
+
+def read_file(
+    path: Path, units: str = "g", fmt: str | None = None
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """Times [s], accelerations [m/s^2] and title of an ``.AT2`` or CSV record, checked.
+
+    The format is the suffix's (``.at2``/``.csv``, any case) unless ``fmt`` is given;
+    ``units`` are those of a CSV's values (an ``.AT2`` is in g: ``m/s2`` is refused).
+    Every problem raises an RbmError in one line naming the file (and the line).
+    """
+    kind = (fmt or path.suffix.lstrip(".")).lower()
+    if kind not in ("at2", "csv"):
+        raise RbmError(f"{path}: unknown record format {kind!r} (expected .AT2 or .csv)")
+    if units not in UNITS:
+        raise RbmError(f"{path}: units must be 'g' or 'm/s2', got {units!r}")
+    check_file(path)
+    if kind == "at2":
+        if UNITS[units] != UNITS["g"]:
+            raise RbmError(f"{path}: an .AT2 file is in g; units {units!r} do not apply")
+        t, values_g, title = read_at2(path)
+        return t, values_g * UNITS["g"], title
+    t, values = read_csv(path)
+    return t, values * UNITS[units], ""
 
 
 def check_file(path: Path) -> None:

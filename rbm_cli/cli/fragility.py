@@ -1,0 +1,77 @@
+"""`rbm fragility`: fragility curve and IDA of a record-suite domain (thin, over
+rbm_cli.report.fragility_run)."""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.cli.common import UserError, check_output, cli, one_line
+
+
+@cli.command()
+@click.argument("domain", metavar="DOMAIN.csv", type=str)
+@click.option("-o", "--output", default=None, metavar="DIR", callback=check_output,
+              help="Folder for the files  [default: the domain's folder]")  # fmt: skip
+@click.option("--resamples", type=click.IntRange(min=0), default=500, show_default=True,
+              help="Bootstrap resamples of the records (0: no band, no intervals).")  # fmt: skip
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the bootstrap.")  # fmt: skip
+@click.option("--intensity-column", default=None, metavar="NAME",
+              help="Column of the intensity  [default: intensity_g, amplitude_g or "
+              "intensity, the first present]")  # fmt: skip
+@click.option("--ci", nargs=2, type=float, default=(5.0, 95.0), show_default=True,
+              metavar="LOW HIGH",
+              help="Percentiles of the bootstrap intervals and band.")  # fmt: skip
+@click.option("--compare", "others", multiple=True, metavar="OTHER.csv",
+              help="Another record-suite domain whose fragility is drawn in fragility.png "
+              "beside this one (repeatable; its own files are not written).")  # fmt: skip
+def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> None:
+    """Fit a lognormal fragility curve to a record-suite domain and draw its IDA.
+
+    DOMAIN.csv is the domain.csv of a sweep over records x intensities (one row
+    per record and intensity, with its record's name). Per intensity: records,
+    collapses and the fraction; the lognormal fragility P = Phi(ln(x/median)/beta)
+    fitted by maximum likelihood on the per-record outcomes (Baker 2015), with a
+    bootstrap over records for the intervals and the band. Failed runs are left
+    out and counted.
+
+    Writes fragility.csv, fragility_curve.csv, fragility.json, fragility.png and
+    ida.png (peak rotation ratio against intensity, a line per record), all
+    moved into place together at the end.
+
+    \b
+    Example:
+        rbm fragility out/suite/domain.csv
+        rbm fragility out/suite/domain.csv -o out/suite_fragility --resamples 2000
+        rbm fragility results/suite_multidrum/domain.csv \
+            --compare results/suite_monolithic/domain.csv -o docs/figures/suite
+    """
+    from rbm_cli.report.fragility_run import run_fragility
+
+    try:
+        made = run_fragility(domain, output, n_resamples=resamples, seed=seed,
+                             intensity_column=intensity_column,
+                             ci_percentiles=tuple(ci), compare=others)  # fmt: skip
+    except RbmError as exc:
+        raise UserError(one_line(exc)) from None
+    res = made.result
+    click.echo(f"records: {res.n_records}, runs: {res.n_runs} (failed, left out: "
+               f"{res.n_failed}), intensities: {len(res.table)}")  # fmt: skip
+    if res.fit is None:
+        click.echo(f"no fit: {res.note}")
+    else:
+        lo, hi = res.ci_percentiles
+        median = f"{res.fit.median_g:.4g} g" + _interval(res.median_ci_g, lo, hi, " g")
+        beta = f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
+        click.echo(f"median {median}, dispersion beta {beta}")
+    folder = made.paths[0].parent
+    click.echo(f"output: {folder}/ " + ", ".join(p.name for p in made.paths))
+
+
+def _interval(ci: tuple[float, float], lo: float, hi: float, unit: str) -> str:
+    if not all(math.isfinite(v) for v in ci):
+        return ""
+    return f" ({lo:g}-{hi:g} %: {ci[0]:.4g}-{ci[1]:.4g}{unit})"

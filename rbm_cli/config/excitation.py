@@ -1,0 +1,366 @@
+"""The ``excitation`` section of a config (SPEC section 3) and its record files.
+
+Keys, by excitation type (a key of another type is refused, naming it):
+
+- every type: ``type``, ``initial: {rotations, velocities}`` [rad, rad/s];
+- ``harmonic``, ``half-sine``, ``free``: ``duration`` [s]; ``harmonic``: ``phase`` [rad]
+  (0 is accepted with any type);
+- pulses, ``one-sine``, ``cycloidal``, ``ricker``, ``mavroeidis-papageorgiou``: as
+  ``half-sine``, ``duration`` [s] is the maximum simulated time (default 20 s), the pulse
+  then free motion; ``mavroeidis-papageorgiou`` also ``gamma`` (> 1, at most 20 [-]) and
+  ``nu`` (in [-2 pi, 2 pi] [rad]), both required;
+- ``record``: ``file`` (one PEER NGA ``.AT2`` or CSV file; a relative path is taken from the
+  folder of the config file, or from the current directory for a config given as a
+  mapping), ``units`` (``g``, default, or ``m/s2``: a CSV's values; an ``.AT2`` is in g),
+  ``free_time`` [s] of free motion after the record's last sample (default
+  :data:`~rbm_cli.config.types.DEFAULT_FREE_TIME`, 5 s), ``scale`` (``pga``, default: the
+  grid's amplitude [g] is the scaled record's PGA; ``factor``: a plain scale factor),
+  ``vertical`` (a second file, same formats and units: the upward ground acceleration,
+  scaled by the same factor as the horizontal record; rigid blocks only,
+  :func:`check_vertical`).
+  ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
+  sets ``ExcitationConfig.duration`` to that.
+
+The record file is read and checked when the config is loaded: a missing or malformed file
+is a one-line :class:`~rbm_cli.base.errors.ConfigError` naming the key, the file and the
+line (the parsers of :mod:`rbm_cli.config.record_files`). The config keeps the path as
+written and the file's SHA-256 (its identity in the config's hash), and the absolute path,
+which :meth:`~rbm_cli.config.types.ExcitationConfig.resolved` leaves out.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rbm_cli.base.errors import ConfigError, RbmError
+from rbm_cli.config.record_files import read_file
+from rbm_cli.config.types import (
+    DEFAULT_FREE_TIME,
+    EXCITATIONS,
+    PULSES,
+    RECORD_SCALES,
+    RECORD_UNITS,
+    ExcitationConfig,
+    InitialConfig,
+)
+from rbm_cli.config.validate import (
+    choice,
+    describe,
+    fmt,
+    in_bounds,
+    join,
+    mapping,
+    number,
+    number_list,
+)
+from rbm_cli.config.validate import one_line as _one_line
+
+__all__ = [
+    "RecordFile",
+    "check_vertical",
+    "excitation_section",
+    "record_file",
+    "resolve_record_path",
+    "with_record",
+]
+
+EXCITATION_KEYS = (
+    "type",
+    "duration",
+    "phase",
+    "initial",
+    "file",
+    "units",
+    "free_time",
+    "scale",
+    "gamma",
+    "nu",
+    "vertical",
+)
+INITIAL_KEYS = ("rotations", "velocities")
+#: Default ``excitation.duration`` per type [s] (SPEC section 3).
+DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
+DEFAULT_DURATION.update({kind: 20.0 for kind in PULSES})  # as the half-sine [assumption]
+#: Mavroeidis-Papageorgiou's gamma [-] (> 1; their fits 1.5-3; a long train above 20 is
+#: a harmonic) and nu [rad] (a phase: one turn either way).
+GAMMA_MAX = 20.0
+NU_MAX = 2.0 * math.pi
+MAX_DURATION = 1e4  # [s]
+#: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
+INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
+PHASE_MAX = 1e3
+#: Keys that apply to some excitation types only (key -> those types).
+ONLY_FOR = {
+    "duration": tuple(t for t in EXCITATIONS if t != "record"),
+    "file": ("record",),
+    "units": ("record",),
+    "free_time": ("record",),
+    "scale": ("record",),
+    "gamma": ("mavroeidis-papageorgiou",),
+    "nu": ("mavroeidis-papageorgiou",),
+    "vertical": ("record",),
+}
+_DIGEST_CHUNK = 1 << 20
+
+
+@dataclass(frozen=True)
+class RecordFile:
+    """A record file a config names, read and checked.
+
+    written : str  The path as written in the config
+    path : str  Its absolute path
+    sha256 : str  SHA-256 of its bytes (hex)
+    end : float  Time of its last sample [s]
+    pga : float  Its peak ground acceleration [m/s^2]
+    """
+
+    written: str
+    path: str
+    sha256: str
+    end: float
+    pga: float
+
+
+def resolve_record_path(value: str | os.PathLike, base_dir: str | os.PathLike | None) -> Path:
+    """The absolute path of a record file as a config writes it.
+
+    An absolute path is kept; a relative one is taken from ``base_dir`` (the folder of the
+    config file), or from the current directory when ``base_dir`` is None (a config given
+    as a mapping). ``~`` is expanded; ``..`` is normalised; symbolic links are kept.
+    """
+    path = Path(os.path.expanduser(os.fspath(value)))
+    if not path.is_absolute():
+        path = Path(base_dir if base_dir is not None else os.getcwd()) / path
+    return Path(os.path.abspath(path))
+
+
+def _digest(path: Path) -> str:
+    h = hashlib.sha256()
+    with path.open("rb") as fh:
+        for block in iter(lambda: fh.read(_DIGEST_CHUNK), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def record_file(
+    value: Any, key: str, base_dir: str | os.PathLike | None, units: str = "g"
+) -> RecordFile:
+    """Read and check the record file ``value`` written at key path ``key``.
+
+    Raises
+    ------
+    ConfigError  ``<key>: <file>: [line N: ]<problem>`` for a value that is not one path,
+        a missing, unreadable or malformed file (record_files' checks).
+    """
+    if not isinstance(value, str) or not value.strip():
+        raise ConfigError(
+            f"{key} must be one record file (a path to a PEER NGA .AT2 or a .csv, as a"
+            f" string), got {describe(value)}"
+        )
+    path = resolve_record_path(value, base_dir)
+    try:
+        t, acc, _ = read_file(path, units)
+        digest = _digest(path)
+    except RbmError as exc:
+        raise ConfigError(f"{key}: {_one_line(str(exc))}") from None
+    except OSError as exc:
+        raise ConfigError(f"{key}: {path}: cannot read ({exc.strerror or exc})") from None
+    return RecordFile(value, str(path), digest, float(t[-1]), float(np.max(np.abs(acc))))
+
+
+def with_record(
+    excitation: ExcitationConfig,
+    value: Any,
+    base_dir: str | os.PathLike | None,
+    key: str = "excitation.file",
+) -> ExcitationConfig:
+    """The record excitation ``excitation`` with its file replaced by ``value`` (read and
+    checked as :func:`record_file` does; same units, scale and free time; the duration
+    recomputed). For a grid axis over record files."""
+    rec = record_file(value, key, base_dir, excitation.units)
+    _check_scalable(rec, excitation.scale, key)
+    end = rec.end
+    if excitation.vertical is not None:
+        ver = record_file(excitation.vertical, "excitation.vertical", base_dir, excitation.units)
+        end = max(end, ver.end)
+    duration = _record_duration(end, excitation.free_time, key)
+    return dataclasses.replace(
+        excitation,
+        type="record",
+        file=rec.written,
+        file_sha256=rec.sha256,
+        file_path=rec.path,
+        duration=duration,
+    )
+
+
+def _check_scalable(rec: RecordFile, scale: str, key: str) -> None:
+    if scale == "pga" and not rec.pga > 0.0:
+        raise ConfigError(
+            f"{key}: {rec.path}: every acceleration is 0, so it cannot be scaled to a PGA"
+            " (excitation.scale: pga); use excitation.scale: factor"
+        )
+
+
+def _record_duration(end: float, free_time: float, key: str) -> float:
+    total = end + free_time
+    if total > MAX_DURATION:
+        raise ConfigError(
+            f"{key}: the record ({fmt(end)} s) plus excitation.free_time ({fmt(free_time)} s)"
+            f" must last at most {fmt(MAX_DURATION)} s, got {fmt(total)}"
+        )
+    return total
+
+
+def _initial(raw: Any, n: int, kind: str) -> InitialConfig:
+    path = "excitation.initial"
+    init = mapping(raw, path, INITIAL_KEYS)
+    per = f"one value per drum ({n})"
+    values = {
+        key: tuple(
+            in_bounds(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
+            for i, x in enumerate(
+                number_list(init[key], join(path, key), unit, length=n, length_text=per)
+            )
+        )
+        if key in init
+        else ()
+        for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
+    }
+    if kind == "free" and not any(values["rotations"]) and not any(values["velocities"]):
+        raise ConfigError(
+            f"{path}: excitation type free needs a non-zero initial rotation or velocity"
+            f" ({path}.rotations or .velocities); with none the column stays at rest"
+        )
+    return InitialConfig(**values)
+
+
+def _refuse_foreign_keys(e: dict, kind: str) -> None:
+    """A key of another excitation type is an error that names it."""
+    for key, kinds in ONLY_FOR.items():
+        if key in e and kind not in kinds:
+            if key == "duration":
+                raise ConfigError(
+                    "excitation.duration does not apply to type record: the run lasts the"
+                    " record plus excitation.free_time [s] (default"
+                    f" {fmt(DEFAULT_FREE_TIME)} s): delete it"
+                )
+            raise ConfigError(
+                f"excitation.{key} applies only to type {' or '.join(kinds)}"
+                f" (type is {kind}): delete it"
+            )
+
+
+def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
+    """The record fields of ExcitationConfig from the section ``e`` of type record."""
+    if "file" not in e:
+        raise ConfigError(
+            "excitation.file is required for type record (a PEER NGA .AT2 or a CSV file)"
+        )
+    units = choice(e.get("units", "g"), "excitation.units", RECORD_UNITS)
+    scale = choice(e.get("scale", "pga"), "excitation.scale", RECORD_SCALES)
+    free_time = number(
+        e.get("free_time", DEFAULT_FREE_TIME),
+        "excitation.free_time",
+        "s",
+        0.0,
+        MAX_DURATION,
+        lo_open=False,
+    )
+    rec = record_file(e["file"], "excitation.file", base_dir, units)
+    _check_scalable(rec, scale, "excitation.file")
+    fields = dict(file=rec.written, file_sha256=rec.sha256, file_path=rec.path)
+    end = rec.end
+    if "vertical" in e:
+        ver = record_file(e["vertical"], "excitation.vertical", base_dir, units)
+        fields.update(vertical=ver.written, vertical_sha256=ver.sha256, vertical_path=ver.path)
+        end = max(end, ver.end)
+    return dict(
+        fields,
+        units=units,
+        scale=scale,
+        free_time=free_time,
+        duration=_record_duration(end, free_time, "excitation.file"),
+    )
+
+
+def check_vertical(excitation: ExcitationConfig, model: str, stiffness_kind: str) -> None:
+    """excitation.vertical is integrated by rigid blocks only: the rigid RBM (whose joint
+    law scales with the weight as a whole) and housner / housner-linear. With a finite
+    joint stiffness the kinks of the law move with g + a_v(t) (not implemented), and the
+    contact engine does not take it."""
+    if excitation.vertical is None:
+        return
+    if model == "bullet" or (model == "rbm" and stiffness_kind != "rigid"):
+        what = "model bullet" if model == "bullet" else f"interface.stiffness {stiffness_kind}"
+        raise ConfigError(
+            f"excitation.vertical needs a rigid block (model rbm with interface.stiffness:"
+            f" rigid, or housner, housner-linear), not {what}: with a finite joint"
+            " stiffness the law's kinks move with g + a_v(t), which this version does not"
+            " integrate"
+        )
+
+
+def _mp_fields(e: dict) -> dict:
+    """gamma and nu of the Mavroeidis-Papageorgiou pulse (both required)."""
+    for key in ("gamma", "nu"):
+        if key not in e:
+            raise ConfigError(
+                f"excitation.{key} is required for type mavroeidis-papageorgiou (gamma > 1,"
+                " at most 20 [-]: the pulse's oscillatory character; nu in [-2 pi, 2 pi]"
+                " [rad]: its phase)"
+            )
+    gamma = number(e["gamma"], "excitation.gamma", "", 1.0, GAMMA_MAX)
+    nu = number(e["nu"], "excitation.nu", "rad", -NU_MAX, NU_MAX, lo_open=False)
+    return dict(gamma=gamma, nu=nu)
+
+
+def excitation_section(
+    raw: Any, n: int, base_dir: str | os.PathLike | None = None
+) -> ExcitationConfig:
+    """The validated ``excitation`` section for a column of n drums.
+
+    Parameters
+    ----------
+    raw : mapping or None  The section as written
+    n : int  Number of drums (the length of the initial lists)
+    base_dir : path or None  Folder relative record paths are taken from (None: the
+        current directory)
+
+    Raises
+    ------
+    ConfigError  One line naming the key path (and, for a record, the file and line).
+    """
+    e = mapping(raw, "excitation", EXCITATION_KEYS)
+    kind = choice(e.get("type", "harmonic"), "excitation.type", EXCITATIONS)
+    _refuse_foreign_keys(e, kind)
+    fields: dict = {}
+    if kind == "record":
+        fields = _record_fields(e, base_dir)
+    else:
+        if kind == "mavroeidis-papageorgiou":
+            fields = _mp_fields(e)
+        fields["duration"] = number(
+            e.get("duration", DEFAULT_DURATION.get(kind, 10.0)),
+            "excitation.duration",
+            "s",
+            0.0,
+            MAX_DURATION,
+        )
+    phase = number(e.get("phase", 0.0), "excitation.phase", "rad")
+    phase = in_bounds(phase, "excitation.phase", "rad", (-PHASE_MAX, PHASE_MAX))
+    if phase != 0.0 and kind != "harmonic":
+        raise ConfigError(
+            f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"
+        )
+    return ExcitationConfig(
+        type=kind, phase=phase, initial=_initial(e.get("initial"), n, kind), **fields
+    )

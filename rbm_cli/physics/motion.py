@@ -1,0 +1,308 @@
+"""The ground motion every model integrates (SPEC section 3), SI inside: a_g [m/s^2], t [s].
+
+A :class:`GroundMotion` is a horizontal ground acceleration a_g(t) in one of the forms of
+:mod:`rbm_cli.physics.ground_forms` (a sine, a Ricker or Mavroeidis-Papageorgiou pulse, or
+a sampled record, linear between its samples, with its upward acceleration a_v(t) if any),
+its segments (the intervals on which a_g is continuous: an integrator restarts between
+them), where the pulse or record ends and the run ends. :mod:`rbm_cli.physics.excitation`
+makes one from a config (``make_ground_motion``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from rbm_cli.config.types import PULSES, G
+from rbm_cli.physics.ground_forms import (
+    FORM_OF_KIND,
+    MP,
+    RICKER,
+    SAMPLED,
+    SINE,
+    exceedance_on_pieces,
+    gravity_factor,
+    sampled_displacement,
+    scalar_form,
+)
+from rbm_cli.physics.pulses import mavroeidis_papageorgiou, ricker_wavelet
+
+#: Kinds whose motion ends (pulse_end) before the run may: free motion follows.
+PULSE_KINDS = ("half-sine", *PULSES, "record")
+#: Points a formula pulse is sampled at for its displacement (plots only) [-].
+_DISPLACEMENT_POINTS = 20_000
+#: Samples a period of a pulse made a record (GroundMotion.sampled) [-].
+SAMPLES_PER_PERIOD = 2000
+
+
+@dataclass(frozen=True, eq=False)
+class GroundMotion:
+    """A ground acceleration a_g(t) on [0, pulse_end], then 0, simulated up to t_end.
+
+    kind : str  'harmonic', 'half-sine', 'free', 'one-sine', 'cycloidal', 'ricker',
+        'mavroeidis-papageorgiou' or 'record'
+    amplitude : float  Peak acceleration max |a_g| [m/s^2]
+    omega : float  Circular frequency [rad/s] (2 pi f_p for the pulses; 0 for a record)
+    phase : float  [rad] (the harmonic's phase; pi/2 for the cycloidal pulse, whose
+        acceleration is a cosine; nu for Mavroeidis-Papageorgiou)
+    pulse_end : float  Time after which a_g = 0 [s] (the harmonic: its duration)
+    t_end : float  Maximum simulated time [s]
+    gain : float or None  Multiplier of the form (ground_forms) [m/s^2]; None: amplitude
+        (a sine or Ricker pulse); amplitude / peak of the unit shape (MP); 1 (a record,
+        whose values are in m/s^2)
+    center : float  Centre t0 of a Ricker or MP pulse [s]
+    gamma : float  MP's oscillatory character gamma [-]
+    knots : ndarray or None  Times a_g is monotone between [s]: a record's sample times,
+        the extrema of a Ricker or MP pulse
+    values : ndarray or None  A record's accelerations at its sample times [m/s^2]
+    name : str  A record's name (its file stem)
+    vertical : ndarray or None  A record's upward ground acceleration a_v at the knots
+        [m/s^2] (excitation.vertical): every weight acts as if gravity were g + a_v(t).
+        With it, the knots are the union of both records' samples, a time written twice
+        where either jumps (its first or last value not 0), value before then after.
+    """
+
+    kind: str
+    amplitude: float
+    omega: float
+    phase: float
+    pulse_end: float
+    t_end: float
+    gain: float | None = None
+    center: float = 0.0
+    gamma: float = 0.0
+    knots: np.ndarray | None = None
+    values: np.ndarray | None = None
+    name: str = ""
+    vertical: np.ndarray | None = None
+
+    @property
+    def form(self) -> int:
+        """The form of a_g (ground_forms: SINE, RICKER, MP or SAMPLED)."""
+        return FORM_OF_KIND[self.kind]
+
+    @property
+    def shape_gain(self) -> float:
+        """The multiplier of the form [m/s^2] (see ``gain``)."""
+        return self.amplitude if self.gain is None else self.gain
+
+    @property
+    def is_pulse(self) -> bool:
+        """Whether the motion ends before the run may (free motion follows it)."""
+        return self.kind in PULSE_KINDS
+
+    @property
+    def clipped(self) -> bool:
+        """Whether integrator steps must end at every knot (a record: a_g has a kink at
+        every sample)."""
+        return self.form == SAMPLED
+
+    @cached_property
+    def _scalar(self):
+        return scalar_form(
+            self.form,
+            self.shape_gain,
+            self.omega,
+            self.phase,
+            self.center,
+            self.gamma,
+            self.knots,
+            self.values,
+        )
+
+    @property
+    def has_vertical(self) -> bool:
+        """Whether an upward ground acceleration changes the weights (a record's)."""
+        return self.vertical is not None
+
+    def gravity(self, forced: bool = True):
+        """(g + a_v(t)) / g [-] as a function of a float t [s] on a forced segment, or None
+        (no vertical motion: the integrators keep their expressions without it)."""
+        if not forced or self.vertical is None:
+            return None
+        knots, vertical = self.knots, self.vertical
+        return lambda tt: gravity_factor(tt, knots, vertical)
+
+    @cached_property
+    def lift_off(self) -> float | None:
+        """First time [s] the ground's upward acceleration reaches -g (g + a_v <= 0: the
+        column would leave the ground), or None."""
+        if self.vertical is None or not np.any(self.vertical <= -G):
+            return None
+        k = int(np.argmax(self.vertical <= -G))
+        if k == 0 or self.knots[k] == self.knots[k - 1]:
+            return float(self.knots[k])
+        t_a, t_b = float(self.knots[k - 1]), float(self.knots[k])
+        v_a, v_b = float(self.vertical[k - 1]), float(self.vertical[k])
+        return t_a + (t_b - t_a) * ((-G - v_a) / (v_b - v_a))
+
+    def until(self, t_stop: float) -> GroundMotion:
+        """The motion simulated up to t_stop [s] only (its pulse cut there)."""
+        return dataclasses.replace(
+            self, pulse_end=min(self.pulse_end, t_stop), t_end=min(self.t_end, t_stop)
+        )
+
+    def scalar(self, forced: bool = True):
+        """a_g(t) [m/s^2] as a function of a float t [s], for the integrators: the
+        motion's form when ``forced``, else 0 (a free segment)."""
+        if not forced or self.amplitude == 0.0:
+            return lambda tt: 0.0
+        return self._scalar
+
+    def accel(self, t: float | np.ndarray) -> np.ndarray | float:
+        """Ground acceleration a_g(t) [m/s^2] (0 after the pulse), vectorised: a Ricker or
+        MP pulse by physics/pulses.py (the integrators evaluate the same formula,
+        ground_forms.scalar_form, to round-off)."""
+        if self.amplitude == 0.0:
+            return np.zeros_like(t) if isinstance(t, np.ndarray) else 0.0
+        tt = np.asarray(t, dtype=float)
+        if self.form == SINE:
+            a = self.amplitude * np.sin(self.omega * tt + self.phase)
+        elif self.form == SAMPLED:
+            a = np.interp(tt, self.knots, self.values, left=0.0, right=0.0)
+        elif self.form == RICKER:
+            a = ricker_wavelet(tt, self.shape_gain, self.omega / (2.0 * math.pi), self.center)
+        elif self.form == MP:
+            f = self.omega / (2.0 * math.pi)
+            peak = math.copysign(self.amplitude, self.shape_gain)
+            a = mavroeidis_papageorgiou(tt, peak, f, self.gamma, self.phase)
+        if self.kind != "harmonic":
+            a = np.where(tt <= self.pulse_end, a, 0.0)
+        return a if isinstance(t, np.ndarray) else float(a)
+
+    def displacement(self, t: np.ndarray) -> np.ndarray:
+        """Ground displacement u_g(t) [m] (for plots; the dynamics see only a_g).
+
+        Harmonic: the steady form -a_g / omega^2. Pulses and records: integrated from
+        rest, so the ground keeps the velocity it has at the end of the pulse (half-sine:
+        2 A / omega); a record exactly (cubic between samples), a Ricker or MP pulse on
+        20 000 points of its duration.
+        """
+        t = np.asarray(t, dtype=float)
+        if self.amplitude == 0.0:
+            return np.zeros_like(t)
+        A, w = self.amplitude, self.omega
+        if self.kind == "harmonic":
+            return -A / w**2 * np.sin(w * t + self.phase)
+        if self.kind == "half-sine":
+            tp = np.minimum(t, self.pulse_end)
+            u = A / w * tp - A / w**2 * np.sin(w * tp)
+            return u + 2.0 * A / w * np.maximum(t - self.pulse_end, 0.0) * (t > self.pulse_end)
+        if self.form == SAMPLED:
+            return sampled_displacement(self.knots, self.values, t)
+        ts = np.linspace(0.0, self.pulse_end, _DISPLACEMENT_POINTS + 1)
+        return sampled_displacement(ts, np.asarray(self.accel(ts)), t)
+
+    def segments(self) -> list[tuple[float, float]]:
+        """Intervals on which a_g is continuous (the integrator restarts between them):
+        a pulse, then its free motion; a record also restarts at its first sample when
+        the acceleration jumps there from rest."""
+        cuts = [0.0]
+        if self.form == SAMPLED:
+            first = self.values[0] != 0.0 or (self.has_vertical and self.vertical[0] != 0.0)
+            if self.knots[0] > 0.0 and first:
+                cuts.append(float(self.knots[0]))
+            twice = np.nonzero(np.diff(self.knots) == 0.0)[0]
+            cuts += [float(self.knots[k]) for k in twice if 0.0 < self.knots[k] < self.pulse_end]
+        if self.is_pulse and self.pulse_end < self.t_end:
+            cuts.append(self.pulse_end)
+        cuts.append(self.t_end)
+        return list(zip(cuts[:-1], cuts[1:], strict=True))
+
+    def after_pulse(self, seg_start: float) -> bool:
+        """Whether the segment starting at seg_start [s] is the free motion after a pulse
+        or a record."""
+        return self.is_pulse and seg_start >= self.pulse_end
+
+    def forced(self, seg_start: float) -> bool:
+        """Whether a_g is non-zero on the segment starting at seg_start [s]."""
+        return self.amplitude > 0.0 and not self.after_pulse(seg_start)
+
+    def next_exceedance(self, t0: float, level: float) -> float | None:
+        """First time t >= t0 with |a_g(t)| > level, or None before t_end.
+
+        With a vertical record the level is level (g + a_v(t)) / g.
+
+        Exact for the sine: |sin(psi)| > s with s = level / amplitude holds on
+        (asin(s) + k pi, pi - asin(s) + k pi). The returned time is where
+        |a_g| = level and rising (or t0 itself when already above). Other forms:
+        exact on their monotone pieces (ground_forms.exceedance_on_pieces).
+        """
+        if self.amplitude <= level and self.vertical is None:
+            return None
+        last = min(self.pulse_end, self.t_end)
+        if t0 >= last:
+            return None
+        if self.form != SINE:
+            values = self.values if self.form == SAMPLED else None
+            return exceedance_on_pieces(
+                self._scalar, self.knots, t0, level, last, values, self.vertical
+            )
+        s = level / self.amplitude
+        psi0 = self.omega * t0 + self.phase
+        if abs(math.sin(psi0)) > s:
+            return t0
+        lo = math.asin(s)
+        k = math.ceil((psi0 - lo) / math.pi)
+        psi = lo + k * math.pi
+        if psi < psi0:
+            psi += math.pi
+        t = (psi - self.phase) / self.omega
+        if t >= last:
+            return None
+        return t
+
+    def rest_end(self, t: float, seg_end: float, level: float, forced: bool) -> tuple[str, float]:
+        """How the rest of a rigid block, at rest at time t, ends.
+
+        Returns ('end', t_end) when no ground motion is left (it rests to the end
+        of the run), ('segment', seg_end) when |a_g| stays below `level`
+        [m/s^2] in the current segment, or ('uplift', t_up) when it exceeds it.
+        """
+        if not forced:
+            return "end", self.t_end
+        t_up = self.next_exceedance(t, level)
+        if t_up is None or t_up >= seg_end:
+            return "segment", seg_end
+        return "uplift", t_up
+
+    def uplift_side(self, t: float) -> int:
+        """Side (sign of theta) a block lifts on at time t: away from a_g (a pulse's
+        formula or samples as the integrators evaluate them)."""
+        if self.form != SINE:
+            return -1 if self._scalar(t) > 0.0 else 1
+        return -1 if self.accel(t) > 0.0 else 1
+
+    def sampled(self, per_period: int = SAMPLES_PER_PERIOD) -> GroundMotion:
+        """This pulse as a record: sampled on [0, pulse_end], per_period samples a period
+        2 pi / omega and at its knots (its extrema, so the peak is kept), linear between.
+
+        For a model that integrates piecewise-linear forcing only (housner-linear's closed
+        form). Linear interpolation errs by at most h^2 max|a''| / 8 with h the sample
+        step: for a Ricker pulse (max|a''| = 6 (pi f)^2 A) and the default 2000 samples a
+        period, 1.9e-6 A. Measured against the rigid RBM, which evaluates the formula
+        (tests/test_pulses_run.py, Ricker and two MP pulses, 18 cells each): collapse
+        times within 2.1e-5 s and peak ratios within 4.2e-5, falling 100-fold with 10
+        times the samples (the sampling's h^2, not the models, makes the difference).
+        """
+        if self.form == SAMPLED or self.form == SINE:
+            return self
+        count = max(2, math.ceil(per_period * self.omega * self.pulse_end / (2.0 * math.pi)))
+        ts = np.union1d(np.linspace(0.0, self.pulse_end, count + 1), self.knots)
+        values = np.asarray(self.accel(ts), dtype=float)
+        return GroundMotion(
+            "record",
+            float(np.max(np.abs(values))),
+            0.0,
+            0.0,
+            self.pulse_end,
+            self.t_end,
+            gain=1.0,
+            knots=ts,
+            values=values,
+            name=f"{self.kind} (sampled)",
+        )

@@ -15,16 +15,16 @@ integrator (rbm_cli.models.rbm.python, same surfaces, same EVENT_EPS, same actio
 - a rigid monolith at rest, lifting when the ground demand exceeds its uplift level, and
   put to rest by an impact that leaves it almost no rate (REST_RATE);
 - the end of the pulse, the end of the run, and the early stop of free motion after a
-  half-sine pulse once a peak is passed below the collapse barrier (monolithic columns).
+  pulse or a record once a peak is passed below the collapse barrier (monolithic columns).
 
 Events are roots of sums of exponentials and sinusoids, found without a chance of missing
 one by certified intervals (rbm_cli.models.rbm.exact_search). Outcome counters: n_steps
 counts the certified intervals, n_rhs the closed-form evaluations of the state.
 
 Formulations `relative` and `geometric` (symmetric stiffness) only; `absolute` stays with
-the Runge-Kutta methods. Excitations: harmonic, half-sine and free; a sampled record is
-piecewise linear in time and the closed form takes it exactly per sample interval
-(Forcing 'linear'), once records reach the run loop.
+the Runge-Kutta methods. Excitations: harmonic, free, the sine pulses (half-sine, one-sine,
+cycloidal) and records, piecewise linear in time, which the closed form takes exactly per
+sample interval (Forcing 'linear'); exact_motion says what is refused and why.
 """
 
 from __future__ import annotations
@@ -217,7 +217,8 @@ def _segment(run: ExactRun, forcing: Forcing, seg_end: float, can_stop: bool):
     """Run up to seg_end [s] under one forcing; the Outcome if the run ends inside."""
     while run.t < seg_end:
         if run.at_rest:
-            kind = _leave_rest(run, seg_end, forcing.kind != "zero")
+            before = run.motion.is_pulse and run.t < run.motion.pulse_end  # a record's start
+            kind = _leave_rest(run, seg_end, forcing.kind != "zero" or before)
             if kind == "end":
                 run.out.t_end = run.t
                 return run.out
@@ -261,11 +262,15 @@ def integrate_exact(
     deadline = time.monotonic() + solver.max_wall_time
     run = ExactRun(model, system, motion, theta0, rate0, solver, record, output_dt, deadline)
     try:
-        for _start, end, forcing in segments:
+        last = "zero"
+        for start, end, forcing in segments:
             if run.t >= end:
                 continue
-            run.h = min(run.h, FIRST_STEP)
-            can_stop = early_stop and forcing.kind == "zero" and motion.kind == "half-sine"
+            if not (forcing.kind == "linear" and last == "linear"):
+                run.h = min(run.h, FIRST_STEP)  # a record's next sample keeps its step
+            last = forcing.kind
+            free = forcing.kind == "zero" and start >= motion.pulse_end
+            can_stop = early_stop and free and motion.is_pulse
             stop = _segment(run, forcing, end, can_stop)
             if stop is not None:
                 return stop

@@ -15,7 +15,7 @@ from typing import NamedTuple
 import numpy as np
 
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, forcing_array
+from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, LINEAR, ZERO, forcing_array
 from rbm_cli.models.rbm.exact_jit_run import (
     AT_REST_END,
     COLLAPSED,
@@ -50,6 +50,33 @@ def prepare_exact(model: Model) -> PreparedExact:
 def _segments(segs: list) -> tuple[np.ndarray, np.ndarray]:
     seg_t = np.array([[s, e] for s, e, _ in segs], dtype=float).reshape(-1, 2)
     seg_fc = np.array([forcing_array(f) for _, _, f in segs]).reshape(-1, FORCING_SIZE)
+    return seg_t, seg_fc
+
+
+def record_arrays(motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:
+    """The segments of a record motion as (seg_t, seg_fc) arrays, as
+    _segments(exact_motion.record_segments(motion)) makes them, without a Python object
+    per sample (3,000 samples: 0.3 ms instead of 21 ms a run)."""
+    knots = np.asarray(motion.knots, dtype=float)
+    values = np.asarray(motion.values, dtype=float)
+    t_end = float(motion.t_end)
+    k = np.nonzero((np.diff(knots) > 0.0) & (knots[:-1] < t_end))[0]
+    lin_t = np.stack([knots[k], np.minimum(knots[k + 1], t_end)], axis=1)
+    lin_fc = np.zeros((k.size, FORCING_SIZE))
+    lin_fc[:, 0] = LINEAR
+    lin_fc[:, 4] = knots[k]
+    lin_fc[:, 5] = values[k]
+    lin_fc[:, 6] = (values[k + 1] - values[k]) / (knots[k + 1] - knots[k])
+    cuts = sorted({0.0, float(knots[0]), float(knots[-1]), float(motion.pulse_end), t_end})
+    before, after = [], []
+    for a, b in zip(cuts[:-1], cuts[1:], strict=False):
+        if b > a and a < t_end and (b <= knots[0] or a >= knots[-1]):
+            (before if b <= knots[0] else after).append((a, min(b, t_end)))
+    zero = np.zeros(FORCING_SIZE)
+    zero[0] = ZERO
+    seg_t = np.concatenate([np.array(before).reshape(-1, 2), lin_t, np.array(after).reshape(-1, 2)])
+    seg_fc = np.concatenate([np.tile(zero, (len(before), 1)), lin_fc,
+                             np.tile(zero, (len(after), 1))])  # fmt: skip
     return seg_t, seg_fc
 
 
@@ -97,12 +124,15 @@ def integrate_exact_compiled(
         runs one model many times (a sweep); made here when None.
     segments : list, optional  The forcing instead of the motion's (exact.integrate_exact)
     """
-    segs = resolve_segments(model, motion, segments)
+    if segments is None and motion.kind == "record":
+        check_exact(model, motion.kind, motion.has_vertical)
+        seg_t, seg_fc = record_arrays(motion)
+    else:
+        seg_t, seg_fc = _segments(resolve_segments(model, motion, segments))
     if prepared is None:
         prepared = prepare_exact(model)
     n = model.n
-    seg_t, seg_fc = _segments(segs)
-    mo = np.array([1.0 if motion.kind == "half-sine" else 0.0, motion.amplitude, motion.omega,
+    mo = np.array([1.0 if motion.is_pulse else 0.0, motion.amplitude, motion.omega,
                    motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
     deadline = time.monotonic() + float(solver.max_wall_time)
     se = np.array([solver.max_steps, solver.max_events, deadline, float(early_stop),
@@ -119,3 +149,20 @@ def integrate_exact_compiled(
             (s[0], s[1 : 1 + n].copy(), s[1 + n :].copy()) for s in samples[: int(st[5])]
         ]
     return out
+
+
+def warm_up() -> None:
+    """Compile (or load from the cache) the exact integrator once, e.g. in a worker: an
+    elastic 2-drum column under a harmonic and a linear forcing."""
+    from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
+    from rbm_cli.models.rbm.exact_motion import sampled_segments
+    from rbm_cli.physics.column import build_column
+    from rbm_cli.physics.equations import build_model
+
+    geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=(1.0, 1.0))
+    model = build_model(build_column(geometry, InterfaceConfig()))
+    motion = GroundMotion("harmonic", 5.0, 6.0, 0.0, 0.1, 0.1)
+    zeros = np.zeros(2)
+    integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig())
+    segments = sampled_segments(np.array([0.0, 0.1]), np.array([0.0, 5.0]), 0.1)
+    integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig(), segments=segments)

@@ -4,7 +4,7 @@ algorithm, statement for statement, in one compiled call per run.
 Mutable scalars live in small arrays: st = [t, h, next_out, t_collapse, at_rest, n_out]
 (floats) and cnt = [n_uplifts, n_impacts, n_steps, n_rhs, n_events, collapse interface,
 the part of n_rhs spent on peaks, the current segment] (ints). A motion is
-mo = [half-sine (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
+mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
 (start, end) with their forcings (exact_jit_modal); settings are
 se = [max_steps, max_events, deadline, early_stop, record, output_dt].
 """
@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
-from rbm_cli.models.rbm.exact_jit_modal import ZERO, f_accel
+from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel
 from rbm_cli.models.rbm.exact_jit_peaks import NOTES, new_notes, note_interval, settle_peaks
 from rbm_cli.models.rbm.exact_jit_piece import (
     cross,
@@ -188,14 +188,37 @@ def _handle(mdl, pc, row, s, se):
 
 
 @njit(cache=True)
-def _leave_rest(mdl, s, mo, seg_end, forced, samples, dt):
+def _linear_exceedance(fc, t0, level, t_stop):
+    """First t in [t0, t_stop) with |a_g(t)| > level under a linear forcing fc: t0 when
+    already above, else where |a_g| reaches level (NaN if it does not before t_stop)."""
+    a = f_accel(fc, t0)
+    if abs(a) > level:
+        return t0
+    slope = fc[6]
+    if slope == 0.0:
+        return math.nan
+    target = level if slope > 0.0 else -level
+    t = t0 + (target - a) / slope
+    return t if t < t_stop else math.nan
+
+
+@njit(cache=True)
+def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
     """A rigid monolith at rest (exact._leave_rest): 0 no ground motion left (rests to
-    the end), 1 the segment ends first, 2 it lifts."""
+    the end), 1 the segment ends first, 2 it lifts (a harmonic's exceedance from its
+    formula, a linear piece's from its line)."""
     t = s.st[T]
-    if not forced:
-        kind, t_stop = 0, mo[5]
+    kind_fc = int(fc[0])
+    if kind_fc == ZERO:
+        if mo[0] != 0.0 and t < mo[4]:  # rest before a record's first sample
+            kind, t_stop = 1, seg_end
+        else:
+            kind, t_stop = 0, mo[5]
     else:
-        t_up = next_exceedance(t, mdl.uplift_level, mo[1], mo[2], mo[3], min(mo[4], mo[5]))
+        if kind_fc == LINEAR:
+            t_up = _linear_exceedance(fc, t, mdl.uplift_level, seg_end)
+        else:
+            t_up = next_exceedance(t, mdl.uplift_level, fc[1], fc[2], fc[3], min(mo[4], mo[5]))
         if math.isnan(t_up) or t_up >= seg_end:
             kind, t_stop = 1, seg_end
         else:
@@ -206,7 +229,7 @@ def _leave_rest(mdl, s, mo, seg_end, forced, samples, dt):
         return kind
     s.theta[:] = 0.0
     s.rate[:] = 0.0
-    s.side[0] = -1 if mo[1] * math.sin(mo[2] * t_stop + mo[3]) > 0.0 else 1
+    s.side[0] = -1 if f_accel(fc, t_stop) > 0.0 else 1
     s.k[0] = 0
     s.st[AT_REST] = 0.0
     s.cnt[UPLIFTS] += 1
@@ -218,7 +241,7 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
     """Run up to seg_end [s] under the forcing fc (exact._segment). Returns a code."""
     while s.st[T] < seg_end:
         if s.st[AT_REST] != 0.0:
-            kind = _leave_rest(mdl, s, mo, seg_end, int(fc[0]) != ZERO, samples, se[5])
+            kind = _leave_rest(mdl, s, mo, seg_end, fc, samples, se[5])
             if kind == 0:
                 return AT_REST_END
             if kind == 1:
@@ -260,8 +283,10 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     for i in range(seg_t.shape[0]):
         if s.st[T] >= seg_t[i, 1]:
             continue
-        s.st[H] = min(s.st[H], FIRST_STEP)
-        can_stop = se[3] != 0.0 and int(seg_fc[i, 0]) == ZERO and mo[0] != 0.0
+        if not (i > 0 and int(seg_fc[i, 0]) == LINEAR and int(seg_fc[i - 1, 0]) == LINEAR):
+            s.st[H] = min(s.st[H], FIRST_STEP)  # a record's next sample keeps its step
+        free = int(seg_fc[i, 0]) == ZERO and seg_t[i, 0] >= mo[4]
+        can_stop = se[3] != 0.0 and free and mo[0] != 0.0
         s.cnt[SEG] = i
         code = _segment(mdl, cache, wk, s, mo, se, seg_fc[i], seg_t[i, 1], can_stop, samples)
         if code != GOING:

@@ -122,7 +122,8 @@ class RbmRunner:
         if config.solver.method == "exact":
             from rbm_cli.models.rbm.exact_motion import check_exact
 
-            check_exact(self.model, config.excitation.type)
+            excitation = config.excitation
+            check_exact(self.model, excitation.type, excitation.vertical is not None)
 
     def _integrator(self, method: str, implementation: str):
         """The integrator of a method and implementation, imported only when a run needs

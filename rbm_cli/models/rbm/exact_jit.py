@@ -152,17 +152,22 @@ def integrate_exact_compiled(
 
 
 def warm_up() -> None:
-    """Compile (or load from the cache) the exact integrator once, e.g. in a worker: an
-    elastic 2-drum column under a harmonic and a linear forcing."""
-    from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
+    """Compile (or load from the cache) the exact integrator once, e.g. in a worker: a
+    rigid monolith and an elastic 2-drum column (their model arrays type differently),
+    under a harmonic and a linear forcing."""
+    from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig, StiffnessConfig
     from rbm_cli.models.rbm.exact_motion import sampled_segments
     from rbm_cli.physics.column import build_column
     from rbm_cli.physics.equations import build_model
 
-    geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=(1.0, 1.0))
-    model = build_model(build_column(geometry, InterfaceConfig()))
     motion = GroundMotion("harmonic", 5.0, 6.0, 0.0, 0.1, 0.1)
-    zeros = np.zeros(2)
-    integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig())
     segments = sampled_segments(np.array([0.0, 0.1]), np.array([0.0, 5.0]), 0.1)
-    integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig(), segments=segments)
+    elastic = InterfaceConfig(stiffness=StiffnessConfig("normal", (5e9,)))
+    for drums, interface in (((2.0,), InterfaceConfig()), ((1.0, 1.0), elastic)):
+        geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=drums)
+        model = build_model(build_column(geometry, interface))
+        zeros = np.zeros(model.n)
+        integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig())
+        if model.uplift_level is None:  # a rigid monolith is refused a given linear forcing
+            integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig(),
+                                     segments=segments)  # fmt: skip

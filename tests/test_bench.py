@@ -60,6 +60,11 @@ def test_quick_bench_meets_the_accuracy_targets(tmp_path):
     default = table[table["default"] == 1]
     assert len(default) == 4 and (default["n_converged"] > 0).all()
     assert (table["implementation"] == "baseline").sum() == 4
+    # both methods on every problem: the exact integrator agrees with the references
+    exact = table[table["method"] == "exact"]
+    assert len(exact) == 4 and (exact["n_converged"] > 0).all()
+    assert (exact["cells_differ"] == 0).all() and (exact["n_failed"] == 0).all()
+    assert (exact["peak_err_max"].fillna(0.0) < PEAK_TARGET).all()
     assert (tmp_path / "bench.png").stat().st_size > 0
 
 

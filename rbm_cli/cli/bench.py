@@ -29,18 +29,24 @@ from rbm_cli.cli.common import UserError, cli, one_line
               "speed-up of 2 workers over 1 (scaling.csv, scaling.png).")  # fmt: skip
 @click.option("--reuse-references", is_flag=True,
               help="Full run: keep the stored references instead of re-making them.")  # fmt: skip
-def bench(quick, output, jobs, problems, references, scaling, reuse_references) -> None:
+@click.option("--pair", is_flag=True,
+              help="Whole grids, two methods only: the default step kernel and the exact "
+              "integrator (and the baseline's sample).")  # fmt: skip
+def bench(quick, output, jobs, problems, references, scaling, reuse_references, pair) -> None:
     """Measure run time against error for every method and tolerance rbm offers.
 
     Problems: the rigid Spanos-Koh slender block, the tapered monolithic column
     with finite K_M, the 8-drum column and a half-sine domain, 40 x 40 cells
     each. References: the closed form (rigid monolithic) or converged runs at
     rtol 1e-10/1e-11/1e-12 (sensitive cells are counted, not scored). The
-    baseline is scipy solve_ivp (RK45, rtol 1e-6) on a sample of cells.
+    baseline is scipy solve_ivp (RK45, rtol 1e-6) on a sample of cells. Both
+    methods run every problem: the step kernel (DOP853) and the exact
+    integrator (solver.method exact), with their agreement on the same cells.
 
     \b
     Example:
         rbm bench --quick
+        rbm bench --pair --reuse-references --problem multidrum
         rbm bench -o bench --scaling
     """
     from rbm_cli.base.files import save_figure_atomic
@@ -54,7 +60,7 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references) 
     try:
         table = run_bench(quick=quick, jobs=jobs, output=output, reference_dir=references,
                           problems=tuple(problems) or None, reuse_references=reuse_references,
-                          log=log)  # fmt: skip
+                          pair=pair, log=log)  # fmt: skip
         save_figure_atomic(work_precision_figure(table), Path(output) / "bench.png")
         if scaling:
             from rbm_cli.study.bench_scaling import run_scaling

@@ -28,7 +28,7 @@ RECORD_SCALES = ("pga", "factor")
 #: still rocking when the shaking ends has time to collapse or settle; a monolithic
 #: column whose energy is below its collapse barrier is stopped early anyway.
 DEFAULT_FREE_TIME = 5.0
-METHODS = ("DOP853", "RK45", "RK23")
+METHODS = ("DOP853", "RK45", "RK23", "exact")
 IMPLEMENTATIONS = ("compiled", "python")
 
 
@@ -227,7 +227,9 @@ class CollapseConfig:
 class SolverConfig:
     """Integrator settings.
 
-    method : str  Runge-Kutta pair of scipy.integrate.solve_ivp
+    method : str  Runge-Kutta pair of scipy.integrate.solve_ivp, or 'exact' (model rbm:
+        closed-form integration of the linear pieces, rbm_cli.models.rbm.exact; its
+        tolerances do not apply)
     rtol, atol : float  Tolerances (atol relative to the rotation scale theta_u)
     max_steps : int  Step budget of one run; beyond it the run is 'failed'
     max_events : int  Budget of events (kinks, impacts) of one run

@@ -27,6 +27,7 @@ import math
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 
+from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import G, SolverConfig
 from rbm_cli.models.block_runner import BlockRunner
 from rbm_cli.models.events import EVENT_EPS, REST_RATE, first_crossing, hermite_dip
@@ -327,7 +328,12 @@ class HousnerRunner(BlockRunner):
     """`housner` (rbm_cli.models.contract.Runner): the config's monolithic column as Housner's
     rigid block, with its true geometry (rbm_cli.physics.block)."""
 
+    def __init__(self, config) -> None:
+        super().__init__(config)
+        _check_method(config.solver)
+
     def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
+        _check_method(solver)
         return housner_run(
             self.geometry,
             motion,
@@ -336,4 +342,13 @@ class HousnerRunner(BlockRunner):
             collapse_ratio=self.config.collapse.ratio,
             initial=self.initial,
             **options,
+        )
+
+
+def _check_method(solver: SolverConfig) -> None:
+    """Housner's equations are not piecewise linear: no `exact` method (one-line RbmError)."""
+    if solver.method not in _METHODS:
+        raise RbmError(
+            f"solver.method {solver.method} is for model rbm (its piecewise-linear equations);"
+            f" model housner takes {', '.join(_METHODS)}"
         )

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.study.bench import PEAK_TARGET, PROBLEMS
-from rbm_cli.study.bench_scaling import CELL
+from rbm_cli.study.bench_scaling import CELL, ROCKING_CELL
 
 
 def _series_label(impl: str, method: str) -> str:
@@ -125,19 +125,22 @@ _SCALING_SERIES = (
 
 
 def scaling_figure(table: pd.DataFrame):
-    """Time per run against drums, k_n and duration, and the 2-worker speed-up.
+    """Time per run against drums, k_n and duration for both methods, and the 2-worker
+    speed-up.
 
     Parameters
     ----------
     table : pandas.DataFrame
         The table of :func:`rbm_cli.study.bench_scaling.run_scaling` (``series``,
-        ``x``, ``time_per_run_s`` [s], ``speedup_2_over_1`` [-]).
+        ``x``, ``method``, ``cell``, ``time_per_run_s`` [s], ``speedup_2_over_1`` [-]).
 
     Returns
     -------
     matplotlib.figure.Figure
-        Four axes side by side: three log-log series and a bar chart of the
-        speed-up of 2 workers over 1 (2 dashed).
+        Four axes side by side: three log-log series (one line per method and cell:
+        circles the step kernel, squares the exact integrator; solid the elastic cell,
+        dashed the rocking one) and a bar chart of the speed-up of 2 workers over 1
+        (2 dashed).
     """
     import matplotlib.ticker
     from matplotlib.figure import Figure
@@ -146,8 +149,8 @@ def scaling_figure(table: pd.DataFrame):
     axes = fig.subplots(1, 4)
     for ax, (series, xlabel) in zip(axes[:3], _SCALING_SERIES, strict=True):
         sub = table[table["series"] == series]
-        xs = sub["x"].astype(float)
-        ax.loglog(xs, sub["time_per_run_s"], "o-")
+        xs = np.unique(sub["x"].astype(float))
+        _draw_methods(ax, sub)
         if series != "k_n":  # label the points themselves (the log axis's minor labels overlap)
             ax.set_xticks(xs, [f"{x:g}" for x in xs])
             ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
@@ -158,9 +161,25 @@ def scaling_figure(table: pd.DataFrame):
     axes[3].bar(sub["x"].astype(str), sub["speedup_2_over_1"])
     axes[3].axhline(2.0, color="0.5", ls="--", lw=0.8)
     axes[3].set_ylabel("speed-up, 2 workers over 1")
-    fig.suptitle(f"rbm scaling, one cell {CELL[0]} g {CELL[1]} Hz (stays elastic)")
+    fig.suptitle(f"rbm scaling, 10 s at {CELL[0]} g {CELL[1]} Hz (stays elastic) and "
+                 f"{ROCKING_CELL[0]} g {ROCKING_CELL[1]} Hz (rocks)")  # fmt: skip
+    axes[0].legend(fontsize="x-small")
     fig.tight_layout()
     return fig
+
+
+def _draw_methods(ax, sub: pd.DataFrame) -> None:
+    """One line per method and cell of a scaling series (a table without those columns:
+    one line)."""
+    if "method" not in sub or sub["method"].isna().all():
+        ax.loglog(sub["x"].astype(float), sub["time_per_run_s"], "o-")
+        return
+    for (method, cell), grp in sub.groupby(["method", "cell"], sort=False):
+        marker, color = ("s", "C3") if method == "exact" else ("o", "C0")
+        ls = "--" if cell == "rocking" else "-"
+        label = f"{method}, {cell} cell"
+        ax.loglog(grp["x"].astype(float), grp["time_per_run_s"], marker=marker, ls=ls,
+                  color=color, label=label, gid=label)  # fmt: skip
 
 
 __all__ = ["scaling_figure", "work_precision_figure"]

@@ -56,7 +56,7 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import Config, GridConfig, SolverConfig
 from rbm_cli.study.bench_runs import run_cells
-from rbm_cli.study.bench_scoring import _key, errors
+from rbm_cli.study.bench_scoring import _key, agreement, errors
 from rbm_cli.study.robustness import MEMBERS, member_config, members
 
 ROOT = Path(__file__).resolve().parents[2]  # the repository (rbm_cli/study/bench.py)
@@ -84,11 +84,13 @@ PROBLEMS = (
             "closed-form", 0.005, "rigid monolithic column, half-sine pulse"),
 )  # fmt: skip
 
+#: The exact integrator (`solver.method: exact`; it has no tolerance: its rtol is unused).
+EXACT = ("compiled", "exact", SolverConfig().rtol)
 #: Methods of the full benchmark: (implementation, method, rtol).
 METHODS = (
     [("compiled", "DOP853", r) for r in (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)]
     + [("compiled", "RK45", r) for r in (1e-5, 1e-6, 1e-7, 1e-8)]
-    + [("python", "DOP853", SolverConfig().rtol)]
+    + [("python", "DOP853", SolverConfig().rtol), EXACT]
 )
 #: Cells of the sample on which the slow methods (the Python loop and the
 #: baseline) run: the same cells for both, and the speed-up of every method is
@@ -208,8 +210,13 @@ def run_bench(
     problems: tuple[str, ...] | None = None,
     log=print,
     reuse_references: bool = False,
+    pair: bool = False,
 ) -> pd.DataFrame:
     """Run the benchmark; write bench.csv (and, full, the references).
+
+    Every run (quick, pair or full) has both methods: the default step kernel and the
+    exact integrator, each row with its agreement with the default on the same cells.
+    pair: only these two (and the baseline) on the full grids.
 
     The figure (bench.png) is drawn by the caller from the returned table
     (:func:`rbm_cli.report.bench_figures.work_precision_figure`)."""
@@ -230,7 +237,7 @@ def run_bench(
         cells = _cells(cfg)
         ref = _reference(prob, cfg, cells, ref_dir, quick, reuse_references, jobs, log)
         sample = _sample(cells, QUICK_SAMPLE if quick else SAMPLE[prob.name])
-        results = _run_methods(cfg, cells, sample, quick, jobs)
+        results = _run_methods(cfg, cells, sample, quick or pair, jobs)
         for row in _method_rows(prob, results, sample, ref, jobs):
             rows.append(row)
             log(_line(row))
@@ -274,11 +281,11 @@ def _default_method() -> tuple[str, str, float]:
 
 
 def _run_methods(cfg: Config, cells: list, sample: list, quick: bool, jobs: int) -> list:
-    """Run every method (quick: the default) and the baseline.
+    """Run every method (quick: the default and the exact method) and the baseline.
 
     Returns (method triple, rows, wall time [s], whether on the sample only) per
     method, the baseline last; the Python loop and the baseline run the sample."""
-    methods = [_default_method()] if quick else list(METHODS)
+    methods = [_default_method(), EXACT] if quick else list(METHODS)
     results = []
     for impl, method, rtol in methods:
         part = sample if impl == "python" else cells
@@ -319,20 +326,28 @@ def _method_rows(
             "domain_estimated": int(sampled),
             "jobs": jobs,
             "speedup_vs_baseline": base_sum / own if own > 0 else math.nan,
+            "steps_median": float(df["n_steps"].median()) if "n_steps" in df else math.nan,
         }
         row.update(errors(df, ref))
+        row.update(agreement(df, results[k_default][1], ref))
         rows.append(row)
     return rows
 
 
 def _line(r: dict) -> str:
+    rtol = "" if r["method"] == "exact" else f" rtol {r['rtol']:.0e}"
+    steps = r.get("steps_median", math.nan)
+    unit = "pieces" if r["method"] == "exact" else "steps"
+    steps = f", {steps:.0f} {unit}" if steps == steps else ""
     return (
-        f"{r['problem']:10s} {r['implementation']:9s} {r['method']:15s} rtol {r['rtol']:.0e}: "
-        f"{r['time_per_run_ms_mean']:9.3f} ms/run, domain {r['domain_wall_s']:8.2f} s"
+        f"{r['problem']:10s} {r['implementation']:9s} {r['method'] + rtol:21s}: "
+        f"{r['time_per_run_ms_mean']:9.3f} ms/run{steps}, domain {r['domain_wall_s']:8.2f} s"
         f"{' (est.)' if r['domain_estimated'] else ''}, x{r['speedup_vs_baseline']:.0f} vs "
         f"baseline; differ {r['cells_differ']}/{r['n_converged']} "
         f"(sensitive {r['n_sensitive']}), boundary {r['boundary_err_g']:.3g} g, "
-        f"peak err median {r['peak_err_median']:.2g} max {r['peak_err_max']:.2g}"
+        f"peak err median {r['peak_err_median']:.2g} max {r['peak_err_max']:.2g}; vs the "
+        f"default: x{r['speedup_vs_default']:.2f}, differ {r['differ_vs_default']}, peak diff "
+        f"max {r['peak_diff_vs_default_max']:.2g}"
     )
 
 

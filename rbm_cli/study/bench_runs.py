@@ -26,17 +26,20 @@ def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: 
 
 
 def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
-    from rbm_cli.models.rbm.kernel import warm_up
     from rbm_cli.models.registry import make_runner
     from rbm_cli.study.simulate import simulate
 
-    warm_up()  # load the compiled kernel in this worker before timing runs
+    if cfg.solver.method == "exact":
+        from rbm_cli.models.rbm.exact_jit import warm_up
+    else:
+        from rbm_cli.models.rbm.kernel import warm_up
+    warm_up()  # load the method's compiled code in this worker before timing runs
     runner = make_runner(cfg)
     rows = []
     for a, f in cells:
         r = simulate(cfg, a, f, runner=runner)
         row = _row(a, f, r.status, r.t_collapse_s, r.max_rotation_ratio, r.wall_time_s)
-        rows.append(dict(row, n_uplifts=r.n_uplifts, n_impacts=r.n_impacts))
+        rows.append(dict(row, n_uplifts=r.n_uplifts, n_impacts=r.n_impacts, n_steps=r.n_steps))
     return rows
 
 

@@ -60,3 +60,29 @@ def errors(run: pd.DataFrame, ref: pd.DataFrame) -> dict:
         "tcol_err_median": float(np.median(tcol)) if len(tcol) else math.nan,
         "tcol_err_max": float(np.max(tcol)) if len(tcol) else math.nan,
     }
+
+
+def agreement(run: pd.DataFrame, other: pd.DataFrame, ref: pd.DataFrame) -> dict:
+    """How a method's rows agree with another method's on the cells both ran (the default
+    step kernel's, for the exact method): converged cells of the reference whose outcome
+    differs, the largest relative difference of the peak rotation ratio (cells with a
+    well-conditioned reference peak that survive in both; a chaotic cell agrees with no
+    other run), and the paired time ratio other / run (run times summed over all common
+    cells)."""
+    m = run.assign(key=_key(run)).merge(other.assign(key=_key(other)), on="key",
+                                        suffixes=("", "_other"))  # fmt: skip
+    own, theirs = float(m["wall_time_s"].sum()), float(m["wall_time_s_other"].sum())
+    flags = ref.assign(key=_key(ref))[["key", "converged", "peak_converged"]]
+    m = m.merge(flags, on="key")
+    ok = (m["status"] != "failed") & (m["status_other"] != "failed") & (m["converged"] == 1)
+    differ = int((m.loc[ok, "collapsed"] != m.loc[ok, "collapsed_other"]).sum())
+    surv = m[ok & (m["peak_converged"] == 1) & (m["collapsed"] == 0) & (m["collapsed_other"] == 0)]
+    surv = surv[surv["max_rotation_ratio_other"] > 0]
+    rel = ((surv["max_rotation_ratio"] - surv["max_rotation_ratio_other"]).abs()
+           / surv["max_rotation_ratio_other"]).to_numpy()  # fmt: skip
+    return {
+        "differ_vs_default": differ,
+        "peak_diff_vs_default_median": float(np.median(rel)) if len(rel) else math.nan,
+        "peak_diff_vs_default_max": float(np.max(rel)) if len(rel) else math.nan,
+        "speedup_vs_default": theirs / own if own > 0 else math.nan,
+    }

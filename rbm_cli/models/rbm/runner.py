@@ -1,6 +1,8 @@
 """The Rigid Beam Model's runner: the column's equations assembled once, run by the compiled
 kernel (default) or the readable Python loop, two implementations of the same integrator
-(`solver.implementation`); tests/test_kernel.py holds them to the same steps."""
+(`solver.implementation`); tests/test_kernel.py holds them to the same steps. With
+`solver.method: exact` the linear pieces are integrated in closed form instead
+(rbm_cli.models.rbm.exact; tests/test_exact.py holds it to the step kernel)."""
 
 from __future__ import annotations
 
@@ -145,11 +147,25 @@ class RbmRunner:
         n = self.model.n
         self.theta0 = np.zeros(n) if not init.rotations else np.asarray(init.rotations, float)
         self.rate0 = np.zeros(n) if not init.velocities else np.asarray(init.velocities, float)
-        self._integrators: dict = {}  # implementation -> integrator, resolved on first use
+        self._integrators: dict = {}  # (exact, implementation) -> integrator, on first use
+        if config.solver.method == "exact":
+            from rbm_cli.models.rbm.exact_motion import check_exact
 
-    def _integrator(self, implementation: str):
-        """The integrator of an implementation, imported only when a run needs it; the
-        compiled one with this column's kernel inputs, prepared once."""
+            excitation = config.excitation
+            check_exact(self.model, excitation.type, excitation.vertical is not None)
+
+    def _integrator(self, method: str, implementation: str):
+        """The integrator of a method and implementation, imported only when a run needs
+        it; the compiled one with this column's kernel inputs, prepared once."""
+        if method == "exact" and implementation == "compiled":
+            from rbm_cli.models.rbm.exact_jit import integrate_exact_compiled, prepare_exact
+
+            return partial(integrate_exact_compiled, prepared=prepare_exact(self.model))
+        if method == "exact":
+            from rbm_cli.models.rbm.exact import integrate_exact
+            from rbm_cli.models.rbm.exact_piece import ModalSystem
+
+            return partial(integrate_exact, system=ModalSystem(self.model))
         if implementation == "compiled":
             from rbm_cli.models.rbm.kernel import integrate_compiled, prepare_kernel
 
@@ -168,10 +184,11 @@ class RbmRunner:
         early_stop: bool = True,
     ) -> Outcome:
         """One run (rbm_cli.models.contract.Runner.run)."""
-        integrator = self._integrators.get(solver.implementation)
+        key = (solver.method == "exact", solver.implementation)
+        integrator = self._integrators.get(key)
         if integrator is None:
-            integrator = self._integrators[solver.implementation] = self._integrator(
-                solver.implementation
+            integrator = self._integrators[key] = self._integrator(
+                solver.method, solver.implementation
             )
         n = self.model.n
         t_lift = motion.lift_off  # a vertical record dropping faster than gravity

@@ -1,0 +1,157 @@
+"""The closed forms of rbm_cli.models.rbm.exact_modal, compiled (numba), one mode at a time.
+
+A forcing is a float array fc of FORCING_SIZE entries: [kind, amplitude [m/s^2],
+omega [rad/s], phase [rad], t0 [s], a0 [m/s^2], a1 [m/s^3]], kind ZERO, HARMONIC
+(a_g = amplitude sin(omega t + phase), absolute t) or LINEAR (a_g = a0 + a1 (t - t0)).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from rbm_cli.models.rbm.exact_modal import RESONANCE_BAND, SERIES_TERMS
+
+ZERO, HARMONIC, LINEAR = 0, 1, 2
+FORCING_SIZE = 7
+
+
+def forcing_array(forcing) -> np.ndarray:
+    """The fc array of an exact_modal.Forcing."""
+    kind = {"zero": ZERO, "harmonic": HARMONIC, "linear": LINEAR}[forcing.kind]
+    return np.array(
+        [kind, forcing.amplitude, forcing.omega, forcing.phase, forcing.t0, forcing.a0,
+         forcing.a1], dtype=np.float64,
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def f_accel(fc, t):
+    """a_g(t) [m/s^2]."""
+    kind = int(fc[0])
+    if kind == HARMONIC:
+        return fc[1] * math.sin(fc[2] * t + fc[3])
+    if kind == LINEAR:
+        return fc[5] + fc[6] * (t - fc[4])
+    return 0.0
+
+
+@njit(cache=True)
+def f_peak(fc, t, h):
+    """Bound of |a_g| on [t, t + h] [m/s^2]."""
+    kind = int(fc[0])
+    if kind == HARMONIC:
+        return abs(fc[1])
+    if kind == LINEAR:
+        return max(abs(f_accel(fc, t)), abs(f_accel(fc, t + h)))
+    return 0.0
+
+
+@njit(cache=True)
+def f_phase(fc, t):
+    """Phase [rad] of a harmonic forcing seen from t: a_g(t + tau) = A sin(om tau + phase)."""
+    return np.fmod(fc[2] * t + fc[3], 2.0 * math.pi)  # exact, as math.fmod
+
+
+#: 1 / (2k + first)!, rows first = 0..3, k < SERIES_TERMS (Horner coefficients).
+_INV_FACT = np.array(
+    [[1.0 / math.factorial(2 * k + first) for k in range(SERIES_TERMS)] for first in range(4)]
+)
+
+
+@njit(cache=True)
+def _terms(az):
+    """Terms of the series enough for |z| = az <= 1 (the next one below 1e-17 relative)."""
+    if az < 1e-6:
+        return 3
+    if az < 1e-3:
+        return 5
+    if az < 0.1:
+        return 7
+    return 10
+
+
+@njit(cache=True)
+def _series(z, first, terms):
+    """sum_k (-z)^k / (2k + first)!, k < terms (Horner)."""
+    out = _INV_FACT[first, terms - 1]
+    for k in range(terms - 2, -1, -1):
+        out = _INV_FACT[first, k] - z * out
+    return out
+
+
+@njit(cache=True)
+def basis1(lam, tau):
+    """(C, S, S2, S3) of one mode at tau [s] (exact_modal.basis)."""
+    z = lam * tau * tau
+    if abs(z) < 1.0:
+        m = _terms(abs(z))
+        return (_series(z, 0, m), tau * _series(z, 1, m), tau * tau * _series(z, 2, m),
+                tau * tau * tau * _series(z, 3, m))  # fmt: skip
+    if lam > 0.0:
+        w = math.sqrt(lam)
+        c = math.cos(w * tau)
+        s = math.sin(w * tau) / w
+        return c, s, (1.0 - c) / lam, (tau - s) / lam
+    k = math.sqrt(-lam)
+    c = math.cosh(k * tau)
+    s = math.sinh(k * tau) / k
+    return c, s, (c - 1.0) / (k * k), (s - tau) / (k * k)
+
+
+@njit(cache=True)
+def near_resonance(lam, om):
+    """Whether a mode takes the resonance-stable form of the harmonic response."""
+    return lam > 0.0 and abs(math.sqrt(lam) - om) < RESONANCE_BAND * om
+
+
+@njit(cache=True)
+def harmonic_near(lam, tau, om, phase, c, s):
+    """(Y, Y') of q'' + lam q = sin(om tau + phase) from rest, resonance-stable form
+    (exact_modal.harmonic_response)."""
+    w = math.sqrt(lam)
+    sig, dlt = w + om, w - om
+    arg = 0.5 * sig * tau + phase
+    half = 0.5 * dlt * tau
+    sinc = math.sin(half) / half if half != 0.0 else 1.0
+    ca, sa = math.cos(arg), math.sin(arg)
+    cph = math.cos(phase)
+    y = (cph * s - tau * ca * sinc) / sig
+    dy = (cph * c + sig * sa * 0.5 * tau * sinc - ca * math.cos(half)) / sig
+    return y, dy
+
+
+@njit(cache=True)
+def advance(lam, q, v, f, g, fc, t, tau, qn, vn):
+    """(q, v) at t + tau [s] from (q, v) at t, into (qn, vn) (exact_modal.advance)."""
+    kind = int(fc[0])
+    harmonic = kind == HARMONIC and fc[1] != 0.0
+    om = fc[2]
+    sph = cph = sw = cw = a0 = phase = 0.0
+    if harmonic:  # the forcing's sines, shared by the modes
+        phase = f_phase(fc, t)
+        sph, cph = math.sin(phase), math.cos(phase)
+        sw, cw = math.sin(om * tau + phase), math.cos(om * tau + phase)
+    elif kind == LINEAR:
+        a0 = f_accel(fc, t)
+    for j in range(lam.size):
+        lj = lam[j]
+        c, s, s2, s3 = basis1(lj, tau)
+        qj = q[j] * c + v[j] * s + f[j] * s2
+        vj = v[j] * c - lj * q[j] * s + f[j] * s
+        if harmonic:
+            if near_resonance(lj, om):
+                y, dy = harmonic_near(lj, tau, om, phase, c, s)
+            else:
+                den = lj - om * om
+                y = (sw - sph * c - om * cph * s) / den
+                dy = (om * cw + lj * sph * s - om * cph * c) / den
+            qj += g[j] * fc[1] * y
+            vj += g[j] * fc[1] * dy
+        elif kind == LINEAR:
+            qj += g[j] * (a0 * s2 + fc[6] * s3)
+            vj += g[j] * (a0 * s + fc[6] * s2)
+        qn[j] = qj
+        vn[j] = vj

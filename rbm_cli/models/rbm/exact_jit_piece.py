@@ -1,0 +1,271 @@
+"""The pieces of the compiled exact integrator (numba): the law pieces each interface is on
+(rbm_cli.models.events.Pieces), the modes of a set of pieces (cached across runs, as
+exact_piece.ModalSystem), a linear piece's rows, and its points.
+
+A point of a piece is a row of a pool array: [t, q (n), v (n), F (nf), F' (nf), F'' (nf)],
+F = Gf q the family values (nf = 2n + 1: law arguments over theta_u, collapse ratios,
+top displacement). An event row r is sgn[r] * F[fam[r]] + off[r] (exact_search rows, in
+the same order: lower law bounds, upper law bounds, collapse on either side, then the
+silent zero crossings of the interfaces awaiting one).
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from rbm_cli.models.events import BIG, EVENT_EPS
+from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, advance, f_accel
+
+#: A linear piece: modes (lam, phi, tom = Phi^T M), modal loads f, g, the eligible modes
+#: and their frequencies w (exact_bounds), family rows gf = Gf Phi and |gf|, event rows
+#: (sgn, off, fam), the interfaces awaiting a silent crossing, the forcing fc.
+#: The pool slot root finding works in.
+SCRATCH_SLOT = 2
+
+Piece = namedtuple("Piece", "lam phi tom f g elig w gf absgf sgn off fam silent fc n nf")
+
+
+# ------------------------------------------------------------------ law pieces
+@njit(cache=True)
+def zero_active(i, k, pending, rigid):
+    return rigid[i] or pending[i]
+
+
+@njit(cache=True)
+def piece_bounds(i, side, k, pending, rigid, edges, nedges):
+    """(lo, hi) [rad] of interface i's current piece (events.Pieces.bounds)."""
+    ki = k[i]
+    start = 0.0 if ki == 0 else edges[i, ki - 1]
+    end = edges[i, ki] if ki < nedges[i] else np.inf
+    if ki == 0 and not zero_active(i, k, pending, rigid):
+        start = -end
+    if side[i] > 0:
+        return start, end
+    return -end, -start
+
+
+@njit(cache=True)
+def locate(x, rate, side, k, pending, rigid, edges, nedges):
+    """Pieces at law arguments x [rad] and their rates (events.Pieces.locate)."""
+    for i in range(x.size):
+        if x[i] > 0.0:
+            side[i] = 1
+        elif x[i] < 0.0:
+            side[i] = -1
+        else:
+            side[i] = 1 if rate[i] >= 0.0 else -1
+        kk = 0
+        while kk < nedges[i] and edges[i, kk] <= abs(x[i]):
+            kk += 1
+        k[i] = kk
+        pending[i] = kk > 0 and not rigid[i]
+
+
+@njit(cache=True)
+def cross(i, going_up, side, k, pending, awaiting, rigid, silent):
+    """Move interface i to its next piece (events.Pieces.cross): 0 uplift, 1 kink, 2 impact."""
+    s, ki = side[i], k[i]
+    if ki == 0 and not zero_active(i, k, pending, rigid):
+        side[i] = 1 if going_up else -1
+        k[i] = 1
+        pending[i] = True
+        awaiting[i] = False
+        return 0
+    if going_up == (s > 0):
+        k[i] = ki + 1
+        return 1
+    if ki > 0:
+        k[i] = ki - 1
+        if ki == 1 and silent[i]:
+            pending[i] = False
+            awaiting[i] = True
+        return 1
+    side[i] = -s
+    pending[i] = False
+    return 2
+
+
+# ------------------------------------------------------------------ modes (cached)
+@njit(cache=True)
+def _slot(keys, used, k):
+    """Slot of the key k in the open-addressing table: where it is, or the free slot
+    where it goes."""
+    cap = used.size
+    hsh = 17
+    for x in k:
+        hsh = (hsh * 1000003 + x + 1) & 0x3FFFFFFFFFFF  # stays well inside int64
+    i = hsh % cap
+    while used[i]:
+        same = True
+        for j in range(k.size):
+            if keys[i, j] != k[j]:
+                same = False
+                break
+        if same:
+            return i
+        i = (i + 1) % cap
+    return i
+
+
+@njit(cache=True)
+def modes(mdl, cache, k):
+    """Slot of the cache holding the modes of the pieces k (computed when absent: the
+    pencil (K, M) through the Cholesky factor M = L L^T, eigh of L^-1 K L^-T)."""
+    keys, used, lam_s, phi_s, tom_s, g_s, count = cache
+    if count[0] >= (used.size * 3) // 4:  # full: start again
+        used[:] = False
+        count[0] = 0
+    i = _slot(keys, used, k)
+    if used[i]:
+        return i
+    n = k.size
+    slopes = np.empty(n)
+    for j in range(n):
+        slopes[j] = mdl.slopes[j, k[j]]
+    stiff = mdl.diff_t @ (slopes[:, None] * mdl.argmap) - mdl.gravity
+    stiff = 0.5 * (stiff + stiff.T)
+    red = mdl.linv @ stiff @ mdl.linv.T
+    red = 0.5 * (red + red.T)
+    lam, u = np.linalg.eigh(red)
+    phi = mdl.linv.T @ u
+    keys[i, :] = k
+    used[i] = True
+    count[0] += 1
+    lam_s[i, :] = lam
+    phi_s[i, :, :] = phi
+    tom_s[i, :, :] = u.T @ mdl.chol.T
+    g_s[i, :] = -(phi.T @ mdl.ground)
+    return i
+
+
+# ------------------------------------------------------------------ a piece
+@njit(cache=True)
+def _rows(mdl, side, k, pending, awaiting):
+    """(sgn, off, fam, silent) of the event rows of the current pieces."""
+    n = side.size
+    ns = 0
+    for i in range(n):
+        ns += awaiting[i]
+    m = 4 * n + ns
+    sgn, off, fam = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
+    silent = np.empty(ns, dtype=np.int64)
+    c = mdl.c_ratio
+    for i in range(n):
+        lo, hi = piece_bounds(i, side, k, pending, mdl.rigid, mdl.edges, mdl.nedges)
+        tu = mdl.tu[i]
+        sgn[i], off[i], fam[i] = 1.0, min(-lo / tu, BIG) + EVENT_EPS, i
+        sgn[n + i], off[n + i], fam[n + i] = -1.0, min(hi / tu, BIG) + EVENT_EPS, i
+        sgn[2 * n + i], off[2 * n + i], fam[2 * n + i] = -1.0, c + EVENT_EPS, n + i
+        sgn[3 * n + i], off[3 * n + i], fam[3 * n + i] = 1.0, c + EVENT_EPS, n + i
+    j = 0
+    for i in range(n):
+        if awaiting[i]:
+            silent[j] = i
+            sgn[4 * n + j], off[4 * n + j], fam[4 * n + j] = float(side[i]), 0.0, i
+            j += 1
+    return sgn, off, fam, silent
+
+
+@njit(cache=True)
+def make_piece(mdl, cache, side, k, pending, awaiting, fc):
+    """The linear piece of the current law pieces under the forcing fc."""
+    n = side.size
+    slot = modes(mdl, cache, k)
+    lam = cache[2][slot].copy()
+    phi = cache[3][slot].copy()
+    tom = cache[4][slot].copy()
+    g = cache[5][slot].copy()
+    a = np.empty(n)
+    for i in range(n):
+        a[i] = side[i] * mdl.intercepts[i, k[i]]
+    f = -(phi.T @ (mdl.diff_t @ a))
+    elig = lam > 0.0
+    if int(fc[0]) == HARMONIC:
+        elig &= lam >= 4.0 * fc[2] * fc[2]
+    w = np.sqrt(np.where(elig, lam, 1.0))
+    gf = mdl.gf_theta @ phi
+    sgn, off, fam, silent = _rows(mdl, side, k, pending, awaiting)
+    return Piece(lam, phi, tom, f, g, elig, w, gf, np.abs(gf), sgn, off, fam, silent, fc, n,
+                 2 * n + 1)  # fmt: skip
+
+
+def point_size(n: int) -> int:
+    """Length of a point row for n modes."""
+    return 1 + 2 * n + 3 * (2 * n + 1)
+
+
+@njit(cache=True)
+def _derived(pc, pts, i):
+    """Family values and rates of point i from its (t, q, v), and the second derivatives
+    of the tracked families (the peaks' rows, n and above)."""
+    n, nf = pc.n, pc.nf
+    of = 1 + 2 * n
+    for r in range(nf):
+        fv = dv = 0.0
+        for j in range(n):
+            fv += pc.gf[r, j] * pts[i, 1 + j]
+            dv += pc.gf[r, j] * pts[i, 1 + n + j]
+        pts[i, of + r] = fv
+        pts[i, of + nf + r] = dv
+    ag = f_accel(pc.fc, pts[i, 0])
+    acc = np.empty(n)
+    for j in range(n):
+        acc[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
+    for r in range(n, nf):
+        ff = 0.0
+        for j in range(n):
+            ff += pc.gf[r, j] * acc[j]
+        pts[i, of + 2 * nf + r] = ff
+
+
+@njit(cache=True)
+def eval_family(pc, pts, src, tau, k, second):
+    """(F_k, F_k', and F_k'' if second else 0) tau [s] after point src, through the
+    scratch point's (q, v) only (SCRATCH_SLOT)."""
+    n = pc.n
+    dst = SCRATCH_SLOT
+    t = pts[src, 0]
+    advance(pc.lam, pts[src, 1 : 1 + n], pts[src, 1 + n : 1 + 2 * n], pc.f, pc.g, pc.fc, t,
+            tau, pts[dst, 1 : 1 + n], pts[dst, 1 + n : 1 + 2 * n])  # fmt: skip
+    fv = dv = ff = 0.0
+    ag = f_accel(pc.fc, t + tau) if second else 0.0
+    for j in range(n):
+        gj = pc.gf[k, j]
+        qj = pts[dst, 1 + j]
+        fv += gj * qj
+        dv += gj * pts[dst, 1 + n + j]
+        if second:
+            ff += gj * (-pc.lam[j] * qj + pc.f[j] + pc.g[j] * ag)
+    return fv, dv, ff
+
+
+@njit(cache=True)
+def set_point(pc, pts, i, t, q, v):
+    """Point i at time t [s] with modal (q, v)."""
+    n = pc.n
+    pts[i, 0] = t
+    pts[i, 1 : 1 + n] = q
+    pts[i, 1 + n : 1 + 2 * n] = v
+    _derived(pc, pts, i)
+
+
+@njit(cache=True)
+def eval_point(pc, pts, src, tau, dst):
+    """Point dst, tau [s] after point src."""
+    n = pc.n
+    t = pts[src, 0]
+    advance(pc.lam, pts[src, 1 : 1 + n], pts[src, 1 + n : 1 + 2 * n], pc.f, pc.g, pc.fc, t,
+            tau, pts[dst, 1 : 1 + n], pts[dst, 1 + n : 1 + 2 * n])  # fmt: skip
+    pts[dst, 0] = t + tau
+    _derived(pc, pts, dst)
+
+
+@njit(cache=True)
+def row_at(pc, pts, i, r):
+    """(value, rate) of event row r at point i."""
+    of = 1 + 2 * pc.n
+    kf = pc.fam[r]
+    return (pc.sgn[r] * pts[i, of + kf] + pc.off[r], pc.sgn[r] * pts[i, of + pc.nf + kf])

@@ -1,0 +1,299 @@
+"""The run loop of the compiled exact integrator (numba): rbm_cli.models.rbm.exact's
+algorithm, statement for statement, in one compiled call per run.
+
+Mutable scalars live in small arrays: st = [t, h, next_out, t_collapse, at_rest, n_out]
+(floats) and cnt = [n_uplifts, n_impacts, n_steps, n_rhs, n_events, collapse interface,
+the part of n_rhs spent on peaks, the current segment] (ints). A motion is
+mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
+(start, end) with their forcings (exact_jit_modal); settings are
+se = [max_steps, max_events, deadline, early_stop, record, output_dt].
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
+from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel
+from rbm_cli.models.rbm.exact_jit_peaks import NOTES, new_notes, note_interval, settle_peaks
+from rbm_cli.models.rbm.exact_jit_piece import (
+    cross,
+    eval_point,
+    locate,
+    make_piece,
+    piece_bounds,
+    row_at,
+    set_point,
+)
+from rbm_cli.models.rbm.exact_jit_search import SCRATCH, next_point
+from rbm_cli.models.rbm.exact_jit_state import clock, energy1, friction, next_exceedance
+
+GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
+FAILED_STEPS, FAILED_EVENTS, FAILED_WALL = 5, 6, 7
+T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
+UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
+#: Steps between two readings of the wall clock.
+CLOCK_EVERY = 64
+
+#: Work arrays of a run: the point pool, mode and family bounds, the peak refinement's
+#: reference counts, free list and stack, and the noted intervals (exact_jit_peaks).
+Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes")
+#: The moving state: rotations, rates, law pieces (side, k, pending, awaiting), maxima of
+#: the tracked quantities, friction demand.
+State = namedtuple("State", "theta rate side k pending awaiting maxima fric st cnt")
+
+
+@njit(cache=True)
+def _emit(pc, pts, s, samples, t_stop, dt):
+    """Record the samples due up to t_stop [s], every dt [s], from point 0 of the piece."""
+    n = s.theta.size
+    while s.st[NEXT_OUT] <= t_stop + 1e-12 and int(s.st[N_OUT]) < samples.shape[0]:
+        row = int(s.st[N_OUT])
+        samples[row, 0] = s.st[NEXT_OUT]
+        eval_point(pc, pts, 0, s.st[NEXT_OUT] - pts[0, 0], SCRATCH)
+        samples[row, 1 : 1 + n] = pc.phi @ pts[SCRATCH, 1 : 1 + n]
+        samples[row, 1 + n : 1 + 2 * n] = pc.phi @ pts[SCRATCH, 1 + n : 1 + 2 * n]
+        s.st[N_OUT] += 1
+        s.st[NEXT_OUT] += dt
+
+
+@njit(cache=True)
+def _emit_rest(s, samples, t_stop, dt):
+    """Record zeros (a rigid block at rest) for the samples due up to t_stop [s]."""
+    while s.st[NEXT_OUT] <= t_stop + 1e-12 and int(s.st[N_OUT]) < samples.shape[0]:
+        row = int(s.st[N_OUT])
+        samples[row, 0] = s.st[NEXT_OUT]
+        samples[row, 1:] = 0.0
+        s.st[N_OUT] += 1
+        s.st[NEXT_OUT] += dt
+
+
+@njit(cache=True)
+def _accel_and_friction(mdl, pc, pts, i, fric):
+    """Friction demand at point i (the step integrators' step ends)."""
+    n = pc.n
+    from_modes = np.empty(n)
+    ag = f_accel(pc.fc, pts[i, 0])
+    for j in range(n):
+        from_modes[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
+    friction(mdl, pc.phi @ from_modes, ag, fric)
+
+
+@njit(cache=True)
+def _passed_peak(mdl, pc, pts):
+    """Early stop of free motion between points 0 and 1 (exact._passed_peak)."""
+    if math.isnan(mdl.barrier):
+        return False
+    k = 1 + 2 * pc.n + pc.n  # collapse ratio of interface 1
+    dk = k + pc.nf
+    if not pts[0, k] * pts[0, dk] > 0.0:
+        return False
+    if not (pts[1, k] * pts[1, dk] <= 0.0 or pts[1, dk] * pts[0, dk] < 0.0):
+        return False
+    theta = pc.phi[0, 0] * pts[1, 1]
+    rate = pc.phi[0, 0] * pts[1, 2]
+    return energy1(mdl, theta, rate) < mdl.barrier * (1.0 - 1e-9)
+
+
+@njit(cache=True)
+def _budget(s, se):
+    """A failure code when a budget is exceeded, else GOING."""
+    if s.cnt[STEPS] > se[0]:
+        return FAILED_STEPS
+    if s.cnt[STEPS] % CLOCK_EVERY == 0 and clock() > se[2]:
+        return FAILED_WALL
+    return GOING
+
+
+@njit(cache=True)
+def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
+    """Advance through the piece to its first event or seg_end [s] (exact._march).
+    Returns the event row, -1 at seg_end, or -(a terminal code)."""
+    pts = wk.pts
+    best, row = math.inf, -1
+    for r in range(pc.sgn.size):
+        d, _ = row_at(pc, pts, 0, r)
+        if d < best:
+            best, row = d, r
+    if best <= 0.0:
+        return row
+    row = -1
+    while pts[0, 0] < seg_end and row < 0:
+        s.cnt[STEPS] += 1
+        code = _budget(s, se)
+        if code != GOING:
+            s.st[T] = pts[0, 0]
+            return -code
+        row, s.st[H], ev, fresh = next_point(pc, pts, s.st[H], seg_end, wk.mb, wk.fb)
+        s.cnt[RHS] += ev
+        ev = note_interval(pc, pts, s.maxima, wk.mb, wk.fb, fresh, wk.notes, s.side, s.k,
+                           s.cnt[SEG], wk)  # fmt: skip
+        s.cnt[RHS] += ev
+        s.cnt[RHS_PEAKS] += ev
+        if se[4] != 0.0:
+            _emit(pc, pts, s, samples, pts[1, 0], se[5])
+        _accel_and_friction(mdl, pc, pts, 1, s.fric)
+        if can_stop and _passed_peak(mdl, pc, pts):
+            s.st[T] = pts[1, 0]
+            return -STOPPED_EARLY
+        pts[0, :] = pts[1, :]
+    n = pc.n
+    s.st[T] = pts[0, 0]
+    s.theta[:] = pc.phi @ pts[0, 1 : 1 + n]
+    s.rate[:] = pc.phi @ pts[0, 1 + n : 1 + 2 * n]
+    return row
+
+
+@njit(cache=True)
+def _handle(mdl, pc, row, s, se):
+    """Apply the event of a row at the state (exact._handle). Returns a code."""
+    n = s.theta.size
+    if row >= 4 * n:
+        i = pc.silent[row - 4 * n]
+        s.side[i] = -s.side[i]
+        s.awaiting[i] = False
+        s.cnt[IMPACTS] += 1
+        return GOING
+    s.cnt[EVENTS] += 1
+    if s.cnt[EVENTS] > se[1]:
+        return FAILED_EVENTS
+    which, i = row // n, row % n
+    if which >= 2:
+        s.st[T_COLLAPSE] = s.st[T]
+        s.cnt[COLLAPSE_IF] = i + 1
+        s.maxima[i] = max(s.maxima[i], mdl.c_ratio)
+        return COLLAPSED
+    going_up = which == 1
+    lo, hi = piece_bounds(i, s.side, s.k, s.pending, mdl.rigid, mdl.edges, mdl.nedges)
+    bound = hi if going_up else lo
+    x_i = mdl.argmap[i] @ s.theta
+    s.theta[:] += mdl.arg_inv[:, i] * (bound - x_i)
+    kind = cross(i, going_up, s.side, s.k, s.pending, s.awaiting, mdl.rigid, mdl.silent)
+    if kind == 0:
+        s.cnt[UPLIFTS] += 1
+    elif kind == 2:
+        s.cnt[IMPACTS] += 1
+        if mdl.restitution < 1.0:
+            xdot = mdl.argmap[i] @ s.rate
+            s.rate[:] += mdl.imp_dir[:, i] * ((mdl.restitution - 1.0) * xdot / mdl.imp_w[i])
+        if mdl.rigid_mono and abs(s.rate[0]) < mdl.rest_rate:
+            s.theta[:] = 0.0
+            s.rate[:] = 0.0
+            s.st[AT_REST] = 1.0
+    return GOING
+
+
+@njit(cache=True)
+def _linear_exceedance(fc, t0, level, t_stop):
+    """First t in [t0, t_stop) with |a_g(t)| > level under a linear forcing fc: t0 when
+    already above, else where |a_g| reaches level (NaN if it does not before t_stop)."""
+    a = f_accel(fc, t0)
+    if abs(a) > level:
+        return t0
+    slope = fc[6]
+    if slope == 0.0:
+        return math.nan
+    target = level if slope > 0.0 else -level
+    t = t0 + (target - a) / slope
+    return t if t < t_stop else math.nan
+
+
+@njit(cache=True)
+def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
+    """A rigid monolith at rest (exact._leave_rest): 0 no ground motion left (rests to
+    the end), 1 the segment ends first, 2 it lifts (a harmonic's exceedance from its
+    formula, a linear piece's from its line)."""
+    t = s.st[T]
+    kind_fc = int(fc[0])
+    if kind_fc == ZERO:
+        if mo[0] != 0.0 and t < mo[4]:  # rest before a record's first sample
+            kind, t_stop = 1, seg_end
+        else:
+            kind, t_stop = 0, mo[5]
+    else:
+        if kind_fc == LINEAR:
+            t_up = _linear_exceedance(fc, t, mdl.uplift_level, seg_end)
+        else:
+            t_up = next_exceedance(t, mdl.uplift_level, fc[1], fc[2], fc[3], min(mo[4], mo[5]))
+        if math.isnan(t_up) or t_up >= seg_end:
+            kind, t_stop = 1, seg_end
+        else:
+            kind, t_stop = 2, t_up
+    _emit_rest(s, samples, t_stop - (1e-15 if kind == 2 else 0.0), dt)
+    s.st[T] = t_stop
+    if kind != 2:
+        return kind
+    s.theta[:] = 0.0
+    s.rate[:] = 0.0
+    s.side[0] = -1 if f_accel(fc, t_stop) > 0.0 else 1
+    s.k[0] = 0
+    s.st[AT_REST] = 0.0
+    s.cnt[UPLIFTS] += 1
+    return kind
+
+
+@njit(cache=True)
+def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
+    """Run up to seg_end [s] under the forcing fc (exact._segment). Returns a code."""
+    while s.st[T] < seg_end:
+        if s.st[AT_REST] != 0.0:
+            kind = _leave_rest(mdl, s, mo, seg_end, fc, samples, se[5])
+            if kind == 0:
+                return AT_REST_END
+            if kind == 1:
+                return GOING
+        pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)
+        set_point(pc, wk.pts, 0, s.st[T], pc.tom @ s.theta, pc.tom @ s.rate)
+        row = _march(mdl, pc, wk, s, se, seg_end, can_stop, samples)
+        if row < -1:
+            return -row
+        if row >= 0:
+            code = _handle(mdl, pc, row, s, se)
+            if code != GOING:
+                return code
+    return GOING
+
+
+@njit(cache=True)
+def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, stack):
+    """One run (exact.integrate_exact). Returns (code, st, cnt, maxima, friction)."""
+    n = theta0.size
+    side = np.ones(n, dtype=np.int64)
+    k = np.zeros(n, dtype=np.int64)
+    pending = np.zeros(n, dtype=np.bool_)
+    awaiting = np.zeros(n, dtype=np.bool_)
+    theta, rate = theta0.copy(), rate0.copy()
+    locate(mdl.argmap @ theta, mdl.argmap @ rate, side, k, pending, mdl.rigid, mdl.edges,
+           mdl.nedges)  # fmt: skip
+    st = np.array([0.0, FIRST_STEP, 0.0, math.nan, 0.0, 0.0])
+    if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
+        st[AT_REST] = 1.0
+    s = State(theta, rate, side, k, pending, awaiting, np.zeros(n + 1), np.zeros(n), st,
+              np.zeros(8, dtype=np.int64))  # fmt: skip
+    nf = 2 * n + 1
+    wk = Work(np.zeros((pool, 1 + 2 * n + 3 * nf)), np.zeros((9, n)), np.zeros((8, nf)),
+              np.zeros(pool, dtype=np.int64), np.zeros(pool - 3, dtype=np.int64),
+              np.zeros((stack, 2), dtype=np.int64),
+              np.zeros((stack, n + 1), dtype=np.bool_), new_notes(n, NOTES))  # fmt: skip
+    code = GOING
+    for i in range(seg_t.shape[0]):
+        if s.st[T] >= seg_t[i, 1]:
+            continue
+        if not (i > 0 and int(seg_fc[i, 0]) == LINEAR and int(seg_fc[i - 1, 0]) == LINEAR):
+            s.st[H] = min(s.st[H], FIRST_STEP)  # a record's next sample keeps its step
+        free = int(seg_fc[i, 0]) == ZERO and seg_t[i, 0] >= mo[4]
+        can_stop = se[3] != 0.0 and free and mo[0] != 0.0
+        s.cnt[SEG] = i
+        code = _segment(mdl, cache, wk, s, mo, se, seg_fc[i], seg_t[i, 1], can_stop, samples)
+        if code != GOING:
+            break
+    if code == GOING:
+        code = SURVIVED
+    ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)
+    s.cnt[RHS] += ev
+    s.cnt[RHS_PEAKS] += ev
+    return code, s.st, s.cnt, s.maxima, s.fric

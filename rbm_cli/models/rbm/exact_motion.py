@@ -1,0 +1,124 @@
+"""What the exact integrator takes of a ground motion: smooth segments, each with one
+closed-form forcing (rbm_cli.models.rbm.exact_modal.Forcing), and what it refuses.
+
+A sampled record (times t_k, accelerations a_k) is exact per sample interval as a
+piecewise-linear forcing, as Nigam and Jennings integrate response spectra:
+sampled_segments turns it into one 'linear' segment per interval. The sine pulses
+(half-sine, one-sine, cycloidal: a sine of phase 0 or pi/2 on [0, pulse_end]) are one
+harmonic segment, then free motion.
+
+Refused, each in one line: the Ricker and Mavroeidis-Papageorgiou pulses (a Gaussian times
+a polynomial, and a sine times a raised cosine cut at its ends: the latter is a sum of
+three sines and could be exact, not done yet), a vertical record (the weights change with
+g + a_v(t): the pieces' coefficients vary in time, no constant-coefficient closed form),
+and the absolute formulation (not symmetric).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.models.rbm.exact_modal import Forcing
+from rbm_cli.physics.equations import Model
+from rbm_cli.physics.excitation import GroundMotion
+
+#: Ground motions the exact integrator takes: sines (one harmonic forcing a segment) and
+#: records (one linear forcing a sample interval).
+SINE_KINDS = ("harmonic", "half-sine", "free", "one-sine", "cycloidal")
+EXACT_KINDS = (*SINE_KINDS, "record")
+#: Why the others are refused.
+_NOT_EXACT = {
+    "ricker": "a Gaussian times a polynomial has no closed-form modal response",
+    "mavroeidis-papageorgiou": "its sum of three sines is not integrated exactly yet",
+}
+
+
+def check_exact(model: Model, kind: str, vertical: bool = False) -> None:
+    """Raise RbmError (one line) unless the exact method takes this model and excitation
+    (vertical: whether the excitation has a vertical record)."""
+    if model.formulation == "absolute":
+        raise RbmError(
+            "solver.method exact needs interface.formulation relative or geometric (absolute"
+            " is not symmetric): use a Runge-Kutta method (DOP853) for absolute"
+        )
+    if kind in _NOT_EXACT:
+        raise RbmError(
+            f"solver.method exact does not take excitation.type {kind} ({_NOT_EXACT[kind]}):"
+            " use a Runge-Kutta method (DOP853)"
+        )
+    if kind not in EXACT_KINDS:
+        raise RbmError(f"solver.method exact does not take excitation.type {kind}")
+    if vertical:
+        raise RbmError(
+            "solver.method exact does not take excitation.vertical (the weights vary with"
+            " g + a_v(t): no constant-coefficient pieces): use a Runge-Kutta method (DOP853)"
+        )
+
+
+def forcing_segments(motion: GroundMotion) -> list[tuple[float, float, Forcing]]:
+    """(start [s], end [s], forcing) of the motion's smooth segments: a record's per
+    sample interval (record_segments), a sine's per segment of the motion."""
+    if motion.kind == "record":
+        return record_segments(motion)
+    out = []
+    for start, end in motion.segments():
+        if motion.forced(start):
+            forcing = Forcing("harmonic", motion.amplitude, motion.omega, motion.phase)
+        else:
+            forcing = Forcing("zero")
+        out.append((start, end, forcing))
+    return out
+
+
+def sampled_segments(
+    times: np.ndarray, accel: np.ndarray, t_end: float
+) -> list[tuple[float, float, Forcing]]:
+    """Segments of a sampled record: a_g linear between samples (times [s], non-decreasing,
+    a time written twice where a_g jumps; accel [m/s^2]), zero after the last sample up
+    to t_end [s]."""
+    times, accel = np.asarray(times, dtype=float), np.asarray(accel, dtype=float)
+    out = []
+    for k in range(times.size - 1):
+        t0, t1 = float(times[k]), float(times[k + 1])
+        if t0 >= t_end:
+            break
+        if t1 <= t0:  # a time written twice: a jump, from the value before to the one after
+            continue
+        slope = (accel[k + 1] - accel[k]) / (t1 - t0)
+        out.append((t0, min(t1, t_end), Forcing("linear", t0=t0, a0=float(accel[k]), a1=slope)))
+    if times.size and times[-1] < t_end:
+        out.append((float(times[-1]), t_end, Forcing("zero")))
+    return out
+
+
+def record_segments(motion: GroundMotion) -> list[tuple[float, float, Forcing]]:
+    """Segments of a record motion: rest up to its first sample, one linear forcing per
+    sample interval of positive length (a time written twice is a jump), then free
+    motion, split at pulse_end [s] (the free motion after the record starts there)."""
+    knots, values = np.asarray(motion.knots, dtype=float), np.asarray(motion.values, float)
+    inner = [s for s in sampled_segments(knots, values, motion.t_end) if s[2].kind == "linear"]
+    cuts = sorted({0.0, float(knots[0]), float(knots[-1]), motion.pulse_end, motion.t_end})
+    out = []
+    for a, b in zip(cuts[:-1], cuts[1:], strict=False):
+        if b > a and (b <= knots[0] or a >= knots[-1]) and a < motion.t_end:
+            out.append((a, min(b, motion.t_end), Forcing("zero")))
+    return sorted(out + inner, key=lambda s: s[0])
+
+
+def resolve_segments(model: Model, motion: GroundMotion, segments=None) -> list:
+    """The forcing segments of a run: the motion's (forcing_segments, which checks its kind),
+    or segments given by the caller (a sampled record: sampled_segments), for which the
+    motion gives only its end and kind. A rigid monolith rests until its uplift level is
+    exceeded, found from a harmonic's formula: under a given piecewise-linear forcing it
+    is not supported yet (one-line RbmError)."""
+    if segments is None:
+        check_exact(model, motion.kind, motion.has_vertical)
+        return forcing_segments(motion)
+    check_exact(model, "free")
+    if model.uplift_level is not None and any(f.kind == "linear" for _, _, f in segments):
+        raise RbmError(
+            "solver.method exact: a rigid monolith under a piecewise-linear forcing is not"
+            " supported yet (its rest and uplift are found for harmonic motions only)"
+        )
+    return list(segments)

@@ -1,0 +1,365 @@
+"""The exact integrator (`solver.method: exact`, rbm_cli.models.rbm.exact and exact_jit)
+against closed forms, against its own bounds sampled densely, and against the step kernel.
+
+- the modal closed forms against the semigroup property and the resonant t cos term;
+- the bounds that make sampling certain (exact_bounds, exact_search) hold on densely
+  sampled random pieces of an 8-drum column: no crossing can hide in a certified interval;
+- a rigid monolith: the exact linear half-sine threshold, the free rocking period, and
+  housner-linear (the same equation in closed form, with SPEC section 2's mapping);
+- an elastic monolith forced at its natural frequency: the undamped resonance
+  theta = C (sin wt - wt cos wt), and an 8-drum column at its first mode against the
+  step kernel at rtol 1e-12;
+- whole domains (tests/test_exact_domains.py): no robust cell differs, and on cells
+  where the step kernel has converged, the same events and peaks within 1e-8.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.load import load_config
+from rbm_cli.models.events import EVENT_EPS, Pieces
+from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.rbm.exact import integrate_exact
+from rbm_cli.models.rbm.exact_bounds import mode_bounds
+from rbm_cli.models.rbm.exact_jit import integrate_exact_compiled
+from rbm_cli.models.rbm.exact_modal import Forcing, advance
+from rbm_cli.models.rbm.exact_motion import sampled_segments
+from rbm_cli.models.rbm.exact_piece import LinearPiece, ModalSystem
+from rbm_cli.models.rbm.exact_search import Evaluator, row_lower, track_upper
+from rbm_cli.models.rbm.kernel import integrate_compiled
+from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.closed_forms import (
+    free_rocking_period,
+    linear_halfsine_threshold,
+    linear_rocking_parameters,
+)
+from rbm_cli.physics.excitation import GroundMotion, make_ground_motion
+from rbm_cli.study.simulate import model_from_config, simulate
+
+from .paths import CONFIGS
+
+
+def exact_config(name: str, **solver):
+    cfg = load_config(CONFIGS / f"{name}.yaml")
+    return dataclasses.replace(
+        cfg, solver=dataclasses.replace(cfg.solver, method="exact", **solver)
+    )
+
+
+# ------------------------------------------------------------------ modal closed forms
+LAMS = np.array([1e6, 9.0, 9.0 * (1 + 1e-9), 9.0 * (1 + 1e-4), 2.0, 30.0, -4.0, 0.0, 1e-9, -1e-9])
+
+
+@pytest.mark.parametrize(
+    "forcing",
+    [
+        Forcing("harmonic", 2.0, 3.0, 0.4),
+        Forcing("linear", t0=0.5, a0=1.0, a1=-3.0),
+        Forcing("zero"),
+    ],
+    ids=["harmonic", "linear", "zero"],
+)
+def test_one_long_advance_equals_many_short_ones(forcing):
+    """The closed form is exact from any point: one step of 1.3 s and 1000 steps agree
+    (modes of both signs, zero, near zero, and at and near resonance with omega = 3)."""
+    f, g = np.full(LAMS.size, 0.3), np.full(LAMS.size, 1.7)
+    q0, v0 = np.linspace(-1.0, 1.0, LAMS.size), np.linspace(2.0, -1.0, LAMS.size)
+    q1, v1 = advance(LAMS, q0, v0, f, g, forcing, 0.7, 1.3)
+    q, v, t = q0, v0, 0.7
+    for _ in range(1000):
+        q, v = advance(LAMS, q, v, f, g, forcing, t, 1.3e-3)
+        t += 1.3e-3
+    assert np.abs(q1 - q).max() < 1e-12
+    assert np.abs(v1 - v).max() < 1e-12 * max(1.0, np.abs(v1).max())
+
+
+@pytest.mark.parametrize("omega", [3.0, 50.0])
+def test_resonance_is_the_t_cos_term(omega):
+    """q'' + w^2 q = sin(w t) from rest: q = (sin wt - wt cos wt) / (2 w^2) exactly."""
+    one = np.ones(1)
+    for t in (0.1, 2.0, 7.3):
+        q, v = advance(np.array([omega**2]), 0 * one, 0 * one, 0 * one, one,
+                       Forcing("harmonic", 1.0, omega, 0.0), 0.0, t)  # fmt: skip
+        wt = omega * t
+        assert q[0] == pytest.approx((math.sin(wt) - wt * math.cos(wt)) / (2 * omega**2), abs=1e-15)
+        assert v[0] == pytest.approx(t * math.sin(wt) / 2, abs=1e-14)
+
+
+# ------------------------------------------------------------------ bounds, densely sampled
+def _random_piece(system, rng, n):
+    pieces = Pieces(system.model, silent=True)
+    for i, law in enumerate(system.model.laws):
+        pieces.side[i] = rng.choice([-1, 1])
+        pieces.k[i] = rng.integers(0, len(law.edges) + 1)
+        pieces.pending[i] = pieces.k[i] > 0
+    kind = rng.choice(["harmonic", "zero", "linear"])
+    forcing = {
+        "harmonic": Forcing("harmonic", rng.uniform(0.5, 15.0), rng.uniform(1.0, 60.0),
+                            rng.uniform(0.0, 6.0)),
+        "zero": Forcing("zero"),
+        "linear": Forcing("linear", t0=0.0, a0=rng.uniform(-5, 5), a1=rng.uniform(-50, 50)),
+    }[kind]  # fmt: skip
+    scale = system.tu.min() * 10.0 ** rng.uniform(-6, -1)
+    theta = rng.normal(size=n) * scale
+    rate = rng.normal(size=n) * scale * 10.0 ** rng.uniform(0, 3)
+    return LinearPiece(system, pieces, forcing, rng.uniform(0.0, 5.0), theta, rate)
+
+
+def test_bounds_hold_on_dense_samples():
+    """On random pieces, states, forcings and intervals (8 drums): every mode's |q''| and
+    |q'''| stay below their bounds, every event row stays above its certified lower bound
+    and every tracked quantity below its upper bound, at 400 points per interval."""
+    cfg = load_config(CONFIGS / "harmonic_multidrum.yaml")
+    system = ModalSystem(model_from_config(cfg))
+    rng = np.random.default_rng(7)
+    n = system.n
+    for _ in range(150):
+        piece = _random_piece(system, rng, n)
+        ev = Evaluator(piece)
+        a = ev.start(piece.t0, piece.q0, piece.v0)
+        h = 10.0 ** rng.uniform(-5, 0)
+        b = ev.point(a, h)
+        mb = mode_bounds(piece, a.t, a.q, a.v, h, b.q, b.v)
+        lower = row_lower(piece, a, b, mb)
+        upper = track_upper(piece, a, b, mb)
+        for s in np.linspace(0.0, h, 401):
+            p = ev.point(a, s)
+            q2 = piece.modal_accel(p.t, p.q)
+            q3 = -piece.lam * p.v + piece.g * _ground_rate(piece.forcing, p.t)
+            assert np.all(np.abs(q2) <= mb.full * (1 + 1e-9))
+            assert np.all(np.abs(q3) <= mb.third * (1 + 1e-9))
+            assert np.all(~(lower > p.d))
+            assert np.all(~(upper < np.abs(p.z)))
+
+
+def _ground_rate(forcing, t):
+    """a_g'(t) [m/s^3]."""
+    if forcing.kind == "harmonic":
+        return forcing.amplitude * forcing.omega * math.cos(forcing.omega * t + forcing.phase)
+    return forcing.a1 if forcing.kind == "linear" else 0.0
+
+
+# ------------------------------------------------------------------ rigid monolith
+@pytest.mark.parametrize("ratio", [0.3, 1.0, 2.0, 4.0])
+def test_rigid_halfsine_threshold(ratio):
+    """A rigid monolith (housner_halfsine) overturns just above the exact linear half-sine
+    threshold and survives just below it (1e-6 apart), at omega / p = ratio."""
+    cfg = exact_config("housner_halfsine")
+    runner = make_runner(cfg)
+    alpha, p = linear_rocking_parameters(runner.model.column)
+    f = ratio * p / (2 * math.pi)
+    a = float(linear_halfsine_threshold(ratio)) * alpha
+    assert simulate(cfg, a * (1 + 1e-6), f, runner=runner).status == "collapsed"
+    assert simulate(cfg, a * (1 - 1e-6), f, runner=runner).status == "survived"
+
+
+def test_free_rocking_period():
+    """Free rocking from theta0 = alpha / 2 (e = 1): the m-th impact comes at
+    T/4 + (m - 1) T/2, T = (4/p) arccosh(1 / (1 - theta0/alpha)); a run that ends 1e-9 T
+    before the 10th has 9 impacts, one that ends 1e-9 T after it has 10; the amplitude
+    stays alpha / 2."""
+    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    alpha, p = linear_rocking_parameters(model_from_config(cfg).column)
+    period = float(free_rocking_period(p, 0.5))
+    t10 = period / 4 + 9 * period / 2
+    for end, impacts in ((t10 - 1e-9 * period, 9), (t10 + 1e-9 * period, 10)):
+        initial = dataclasses.replace(cfg.excitation.initial, rotations=(0.5 * alpha,))
+        exc = dataclasses.replace(cfg.excitation, type="free", duration=end, initial=initial)
+        solver = dataclasses.replace(cfg.solver, method="exact")
+        c = dataclasses.replace(cfg, excitation=exc, solver=solver)
+        out = simulate(c, 0.0, 0.0)
+        assert out.status == "survived"
+        assert out.n_impacts == impacts
+        # peak alpha / 2 = theta_u / 2, up to the event convention shared with the step
+        # kernel: an impact is located EVENT_EPS theta_u past zero and projected back, which
+        # adds M_u EVENT_EPS theta_u of energy, i.e. 2 EVENT_EPS theta_u of amplitude at
+        # theta_u / 2 (dE / d amplitude = M_u / 2 there)
+        assert abs(out.max_rotation_ratio - 0.5) <= 4 * EVENT_EPS * impacts
+
+
+def test_rigid_monolith_equals_housner_linear():
+    """The rigid RBM with n = 1 is housner-linear (alpha = B/H, p from SPEC section 2):
+    on sub-grids of spanos_koh_slender and housner_halfsine the exact method and the
+    closed form give the same outcome and event counts, and peaks and collapse times within
+    1e-8 where the closed form is well-conditioned (a 1e-10 change of the amplitude moves
+    its peak by less than 1e-9). The two locate an impact differently (the closed form at
+    theta = 0, the RBM EVENT_EPS theta_u past it, then projected back), a 1e-12 difference
+    per impact that the motion may amplify; hence 1e-8, not rounding."""
+    compared = 0
+    for study, stride in (("spanos_koh_slender", 3), ("housner_halfsine", 6)):
+        cfg = exact_config(study)
+        runner = make_runner(cfg)
+        alpha, p = linear_rocking_parameters(runner.model.column)
+        tu = runner.model.column.rotation_capacity[0]
+        for f in cfg.grid.frequencies_hz[::stride]:
+            for a in cfg.grid.amplitudes_g[::stride]:
+                ref = housner_linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f), 1.0)
+                nudged = housner_linear_run(
+                    alpha, p, make_ground_motion(cfg.excitation, a * (1 + 1e-10), f), 1.0
+                )
+                out = simulate(cfg, a, f, runner=runner)
+                assert out.status == ref.status, (a, f)
+                assert (out.n_uplifts, out.n_impacts) == (ref.n_uplifts, ref.n_impacts), (a, f)
+                peak = float(ref.max_ratio[0]) * alpha / tu
+                if abs(float(nudged.max_ratio[0]) * alpha / tu - peak) > 1e-9 * peak:
+                    continue
+                if ref.status == "survived":
+                    assert out.max_rotation_ratio == pytest.approx(peak, rel=1e-8), (a, f)
+                else:
+                    assert out.t_collapse_s == pytest.approx(ref.t_collapse, rel=1e-8), (a, f)
+                compared += 1
+    assert compared > 40
+
+
+# ------------------------------------------------------------------ resonance
+def test_elastic_monolith_at_resonance_is_the_t_cos_term():
+    """An elastic monolith (harmonic_monolithic) forced at its natural frequency w, small
+    enough to stay on its elastic branch for 2 s: theta = -(r A / M) (sin wt - wt cos wt)
+    / (2 w^2), whose peak over [0, 2 s] is at the last t = k pi / w."""
+    cfg = exact_config("harmonic_monolithic")
+    cfg = dataclasses.replace(cfg, excitation=dataclasses.replace(cfg.excitation, duration=2.0))
+    model = model_from_config(cfg)
+    f = model.elastic_frequencies_hz()[0]
+    w = 2 * math.pi * f
+    amp_g = 1e-3
+    c = abs(model.ground_load[0]) / model.mass[0, 0] * amp_g * 9.81 / (2 * w * w)
+    k = math.floor(w * 2.0 / math.pi)
+    peak = max(c * k * math.pi, c * abs(math.sin(2 * w) - 2 * w * math.cos(2 * w)))
+    out = simulate(cfg, amp_g, f)
+    assert out.n_uplifts == 0
+    assert out.max_rotation_ratio == pytest.approx(
+        peak / model.column.rotation_capacity[0], rel=1e-10
+    )
+
+
+def test_multidrum_at_its_first_mode_matches_the_step_kernel():
+    """An 8-drum column forced at its first elastic frequency (resonance, no damping) for
+    3 s, small enough to stay elastic: the peak agrees with the step kernel at rtol 1e-12
+    to 1e-8."""
+    cfg = load_config(CONFIGS / "harmonic_multidrum.yaml")
+    cfg = dataclasses.replace(cfg, excitation=dataclasses.replace(cfg.excitation, duration=3.0))
+    model = model_from_config(cfg)
+    f = model.elastic_frequencies_hz()[0]
+    motion = make_ground_motion(cfg.excitation, 2e-4, f)
+    zeros = np.zeros(model.n)
+    tight = dataclasses.replace(cfg.solver, rtol=1e-12, atol=1e-16)
+    ref = integrate_compiled(model, motion, zeros, zeros, tight)
+    out = integrate_exact_compiled(model, motion, zeros, zeros, cfg.solver)
+    assert ref.n_uplifts == out.n_uplifts == 0
+    assert np.max(out.max_ratio) == pytest.approx(np.max(ref.max_ratio), rel=1e-8)
+    assert out.max_top == pytest.approx(ref.max_top, rel=1e-8)
+
+
+# ------------------------------------------------------------------ the two implementations
+@pytest.mark.parametrize(
+    ("study", "amplitude", "frequency"),
+    [("spanos_koh_slender", 0.5, 2.0), ("housner_halfsine", 0.5, 2.0),
+     ("harmonic_monolithic", 0.5, 2.0), ("harmonic_multidrum", 0.15, 2.0)],
+)  # fmt: skip
+def test_compiled_equals_python(study, amplitude, frequency):
+    """The compiled kernel transcribes the Python loop: same steps and events, peaks to
+    1e-12 (non-chaotic cells)."""
+    cfg = load_config(CONFIGS / f"{study}.yaml")
+    model = model_from_config(cfg)
+    motion = make_ground_motion(cfg.excitation, amplitude, frequency)
+    zeros = np.zeros(model.n)
+    ref = integrate_exact(model, motion, zeros, zeros, cfg.solver)
+    out = integrate_exact_compiled(model, motion, zeros, zeros, cfg.solver)
+    assert out.status == ref.status
+    assert (out.n_uplifts, out.n_impacts, out.n_events) == (
+        ref.n_uplifts,
+        ref.n_impacts,
+        ref.n_events,
+    )
+    assert out.n_steps == ref.n_steps
+    assert np.max(out.max_ratio) == pytest.approx(np.max(ref.max_ratio), rel=1e-12)
+    assert out.max_top == pytest.approx(ref.max_top, rel=1e-12)
+
+
+def test_history_is_sampled_from_the_closed_form():
+    """rbm run's history with the exact method: samples every output_dt on the closed form,
+    the same from the compiled and the Python loop to 1e-10 of the largest rotation (their
+    eigensolvers differ: scipy's generalized eigh and numpy's eigh after a Cholesky
+    reduction; the modes then differ by rounding times the pencil's condition, 4e3 here)."""
+    cfg = exact_config("harmonic_multidrum")
+    model = model_from_config(cfg)
+    motion = make_ground_motion(cfg.excitation, 0.15, 2.0)
+    zeros = np.zeros(model.n)
+    a = integrate_exact(model, motion, zeros, zeros, cfg.solver, record=True, output_dt=0.01)
+    b = integrate_exact_compiled(
+        model, motion, zeros, zeros, cfg.solver, record=True, output_dt=0.01
+    )
+    assert len(a.samples) == len(b.samples) == 1001
+    ta, tb = np.array([s[0] for s in a.samples]), np.array([s[0] for s in b.samples])
+    assert np.allclose(ta, tb, atol=1e-12, rtol=0)
+    tha, thb = np.array([s[1] for s in a.samples]), np.array([s[1] for s in b.samples])
+    assert np.abs(tha - thb).max() < 1e-10 * np.abs(tha).max()
+
+
+# ------------------------------------------------------------------ refusals
+def test_absolute_formulation_is_refused_in_one_line():
+    cfg = exact_config("harmonic_multidrum")
+    cfg = dataclasses.replace(
+        cfg, interface=dataclasses.replace(cfg.interface, formulation="absolute")
+    )
+    with pytest.raises(RbmError) as err:
+        make_runner(cfg)
+    assert "\n" not in str(err.value) and "absolute" in str(err.value)
+
+
+def test_housner_model_refuses_exact_in_one_line():
+    """Housner's large-rotation block is not piecewise linear: its runner says so."""
+    cfg = exact_config("spanos_koh_slender_housner")
+    with pytest.raises(RbmError) as err:
+        make_runner(cfg)
+    assert "\n" not in str(err.value) and "housner" in str(err.value)
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["python", "compiled"])
+def test_piecewise_linear_forcing_is_exact(compiled):
+    """A sampled record's forcing (piecewise linear, exact_motion.sampled_segments) through
+    the run loop: an elastic monolith from rest under a_g = s t up to t1, then held at
+    s t1. theta'' + w^2 theta = -(r / M) a_g gives theta = -(r s / M) [R(t) - R(t - t1)] / w^2
+    with R(u) = u - sin(w u) / w for u > 0: the recorded history equals it to 1e-11 of its
+    peak (and the Python loop and the compiled kernel run the same segments)."""
+    cfg = load_config(CONFIGS / "harmonic_monolithic.yaml")
+    model = model_from_config(cfg)
+    w = 2 * math.pi * model.elastic_frequencies_hz()[0]
+    t1, t_end, hold = 0.37, 1.5, 2e-3 * 9.81
+    times = np.array([0.0, t1, t_end])
+    segments = sampled_segments(times, np.array([0.0, hold, hold]), t_end)
+    motion = GroundMotion("free", 0.0, 1.0, 0.0, 0.0, t_end)
+    zeros = np.zeros(1)
+    run = integrate_exact_compiled if compiled else integrate_exact
+    out = run(model, motion, zeros, zeros, cfg.solver, record=True, output_dt=1e-3,
+              early_stop=False, segments=segments)  # fmt: skip
+    t = np.array([s[0] for s in out.samples])
+    theta = np.array([s[1][0] for s in out.samples])
+
+    def ramp(u):
+        u = np.maximum(u, 0.0)
+        return u - np.sin(w * u) / w
+
+    c = model.ground_load[0] / model.mass[0, 0] * hold / t1
+    expected = -c * (ramp(t) - ramp(t - t1)) / w**2
+    assert out.n_uplifts == 0 and len(t) == 1501
+    assert np.abs(theta - expected).max() < 1e-11 * np.abs(expected).max()
+    fine = np.linspace(0.0, t_end, 1_500_001)
+    tu = model.column.rotation_capacity[0]
+    peak = np.abs(c * (ramp(fine) - ramp(fine - t1)) / w**2).max() / tu
+    assert peak <= out.max_ratio[0] <= peak * (1 + 1e-9)
+
+
+def test_rigid_monolith_under_a_sampled_forcing_is_refused():
+    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    model = model_from_config(cfg)
+    segments = sampled_segments(np.array([0.0, 1.0]), np.array([0.0, 1.0]), 2.0)
+    motion = GroundMotion("free", 0.0, 1.0, 0.0, 0.0, 2.0)
+    with pytest.raises(RbmError):
+        integrate_exact(model, motion, np.zeros(1), np.zeros(1), cfg.solver, segments=segments)

@@ -293,12 +293,12 @@ class _Run:
         """Run the cells still to do; (compile time, wall time) [s]."""
         n_cells = len(self.cells)
         try:
-            compile_s = _warm_up(self.points, todo)
+            compile_s = _warm_up(self.points, todo, backend, scheduler)
             start = time.perf_counter()
             chunks = tasks(self.config, self.points, todo, jobs)
             if stop_after is not None:
                 chunks = chunks[:stop_after]
-            work = [(cfg, c, self.ensemble) for cfg, c in chunks]
+            work = [(cfg, c, self.ensemble) for cfg, c in _probe_first(chunks)]
             _run_tasks(self.store, work, jobs, backend, scheduler, self.digest, self.done,
                        n_cells, progress, self.resume_command,
                        self.config.grid.axis_paths)  # fmt: skip
@@ -320,7 +320,8 @@ def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, pr
         progress(n_done, n_cells)
     store.open_journal()
     try:
-        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler):
+        sizes = [len(cells) for _, cells, _ in tasks]  # what a pool pays for (parallel)
+        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler, sizes):
             if rows is not None:
                 store.append(rows, digest)
                 for row in rows:
@@ -361,16 +362,34 @@ def _finished_summary(folder: Path, n_cells: int) -> SweepSummary:
     )
 
 
-def _warm_up(points: list[GridPoint], todo: list) -> float:
-    """Compile (or load) the kernel once here, so the workers load it from numba's
-    cache; its time [s], which the sweep's wall time and ETA leave out."""
+def _probe_first(chunks: list) -> list:
+    """The chunks, the first cut in pieces of 1, 2, 4... cells: loky's first chunks run
+    here until the time they take says whether a pool pays (rbm_cli.study.parallel), and
+    small pieces make that known early. Rows do not depend on the cut."""
+    if not chunks:
+        return chunks
+    config, cells = chunks[0]
+    pieces, i, n = [], 0, 1
+    while i < len(cells):
+        pieces.append((config, cells[i : i + n]))
+        i, n = i + n, 2 * n
+    return pieces + chunks[1:]
+
+
+def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | None) -> float:
+    """Compile (or load) the kernel once here, if this process runs cells (every backend
+    but a Dask scheduler's; loky runs its first chunks here) or if it must be compiled
+    (then workers load it from numba's cache instead of each compiling it); its time [s],
+    which the sweep's wall time and ETA leave out."""
     compiled = any(
         p.config.model == "rbm" and p.config.solver.implementation == "compiled" for p in points
     )
     if not (todo and compiled):
         return 0.0
-    from rbm_cli.models.rbm.kernel import warm_up
+    from rbm_cli.models.rbm.kernel import needs_compile, warm_up
 
+    if backend == "dask" and scheduler and needs_compile() is False:
+        return 0.0  # no cell runs here, and the workers find the kernel in the cache
     start = time.perf_counter()
     warm_up()
     return time.perf_counter() - start

@@ -80,7 +80,7 @@ def _record_pool(monkeypatch) -> list:
     """Replace the pool by a recorder of the items handed to it (not run)."""
     handed: list = []
 
-    def fake_loky(fn, args, jobs):
+    def fake_loky(fn, args, jobs, placed=None):
         handed.extend(args)
         yield from [None] * len(args)
 
@@ -162,6 +162,19 @@ def test_a_cheap_sweep_with_two_jobs_starts_no_pool(tmp_path, monkeypatch):
     two = run_sweep(cfg, tmp_path / "two", jobs=2)
     one = run_sweep(cfg, tmp_path / "one", jobs=1)
     assert (two.folder / "domain.csv").read_bytes() == (one.folder / "domain.csv").read_bytes()
+    assert two.workers == 0 and one.workers == 0  # both ran here, whatever --jobs said
+
+
+def test_the_summary_line_says_where_the_cells_ran(tmp_path):
+    from click.testing import CliRunner
+
+    from rbm_cli.cli.main import cli
+
+    path = tmp_path / "cheap.yaml"
+    path.write_text((CONFIGS / "spanos_koh_slender.yaml").read_text())
+    res = CliRunner().invoke(cli, ["sweep", str(path), "-o", str(tmp_path / "o"), "-j", "2"])
+    assert res.exit_code == 0, res.output
+    assert " in this process" in res.output and "worker" not in res.output
 
 
 def test_rows_are_the_same_here_and_on_the_pool(tmp_path, monkeypatch, workers):
@@ -176,13 +189,14 @@ def test_rows_are_the_same_here_and_on_the_pool(tmp_path, monkeypatch, workers):
     started = []
     real = parallel._loky
 
-    def counted(fn, args, jobs):
+    def counted(fn, args, jobs, placed=None):
         started.append(len(args))
-        yield from real(fn, args, jobs)
+        yield from real(fn, args, jobs, placed)
 
     monkeypatch.setattr(parallel, "_loky", counted)
     pool = run_sweep(cfg, tmp_path / "pool", jobs=2)
     assert started and started[0] > 1  # the pool ran most of the chunks
+    assert pool.workers == 2 and here.workers == 0
     assert (pool.folder / "domain.csv").read_bytes() == (here.folder / "domain.csv").read_bytes()
     assert workers and all(reaped(pid) for pid in workers)
 
@@ -285,3 +299,60 @@ def test_ctrl_c_on_a_pool_keeps_the_cells_and_leaves_no_process(tmp_path, rows):
     while _group(proc.pid) and time.monotonic() < deadline:
         time.sleep(0.1)  # (its resource trackers end when they see it gone)
     assert _group(proc.pid) == []
+
+
+def _sigint_off(pid: int) -> bool:
+    """SIGINT blocked or ignored in every thread of process pid (Linux's /proc)."""
+    bit = 1 << (signal.SIGINT - 1)
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        try:
+            status = (task / "status").read_text()
+        except FileNotFoundError:  # a thread that has just ended
+            continue
+        fields = dict(line.split(":\t", 1) for line in status.splitlines() if ":\t" in line)
+        if not (int(fields["SigBlk"], 16) | int(fields["SigIgn"], 16)) & bit:
+            return False
+    return True
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="reads /proc")
+@pytest.mark.parametrize("launch", [1, 2])
+def test_ctrl_c_while_loky_starts_a_worker_is_raised_here(monkeypatch, launch):
+    """A Ctrl-C that lands right after loky launched worker `launch` of 2 (the start
+    runs in a thread of its own): KeyboardInterrupt in this thread, both workers started
+    with SIGINT held (they never see it), stopped and reaped; this thread's handler and
+    mask as they were, and the next Ctrl-C raises too (nothing left noted or held)."""
+    from joblib.externals.loky.backend import popen_loky_posix
+
+    real = popen_loky_posix.Popen._launch
+    launched: list[int] = []
+
+    def launch_then_ctrl_c(self, process_obj):
+        real(self, process_obj)
+        launched.append(self.pid)
+        if len(launched) == launch:
+            os.kill(os.getpid(), signal.SIGINT)  # to the process, as a terminal's
+        if len(launched) == 2:
+            held.extend(_sigint_off(pid) for pid in launched)
+
+    held: list[bool] = []
+    stopped: list[int] = []
+    real_stop = parallel._stop
+
+    def stop(executor):
+        stopped.extend(executor._processes)
+        real_stop(executor)
+
+    monkeypatch.setattr(popen_loky_posix.Popen, "_launch", launch_then_ctrl_c)
+    monkeypatch.setattr(parallel, "_stop", stop)
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, [])
+    with pytest.raises(KeyboardInterrupt):
+        list(parallel._loky(time.sleep, [(5.0,)] * 4, 2))
+    assert sorted(stopped) == sorted(launched) and len(launched) == 2
+    assert held == [True, True]
+    assert all(reaped(pid) for pid in launched)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert signal.pthread_sigmask(signal.SIG_BLOCK, []) == mask
+    with pytest.raises(KeyboardInterrupt):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(1)

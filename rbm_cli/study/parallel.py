@@ -52,6 +52,9 @@ POOL_COST_S = 1.0
 #: Work timed in this process [s] before its time per cell is trusted: one cell's time
 #: (a first call's lazy set-up in it, or a cell below uplift) says little of the rest.
 PROBE_S = 0.2
+#: Longest wait [s] of the sweep's thread on the pool's starter in one piece: a Ctrl-C
+#: that another thread received is acted on between two (it does not end a join).
+WAIT_SLICE_S = 0.05
 
 
 def _watch_parent(parent: int) -> None:
@@ -75,13 +78,18 @@ def run_chunks(
     backend: str,
     scheduler: str | None,
     sizes: Sequence[int] | None = None,
+    placed: dict | None = None,
 ) -> Iterator:
     """fn(*a) for every a in args, on up to `jobs` workers; yields each result as it
     finishes (in no set order), and None now and then while nothing finishes (loky).
     Stops every worker before an exception leaves (KeyboardInterrupt included).
 
     sizes : the cells of each item (default 1 each), for loky's estimate of the time
-        left (the module's docstring: a pool only when it pays; jobs=1 never)."""
+        left (the module's docstring: a pool only when it pays; jobs=1 never).
+    placed : filled with "workers": the processes or threads the items ran on, 0 if
+        all ran in this process (loky, sequential), None if not known (dask)."""
+    placed = {} if placed is None else placed
+    placed["workers"] = {"loky": 0, "sequential": 0, "threading": jobs}.get(backend)
     if not args:
         return
     if backend == "sequential":
@@ -89,7 +97,7 @@ def run_chunks(
             yield fn(*a)
         return
     if backend == "loky":
-        yield from _here_then_pool(fn, args, jobs, sizes or [1] * len(args))
+        yield from _here_then_pool(fn, args, jobs, sizes or [1] * len(args), placed)
         return
     import joblib
 
@@ -113,12 +121,12 @@ def pool_pays(time_left_s: float, jobs: int) -> bool:
     return time_left_s * (1 - 1 / workers) > POOL_COST_S
 
 
-def _here_then_pool(fn: Callable, args: Sequence[tuple], jobs: int, sizes) -> Iterator:
+def _here_then_pool(fn: Callable, args: Sequence[tuple], jobs: int, sizes, placed) -> Iterator:
     """Items in this process until the estimate says a pool pays, the rest on loky."""
     left, done, spent = sum(sizes), 0, 0.0
     for i, a in enumerate(args):
         if done and spent >= PROBE_S and pool_pays(spent / done * left, jobs):
-            yield from _loky(fn, args[i:], jobs)
+            yield from _loky(fn, args[i:], jobs, placed)
             return
         start = time.perf_counter()
         result = fn(*a)
@@ -127,7 +135,9 @@ def _here_then_pool(fn: Callable, args: Sequence[tuple], jobs: int, sizes) -> It
         yield result
 
 
-def _loky(fn: Callable, args: Iterable[tuple], jobs: int) -> Iterator:
+def _loky(fn: Callable, args: Iterable[tuple], jobs: int, placed: dict | None = None) -> Iterator:
+    """fn(*a) for every a in args on a loky pool of `jobs` workers, started here and
+    stopped at the end (placed["workers"] = jobs once it started)."""
     from concurrent.futures import FIRST_COMPLETED, wait
     from multiprocessing import resource_tracker
 
@@ -135,7 +145,7 @@ def _loky(fn: Callable, args: Iterable[tuple], jobs: int) -> Iterator:
 
     queue = iter(args)
     pending: set = set()
-    executor = None
+    executor = starter = None
 
     def refill() -> None:  # at most IN_FLIGHT chunks a worker queued, as joblib does
         while len(pending) < IN_FLIGHT * jobs:
@@ -151,11 +161,14 @@ def _loky(fn: Callable, args: Iterable[tuple], jobs: int) -> Iterator:
             initializer=_worker_init,
             initargs=(os.getpid(),),
         )
-        # multiprocessing's resource tracker, started on first use, unblocks SIGINT as
-        # it starts: started first, so that the workers below inherit the blocked mask
+        # multiprocessing's resource tracker, started on first use, unblocks SIGINT in
+        # the thread that starts it: started here, not in the starter below
         resource_tracker.ensure_running()
-        with _sigint_deferred():  # the workers start in the first submits
-            refill()
+        starter = _Starter(refill)  # the workers start in the first submits
+        starter.start()
+        starter.wait()
+        if placed is not None:
+            placed["workers"] = jobs
         while pending:
             done, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
             if not done:
@@ -167,34 +180,67 @@ def _loky(fn: Callable, args: Iterable[tuple], jobs: int) -> Iterator:
     except BaseException:
         # the queued futures are failed by the shutdown itself (cancelling them first
         # made loky's manager thread raise InvalidStateError and the process hang)
+        if starter is not None:
+            starter.finish()  # every worker started is in loky's table before the stop
         if executor is not None:
             _stop(executor)
         raise
 
 
-@contextlib.contextmanager
-def _sigint_deferred() -> Iterator[None]:
-    """While the pool's workers start: SIGINT blocked in this thread, so that they inherit
-    the mask (exec keeps it) and never see a Ctrl-C, even before _worker_init has run
-    (once a worker has imported loky: a Ctrl-C before printed its traceback); and a Ctrl-C
-    meanwhile (another thread of this process takes it) only noted, and handled once they
-    are started: raised inside loky's start of a worker, it left that worker out of the
-    pool's table, never stopped, and the sweep hung at exit waiting for it."""
-    noted: list[int] = []
-    main = threading.current_thread() is threading.main_thread()
-    previous = signal.getsignal(signal.SIGINT) if main else None
-    deferred = callable(previous)  # a Python handler (not SIG_IGN, SIG_DFL or C's own)
-    if deferred:
-        signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum))
-    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # a pending Ctrl-C lands now
-        if deferred:
-            signal.signal(signal.SIGINT, previous)
-    if noted:
-        previous(signal.SIGINT, None)  # Python's default: raise KeyboardInterrupt
+class _Starter:
+    """The first submits, in which loky starts the workers, in a thread of their own
+    created with SIGINT blocked (issue 18). The workers inherit that thread's mask (exec
+    keeps it), so a Ctrl-C to the group while they import stays pending in them until
+    _worker_init ignores it (before, it printed a worker's traceback). The sweep's own
+    thread keeps its SIGINT handler and its mask (blocked only while the starter is
+    created): a Ctrl-C raises KeyboardInterrupt there, in start() or wait(), as anywhere
+    else, while a start that has begun, which a KeyboardInterrupt inside loky's Popen
+    left half done (a worker missing from the pool's table, never stopped: the sweep
+    hung at exit), goes on to its end in the starter; finish() waits for that before the
+    pool is stopped. The starter begins only once go is set: whether it will start
+    workers is then known from that flag alone."""
+
+    def __init__(self, submit: Callable[[], None]):
+        self.go, self.cancel, self.done = threading.Event(), threading.Event(), threading.Event()
+        self.error: list[BaseException] = []
+        self.thread = threading.Thread(target=self._run, args=(submit,), daemon=True)
+
+    def _run(self, submit: Callable[[], None]) -> None:
+        try:
+            while not self.go.wait(WAIT_SLICE_S):
+                if self.cancel.is_set():
+                    return
+            submit()
+        except BaseException as exc:  # raised in the sweep's thread by wait()
+            self.error.append(exc)
+        finally:
+            self.done.set()
+
+    def start(self) -> None:
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            self.thread.start()  # a thread starts with its creator's mask
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)  # a Ctrl-C meanwhile: now
+        self.go.set()
+
+    def wait(self) -> None:
+        """Until the submits are done (a Ctrl-C raises meanwhile: short waits, for one
+        that another thread received is acted on between two); their error, if any."""
+        while not self.done.wait(WAIT_SLICE_S):
+            pass
+        if self.error:
+            raise self.error[0]
+
+    def finish(self) -> None:
+        """Cancel a start not begun; else wait for its end, whatever Ctrl-C says (the
+        one being handled is enough)."""
+        if not self.go.is_set():
+            self.cancel.set()
+            return
+        while not self.done.is_set():
+            with contextlib.suppress(KeyboardInterrupt):
+                self.done.wait(WAIT_SLICE_S)
 
 
 def _stop(executor) -> None:

@@ -67,6 +67,7 @@ class SweepSummary:
     wall_time_s: float
     compile_s: float = 0.0  # compiling (or loading) the kernel, left out of wall_time_s
     already_finished: bool = False  # resume on a folder that holds this config's result
+    workers: int | None = None  # the cells ran in this process (0), on N workers, or ? (None)
 
 
 def config_hash(config: Config) -> str:
@@ -251,10 +252,11 @@ def run_sweep(
                            resume_command)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
-    return _summary(folder, len(cells), len(todo), counts, wall, compile_s)
+    return _summary(folder, len(cells), len(todo), counts, wall, compile_s,
+                    run.placed.get("workers"))  # fmt: skip
 
 
-def _summary(folder, n_cells, n_run, counts, wall, compile_s) -> SweepSummary:
+def _summary(folder, n_cells, n_run, counts, wall, compile_s, workers=None) -> SweepSummary:
     return SweepSummary(
         folder=folder,
         n_cells=n_cells,
@@ -265,6 +267,7 @@ def _summary(folder, n_cells, n_run, counts, wall, compile_s) -> SweepSummary:
         n_failed=int(counts.get("failed", 0)),
         wall_time_s=wall,
         compile_s=compile_s,
+        workers=workers,
     )
 
 
@@ -280,6 +283,7 @@ class _Run:
     ensemble: int
     resume_command: str
     done: dict
+    placed: dict = dataclasses.field(default_factory=dict)  # where the cells ran (parallel)
 
     def cells_kept(self) -> int:
         """Cells kept after a Ctrl-C, counted from the journal: Ctrl-C may land between a
@@ -301,7 +305,7 @@ class _Run:
             work = [(cfg, c, self.ensemble) for cfg, c in _probe_first(chunks)]
             _run_tasks(self.store, work, jobs, backend, scheduler, self.digest, self.done,
                        n_cells, progress, self.resume_command,
-                       self.config.grid.axis_paths)  # fmt: skip
+                       self.config.grid.axis_paths, self.placed)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(self.store.folder, self.cells_kept(), n_cells,
                                    self.resume_command) from None  # fmt: skip
@@ -313,7 +317,7 @@ class _Run:
 
 
 def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
-               resume_command, paths) -> None:  # fmt: skip
+               resume_command, paths, placed) -> None:  # fmt: skip
     """Run the chunks; each one's rows go to the journal (fsync'ed), then into done."""
     n_done = len(done)
     if progress:
@@ -321,7 +325,7 @@ def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, pr
     store.open_journal()
     try:
         sizes = [len(cells) for _, cells, _ in tasks]  # what a pool pays for (parallel)
-        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler, sizes):
+        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler, sizes, placed):
             if rows is not None:
                 store.append(rows, digest)
                 for row in rows:

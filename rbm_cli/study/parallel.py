@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import queue
 import signal
 import threading
 import time
@@ -248,6 +249,13 @@ def _stop(executor) -> None:
     interpreter first (~1 s at exit), and loky leaves killed ones unreaped (zombies in
     the group). A later sweep that pays for a pool starts another."""
     workers = list(getattr(executor, "_processes", {}).values())  # loky's own table
+    # the ids of submitted chunks not yet sent to a worker: on shutdown(kill_workers),
+    # loky's manager thread fails every pending chunk, then looks these up again and
+    # dies on a KeyError (a traceback on stderr) when one was submitted since its last
+    # pass (a Ctrl-C just after a submit). Their futures fail all the same.
+    with contextlib.suppress(AttributeError, queue.Empty):
+        while True:
+            executor._work_ids.get_nowait()
     executor.shutdown(wait=True, kill_workers=True)
     for worker in workers:
         worker.join(timeout=WATCH_INTERVAL_S)

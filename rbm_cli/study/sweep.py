@@ -252,11 +252,10 @@ def run_sweep(
                            resume_command)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
-    return _summary(folder, len(cells), len(todo), counts, wall, compile_s,
-                    run.placed.get("workers"))  # fmt: skip
+    return _summary(folder, len(cells), len(todo), counts, wall, compile_s, run.placed)
 
 
-def _summary(folder, n_cells, n_run, counts, wall, compile_s, workers=None) -> SweepSummary:
+def _summary(folder, n_cells, n_run, counts, wall, compile_s, placed=None) -> SweepSummary:
     return SweepSummary(
         folder=folder,
         n_cells=n_cells,
@@ -267,7 +266,7 @@ def _summary(folder, n_cells, n_run, counts, wall, compile_s, workers=None) -> S
         n_failed=int(counts.get("failed", 0)),
         wall_time_s=wall,
         compile_s=compile_s,
-        workers=workers,
+        workers=(placed or {}).get("workers"),
     )
 
 

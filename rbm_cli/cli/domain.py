@@ -132,6 +132,14 @@ def sweep(
     _print_sweep_summary(summary, jobs)
 
 
+def _where(summary, jobs: int) -> str:
+    """Where the cells ran: a sweep starts a pool only when it pays (issue 18)."""
+    if summary.workers == 0:
+        return "in this process"
+    n = jobs if summary.workers is None else summary.workers
+    return f"on {n} worker" + ("s" if n != 1 else "")
+
+
 def _print_sweep_summary(summary, jobs: int) -> None:
     """What a finished `rbm sweep` says on stdout (failed cells: a warning on stderr)."""
     from rbm_cli.cli.progress import duration
@@ -150,7 +158,7 @@ def _print_sweep_summary(summary, jobs: int) -> None:
     click.echo(
         f"{summary.n_cells} cells ({summary.n_run} run, {summary.n_resumed} resumed): "
         f"{summary.n_collapsed} collapsed, {summary.n_survived} survived, "
-        f"{summary.n_failed} failed in {summary.wall_time_s:.3g} s on {jobs} worker(s)"
+        f"{summary.n_failed} failed in {summary.wall_time_s:.3g} s {_where(summary, jobs)}"
         f"{compiled}"
     )
     click.echo(f"output: {summary.folder}")

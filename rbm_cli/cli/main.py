@@ -10,19 +10,30 @@ module registers its commands on it when imported here.
 
 from __future__ import annotations
 
-import matplotlib
+import os
+import sys
 
-matplotlib.use("Agg")  # the CLI saves figures to files; only the CLI picks a backend
+from rbm_cli.cli import bench, domain, fragility, run  # noqa: F401  (register the commands)
+from rbm_cli.cli.common import cli
 
-from rbm_cli.cli import bench, domain, fragility, run  # noqa: E402, F401  (register the commands)
-from rbm_cli.cli.common import cli  # noqa: E402
+if "matplotlib" in sys.modules:  # (main() called from a program that drew already)
+    sys.modules["matplotlib"].use("Agg")
+else:  # the CLI saves figures to files; only the CLI picks a backend; matplotlib is
+    os.environ["MPLBACKEND"] = "Agg"  # imported by the commands that draw, not here
 
 __all__ = ["cli", "main"]
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console-script entry point (``rbm``)."""
-    cli.main(args=argv, prog_name="rbm")
+    """Console-script entry point (``rbm``): the process ends with it, so what it holds is
+    frozen out of the garbage collector first, and the exit does not traverse it (a
+    sweep's ~200,000 objects: ~0.2-0.4 s of its wall time, issue 18)."""
+    import gc
+
+    try:
+        cli.main(args=argv, prog_name="rbm")
+    finally:
+        gc.freeze()
 
 
 if __name__ == "__main__":  # pragma: no cover

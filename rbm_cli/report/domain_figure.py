@@ -9,9 +9,7 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Sequence
-
-import pandas as pd
-from matplotlib.figure import Figure
+from typing import TYPE_CHECKING
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
@@ -22,6 +20,10 @@ from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.study.domain import axis_columns
 
 __all__ = ["domain_figure", "draw_domain_on", "uplift_level"]
+
+if TYPE_CHECKING:  # matplotlib is imported when a figure is drawn, not with this module
+    import pandas as pd
+    from matplotlib.figure import Figure
 
 
 def _plain(df: pd.DataFrame, dimensionless: bool, layout: str) -> bool:
@@ -98,6 +100,8 @@ def draw_domain_on(
     view = domain_view(df, config, dimensionless, layout, where)
     others = _compared(view, compare, labels, compare_configs, where)
     if ax is None:
+        from matplotlib.figure import Figure
+
         ax = Figure(figsize=figure_size(view)).add_subplot()
     if view.layout == "panels":
         fig, spec = ax.figure, ax.get_subplotspec()
@@ -156,6 +160,8 @@ def domain_figure(
     """
     if _plain(df, dimensionless, layout):
         return _plain_figure(df, config, compare, labels)
+    from matplotlib.figure import Figure
+
     view = domain_view(df, config, dimensionless, layout, where)
     fig = Figure(figsize=figure_size(view))
     ax = fig.add_subplot()
@@ -197,6 +203,8 @@ def _colorbar_below(fig, axes: list) -> None:
 
 def _plain_figure(df, config, compare, labels) -> Figure:
     """A domain over amplitude and frequency only, in physical axes (as it always was)."""
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(9.5, 5))
     ax = fig.add_subplot()
     if config is None:  # a domain without its config: no column, no curves of it

@@ -67,6 +67,7 @@ class SweepSummary:
     wall_time_s: float
     compile_s: float = 0.0  # compiling (or loading) the kernel, left out of wall_time_s
     already_finished: bool = False  # resume on a folder that holds this config's result
+    workers: int | None = None  # the cells ran in this process (0), on N workers, or ? (None)
 
 
 def config_hash(config: Config) -> str:
@@ -251,10 +252,10 @@ def run_sweep(
                            resume_command)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
-    return _summary(folder, len(cells), len(todo), counts, wall, compile_s)
+    return _summary(folder, len(cells), len(todo), counts, wall, compile_s, run.placed)
 
 
-def _summary(folder, n_cells, n_run, counts, wall, compile_s) -> SweepSummary:
+def _summary(folder, n_cells, n_run, counts, wall, compile_s, placed=None) -> SweepSummary:
     return SweepSummary(
         folder=folder,
         n_cells=n_cells,
@@ -265,6 +266,7 @@ def _summary(folder, n_cells, n_run, counts, wall, compile_s) -> SweepSummary:
         n_failed=int(counts.get("failed", 0)),
         wall_time_s=wall,
         compile_s=compile_s,
+        workers=(placed or {}).get("workers"),
     )
 
 
@@ -280,6 +282,7 @@ class _Run:
     ensemble: int
     resume_command: str
     done: dict
+    placed: dict = dataclasses.field(default_factory=dict)  # where the cells ran (parallel)
 
     def cells_kept(self) -> int:
         """Cells kept after a Ctrl-C, counted from the journal: Ctrl-C may land between a
@@ -293,15 +296,15 @@ class _Run:
         """Run the cells still to do; (compile time, wall time) [s]."""
         n_cells = len(self.cells)
         try:
-            compile_s = _warm_up(self.points, todo)
+            compile_s = _warm_up(self.points, todo, backend, scheduler)
             start = time.perf_counter()
             chunks = tasks(self.config, self.points, todo, jobs)
             if stop_after is not None:
                 chunks = chunks[:stop_after]
-            work = [(cfg, c, self.ensemble) for cfg, c in chunks]
+            work = [(cfg, c, self.ensemble) for cfg, c in _probe_first(chunks)]
             _run_tasks(self.store, work, jobs, backend, scheduler, self.digest, self.done,
                        n_cells, progress, self.resume_command,
-                       self.config.grid.axis_paths)  # fmt: skip
+                       self.config.grid.axis_paths, self.placed)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(self.store.folder, self.cells_kept(), n_cells,
                                    self.resume_command) from None  # fmt: skip
@@ -313,14 +316,15 @@ class _Run:
 
 
 def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
-               resume_command, paths) -> None:  # fmt: skip
+               resume_command, paths, placed) -> None:  # fmt: skip
     """Run the chunks; each one's rows go to the journal (fsync'ed), then into done."""
     n_done = len(done)
     if progress:
         progress(n_done, n_cells)
     store.open_journal()
     try:
-        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler):
+        sizes = [len(cells) for _, cells, _ in tasks]  # what a pool pays for (parallel)
+        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler, sizes, placed):
             if rows is not None:
                 store.append(rows, digest)
                 for row in rows:
@@ -361,18 +365,35 @@ def _finished_summary(folder: Path, n_cells: int) -> SweepSummary:
     )
 
 
-def _warm_up(points: list[GridPoint], todo: list) -> float:
-    """Compile (or load) the kernel once here, so the workers load it from numba's
-    cache (after the background compile of an earlier `rbm run`, if one runs); its time
-    [s], which the sweep's wall time and ETA leave out."""
+def _probe_first(chunks: list) -> list:
+    """The chunks, the first cut in pieces of 1, 2, 4... cells: loky's first chunks run
+    here until the time they take says whether a pool pays (rbm_cli.study.parallel), and
+    small pieces make that known early. Rows do not depend on the cut."""
+    if not chunks:
+        return chunks
+    config, cells = chunks[0]
+    pieces, i, n = [], 0, 1
+    while i < len(cells):
+        pieces.append((config, cells[i : i + n]))
+        i, n = i + n, 2 * n
+    return pieces + chunks[1:]
+
+
+def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | None) -> float:
+    """Compile (or load) the kernel once here, if this process runs cells (every backend
+    but a Dask scheduler's; loky runs its first chunks here) or if it must be compiled
+    (then workers load it from numba's cache instead of each compiling it); its time [s],
+    which the sweep's wall time and ETA leave out (a background compile: waited for)."""
     compiled = any(
         p.config.model == "rbm" and p.config.solver.implementation == "compiled" for p in points
     )
     if not (todo and compiled):
         return 0.0
     from rbm_cli.models.rbm.compile_ahead import wait
-    from rbm_cli.models.rbm.kernel import warm_up
+    from rbm_cli.models.rbm.kernel import needs_compile, warm_up
 
+    if backend == "dask" and scheduler and needs_compile() is False:
+        return 0.0  # no cell runs here, and the workers find the kernel in the cache
     start = time.perf_counter()
     wait()  # a compile an earlier `rbm run` started in the background: not a second one
     warm_up()

@@ -7,6 +7,7 @@ rbm_cli.models.result.RunResult, the row of a domain.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -39,6 +40,23 @@ class Outcome:
         self.status, self.t_end = status, t
         self.message = message if status != "failed" else f"{message} at t={t:.6g} s"
         return self
+
+    def past_budget(self, solver, deadline: float, t: float) -> Outcome | None:
+        """The run ended 'failed' at t [s] if its steps exceed solver.max_steps or the
+        monotonic clock is past deadline [s] (solver.max_wall_time); else None."""
+        if self.n_steps > solver.max_steps:
+            return self.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+        if time.monotonic() > deadline:
+            budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
+            return self.stop("failed", f"wall-clock budget exceeded ({budget})", t)
+        return None
+
+    def past_events(self, solver, t: float) -> Outcome | None:
+        """The run ended 'failed' at t [s] if its events exceed solver.max_events; else
+        None."""
+        if self.n_events > solver.max_events:
+            return self.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
+        return None
 
     def lifted_off(self, t_lift: float | None) -> Outcome:
         """A run that reached t_lift [s], where g + a_v(t) <= 0 (the ground's upward

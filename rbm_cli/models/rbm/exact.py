@@ -93,13 +93,7 @@ class ExactRun:
 
     def budget(self) -> Outcome | None:
         """The failed Outcome if a budget is exceeded, else None."""
-        out, solver = self.out, self.solver
-        if out.n_steps > solver.max_steps:
-            return out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", self.t)
-        if time.monotonic() > self.deadline:
-            budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
-            return out.stop("failed", f"wall-clock budget exceeded ({budget})", self.t)
-        return None
+        return self.out.past_budget(self.solver, self.deadline, self.t)
 
 
 def _friction(run: ExactRun, piece: LinearPiece, p: Point) -> None:
@@ -170,8 +164,8 @@ def _handle(run: ExactRun, piece: LinearPiece, row: int) -> Outcome | None:
         out.n_impacts += 1
         return None
     out.n_events += 1
-    if out.n_events > run.solver.max_events:
-        return out.stop("failed", f"event budget exceeded ({run.solver.max_events} events)", t)
+    if out.past_events(run.solver, t) is not None:
+        return out
     which, i = divmod(row, n)
     if which >= 2:
         out.status, out.t_collapse, out.collapse_interface = "collapsed", t, i + 1

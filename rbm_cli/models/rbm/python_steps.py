@@ -15,7 +15,6 @@ rbm_cli.models.rbm.python describes.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 from functools import partial
 from typing import NamedTuple
@@ -233,12 +232,7 @@ def take_step(run: RunState, integ) -> Outcome | None:
     if integ.status == "failed":
         return out.stop("failed", f"integrator: {msg}", t)
     out.n_steps += 1
-    if out.n_steps > solver.max_steps:
-        return out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
-    if time.monotonic() > run.deadline:
-        budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
-        return out.stop("failed", f"wall-clock budget exceeded ({budget})", t)
-    return None
+    return out.past_budget(solver, run.deadline, t)
 
 
 def end_of_step(run: RunState, piece: SmoothPiece, integ, surfaces: tuple) -> StepEnd:
@@ -338,8 +332,8 @@ def handle_event(run: RunState, piece: SmoothPiece, event_row: int) -> Outcome |
     which applies the restitution and may put a rigid block to rest)."""
     out, n, t = run.out, run.n, run.t
     out.n_events += 1
-    if out.n_events > run.solver.max_events:
-        return out.stop("failed", f"event budget exceeded ({run.solver.max_events} events)", t)
+    if out.past_events(run.solver, t) is not None:
+        return out
     which, i = divmod(event_row, n)
     if which >= 2:
         out.status = "collapsed"

@@ -17,6 +17,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import signal
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -363,3 +367,43 @@ def test_rigid_monolith_under_a_sampled_forcing_is_refused():
     motion = GroundMotion("free", 0.0, 1.0, 0.0, 0.0, 2.0)
     with pytest.raises(RbmError):
         integrate_exact(model, motion, np.zeros(1), np.zeros(1), cfg.solver, segments=segments)
+
+
+# ------------------------------------------------------------------ guards of a compiled run
+def _long_exact_run(**solver):
+    """An 8-drum column shaken elastically for 1e4 s (minutes of work): a run only a guard
+    ends."""
+    cfg = load_config(CONFIGS / "harmonic_multidrum.yaml")
+    cfg = dataclasses.replace(cfg, excitation=dataclasses.replace(cfg.excitation, duration=1e4))
+    model = model_from_config(cfg)
+    motion = make_ground_motion(cfg.excitation, 0.05, 2.0)  # [g, Hz]: stays elastic
+    zeros = np.zeros(model.n)
+    settings = dataclasses.replace(cfg.solver, method="exact", max_steps=10**9,
+                                   max_events=10**9, **solver)  # fmt: skip
+    start = time.monotonic()
+    out = integrate_exact_compiled(model, motion, zeros, zeros, settings)
+    return out, time.monotonic() - start
+
+
+def test_the_wall_clock_budget_ends_a_compiled_exact_run():
+    out, took = _long_exact_run(max_wall_time=0.5)
+    assert out.status == "failed"
+    assert "wall-clock budget exceeded (0.5 s, solver.max_wall_time)" in out.message
+    assert took < 10.0
+
+
+def test_ctrl_c_stops_a_compiled_exact_run():
+    """Ctrl-C (SIGINT) reaches the compiled exact loop through kernel_guard.poll and
+    raises KeyboardInterrupt once the call has returned."""
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT is handled by the test runner here")
+    _long_exact_run(max_wall_time=0.1)  # compiled (or loaded) before the clock starts
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            _long_exact_run(max_wall_time=120.0)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 10.0

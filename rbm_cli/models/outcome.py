@@ -41,21 +41,44 @@ class Outcome:
         self.message = message if status != "failed" else f"{message} at t={t:.6g} s"
         return self
 
+    def collapse(self, t: float, interface: int) -> Outcome:
+        """The run collapsed at t [s] at an interface (numbered from 1)."""
+        self.status, self.t_collapse, self.collapse_interface = "collapsed", t, interface
+        self.message = f"interface {interface} reached its collapse limit"
+        return self
+
+    def stopped_early(self) -> Outcome:
+        """The run stopped at a peak of free motion below the collapse barrier."""
+        self.message = "free motion below the collapse barrier: stopped early"
+        return self
+
+    def out_of_steps(self, solver, t: float) -> Outcome:
+        """The run ended 'failed' at t [s]: more steps than solver.max_steps."""
+        return self.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+
+    def out_of_events(self, solver, t: float) -> Outcome:
+        """The run ended 'failed' at t [s]: more events than solver.max_events."""
+        return self.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
+
+    def out_of_time(self, solver, t: float) -> Outcome:
+        """The run ended 'failed' at t [s]: past its wall-clock budget."""
+        budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
+        return self.stop("failed", f"wall-clock budget exceeded ({budget})", t)
+
     def past_budget(self, solver, deadline: float, t: float) -> Outcome | None:
         """The run ended 'failed' at t [s] if its steps exceed solver.max_steps or the
         monotonic clock is past deadline [s] (solver.max_wall_time); else None."""
         if self.n_steps > solver.max_steps:
-            return self.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+            return self.out_of_steps(solver, t)
         if time.monotonic() > deadline:
-            budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
-            return self.stop("failed", f"wall-clock budget exceeded ({budget})", t)
+            return self.out_of_time(solver, t)
         return None
 
     def past_events(self, solver, t: float) -> Outcome | None:
         """The run ended 'failed' at t [s] if its events exceed solver.max_events; else
         None."""
         if self.n_events > solver.max_events:
-            return self.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
+            return self.out_of_events(solver, t)
         return None
 
     def lifted_off(self, t_lift: float | None) -> Outcome:

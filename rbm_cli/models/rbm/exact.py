@@ -141,9 +141,8 @@ def _march(run: ExactRun, piece: LinearPiece, seg_end: float, can_stop: bool):
             _friction(run, piece, b)
             if can_stop and _passed_peak(run, piece, a, b):
                 run.t = b.t
-                out.message = "free motion below the collapse barrier: stopped early"
                 out.t_end = b.t
-                return out
+                return out.stopped_early()
             a = b
     finally:
         out.n_rhs += ev.n_evals
@@ -168,11 +167,9 @@ def _handle(run: ExactRun, piece: LinearPiece, row: int) -> Outcome | None:
         return out
     which, i = divmod(row, n)
     if which >= 2:
-        out.status, out.t_collapse, out.collapse_interface = "collapsed", t, i + 1
         run.maxima[i] = max(run.maxima[i], model.collapse_ratio)
-        out.message = f"interface {i + 1} reached its collapse limit"
         out.t_end = t
-        return out
+        return out.collapse(t, i + 1)
     going_up = which == 1
     lo, hi = run.pieces.bounds()
     bound = hi[i] if going_up else lo[i]

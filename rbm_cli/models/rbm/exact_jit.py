@@ -22,11 +22,13 @@ from rbm_cli.models.rbm.exact_jit_run import (
     FAILED_EVENTS,
     FAILED_STEPS,
     FAILED_WALL,
+    INTERRUPTED,
     STOPPED_EARLY,
     run_exact,
 )
 from rbm_cli.models.rbm.exact_jit_state import ExactModel, exact_model, new_cache
 from rbm_cli.models.rbm.exact_motion import check_exact, resolve_segments
+from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -89,18 +91,17 @@ def _outcome(code, st, cnt, maxima, fric, solver, n: int) -> Outcome:
     out.n_uplifts, out.n_impacts, out.n_steps, out.n_rhs, out.n_events = (int(x) for x in cnt[:5])
     t = out.t_end
     if code == COLLAPSED:
-        i = int(cnt[5])
-        out.status, out.t_collapse, out.collapse_interface = "collapsed", float(st[3]), i
-        out.message = f"interface {i} reached its collapse limit"
+        out.collapse(float(st[3]), int(cnt[5]))
     elif code == STOPPED_EARLY:
-        out.message = "free motion below the collapse barrier: stopped early"
+        out.stopped_early()
     elif code == FAILED_STEPS:
-        out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+        out.out_of_steps(solver, t)
     elif code == FAILED_EVENTS:
-        out.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
+        out.out_of_events(solver, t)
     elif code == FAILED_WALL:
-        budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
-        out.stop("failed", f"wall-clock budget exceeded ({budget})", t)
+        out.out_of_time(solver, t)
+    elif code == INTERRUPTED:  # pragma: no cover - disarm() raises first
+        raise KeyboardInterrupt
     elif code != AT_REST_END and not math.isfinite(out.max_top):
         out.stop("failed", "numerical failure: non-finite state", t)
     return out
@@ -139,10 +140,14 @@ def integrate_exact_compiled(
                    float(record), output_dt], dtype=float)  # fmt: skip
     n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((n_max, 1 + 2 * n))
-    code, st, cnt, maxima, fric = run_exact(
-        prepared.arrays, prepared.cache, seg_t, seg_fc, mo, se,
-        np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), samples, POOL, STACK,
-    )  # fmt: skip
+    armed = arm()  # Ctrl-C reaches the run through poll (kernel_guard)
+    try:
+        code, st, cnt, maxima, fric = run_exact(
+            prepared.arrays, prepared.cache, seg_t, seg_fc, mo, se,
+            np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), samples, POOL, STACK,
+        )  # fmt: skip
+    finally:
+        disarm(armed)
     out = _outcome(code, st, cnt, maxima, fric, solver, n)
     if record:
         out.samples = [

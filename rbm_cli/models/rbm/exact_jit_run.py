@@ -30,13 +30,15 @@ from rbm_cli.models.rbm.exact_jit_piece import (
     set_point,
 )
 from rbm_cli.models.rbm.exact_jit_search import SCRATCH, next_point
-from rbm_cli.models.rbm.exact_jit_state import clock, energy1, friction, next_exceedance
+from rbm_cli.models.rbm.exact_jit_state import energy1, friction
+from rbm_cli.models.rbm.kernel_ground import sine_exceedance
+from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
 
 GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
-FAILED_STEPS, FAILED_EVENTS, FAILED_WALL = 5, 6, 7
+FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
-#: Steps between two readings of the wall clock.
+#: Steps between two polls of the wall clock and Ctrl-C (kernel_guard.poll).
 CLOCK_EVERY = 64
 
 #: Work arrays of a run: the point pool, mode and family bounds, the peak refinement's
@@ -104,8 +106,10 @@ def _budget(s, se):
     """A failure code when a budget is exceeded, else GOING."""
     if s.cnt[STEPS] > se[0]:
         return FAILED_STEPS
-    if s.cnt[STEPS] % CLOCK_EVERY == 0 and clock() > se[2]:
-        return FAILED_WALL
+    if s.cnt[STEPS] % CLOCK_EVERY == 0:
+        guard = poll(se[2])
+        if guard != GO_ON:
+            return FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
     return GOING
 
 
@@ -190,16 +194,16 @@ def _handle(mdl, pc, row, s, se):
 @njit(cache=True)
 def _linear_exceedance(fc, t0, level, t_stop):
     """First t in [t0, t_stop) with |a_g(t)| > level under a linear forcing fc: t0 when
-    already above, else where |a_g| reaches level (NaN if it does not before t_stop)."""
+    already above, else where |a_g| reaches level (-1 if it does not before t_stop)."""
     a = f_accel(fc, t0)
     if abs(a) > level:
         return t0
     slope = fc[6]
     if slope == 0.0:
-        return math.nan
+        return -1.0
     target = level if slope > 0.0 else -level
     t = t0 + (target - a) / slope
-    return t if t < t_stop else math.nan
+    return t if t < t_stop else -1.0
 
 
 @njit(cache=True)
@@ -218,8 +222,8 @@ def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
         if kind_fc == LINEAR:
             t_up = _linear_exceedance(fc, t, mdl.uplift_level, seg_end)
         else:
-            t_up = next_exceedance(t, mdl.uplift_level, fc[1], fc[2], fc[3], min(mo[4], mo[5]))
-        if math.isnan(t_up) or t_up >= seg_end:
+            t_up = sine_exceedance(t, mdl.uplift_level, fc[1], fc[2], fc[3], min(mo[4], mo[5]))
+        if t_up < 0.0 or t_up >= seg_end:  # -1: none
             kind, t_stop = 1, seg_end
         else:
             kind, t_stop = 2, t_up

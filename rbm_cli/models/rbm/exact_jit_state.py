@@ -1,15 +1,14 @@
 """What the compiled exact integrator's run loop needs besides pieces and search (numba):
 the model's arrays, the friction demand, the energy of a monolith, the rest of a rigid
-block, recorded samples and the wall clock."""
+block and recorded samples."""
 
 from __future__ import annotations
 
 import math
-import time
 from collections import namedtuple
 
 import numpy as np
-from numba import njit, objmode
+from numba import njit
 
 from rbm_cli.models.events import REST_RATE
 from rbm_cli.physics.equations import Model
@@ -105,30 +104,3 @@ def energy1(mdl, theta, rate):
     x = mdl.argmap[0, 0] * theta
     return (0.5 * mdl.mass[0, 0] * rate * rate + _potential(mdl, 0, x)
             - 0.5 * mdl.gravity[0, 0] * theta * theta)  # fmt: skip
-
-
-@njit(cache=True)
-def next_exceedance(t0, level, amp, om, ph, last):
-    """First t >= t0 with |amp sin(om t + ph)| > level before `last`, or NaN
-    (GroundMotion.next_exceedance)."""
-    if amp <= level or t0 >= last:
-        return math.nan
-    s = level / amp
-    psi0 = om * t0 + ph
-    if abs(math.sin(psi0)) > s:
-        return t0
-    lo = math.asin(s)
-    k = math.ceil((psi0 - lo) / math.pi)
-    psi = lo + k * math.pi
-    if psi < psi0:
-        psi += math.pi
-    t = (psi - ph) / om
-    return math.nan if t >= last else t
-
-
-@njit(cache=True)
-def clock():
-    """time.monotonic() [s]."""
-    with objmode(t="float64"):
-        t = time.monotonic()
-    return t

@@ -100,22 +100,18 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
             (float(r[0]), r[1 : 1 + n].copy(), r[1 + n :].copy()) for r in samples[:n_out]
         ]
     if code == COLLAPSED:
-        out.status = "collapsed"
-        out.t_collapse = float(t_col)
-        out.collapse_interface = int(c_if)
-        out.message = f"interface {int(c_if)} reached its collapse limit"
+        out.collapse(float(t_col), int(c_if))
     elif code == STOPPED_EARLY:
-        out.message = "free motion below the collapse barrier: stopped early"
+        out.stopped_early()
     elif code == FAILED_STEP:
         out.stop("failed", "integrator: Required step size is less than spacing between "
                  "numbers.", t_end)  # fmt: skip
     elif code == FAILED_STEPS:
-        out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t_end)
+        out.out_of_steps(solver, t_end)
     elif code == FAILED_EVENTS:
-        out.stop("failed", f"event budget exceeded ({solver.max_events} events)", t_end)
+        out.out_of_events(solver, t_end)
     elif code == FAILED_WALL:
-        out.stop("failed", f"wall-clock budget exceeded ({solver.max_wall_time:g} s, "
-                 "solver.max_wall_time)", t_end)  # fmt: skip
+        out.out_of_time(solver, t_end)
     elif code == FAILED_NONFINITE:
         out.stop("failed", "the state became NaN or infinite (non-finite arithmetic)", t_end)
     elif code == INTERRUPTED:  # pragma: no cover - disarm() raises first

@@ -140,7 +140,7 @@ def _level_at(t, level, knots, vertical):
 
 
 @njit(cache=True)
-def _next_exceedance(t0, level, amp, om, ph, last):
+def sine_exceedance(t0, level, amp, om, ph, last):
     """GroundMotion.next_exceedance of a sine; -1 for none before `last`."""
     if amp <= level or t0 >= last:
         return -1.0
@@ -215,7 +215,7 @@ def _next_uplift(t0, level, peak, gr, knots, values, vertical, last):
     (times (g + a_v) / g with a vertical record; peak = max |a_g|); -1 for none before
     `last`."""
     if gr[0] == SINE:
-        return _next_exceedance(t0, level, gr[1], gr[2], gr[3], last)
+        return sine_exceedance(t0, level, gr[1], gr[2], gr[3], last)
     if (peak <= level and vertical.size == 0) or t0 >= last:
         return -1.0
     return _exceedance_pieces(t0, level, last, gr, knots, values, vertical)

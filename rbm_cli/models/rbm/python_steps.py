@@ -320,9 +320,8 @@ def step_to_event(run: RunState, piece: SmoothPiece, integ, can_stop: bool):
         if end.event_row is not None:
             return end.event_row
         if can_stop and below_barrier(run, z_prev, dz_prev, z_old, dz_old):
-            out.message = "free motion below the collapse barrier: stopped early"
             out.t_end = run.t
-            return out
+            return out.stopped_early()
     return None
 
 
@@ -336,13 +335,9 @@ def handle_event(run: RunState, piece: SmoothPiece, event_row: int) -> Outcome |
         return out
     which, i = divmod(event_row, n)
     if which >= 2:
-        out.status = "collapsed"
-        out.t_collapse = t
-        out.collapse_interface = i + 1
         out.max_ratio[i] = max(out.max_ratio[i], run.c_ratio)
-        out.message = f"interface {i + 1} reached its collapse limit"
         out.t_end = t
-        return out
+        return out.collapse(t, i + 1)
     going_up = which == 1
     # put the argument exactly on the surface it crossed (the event is
     # located EVENT_EPS beyond it); removes the energy that repeated

@@ -22,6 +22,8 @@ from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.excitation import make_ground_motion, merge_records
 from rbm_cli.physics.records import write_csv
 
+from .record_files import half_sine_csv
+
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "drums": 1}
 MODELS = [("rbm", "compiled"), ("rbm", "python"), ("housner", "compiled"),
           ("housner-linear", "compiled")]  # fmt: skip
@@ -34,15 +36,6 @@ def _record(model, impl, horizontal, vertical, **extra):
     data = {"name": "v", "model": model, "column": COLUMN, "excitation": exc,
             "solver": {"implementation": impl}}  # fmt: skip
     return parse_config(data)
-
-
-def _half_sine(path, f):
-    """A 1 g half-sine of frequency f [Hz] as a CSV, 2000 samples."""
-    end = 0.5 / f
-    t = np.linspace(0.0, end, 2001)
-    a = G * np.sin(np.pi * t / end)
-    a[0] = a[-1] = 0.0
-    return write_csv(path, (t, a), units="g")
 
 
 @pytest.mark.parametrize("model, impl", MODELS)
@@ -62,7 +55,7 @@ def test_constant_vertical_is_a_change_of_gravity(tmp_path, model, impl, c):
     ref_runner = make_runner(ref_cfg)
     outcomes = set()
     for f in frequencies:
-        horizontal = _half_sine(tmp_path / f"h{f}.csv", f)
+        horizontal = half_sine_csv(tmp_path / f"h{f}.csv", f)
         for a in (0.3, 0.5, 0.8, 1.2):
             vertical = write_csv(
                 tmp_path / "v.csv", (np.array([0.0, SPAN]), np.full(2, c * G / a)), units="g"
@@ -97,7 +90,7 @@ def test_ground_dropping_faster_than_gravity_fails_the_run(tmp_path, model, impl
     assert out.status == "failed"
     assert "g + a_v(t) <= 0" in out.message and "at t=1 s" in out.message
     # a strong pulse first: the block collapses before the ground drops away
-    strong = _half_sine(tmp_path / "s.csv", 2.0)
+    strong = half_sine_csv(tmp_path / "s.csv", 2.0)
     cfg = _record(model, impl, strong, vertical, scale="factor")
     out = make_runner(cfg).run(make_ground_motion(cfg.excitation, 3.0), cfg.solver)
     assert out.status == "collapsed" and out.t_collapse < 1.0 / 3.0

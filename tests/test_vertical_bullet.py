@@ -27,6 +27,8 @@ from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.physics.records import write_csv
 from rbm_cli.study.simulate import simulate
 
+from .record_files import half_sine_csv
+
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}  # Spanos-Koh slender, tan(alpha) 0.25
 #: Friction high enough that the block does not slide (docs/engine.md: with 2.0 the block
 #: agrees with `housner` on 30 of 30 cells).
@@ -42,15 +44,6 @@ def _config(model, horizontal, vertical=None, **interface):
     if interface:
         data["interface"] = interface
     return parse_config(data)
-
-
-def _half_sine(path, f):
-    """A 1 g half-sine of frequency f [Hz] as a CSV, 2000 samples."""
-    end = 0.5 / f
-    t = np.linspace(0.0, end, 2001)
-    a = G * np.sin(np.pi * t / end)
-    a[0] = a[-1] = 0.0
-    return write_csv(path, (t, a), units="g")
 
 
 def _sine(path, f, peak_g, span=SPAN):
@@ -88,7 +81,7 @@ def test_constant_vertical_is_a_change_of_gravity(tmp_path, c):
     ref_runner = make_runner(ref_cfg)
     outcomes = set()
     for f in (0.5, 1.0, 2.0):
-        horizontal = _half_sine(tmp_path / f"h{f}.csv", f)
+        horizontal = half_sine_csv(tmp_path / f"h{f}.csv", f)
         for a in (0.2, 0.5, 0.8, 1.2):
             vertical = _constant(tmp_path / "v.csv", c * G / a)  # scaled by a in the run
             cfg = _config("bullet", horizontal, vertical, friction=FRICTION)
@@ -177,7 +170,7 @@ def test_ground_dropping_faster_than_gravity_fails_the_run(tmp_path):
     assert "g + a_v(t) <= 0" in out.message and "at t=1.1 s" in out.message
     assert out.n_steps == round(1.1 / rocking.solver.time_step)
     assert out.history.t[-1] <= 1.1 and out.max_ratio[0] > 0.01  # it rocked until then
-    strong = _config("bullet", _half_sine(tmp_path / "s.csv", 2.0), vertical)
+    strong = _config("bullet", half_sine_csv(tmp_path / "s.csv", 2.0), vertical)
     motion = make_ground_motion(strong.excitation, 3.0)
     assert motion.lift_off == pytest.approx(0.5 / 1.2, abs=1e-12)
     out = make_runner(strong).run(motion, strong.solver)

@@ -1,95 +1,18 @@
-"""First use without the wait (issue 18, "first use"): on an empty compile cache `rbm run`
-starts the kernel's compile in a background process and answers with the Python
-integrator; a sweep started meanwhile waits for that compile instead of compiling again;
-once it is done the compiled kernel runs and agrees with the Python run.
+"""First use without the wait (issue 18, "first use"): the switch and the
+one-compile-at-a-time rule of rbm_cli.models.rbm.compile_ahead.
 
-Independent reasons: the Python loop and the compiled kernel are two implementations of
-one method held to the same steps (tests/test_kernel.py), so their collapse times agree
-far below the solver's tolerance (rtol 1e-10 here; checked to 1e-8 relative); the lock is
-read by this test with its own flock, not through the module under test.
-
-One compile of the kernel in a fresh numba cache: about 20 s, more under load.
+The whole first-use flow (on an empty compile cache `rbm run` answers with the Python
+integrator while the kernel compiles in the background, a sweep waits for that compile,
+then the compiled kernel agrees with the Python run) is the first half of
+tests/test_kernel_cache.py's slow test, whose cache check reuses that compile.
 """
 
 from __future__ import annotations
 
-import fcntl
-import json
-import os
 import subprocess
 import sys
-import time
-from pathlib import Path
-
-import pytest
 
 from rbm_cli.models.rbm import compile_ahead
-
-CONFIG = """name: block
-column: {height: 4.0, base_width: 1.0}
-excitation: {type: harmonic, duration: 6.0}
-grid:
-  amplitudes: [0.3, 0.5]
-  frequencies: [1.0]
-"""
-
-
-def _rbm(args: list[str], env: dict, cwd: Path) -> subprocess.CompletedProcess:
-    cmd = [sys.executable, "-c", "from rbm_cli.cli.main import main; main()", *args]
-    return subprocess.run(cmd, env=env, cwd=cwd, capture_output=True, text=True, timeout=900)
-
-
-def _locked(path: Path) -> bool:
-    """Whether some process holds an exclusive flock on path (read with our own flock)."""
-    fd = os.open(path, os.O_RDWR)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        return True
-    finally:
-        os.close(fd)
-    return False
-
-
-def _summary(folder: Path) -> dict:
-    return json.loads((folder / "summary.json").read_text())
-
-
-@pytest.mark.slow
-def test_first_run_answers_while_the_kernel_compiles(tmp_path):
-    cache = tmp_path / "numba-cache"
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), MPLBACKEND="Agg")
-    env.pop(compile_ahead.ENV_SWITCH, None)
-    (tmp_path / "block.yaml").write_text(CONFIG)
-    run_args = ["run", "block.yaml", "-a", "0.5", "-f", "1"]
-
-    first = _rbm([*run_args, "-o", "first"], env, tmp_path)
-    assert first.returncode == 0, first.stderr
-    assert "compiling in the background" in first.stderr, first.stderr
-    s1 = _summary(tmp_path / "first/block/run_A0.5_f1")
-    assert s1["config"]["solver"]["implementation"] == "python"
-    assert s1["status"] == "collapsed"
-
-    locks = list(cache.rglob(compile_ahead.LOCK_NAME))
-    assert len(locks) == 1, locks
-    # a sweep now waits for that compile (unless it finished already: then it loads it)
-    sweep = _rbm(["sweep", "block.yaml", "-o", "swept"], env, tmp_path)
-    assert sweep.returncode == 0, sweep.stderr
-    assert "note: compiling the integrator" not in sweep.stderr  # never a second compile
-    deadline = time.monotonic() + 900
-    while _locked(locks[0]):  # the background compile still runs (sweep's notes aside)
-        assert time.monotonic() < deadline, "the background compile did not end"
-        time.sleep(0.5)
-    log = (locks[0].parent / compile_ahead.LOG_NAME).read_text()
-    assert "kernel compiled" in log, log
-
-    second = _rbm([*run_args, "-o", "second"], env, tmp_path)
-    assert second.returncode == 0, second.stderr
-    assert "note:" not in second.stderr, second.stderr  # compiled kernel, from the cache
-    s2 = _summary(tmp_path / "second/block/run_A0.5_f1")
-    assert s2["config"]["solver"]["implementation"] == "compiled"
-    assert s2["status"] == s1["status"]
-    assert s2["t_collapse_s"] == pytest.approx(s1["t_collapse_s"], rel=1e-8)
 
 
 def test_the_switch_keeps_the_compile_in_the_foreground(monkeypatch):

@@ -101,13 +101,13 @@ def sweep(
     # this process runs the cells (issue 18)
     with FigureProcess.start() or contextlib.nullcontext() as painter:
         _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensemble, quiet,
-               None if painter is None else painter.figure)  # fmt: skip
+               painter)  # fmt: skip
 
 
 def _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensemble, quiet,
-           figure) -> None:  # fmt: skip
-    """The body of `rbm sweep` once the config is loaded (figure: what draws domain.png,
-    None for rbm_cli.report.domain_figure in this process)."""
+           painter) -> None:  # fmt: skip
+    """The body of `rbm sweep` once the config is loaded (painter: the FigureProcess that
+    draws domain.png, or None to draw it in this process)."""
     from rbm_cli.api import SweepInterrupted, run_sweep
     from rbm_cli.cli.progress import Progress
 
@@ -140,7 +140,7 @@ def _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensembl
             ensemble=ensemble,
             notify=note,
             resume_command=command,
-            figure=figure,
+            figure_process=painter,
         )
     except RbmError as exc:
         raise UserError(one_line(exc)) from None

@@ -90,7 +90,15 @@ def _serve(requests: int, replies: int) -> None:
 
 class FigureProcess:
     """The child that draws a sweep's domain.png; :meth:`figure` is the sweep's ``figure``
-    argument (rbm_cli.study.sweep.run_sweep). Use as a context manager, or call close."""
+    argument (rbm_cli.study.sweep.run_sweep) in place of :attr:`draws`, the function the
+    child runs. Use as a context manager, or call close."""
+
+    @property
+    def draws(self):
+        """The function the child draws with (rbm_cli.report.domain_figure.domain_figure)."""
+        from rbm_cli.report.domain_figure import domain_figure
+
+        return domain_figure
 
     def __init__(self, pid: int, requests: int, replies: int):
         self.pid, self._requests, self._replies = pid, requests, replies

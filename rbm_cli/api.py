@@ -283,11 +283,9 @@ def run_sweep(
     **kwargs,
 ) -> SweepSummary:
     """Run a config's grid into OUTPUT/<name>/ (domain.csv, boundary.csv, domain.png,
-    meta.json): rbm_cli.study.sweep.run_sweep with the domain figure of
-    rbm_cli.report.domain_figure (or `figure`). Same parameters; :func:`sweep` returns the
-    domain itself. ``figure_process``: a rbm_cli.report.figure_process.FigureProcess
-    started earlier (the CLI's), whose child draws the figure when it is the one its child
-    draws (``FigureProcess.draws``)."""
+    meta.json): rbm_cli.study.sweep.run_sweep with rbm_cli.report.domain_figure (or
+    `figure`; the CLI's rbm_cli.report.figure_process draws the former in its child).
+    Same parameters; :func:`sweep` returns the domain itself."""
     draw = figure if figure is not None else domain_figure
     if figure_process is not None and draw is figure_process.draws:
         draw = figure_process.figure

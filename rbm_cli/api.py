@@ -279,13 +279,16 @@ def run_sweep(
     output: str | os.PathLike = "out",
     *args,
     figure: Callable[[pd.DataFrame, Config], object] | None = None,
+    figure_process=None,
     **kwargs,
 ) -> SweepSummary:
     """Run a config's grid into OUTPUT/<name>/ (domain.csv, boundary.csv, domain.png,
-    meta.json): rbm_cli.study.sweep.run_sweep with the domain figure of
-    rbm_cli.report.domain_figure (or `figure`). Same parameters; :func:`sweep` returns the
-    domain itself."""
+    meta.json): rbm_cli.study.sweep.run_sweep with rbm_cli.report.domain_figure (or
+    `figure`; the CLI's rbm_cli.report.figure_process draws the former in its child).
+    Same parameters; :func:`sweep` returns the domain itself."""
     draw = figure if figure is not None else domain_figure
+    if figure_process is not None and draw is figure_process.draws:
+        draw = figure_process.figure
     return _run_sweep(config, output, *args, figure=draw, **kwargs)
 
 

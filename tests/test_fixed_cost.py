@@ -220,12 +220,18 @@ def test_a_worker_does_not_import_plotting(workers):
     assert "rbm_cli.report.domain_figure" not in modules
 
 
+def test_a_worker_imports_no_scipy_solver(workers):
+    """The compiled path's tableaux are written out (models/rbm/kernel_tableaux.py) and
+    Brent's method is imported where the Python paths call it: a worker never imports
+    scipy.integrate or scipy.optimize (numba itself imports scipy.linalg for its BLAS)."""
+    modules = _worker_modules(rigid(), workers)
+    assert not {"scipy.integrate", "scipy.optimize"} & modules
+
+
 @pytest.mark.xfail(
     strict=True,
     reason="not yet: rbm_cli.study.sweep (run_chunk's module), sweep_folder and study.domain"
-    " (cells.add_point's cell_key) import pandas and joblib; models/rbm/kernel_rk imports"
-    " scipy.integrate for its tableaux; models/events and physics/closed_forms (via"
-    " similarity.rocking_scales) import scipy.optimize",
+    " (cells.add_point's cell_key) import pandas",
 )
 def test_a_worker_imports_only_what_the_compiled_path_needs(workers):
     modules = _worker_modules(rigid(), workers)

@@ -101,13 +101,22 @@ def _inverse(a):
     return inv, True
 
 
+#: Multiply-adds up to which inverse and product run the Python body of their compiled
+#: loop (``py_func``): the same IEEE operations in the same order (no FMA, no reordering
+#: in either), so the same bits, without loading numba's compiled code, or compiling it on
+#: a first use, for the small matrices of a column's assembly (issue 18: a first run on an
+#: empty cache no longer compiles them before its Python integration). ~5 ms of Python.
+PYTHON_WORK = 20_000
+
+
 def inverse(a: np.ndarray) -> np.ndarray:
     """Inverse of a square matrix, the same bits on every machine.
 
     Raises numpy.linalg.LinAlgError if the matrix is singular (a zero pivot); a
     matrix with infinite or NaN entries gives a non-finite inverse, as LAPACK's does.
     """
-    inv, ok = _inverse(np.ascontiguousarray(a, dtype=float))
+    a2 = np.ascontiguousarray(a, dtype=float)
+    inv, ok = (_inverse.py_func if a2.shape[0] ** 3 <= PYTHON_WORK else _inverse)(a2)
     if not ok:
         raise np.linalg.LinAlgError("singular matrix")
     return inv
@@ -118,7 +127,9 @@ def product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a2 = np.ascontiguousarray(a, dtype=float)
     b2 = np.ascontiguousarray(b, dtype=float)
     va, vb = a2.ndim == 1, b2.ndim == 1
-    out = matmul(a2.reshape(1, -1) if va else a2, b2.reshape(-1, 1) if vb else b2)
+    x, y = a2.reshape(1, -1) if va else a2, b2.reshape(-1, 1) if vb else b2
+    work = x.shape[0] * x.shape[1] * y.shape[1]
+    out = (matmul.py_func if work <= PYTHON_WORK else matmul)(x, y)
     if va and vb:
         return out[0, 0]
     if va:
@@ -343,6 +354,15 @@ def exp(x):
     if k > 1020:  # scale in two exact steps (no overflow in between)
         return math.ldexp(math.ldexp(y, k - 1000), 1000)
     return math.ldexp(y, k)
+
+
+def pow_pos_python(x: float, y: float) -> float:
+    """pow_pos run as Python (the py_func of it, of exp and of log), for the Python
+    integrator: the same IEEE operations in the same order, so the same bits, and a first
+    run on an empty cache does not compile them (issue 18)."""
+    if x == 0.0 or y in (-0.125, 0.125):
+        return pow_pos.py_func(x, y)
+    return exp.py_func(y * log.py_func(x))  # pow_pos's last line
 
 
 @njit(cache=True)

@@ -42,6 +42,12 @@ class RbmGroup(click.Group):
     """A click group whose usage errors are one line, like every other error, and
     whose Ctrl-C is one line too (click's own says only 'Aborted!')."""
 
+    def resolve_command(self, ctx: click.Context, args):
+        name, cmd, rest = super().resolve_command(ctx, args)
+        if name not in LATE_GC:  # a command that does not call work_starts
+            work_starts()
+        return name, cmd, rest
+
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
@@ -51,6 +57,21 @@ class RbmGroup(click.Group):
             raise UserError(message + hint) from None
         except KeyboardInterrupt:
             raise Interrupted("interrupted (Ctrl-C)") from None
+
+
+#: Commands that turn the garbage collector back on themselves (work_starts), once their
+#: imports and the kernel's load are done; cli.main turns it off as the process starts.
+LATE_GC = ("sweep", "run")
+
+
+def work_starts() -> None:
+    """The command's imports and set-up are done: what they made is frozen out of the
+    garbage collector (it lives to the end) and the collector is turned back on. Idempotent."""
+    import gc
+
+    if not gc.isenabled():
+        gc.freeze()
+        gc.enable()
 
 
 def load(config_path: str):

@@ -20,6 +20,7 @@ from rbm_cli.cli.common import (
     load,
     one_line,
     output_option,
+    work_starts,
 )
 
 
@@ -149,6 +150,7 @@ def run(
         check_writable_dir(Path(output) / cfg.name)
         column = build_column(cfg.column, cfg.interface)
         cfg = first_use(cfg)
+        work_starts()
         result = run_cell(cfg, amplitude_g, frequency_hz, output_dt=output_dt).result
         summary = run_summary(
             result,

@@ -5,7 +5,6 @@ where the first event of a step is, and cubic Hermite checks between points
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from rbm_cli.physics.equations import Model
 
@@ -225,6 +224,8 @@ def first_crossing(dist, t0, t1, intervals=CHECK_INTERVALS, xtol=1e-14):
         if dip is not None and row_value(a + dip[0], dip[1]) < 0.0:
             cands.append((a + dip[0], dip[1]))
         if cands:
+            from scipy.optimize import brentq  # here: no scipy at import (issue 18)
+
             roots = [(brentq(row_value, a, hi, args=(r,), xtol=xtol), r) for hi, r in cands]
             return min(roots)
     return None

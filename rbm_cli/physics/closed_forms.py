@@ -27,7 +27,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from rbm_cli.config.types import G
 from rbm_cli.physics.column import Column
@@ -94,6 +93,8 @@ def _halfsine_psi(ratio: float) -> float:
     hi = 0.5 * math.pi
     if f(hi) <= 0.0:  # k so small that sin(pi/2 - k) rounds the sign away
         return hi
+    from scipy.optimize import brentq  # here: no scipy at import (issue 18)
+
     return brentq(f, 0.0, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
 
 

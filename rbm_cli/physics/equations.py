@@ -27,7 +27,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy.linalg import eig
 
 from rbm_cli.base.detmath import inverse, product
 from rbm_cli.physics.column import Column
@@ -143,6 +142,8 @@ class Model:
         if self.rigid:
             return []
         slopes = np.array([law.slopes[0] for law in self.laws])
+        from scipy.linalg import eig  # here: no scipy at import (issue 18)
+
         w2 = np.real(eig(self.stiffness(slopes), self.mass, right=False))
         return sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
 

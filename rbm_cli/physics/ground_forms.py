@@ -25,7 +25,6 @@ from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from rbm_cli.config.types import G
 from rbm_cli.physics.pulses import _mp_shape
@@ -202,6 +201,8 @@ def ricker_knots(omega: float, center: float) -> np.ndarray:
 def _mp_extrema(gamma: float, nu: float) -> tuple[float, ...]:
     """Extrema of the MP shape (pulses._mp_shape) over s in [-gamma/2, gamma/2] [cycles]:
     sign changes of its slope on 400 points a cycle, each refined by Brent's method."""
+    from scipy.optimize import minimize_scalar  # here: no scipy at import (issue 18)
+
     half = gamma / 2.0
     s = np.linspace(-half, half, int(400 * gamma) + 1)
     v = _mp_shape(s, gamma, nu)

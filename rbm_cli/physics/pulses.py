@@ -33,7 +33,6 @@ import math
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from rbm_cli.base.errors import RbmError
 
@@ -254,6 +253,8 @@ def _mp_peak(gamma: float, nu: float) -> float:
     values = np.abs(_mp_shape(s, gamma, nu))
     k = int(np.argmax(values))
     lo, hi = s[max(k - 1, 0)], s[min(k + 1, s.size - 1)]
+    from scipy.optimize import minimize_scalar  # here: no scipy at import (issue 18)
+
     best = minimize_scalar(
         lambda x: -abs(float(_mp_shape(x, gamma, nu))),
         bounds=(lo, hi),

@@ -11,10 +11,10 @@ import hashlib
 import json
 import os
 import platform
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
-import joblib
 import numpy as np
 import pandas as pd
 
@@ -160,8 +160,20 @@ def _common_equal(a, b) -> bool:
     return a == b
 
 
+def _version(name: str) -> str:
+    """A library's version without importing it here: its ``__version__`` if it is
+    imported, else its installed distribution's (the same string; a sweep that ran in
+    this process never imports joblib, and its figure may be drawn in another process,
+    rbm_cli.report.figure_process, issue 18)."""
+    module = sys.modules.get(name)
+    if module is not None:
+        return module.__version__
+    from importlib.metadata import version
+
+    return version(name)
+
+
 def _versions() -> dict:
-    import matplotlib
     import scipy
 
     return {
@@ -170,8 +182,8 @@ def _versions() -> dict:
         "numpy": np.__version__,
         "scipy": scipy.__version__,
         "pandas": pd.__version__,
-        "joblib": joblib.__version__,
-        "matplotlib": matplotlib.__version__,
+        "joblib": _version("joblib"),
+        "matplotlib": _version("matplotlib"),
     }
 
 

@@ -8,18 +8,27 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.integrate._ivp import dop853_coefficients as _dop
-from scipy.integrate._ivp.rk import RK23 as _RK23
-from scipy.integrate._ivp.rk import RK45 as _RK45
 
 from rbm_cli.base.detmath import pow_pos
+from rbm_cli.models.rbm import kernel_tableaux as _tb
 from rbm_cli.models.rbm.kernel_ground import _gravity, _ground
 
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
 
-# ---- Butcher tableaux, padded to one shape: (A, B, C, E, P, n_stages, est_order)
-_NS_MAX = _dop.N_STAGES_EXTENDED
+# ---- Butcher tableaux (scipy's, written out in kernel_tableaux), padded to one shape:
+# (A, B, C, E, P, n_stages, est_order)
+_NS_MAX = _tb.DOP853_N_STAGES_EXTENDED
+
+
+def _fill(out: np.ndarray, rows) -> np.ndarray:
+    """out with each row (or entry) of rows at its start, the rest left as it was (zeros)."""
+    if out.ndim == 1:
+        out[: len(rows)] = rows
+        return out
+    for i, row in enumerate(rows):
+        out[i, : len(row)] = row
+    return out
 
 
 def _tableau(method: str):
@@ -30,23 +39,31 @@ def _tableau(method: str):
     E3 = np.zeros(_NS_MAX)
     P = np.zeros((_NS_MAX, 8))
     if method == "DOP853":
-        ns = _dop.N_STAGES
-        A[:, :] = _dop.A
-        C[:] = _dop.C
-        B[:ns] = _dop.B
-        E[: ns + 1] = _dop.E5
-        E3[: ns + 1] = _dop.E3
+        _fill(A, _tb.DOP853_A)
+        _fill(C, _tb.DOP853_C)
+        _fill(B, _tb.DOP853_B)
+        _fill(E, _tb.DOP853_E5)
+        _fill(E3, _tb.DOP853_E3)
         # dense output: D (4 x 16) stored transposed in P[:, :4]
-        P[:, :4] = _dop.D.T
-        return A, B, C, E, E3, P, ns, 7
-    cls = _RK45 if method == "RK45" else _RK23
-    ns = cls.n_stages
-    A[: cls.A.shape[0], : cls.A.shape[1]] = cls.A
-    C[:ns] = cls.C
-    B[:ns] = cls.B
-    E[: ns + 1] = cls.E
-    P[: ns + 1, : cls.P.shape[1]] = cls.P
-    return A, B, C, E, E3, P, ns, cls.error_estimator_order
+        D = _fill(np.zeros((4, _NS_MAX)), _tb.DOP853_D)
+        P[:, :4] = D.T
+        return A, B, C, E, E3, P, _tb.DOP853_N_STAGES, 7
+    name = "RK45" if method == "RK45" else "RK23"
+    _fill(A, getattr(_tb, f"{name}_A"))
+    _fill(C, getattr(_tb, f"{name}_C"))
+    _fill(B, getattr(_tb, f"{name}_B"))
+    _fill(E, getattr(_tb, f"{name}_E"))
+    _fill(P, getattr(_tb, f"{name}_P"))
+    return (
+        A,
+        B,
+        C,
+        E,
+        E3,
+        P,
+        getattr(_tb, f"{name}_N_STAGES"),
+        getattr(_tb, f"{name}_ERROR_ESTIMATOR_ORDER"),
+    )
 
 
 _TAB = [_tableau(m) for m in ("RK23", "RK45", "DOP853")]

@@ -33,7 +33,7 @@ import time
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 
-from rbm_cli.base.detmath import pow_pos
+from rbm_cli.base.detmath import pow_pos_python as pow_pos
 from rbm_cli.config.types import SolverConfig
 from rbm_cli.models.events import BIG, EVENT_EPS, REST_RATE, Pieces  # noqa: F401 (kernel's)
 from rbm_cli.models.knots import clip_at_knots, next_knot

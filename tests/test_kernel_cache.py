@@ -44,7 +44,8 @@ before = needs_compile()
 from rbm_cli.api import run
 cfg = {"name": "block", "column": {"height": 2.0, "base_width": 0.5},
        "excitation": {"type": "harmonic", "duration": 4.0},
-       "solver": {"implementation": "compiled", "rtol": 1e-9, "atol": 1e-11}}
+       "solver": {"method": "DOP853", "implementation": "compiled", "rtol": 1e-9,
+                  "atol": 1e-11}}
 cell = run(cfg, amplitude_g=0.4, frequency_hz=2.0, record=False)
 print(json.dumps({"file": rbm_cli.__file__, "before": before, "after": needs_compile(),
                   "n_steps": int(cell.result.n_steps), "status": cell.status}))

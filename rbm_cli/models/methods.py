@@ -16,10 +16,7 @@ An explicit method is kept: `DOP853` on a rigid monolith runs the step kernel.
 
 from __future__ import annotations
 
-from rbm_cli.config.types import STEP_DEFAULT, Config, SolverConfig
-
-#: Excitations the closed form takes (exact_motion.EXACT_KINDS: sines and records).
-CLOSED_FORM_KINDS = ("harmonic", "half-sine", "free", "one-sine", "cycloidal", "record")
+from rbm_cli.config.types import CLOSED_FORM_KINDS, STEP_DEFAULT, Config, SolverConfig
 
 
 def closed_form_applies(config: Config, solver: SolverConfig | None = None) -> bool:
@@ -70,3 +67,16 @@ def compiled_code(config: Config) -> str | None:
     if config.model != "rbm" or not compiled:
         return None
     return "closed-form" if method == "closed-form" else "kernel"
+
+
+def load_closed_form() -> float:
+    """Compile (or load from numba's cache) the block's closed form in this process, e.g.
+    before a sweep's workers start, so that they load it instead of each compiling it;
+    returns the time it took [s]."""
+    import time
+
+    from rbm_cli.models.rbm.closed_form import warm_up
+
+    start = time.perf_counter()
+    warm_up()
+    return time.perf_counter() - start

@@ -26,8 +26,8 @@ import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
-from rbm_cli.config.types import STEP_DEFAULT, Config
-from rbm_cli.models.methods import compiled_code
+from rbm_cli.config.types import Config, hash_form
+from rbm_cli.models.methods import compiled_code, load_closed_form
 from rbm_cli.models.result import CSV_FIELDS
 from rbm_cli.study.cells import (
     Cell,
@@ -72,17 +72,9 @@ class SweepSummary:
 
 
 def config_hash(config: Config) -> str:
-    """Fingerprint of everything that changes a domain (the resolved config).
-
-    solver.max_wall_time is left out: a guard against a run that would not end, not a
-    setting of the domain (and hashes of domains made before it existed stay valid).
-    solver.method auto hashes as STEP_DEFAULT, the default before it existed: where auto
-    runs the closed form, the two agree on every robust cell (tests/test_closed_form_jit)."""
-    resolved = config.resolved()
-    resolved["solver"].pop("max_wall_time", None)
-    if resolved["solver"]["method"] == "auto":
-        resolved["solver"]["method"] = STEP_DEFAULT
-    text = json.dumps(resolved, sort_keys=True, default=str)
+    """Fingerprint of everything that changes a domain: the resolved config, as
+    rbm_cli.config.types.hash_form gives it (hashes of stored domains stay valid)."""
+    text = json.dumps(hash_form(config), sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -390,14 +382,10 @@ def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str |
     (then workers load it from numba's cache instead of each compiling it); its time [s],
     which the sweep's wall time and ETA leave out (a background compile: waited for)."""
     codes = {compiled_code(p.config) for p in points} - {None}
-    if not todo or not codes:
+    if not (todo and codes):
         return 0.0
     if codes == {"closed-form"}:  # the block's closed form only: no kernel to load
-        from rbm_cli.models.rbm.closed_form import warm_up as warm_up_closed_form
-
-        start = time.perf_counter()
-        warm_up_closed_form()
-        return time.perf_counter() - start
+        return load_closed_form()
     from rbm_cli.models.rbm.compile_ahead import wait
     from rbm_cli.models.rbm.kernel import needs_compile, warm_up
 

@@ -24,9 +24,8 @@ from typing import NamedTuple
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import G
+from rbm_cli.config.types import CLOSED_FORM_KINDS, G
 from rbm_cli.models.events import EVENT_EPS, REST_RATE
-from rbm_cli.models.methods import CLOSED_FORM_KINDS
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm import closed_form_jit_run as cr
 from rbm_cli.models.rbm.closed_form_jit_run import run_block

@@ -16,9 +16,9 @@ from functools import partial
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import STEP_DEFAULT, Config, G, SolverConfig
+from rbm_cli.config.types import CLOSED_FORM_KINDS, STEP_DEFAULT, Config, G, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
-from rbm_cli.models.methods import CLOSED_FORM_KINDS, resolve_method
+from rbm_cli.models.methods import resolve_method
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.result import history_from_samples
 from rbm_cli.physics.column import Column, build_column

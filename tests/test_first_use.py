@@ -28,6 +28,7 @@ from rbm_cli.models.rbm import compile_ahead
 CONFIG = """name: block
 column: {height: 4.0, base_width: 1.0}
 excitation: {type: harmonic, duration: 6.0}
+solver: {method: DOP853}
 grid:
   amplitudes: [0.3, 0.5]
   frequencies: [1.0]

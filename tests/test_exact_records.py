@@ -165,8 +165,9 @@ def test_the_record_arrays_are_the_record_segments():
     """The compiled path's arrays of a record (record_arrays, vectorised) and the Python
     path's segments (record_segments, one Forcing per interval) are the same, a jump (a
     time written twice) and rest before the first sample included."""
-    from rbm_cli.models.rbm.exact_jit import _segments, record_arrays
     from rbm_cli.models.rbm.exact_motion import record_segments
+    from rbm_cli.models.rbm.forcing_arrays import record_arrays
+    from rbm_cli.models.rbm.forcing_arrays import segment_arrays as _segments
     from rbm_cli.physics.motion import GroundMotion
 
     knots = np.array([0.5, 0.6, 0.7, 0.7, 0.8])

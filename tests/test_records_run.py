@@ -131,7 +131,7 @@ def test_record_kernel_matches_python_loop(half_sines, drums, stiffness, amplitu
         data = {"name": "md", "column": {**COLUMN, "drums": drums},
                 "interface": {"stiffness": stiffness},
                 "excitation": {"type": "record", "file": str(path), "free_time": 1.0},
-                "solver": {"implementation": impl}}  # fmt: skip
+                "solver": {"method": "DOP853", "implementation": impl}}  # fmt: skip
         cfg = parse_config(data)
         motion = make_ground_motion(cfg.excitation, amplitude)
         outs.append(make_runner(cfg).run(motion, cfg.solver, early_stop=False))

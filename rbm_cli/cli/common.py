@@ -87,7 +87,9 @@ def load(config_path: str):
 def compile_notice(cfg) -> None:
     """One line on stderr before a sweep that will compile the kernel (first use), or wait
     for the compile that an earlier ``rbm run`` started in the background."""
-    if cfg.model == "rbm" and cfg.solver.implementation == "compiled":
+    from rbm_cli.models.methods import compiled_code
+
+    if compiled_code(cfg) == "kernel":
         from rbm_cli.models.rbm.compile_ahead import compiling_elsewhere
         from rbm_cli.models.rbm.kernel import needs_compile
 
@@ -108,7 +110,9 @@ def first_use(cfg):
     ``solver.implementation: python``, so the run's summary does too); with
     RBM_BACKGROUND_COMPILE=0, or when no background compile can start, the kernel
     compiles here first, as a note says."""
-    if not (cfg.model == "rbm" and cfg.solver.implementation == "compiled"):
+    from rbm_cli.models.methods import compiled_code
+
+    if compiled_code(cfg) != "kernel":  # Python, or the closed form (compiles in seconds)
         return cfg
     from rbm_cli.models.rbm import compile_ahead
     from rbm_cli.models.rbm.kernel import needs_compile

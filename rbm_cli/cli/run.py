@@ -52,7 +52,7 @@ def _check_excitation(kind: str, amplitude: float | None, frequency: float | Non
 
 
 def _print_summary(result, folder: Path) -> None:
-    lines = [("status", result.status)]
+    lines = [("status", result.status), ("method", result.method or "-")]
     if result.collapsed:
         where = result.collapse_interface if result.collapse_interface is not None else "?"
         lines.append(("collapse", f"t = {result.t_collapse_s:.6g} s at interface {where}"))

@@ -28,7 +28,13 @@ RECORD_SCALES = ("pga", "factor")
 #: still rocking when the shaking ends has time to collapse or settle; a monolithic
 #: column whose energy is below its collapse barrier is stopped early anyway.
 DEFAULT_FREE_TIME = 5.0
-METHODS = ("DOP853", "RK45", "RK23", "exact")
+METHODS = ("auto", "DOP853", "RK45", "RK23", "exact", "closed-form")
+#: Excitations with a closed-form response (sines, and records exact per sample interval):
+#: what `solver.method: closed-form` (and `exact`) take (rbm_cli.models.methods).
+CLOSED_FORM_KINDS = ("harmonic", "half-sine", "free", "one-sine", "cycloidal", "record")
+#: The method `auto` stands for where the closed form does not apply, and in a config's
+#: hash (the default before `auto` existed: the hashes of stored domains stay valid).
+STEP_DEFAULT = "DOP853"
 IMPLEMENTATIONS = ("compiled", "python")
 
 
@@ -227,9 +233,12 @@ class CollapseConfig:
 class SolverConfig:
     """Integrator settings.
 
-    method : str  Runge-Kutta pair of scipy.integrate.solve_ivp, or 'exact' (model rbm:
-        closed-form integration of the linear pieces, rbm_cli.models.rbm.exact; its
-        tolerances do not apply)
+    method : str  'auto' (the default: the closed form where it applies, else DOP853;
+        rbm_cli.models.methods.resolve_method), a Runge-Kutta pair of
+        scipy.integrate.solve_ivp, 'exact' (model rbm: closed-form integration of the
+        linear pieces, rbm_cli.models.rbm.exact) or 'closed-form' (the rigid block's
+        closed form: a rigid RBM monolith, housner-linear; rbm_cli.models.rbm.closed_form);
+        the tolerances do not apply to the last two
     rtol, atol : float  Tolerances (atol relative to the rotation scale theta_u)
     max_steps : int  Step budget of one run; beyond it the run is 'failed'
     max_events : int  Budget of events (kinks, impacts) of one run
@@ -240,7 +249,7 @@ class SolverConfig:
         'failed' (a guard against a run that would not end, not a tolerance)
     """
 
-    method: str = "DOP853"
+    method: str = "auto"
     rtol: float = 1e-10
     atol: float = 1e-12
     max_steps: int = 2_000_000
@@ -286,3 +295,17 @@ class Config:
         if not out["grid"]["axes"]:  # a plain grid resolves (and hashes) as it always did
             del out["grid"]["axes"]
         return out
+
+
+def hash_form(config: Config) -> dict:
+    """What a config's hash is taken of (rbm_cli.study.sweep.config_hash): its resolved
+    form, without solver.max_wall_time (a guard against a run that would not end, not a
+    setting of the domain; hashes of domains made before it existed stay valid), and with
+    solver.method auto written as STEP_DEFAULT, the default before auto existed (so stored
+    domains and journals keep their hashes; where auto runs the closed form instead, the two
+    agree on every robust cell: tests/test_closed_form_jit.py, tests/test_regression.py)."""
+    resolved = config.resolved()
+    resolved["solver"].pop("max_wall_time", None)
+    if resolved["solver"]["method"] == "auto":
+        resolved["solver"]["method"] = STEP_DEFAULT
+    return resolved

@@ -22,6 +22,7 @@ References
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -40,6 +41,7 @@ from rbm_cli.models.housner_steps import (
     peak_in_step,
 )
 from rbm_cli.models.knots import clip_at_knots
+from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.block import (
     BlockGeometry,
@@ -334,7 +336,8 @@ class HousnerRunner(BlockRunner):
 
     def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
         _check_method(solver)
-        return housner_run(
+        solver = dataclasses.replace(solver, method=step_method(solver))  # auto: DOP853
+        out = housner_run(
             self.geometry,
             motion,
             solver=solver,
@@ -343,12 +346,15 @@ class HousnerRunner(BlockRunner):
             initial=self.initial,
             **options,
         )
+        out.method = solver.method
+        return out
 
 
 def _check_method(solver: SolverConfig) -> None:
-    """Housner's equations are not piecewise linear: no `exact` method (one-line RbmError)."""
-    if solver.method not in _METHODS:
+    """Housner's equations are not piecewise linear: no `exact` or `closed-form` method
+    (one-line RbmError); `auto` is DOP853."""
+    if step_method(solver) not in _METHODS:
         raise RbmError(
             f"solver.method {solver.method} is for model rbm (its piecewise-linear equations);"
-            f" model housner takes {', '.join(_METHODS)}"
+            f" model housner takes auto, {', '.join(_METHODS)}"
         )

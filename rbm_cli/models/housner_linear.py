@@ -349,17 +349,24 @@ def housner_linear_run(
 
 class HousnerLinearRunner(BlockRunner):
     """`housner-linear` (rbm_cli.models.contract.Runner): the config's monolithic column as
-    Spanos and Koh's piecewise-linear block (true geometry), integrated in closed form
-    (`solver` is unused)."""
+    Spanos and Koh's piecewise-linear block (true geometry), in closed form: compiled
+    (rbm_cli.models.rbm.closed_form) with `solver.implementation: compiled` (the default),
+    housner_linear_run with `python` or a vertical record (its gam taken per piece). Its
+    method is `closed-form` whatever solver.method says (as before `auto` existed, when the
+    solver was unused), so configs that name a method still run."""
 
     def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
-        return housner_linear_run(
-            self.geometry.slenderness,
-            self.geometry.frequency_parameter,
-            motion,
-            restitution=self.restitution,
-            collapse_ratio=self.config.collapse.ratio,
-            height=self.config.column.height,
-            initial=self.initial,
-            **options,
-        )
+        geometry = self.geometry
+        args = (geometry.slenderness, geometry.frequency_parameter)
+        kw = dict(restitution=self.restitution, collapse_ratio=self.config.collapse.ratio)
+        motion = motion.sampled()  # a pulse with no closed form as a record; else itself
+        if solver.implementation == "compiled" and not motion.has_vertical:
+            from rbm_cli.models.rbm.closed_form import linear_block, run_closed_form
+
+            block = linear_block(*args, height=self.config.column.height, **kw)
+            out = run_closed_form(block, motion, *self.initial, solver, **options)
+        else:
+            out = housner_linear_run(*args, motion, height=self.config.column.height,
+                                     initial=self.initial, **kw, **options)  # fmt: skip
+        out.method = "closed-form"
+        return out

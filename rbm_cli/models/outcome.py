@@ -34,6 +34,7 @@ class Outcome:
     n_events: int = 0
     samples: list = field(default_factory=list)  # (t, theta, rate) when recording
     history: History | None = None  # the sampled history, made by the runner when recording
+    method: str = ""  # the method that ran (solver.method, `auto` resolved), set by the runner
 
     def stop(self, status: str, message: str, t: float) -> Outcome:
         """End the run at time t with a status and a reason."""

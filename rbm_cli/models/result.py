@@ -65,6 +65,7 @@ class RunResult:
     n_steps, n_rhs : int  Accepted integrator steps, right-hand-side evaluations
     friction_demand : tuple of float  max over time of |T_i / N_i| per interface
     wall_time_s : float  Wall time of the run [s]
+    method : str  The method that ran (solver.method, `auto` resolved; not in domain.csv)
     """
 
     status: str
@@ -82,6 +83,7 @@ class RunResult:
     friction_demand: tuple[float, ...]
     wall_time_s: float
     history: History | None = None
+    method: str = ""
 
     @property
     def collapsed(self) -> bool:
@@ -104,6 +106,7 @@ class RunResult:
         out["friction_demand"] = [v if np.isfinite(v) else None for v in self.friction_demand]
         out["max_friction_demand"] = self.max_friction_demand
         out["wall_time_s"] = self.wall_time_s
+        out["method"] = self.method
         for k, v in out.items():
             if isinstance(v, float) and not np.isfinite(v):
                 out[k] = None

@@ -54,7 +54,8 @@ import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config
-from rbm_cli.config.types import Config, GridConfig, SolverConfig
+from rbm_cli.config.types import STEP_DEFAULT, Config, GridConfig, SolverConfig
+from rbm_cli.models.methods import resolve_method
 from rbm_cli.study.bench_runs import run_cells
 from rbm_cli.study.bench_scoring import _key, agreement, errors
 from rbm_cli.study.robustness import MEMBERS, member_config, members
@@ -85,6 +86,8 @@ PROBLEMS = (
 )  # fmt: skip
 
 #: The exact integrator (`solver.method: exact`; it has no tolerance: its rtol is unused).
+#: On the rigid monoliths the default (`auto`) is the block's closed form (`closed-form`,
+#: no tolerance either), run beside these (_run_methods).
 EXACT = ("compiled", "exact", SolverConfig().rtol)
 #: Methods of the full benchmark: (implementation, method, rtol).
 METHODS = (
@@ -214,9 +217,10 @@ def run_bench(
 ) -> pd.DataFrame:
     """Run the benchmark; write bench.csv (and, full, the references).
 
-    Every run (quick, pair or full) has both methods: the default step kernel and the
-    exact integrator, each row with its agreement with the default on the same cells.
-    pair: only these two (and the baseline) on the full grids.
+    Every run (quick, pair or full) has the default method (`auto` resolved: the closed
+    form on the rigid monoliths, the step kernel elsewhere), the step kernel and the exact
+    integrator, each row with its agreement with the default on the same cells.
+    pair: only these (and the baseline) on the full grids.
 
     The figure (bench.png) is drawn by the caller from the returned table
     (:func:`rbm_cli.report.bench_figures.work_precision_figure`)."""
@@ -275,17 +279,26 @@ def _reference(
     return ref
 
 
-def _default_method() -> tuple[str, str, float]:
-    """(implementation, method, rtol) of rbm's default solver."""
-    return ("compiled", SolverConfig().method, SolverConfig().rtol)
+def _default_method(cfg: Config) -> tuple[str, str, float]:
+    """(implementation, method, rtol) of rbm's default solver on a problem: `auto`
+    resolved (the closed form on a rigid monolith, else DOP853)."""
+    solver = SolverConfig()
+    default = dataclasses.replace(cfg, solver=solver)
+    return ("compiled", resolve_method(default), solver.rtol)
 
 
 def _run_methods(cfg: Config, cells: list, sample: list, quick: bool, jobs: int) -> list:
-    """Run every method (quick: the default and the exact method) and the baseline.
+    """Run every method (quick: the default, the step kernel if it is not the default,
+    and the exact method) and the baseline.
 
     Returns (method triple, rows, wall time [s], whether on the sample only) per
     method, the baseline last; the Python loop and the baseline run the sample."""
-    methods = [_default_method(), EXACT] if quick else list(METHODS)
+    default = _default_method(cfg)
+    step = ("compiled", STEP_DEFAULT, SolverConfig().rtol)
+    if quick:
+        methods = list(dict.fromkeys([default, step, EXACT]))
+    else:
+        methods = list(METHODS) + ([default] if default not in METHODS else [])
     results = []
     for impl, method, rtol in methods:
         part = sample if impl == "python" else cells
@@ -300,7 +313,7 @@ def _method_rows(
     prob: Problem, results: list, sample: list, ref: pd.DataFrame, jobs: int
 ) -> list[dict]:
     """One table row per method of `results` (from :func:`_run_methods`): times and errors."""
-    default = _default_method()
+    default = _default_method(problem_config(prob, stride=40))
     # paired times: each method's run times summed over the sample's cells
     on_sample = set(_key(pd.DataFrame(sample, columns=["amplitude_g", "frequency_hz"])))
     paired = [float(d.loc[_key(d).isin(on_sample), "wall_time_s"].sum()) for _, d, _, _ in results]
@@ -335,9 +348,10 @@ def _method_rows(
 
 
 def _line(r: dict) -> str:
-    rtol = "" if r["method"] == "exact" else f" rtol {r['rtol']:.0e}"
+    closed = r["method"] in ("exact", "closed-form")  # no tolerance; pieces, not steps
+    rtol = "" if closed else f" rtol {r['rtol']:.0e}"
     steps = r.get("steps_median", math.nan)
-    unit = "pieces" if r["method"] == "exact" else "steps"
+    unit = "pieces" if closed else "steps"
     steps = f", {steps:.0f} {unit}" if steps == steps else ""
     return (
         f"{r['problem']:10s} {r['implementation']:9s} {r['method'] + rtol:21s}: "

@@ -26,11 +26,15 @@ def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: 
 
 
 def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
+    from rbm_cli.models.methods import resolve_method
     from rbm_cli.models.registry import make_runner
     from rbm_cli.study.simulate import simulate
 
-    if cfg.solver.method == "exact":
+    method = resolve_method(cfg)
+    if method == "exact":
         from rbm_cli.models.rbm.exact_jit import warm_up
+    elif method == "closed-form":
+        from rbm_cli.models.rbm.closed_form import warm_up
     else:
         from rbm_cli.models.rbm.kernel import warm_up
     warm_up()  # load the method's compiled code in this worker before timing runs

@@ -95,4 +95,5 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         friction_demand=tuple(float(v) for v in out.friction),
         wall_time_s=wall,
         history=history,
+        method=out.method,
     )

@@ -26,7 +26,8 @@ import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
-from rbm_cli.config.types import Config
+from rbm_cli.config.types import Config, hash_form
+from rbm_cli.models.methods import compiled_code, load_closed_form
 from rbm_cli.models.result import CSV_FIELDS
 from rbm_cli.study.cells import (
     Cell,
@@ -71,13 +72,9 @@ class SweepSummary:
 
 
 def config_hash(config: Config) -> str:
-    """Fingerprint of everything that changes a domain (the resolved config).
-
-    solver.max_wall_time is left out: a guard against a run that would not end, not a
-    setting of the domain (and hashes of domains made before it existed stay valid)."""
-    resolved = config.resolved()
-    resolved["solver"].pop("max_wall_time", None)
-    text = json.dumps(resolved, sort_keys=True, default=str)
+    """Fingerprint of everything that changes a domain: the resolved config, as
+    rbm_cli.config.types.hash_form gives it (hashes of stored domains stay valid)."""
+    text = json.dumps(hash_form(config), sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -384,11 +381,11 @@ def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str |
     but a Dask scheduler's; loky runs its first chunks here) or if it must be compiled
     (then workers load it from numba's cache instead of each compiling it); its time [s],
     which the sweep's wall time and ETA leave out (a background compile: waited for)."""
-    compiled = any(
-        p.config.model == "rbm" and p.config.solver.implementation == "compiled" for p in points
-    )
-    if not (todo and compiled):
+    codes = {compiled_code(p.config) for p in points} - {None}
+    if not (todo and codes):
         return 0.0
+    if codes == {"closed-form"}:  # the block's closed form only: no kernel to load
+        return load_closed_form()
     from rbm_cli.models.rbm.compile_ahead import wait
     from rbm_cli.models.rbm.kernel import needs_compile, warm_up
 

@@ -21,7 +21,7 @@ import pandas as pd
 from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
-from rbm_cli.study.cells import key, max_drums
+from rbm_cli.study.cells import grid_points, key, max_drums
 from rbm_cli.study.domain import boundary, csv_text
 from rbm_cli.study.provenance import provenance
 from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
@@ -187,6 +187,19 @@ def _versions() -> dict:
     }
 
 
+def solver_methods(config) -> str:
+    """The method(s) the sweep's cells ran with (solver.method, `auto` resolved at each
+    point of the grid: rbm_cli.models.methods.resolve_method), e.g. 'closed-form' or
+    'closed-form, DOP853' when the points differ."""
+    from rbm_cli.models.methods import resolve_method
+
+    try:
+        configs = [p.config for p in grid_points(config)] or [config]
+    except RbmError:  # not a sweep's config (checked before the sweep runs)
+        configs = [config]
+    return ", ".join(dict.fromkeys(resolve_method(c) for c in configs))
+
+
 def sweep_meta(
     config: Config, digest: str, n_cells: int, n_run: int, counts: dict, ensemble: int,
     folder: Path | None = None,
@@ -204,6 +217,7 @@ def sweep_meta(
         "config_written": config.written,
         "config_dir": where,
         "config_hash": digest,
+        "solver_method": solver_methods(config),
         "versions": _versions(),
         "wall_time_s": None,
         "jobs": None,

@@ -23,6 +23,7 @@ from numba import njit
 
 from rbm_cli.base.detmath import matmul, matvec
 from rbm_cli.models.events import REST_RATE
+from rbm_cli.models.methods import step_method
 from rbm_cli.models.rbm.kernel_rk import METHOD_CODES
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
@@ -257,7 +258,7 @@ def excitation(motion: GroundMotion) -> tuple:
 def solver_settings(solver, atol_scale: np.ndarray, deadline: float) -> tuple:
     """The kernel's SolverSettings of a SolverConfig (atol scaled by atol_scale; deadline
     [s]), as the plain tuple run_kernel takes."""
-    return (METHOD_CODES[solver.method], float(solver.rtol), solver.atol * atol_scale,
+    return (METHOD_CODES[step_method(solver)], float(solver.rtol), solver.atol * atol_scale,
             int(solver.max_steps), int(solver.max_events), deadline)  # fmt: skip
 
 

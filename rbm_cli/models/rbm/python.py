@@ -37,6 +37,7 @@ from rbm_cli.base.detmath import pow_pos_python as pow_pos
 from rbm_cli.config.types import SolverConfig
 from rbm_cli.models.events import BIG, EVENT_EPS, REST_RATE, Pieces  # noqa: F401 (kernel's)
 from rbm_cli.models.knots import clip_at_knots, next_knot
+from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.python_steps import (
     RunState,
@@ -102,7 +103,7 @@ def _start_stepper(run: RunState, piece: SmoothPiece, seg_end: float):
     smooth up to its second derivative; a fresh initial-step guess was rejected 1.4 times
     per event)."""
     solver = run.solver
-    stepper = _METHODS[solver.method]
+    stepper = _METHODS[step_method(solver)]  # auto: DOP853
     if run.h_carry is None:  # counted as scipy counts it: its own f0, then one call
         f0 = piece.rhs(run.t, run.y, counted=False)
         bound = seg_end  # a record: its guess stays on the straight piece (the kernel's)

@@ -1,0 +1,61 @@
+"""A ground motion's forcing segments as the arrays the compiled closed forms read: the
+exact integrator (exact_jit) and the rigid block's closed form (closed_form).
+
+seg_t (segments, 2): start and end [s] of each smooth segment; seg_fc (segments,
+FORCING_SIZE): its forcing (exact_jit_modal: zero, harmonic or linear).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, LINEAR, ZERO, forcing_array
+from rbm_cli.models.rbm.exact_motion import check_exact, resolve_segments
+from rbm_cli.physics.equations import Model
+from rbm_cli.physics.excitation import GroundMotion
+
+
+def segment_arrays(segs: list) -> tuple[np.ndarray, np.ndarray]:
+    """(seg_t, seg_fc) of a list of (start [s], end [s], exact_modal.Forcing)."""
+    seg_t = np.array([[s, e] for s, e, _ in segs], dtype=float).reshape(-1, 2)
+    seg_fc = np.array([forcing_array(f) for _, _, f in segs]).reshape(-1, FORCING_SIZE)
+    return seg_t, seg_fc
+
+
+def record_arrays(motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:
+    """The segments of a record motion as (seg_t, seg_fc) arrays, as
+    segment_arrays(exact_motion.record_segments(motion)) makes them, without a Python object
+    per sample (3,000 samples: 0.3 ms instead of 21 ms a run)."""
+    knots = np.asarray(motion.knots, dtype=float)
+    values = np.asarray(motion.values, dtype=float)
+    t_end = float(motion.t_end)
+    k = np.nonzero((np.diff(knots) > 0.0) & (knots[:-1] < t_end))[0]
+    lin_t = np.stack([knots[k], np.minimum(knots[k + 1], t_end)], axis=1)
+    lin_fc = np.zeros((k.size, FORCING_SIZE))
+    lin_fc[:, 0] = LINEAR
+    lin_fc[:, 4] = knots[k]
+    lin_fc[:, 5] = values[k]
+    lin_fc[:, 6] = (values[k + 1] - values[k]) / (knots[k + 1] - knots[k])
+    cuts = sorted({0.0, float(knots[0]), float(knots[-1]), float(motion.pulse_end), t_end})
+    before, after = [], []
+    for a, b in zip(cuts[:-1], cuts[1:], strict=False):
+        if b > a and a < t_end and (b <= knots[0] or a >= knots[-1]):
+            (before if b <= knots[0] else after).append((a, min(b, t_end)))
+    zero = np.zeros(FORCING_SIZE)
+    zero[0] = ZERO
+    seg_t = np.concatenate([np.array(before).reshape(-1, 2), lin_t, np.array(after).reshape(-1, 2)])
+    seg_fc = np.concatenate([np.tile(zero, (len(before), 1)), lin_fc,
+                             np.tile(zero, (len(after), 1))])  # fmt: skip
+    return seg_t, seg_fc
+
+
+def motion_arrays(
+    model: Model, motion: GroundMotion, segments: list | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(seg_t, seg_fc) of a run: a record's (record_arrays), the motion's other segments
+    (exact_motion.resolve_segments, which refuses what has no closed form in one line), or
+    segments given by the caller."""
+    if segments is None and motion.kind == "record":
+        check_exact(model, motion.kind, motion.has_vertical)
+        return record_arrays(motion)
+    return segment_arrays(resolve_segments(model, motion, segments))

@@ -1,0 +1,322 @@
+"""The rigid block's compiled closed form (rbm_cli.models.rbm.closed_form): the RBM's
+`solver.method: closed-form` on a rigid monolith (what `auto`, the default, runs there) and
+the compiled `housner-linear`.
+
+Expected values from other sources:
+
+- the step kernel (DOP853 at rtol 1e-11 and 1e-12) on sub-grids of the shipped rigid
+  studies (harmonic, half-sine) and under a record: on the cells where its two tolerances
+  agree (same outcome and events, peaks and collapse times within 1e-9), the same outcome
+  and events, peaks and collapse times within 1e-8 of rtol 1e-12 (the two locate an impact
+  differently: the kernel EVENT_EPS theta_u past zero, then projected back);
+- housner_linear_run, the Python closed form (scipy's brentq on numpy), with the RBM's
+  mapping (physics.closed_forms.linear_rocking_parameters) and for housner-linear itself;
+- free rocking: the energy theta'^2/2 + p^2 (alpha |theta| - theta^2/2) is conserved
+  between impacts, and the impacts come at the period of
+  physics.closed_forms.free_rocking_period;
+- a dense sampling of random pieces: the first event the scan finds is the first crossing
+  of 200,001 samples (none missed, none invented).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.load import load_config, parse_config
+from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.closed_forms import free_rocking_period, linear_rocking_parameters
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.study.simulate import simulate
+
+from .paths import CONFIGS
+
+RECORD = CONFIGS / "records" / "synthetic" / "rdk_01.AT2"
+COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "drums": 1}
+_COMPARED = ("max_rotation_ratio", "max_top_displacement_m", "t_collapse_s")
+
+
+def _with(cfg, **solver):
+    return dataclasses.replace(cfg, solver=dataclasses.replace(cfg.solver, **solver))
+
+
+def _close(x, y, rel):
+    return (math.isnan(x) and math.isnan(y)) or abs(x - y) <= rel * abs(y)
+
+
+def _converged(k11, k12) -> bool:
+    return (
+        k11.status == k12.status
+        and (k11.n_uplifts, k11.n_impacts) == (k12.n_uplifts, k12.n_impacts)
+        and all(_close(getattr(k11, a), getattr(k12, a), 1e-9) for a in _COMPARED)
+    )
+
+
+def _against_kernel(cfg, cells) -> int:
+    """Closed form (the default) against the step kernel on the converged cells; returns
+    how many were compared."""
+    runs = {}
+    for label, solver in (("cf", {}), ("k11", {"method": "DOP853", "rtol": 1e-11}),
+                          ("k12", {"method": "DOP853", "rtol": 1e-12})):  # fmt: skip
+        c = _with(cfg, **solver)
+        runner = make_runner(c)
+        runs[label] = [simulate(c, a, f, runner=runner) for a, f in cells]
+    assert {r.method for r in runs["cf"]} == {"closed-form"}
+    assert {r.method for r in runs["k12"]} == {"DOP853"}
+    count = 0
+    for cell, cf, k11, k12 in zip(cells, runs["cf"], runs["k11"], runs["k12"], strict=True):
+        if not _converged(k11, k12):
+            continue
+        assert cf.status == k12.status, cell
+        if "stopped early" not in cf.message + k12.message:
+            assert (cf.n_uplifts, cf.n_impacts) == (k12.n_uplifts, k12.n_impacts), cell
+        for name in _COMPARED:
+            assert _close(getattr(cf, name), getattr(k12, name), 1e-8), (cell, name)
+        # the closed form's friction demand is the maximum over time; the kernel reads it
+        # at its step ends only, so it can only be lower
+        assert cf.max_friction_demand >= k12.max_friction_demand * (1 - 1e-9), cell
+        count += 1
+    return count
+
+
+@pytest.mark.parametrize("study, stride", [("spanos_koh_slender", 4), ("housner_halfsine", 4)])
+def test_the_step_kernel_agrees_on_a_grid(study, stride):
+    cfg = load_config(CONFIGS / f"{study}.yaml")
+    cells = [(a, f) for f in cfg.grid.frequencies_hz[::stride]
+             for a in cfg.grid.amplitudes_g[::stride]]  # fmt: skip
+    assert _against_kernel(cfg, cells) >= 0.8 * len(cells)
+
+
+def test_the_step_kernel_agrees_under_a_record_and_pulses():
+    """A synthetic record (0.01 s samples) at three PGAs, a one-sine and a cycloidal pulse."""
+    count = 0
+    for excitation, cells in (
+        ({"type": "record", "file": str(RECORD), "units": "g", "free_time": 2.0},
+         [(0.2, None), (0.5, None), (0.9, None)]),
+        ({"type": "one-sine", "duration": 4.0}, [(0.25, 1.0), (0.5, 2.0), (1.2, 3.0)]),
+        ({"type": "cycloidal", "duration": 4.0}, [(0.3, 1.0), (0.5, 2.0), (1.2, 3.0)]),
+    ):  # fmt: skip
+        cfg = parse_config({"name": "x", "column": COLUMN, "excitation": excitation})
+        count += _against_kernel(cfg, cells)
+    assert count >= 6
+
+
+def _facts(run):
+    """(status, uplifts, impacts, peak ratio, collapse time [s]) of a RunResult or an
+    Outcome."""
+    if hasattr(run, "max_rotation_ratio"):
+        return (run.status, run.n_uplifts, run.n_impacts, run.max_rotation_ratio,
+                run.t_collapse_s)  # fmt: skip
+    return run.status, run.n_uplifts, run.n_impacts, float(run.max_ratio[0]), run.t_collapse
+
+
+def test_the_python_closed_form_agrees():
+    """The RBM's closed form against housner_linear_run with the SPEC's mapping, and
+    housner-linear compiled against python: same outcome and events, peaks and collapse
+    times within 1e-9 where a 1e-10 change of the amplitude moves the peak by < 1e-9 (the
+    RBM places an impact EVENT_EPS theta_u past zero, housner-linear at zero)."""
+    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    runner = make_runner(cfg)
+    alpha, p = linear_rocking_parameters(runner.model.column)
+    lin = load_config(CONFIGS / "spanos_koh_slender_linear.yaml")
+    lin_c, lin_p = make_runner(lin), make_runner(_with(lin, implementation="python"))
+    compared = 0
+    for f in cfg.grid.frequencies_hz[::5]:
+        for a in cfg.grid.amplitudes_g[::5]:
+            motion = make_ground_motion(cfg.excitation, a, f)
+            ref = housner_linear_run(alpha, p, motion)
+            nudged = housner_linear_run(
+                alpha, p, make_ground_motion(cfg.excitation, a * (1 + 1e-10), f)
+            )
+            steady = abs(nudged.max_ratio[0] - ref.max_ratio[0]) <= 1e-9 * ref.max_ratio[0]
+            compiled, python = simulate(lin, a, f, runner=lin_c), simulate(lin, a, f, runner=lin_p)
+            assert compiled.method == python.method == "closed-form"
+            for out, want in ((simulate(cfg, a, f, runner=runner), ref), (compiled, python)):
+                got, expected = _facts(out), _facts(want)
+                assert got[:3] == expected[:3], (a, f)
+                if steady:
+                    assert _close(got[3], expected[3], 1e-9), (a, f)
+                    assert _close(got[4], expected[4], 1e-9), (a, f)
+                    compared += 1
+    assert compared >= 40
+
+
+def test_free_rocking_conserves_energy_at_the_closed_form_period():
+    """Free rocking from theta0 = 0.1 rad, e = 1: the energy theta'^2/2 + p^2 (alpha |theta|
+    - theta^2/2) at every sample equals its initial value to round-off for housner-linear's
+    impacts (at theta = 0); the RBM's (where s theta = -eps, then projected onto 0) each
+    add p^2 alpha eps, no more; the impacts come at T/4, 3T/4, ... of free_rocking_period."""
+    from rbm_cli.models.events import EVENT_EPS
+    from rbm_cli.models.rbm.closed_form import linear_block, rbm_block, run_closed_form
+
+    cfg = parse_config({"name": "free", "column": COLUMN, "interface": {"restitution": 1.0},
+                        "excitation": {"type": "free", "duration": 8.0,
+                                       "initial": {"rotations": [0.1]}}})  # fmt: skip
+    model = make_runner(cfg).model
+    alpha, p = linear_rocking_parameters(model.column)
+    motion = make_ground_motion(cfg.excitation, 0.0, 0.0)
+    e0 = p * p * (alpha * 0.1 - 0.5 * 0.1**2)
+    period = free_rocking_period(p, 0.1 / alpha)
+    for block, per_impact in ((linear_block(alpha, p), 0.0),
+                              (rbm_block(model), p * p * alpha * EVENT_EPS * alpha)):  # fmt: skip
+        out = run_closed_form(block, motion, 0.1, 0.0, cfg.solver, record=True, output_dt=1e-3)
+        theta = np.array([s[1][0] for s in out.samples])
+        rate = np.array([s[2][0] for s in out.samples])
+        energy = 0.5 * rate**2 + p * p * (alpha * np.abs(theta) - 0.5 * theta**2)
+        assert out.n_impacts == math.floor((8.0 / period - 0.25) / 0.5) + 1
+        assert np.abs(energy - e0).max() <= 1e-14 * e0 + 1.01 * out.n_impacts * per_impact
+        assert out.status == "survived"
+        # the RBM's impact adds p^2 alpha eps of energy: 2 eps of amplitude at alpha / 2
+        grown = 4 * EVENT_EPS * out.n_impacts if per_impact else 0.0
+        assert abs(out.max_ratio[0] - 0.1 / alpha) <= 1e-13 + grown
+
+
+def _dense(pc, ts):
+    """s theta at t0 + ts, written out from the piece's coefficients (numpy)."""
+    from rbm_cli.models.rbm import closed_form_jit as cj
+
+    theta = (pc[cj.SIDE] * pc[cj.ALPHA] + pc[cj.AMP] * np.sin(pc[cj.OM] * ts + pc[cj.PHI])
+             + pc[cj.Q0] + pc[cj.Q1] * ts + pc[cj.C1] * np.exp(pc[cj.P] * ts)
+             + pc[cj.C2] * np.exp(-pc[cj.P] * ts))  # fmt: skip
+    return pc[cj.SIDE] * theta
+
+
+def _random_piece(rng, pc):
+    from rbm_cli.models.rbm.closed_form import linear_block
+    from rbm_cli.models.rbm.closed_form_jit import start_piece
+
+    alpha, p = rng.uniform(0.05, 0.3), rng.uniform(0.5, 5.0)
+    blk = linear_block(alpha, p).params
+    fc = np.zeros(7)
+    kind = rng.integers(0, 3)
+    if kind == 1:
+        fc[:4] = 1, rng.uniform(0.2, 3.0) * 9.81 * alpha, rng.uniform(0.5, 40.0), rng.uniform(0, 6)
+    elif kind == 2:
+        fc[0], fc[5], fc[6] = 2, rng.uniform(-2, 2) * 9.81 * alpha, rng.uniform(-50, 50)
+    side = rng.choice([-1.0, 1.0])
+    theta, rate = side * alpha * rng.uniform(0.0, 0.99), side * alpha * p * rng.uniform(-0.5, 0.5)
+    start_piece(blk, rng.uniform(0.0, 3.0), theta, rate, side, fc, pc)
+    return blk
+
+
+def test_the_scan_misses_no_crossing_of_random_pieces():
+    """Random pieces (harmonic, linear, free) against 100,001 samples: the scan's first
+    event (impact where s theta + eps <= 0, collapse where s theta >= limit) is the first
+    sample crossing, to the sample spacing; the peak before it is not below the samples'."""
+    from rbm_cli.models.rbm.closed_form_jit import (
+        B_EPS,
+        B_LIMIT,
+        COLLAPSE,
+        IMPACT,
+        NONE,
+        PIECE_SIZE,
+        scan_piece,
+    )  # fmt: skip
+
+    rng = np.random.default_rng(11)
+    checked = {NONE: 0, IMPACT: 0, COLLAPSE: 0}
+    pc = np.zeros(PIECE_SIZE)
+    for _ in range(400):
+        blk = _random_piece(rng, pc)
+        tau_max = 10.0 ** rng.uniform(-1.5, 0.6)
+        acc = np.zeros(4)
+        got, tau = scan_piece(pc, blk, tau_max, acc)
+        ts = np.linspace(0.0, tau_max, 100_001)
+        f = _dense(pc, ts)
+        hit = np.nonzero((f + blk[B_EPS] <= 0.0) | (f >= blk[B_LIMIT]))[0]
+        k = hit[0] if hit.size else ts.size
+        if hit.size == 0:
+            assert got == NONE and tau == tau_max
+        else:
+            want = COLLAPSE if f[k] >= blk[B_LIMIT] else IMPACT
+            assert got == want and ts[k - 1] - 1e-9 <= tau <= ts[k] + 1e-9
+        if got != COLLAPSE:  # the peak before the event (a collapse's is the limit)
+            assert acc[0] >= f[:k].max() - 1e-14
+        checked[got] += 1
+    assert min(checked.values()) >= 40
+
+
+@pytest.mark.parametrize("delta", [1e-4, 1e-7, -1e-9])
+def test_a_grazing_peak_is_seen(delta):
+    """Free motion from theta = 0 at the rate that peaks at alpha (1 - delta): delta > 0
+    turns back (impact), delta < 0 collapses; one interval of the scan spans the peak."""
+    from rbm_cli.models.rbm.closed_form import linear_block
+    from rbm_cli.models.rbm.closed_form_jit import (
+        COLLAPSE,
+        IMPACT,
+        PIECE_SIZE,
+        scan_piece,
+        start_piece,
+    )  # fmt: skip
+
+    alpha, p = 0.2, 2.0
+    blk = linear_block(alpha, p).params
+    pc, acc = np.zeros(PIECE_SIZE), np.zeros(4)
+    peak = alpha * (1.0 - delta)
+    rate = math.sqrt(2.0 * p * p * (alpha * peak - 0.5 * peak * peak))  # energy at the peak
+    start_piece(blk, 0.0, 0.0, rate, 1.0, np.zeros(7), pc)
+    got, tau = scan_piece(pc, blk, 20.0, acc)
+    assert got == (IMPACT if delta > 0 else COLLAPSE)
+    if delta > 0:
+        assert acc[0] == pytest.approx(peak, rel=1e-11 / delta)  # dpeak/dE ~ 1 / delta
+
+
+def test_auto_resolves_and_an_explicit_method_is_kept():
+    """auto: the closed form on a rigid monolith, DOP853 on an elastic column, a Ricker
+    pulse, a vertical record (tests/test_vertical.py's kind) or the Python implementation;
+    explicit DOP853 runs the step kernel; closed-form where it does not apply: one line."""
+    from rbm_cli.models.methods import resolve_method
+    from rbm_cli.study.sweep import config_hash
+
+    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    assert cfg.solver.method == "auto" and resolve_method(cfg) == "closed-form"
+    step = _with(cfg, method="DOP853")
+    out, kernel = simulate(cfg, 0.5, 1.0), simulate(step, 0.5, 1.0)
+    assert (out.method, kernel.method) == ("closed-form", "DOP853")
+    assert kernel.n_steps > 10 * out.n_steps  # steps of the kernel, pieces of the closed form
+    assert config_hash(cfg) == config_hash(step)  # auto hashes as the former default
+    assert resolve_method(_with(cfg, implementation="python")) == "DOP853"
+    for other in ("harmonic_monolithic", "harmonic_multidrum"):  # elastic joints
+        assert resolve_method(load_config(CONFIGS / f"{other}.yaml")) == "DOP853"
+    ricker = parse_config({"name": "r", "column": COLUMN, "excitation": {"type": "ricker"}})
+    assert simulate(ricker, 0.5, 2.0).method == "DOP853"
+    with pytest.raises(RbmError, match="closed-form") as err:
+        make_runner(_with(load_config(CONFIGS / "harmonic_monolithic.yaml"),
+                          method="closed-form"))  # fmt: skip
+    assert "\n" not in str(err.value)
+    with pytest.raises(RbmError, match="ricker"):
+        make_runner(_with(ricker, method="closed-form"))
+
+
+def test_a_vertical_record_falls_back_to_the_integrator(tmp_path):
+    from rbm_cli.config.types import G
+    from rbm_cli.physics.records import write_csv
+
+    t = np.linspace(0.0, 1.0, 101)
+    h = write_csv(tmp_path / "h.csv", (t, 0.5 * G * np.sin(2 * np.pi * t)), units="g")
+    v = write_csv(tmp_path / "v.csv", (t, 0.2 * G * np.ones_like(t)), units="g")
+    exc = {"type": "record", "file": str(h), "vertical": str(v), "scale": "factor"}
+    cfg = parse_config({"name": "v", "column": COLUMN, "excitation": exc})
+    from rbm_cli.models.methods import resolve_method
+
+    assert resolve_method(cfg) == "DOP853"
+    assert simulate(cfg, 1.0, None).method == "DOP853"
+    with pytest.raises(RbmError, match="vertical"):
+        make_runner(_with(cfg, method="closed-form"))
+    lin = dataclasses.replace(cfg, model="housner-linear")
+    assert simulate(lin, 1.0, None).status in ("survived", "collapsed")  # the Python one
+
+
+def test_a_history_is_recorded():
+    """`rbm run`'s history: samples every output_dt, the closed form's (the step kernel's
+    to 1e-8 of alpha)."""
+    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    out = simulate(cfg, 0.6, 1.5, record=True, output_dt=0.01)
+    ref = simulate(_with(cfg, method="DOP853", rtol=1e-12), 0.6, 1.5, record=True, output_dt=0.01)
+    assert out.history.t.size == ref.history.t.size > 100
+    assert np.abs(out.history.rotations - ref.history.rotations).max() < 1e-8 * 0.25

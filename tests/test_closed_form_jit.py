@@ -22,6 +22,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import signal
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -320,3 +324,42 @@ def test_a_history_is_recorded():
     ref = simulate(_with(cfg, method="DOP853", rtol=1e-12), 0.6, 1.5, record=True, output_dt=0.01)
     assert out.history.t.size == ref.history.t.size > 100
     assert np.abs(out.history.rotations - ref.history.rotations).max() < 1e-8 * 0.25
+
+
+# ------------------------------------------------------------------ guards of a compiled run
+def _long_rocking(max_wall_time):
+    """The slender block rocking without loss (e = 1) under a harmonic for 1e7 s: millions
+    of pieces, a run only a guard ends. Returns the Outcome and the time it took [s]."""
+    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    cfg = dataclasses.replace(cfg, excitation=dataclasses.replace(cfg.excitation, duration=1e7))
+    cfg = _with(cfg, method="closed-form", max_steps=10**12, max_events=10**12,
+                max_wall_time=max_wall_time)  # fmt: skip
+    runner = make_runner(cfg)
+    motion = make_ground_motion(cfg.excitation, 0.3, 3.0)  # [g, Hz]: rocks (916 impacts in 200 s)
+    start = time.monotonic()
+    out = runner.run(motion, cfg.solver)
+    return out, time.monotonic() - start
+
+
+def test_the_wall_clock_budget_ends_a_compiled_closed_form_run():
+    out, took = _long_rocking(0.5)
+    assert out.status == "failed", out.message
+    assert "wall-clock budget exceeded (0.5 s, solver.max_wall_time)" in out.message
+    assert took < 10.0
+
+
+def test_ctrl_c_stops_a_compiled_closed_form_run():
+    """Ctrl-C (SIGINT) reaches the compiled closed form through kernel_guard.poll and raises
+    KeyboardInterrupt once the call has returned."""
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        pytest.skip("SIGINT is handled by the test runner here")
+    _long_rocking(0.1)  # compiled (or loaded) before the clock starts
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            _long_rocking(120.0)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 10.0

@@ -31,6 +31,7 @@ from rbm_cli.models.rbm import closed_form_jit_run as cr
 from rbm_cli.models.rbm.closed_form_jit_run import run_block
 from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, HARMONIC
 from rbm_cli.models.rbm.forcing_arrays import record_arrays
+from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -123,20 +124,21 @@ def _messages(block: Block, code: int, out: Outcome, solver) -> None:
     """Status and message of the outcome from the run's code (the runner's wording)."""
     t = out.t_end
     if code == cr.COLLAPSED:
-        out.status, out.collapse_interface = "collapsed", 1
-        out.message = ("interface 1 reached its collapse limit" if block.rbm
-                       else "the block reached its collapse limit")  # fmt: skip
+        out.collapse(out.t_collapse, 1)
+        if not block.rbm:
+            out.message = "the block reached its collapse limit"
     elif code == cr.STOPPED_EARLY:
-        out.message = "free motion below the collapse barrier: stopped early"
+        out.stopped_early()
     elif code == cr.AT_REST_END and not block.rbm:
         out.message = "at rest in free motion: stopped"
     elif code == cr.FAILED_STEPS:
-        out.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+        out.out_of_steps(solver, t)
     elif code == cr.FAILED_EVENTS:
-        out.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
+        out.out_of_events(solver, t)
     elif code == cr.FAILED_WALL:
-        budget = f"{solver.max_wall_time:g} s, solver.max_wall_time"
-        out.stop("failed", f"wall-clock budget exceeded ({budget})", t)
+        out.out_of_time(solver, t)
+    elif code == cr.INTERRUPTED:  # pragma: no cover - disarm() raises first
+        raise KeyboardInterrupt
     if out.status != "failed" and not math.isfinite(out.max_top):
         out.stop("failed", "numerical failure: non-finite state", t)
 
@@ -169,8 +171,12 @@ def run_closed_form(
                    float(record), output_dt], dtype=float)  # fmt: skip
     n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((n_max, 3))
-    code, st, cnt = run_block(block.params, seg_t, seg_fc, mo, se, float(theta0), float(rate0),
-                              samples)  # fmt: skip
+    armed = arm()  # Ctrl-C reaches the run through poll (kernel_guard)
+    try:
+        code, st, cnt = run_block(block.params, seg_t, seg_fc, mo, se, float(theta0),
+                                  float(rate0), samples)  # fmt: skip
+    finally:
+        disarm(armed)
     out = Outcome(t_end=float(st[0]), t_collapse=float(st[9]), max_top=block.height * st[5])
     out.max_ratio = np.array([st[5] / block.ratio_scale])
     out.friction = np.array([st[6] if block.rbm else math.nan])

@@ -37,16 +37,17 @@ from rbm_cli.models.rbm.closed_form_jit import (
     scan_piece,
     start_piece,
 )
-from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel
-from rbm_cli.models.rbm.exact_jit_state import clock, next_exceedance
+from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel, linear_exceedance
+from rbm_cli.models.rbm.kernel_ground import sine_exceedance
+from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
 
 GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
-FAILED_STEPS, FAILED_EVENTS, FAILED_WALL = 5, 6, 7
+FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
 T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE = range(10)
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)
 #: Energy margin of the early stop [fraction of the barrier] (housner_state.STOP_MARGIN).
 STOP_MARGIN = 1e-9
-#: Pieces between two readings of the wall clock.
+#: Pieces between two polls of the wall clock and Ctrl-C (kernel_guard.poll).
 CLOCK_EVERY = 64
 
 
@@ -74,21 +75,6 @@ def _emit(pc, st, samples, t_stop, dt, rest):
 
 
 @njit(cache=True)
-def _linear_exceedance(fc, t0, level, t_stop):
-    """First t in [t0, t_stop) with |a_g(t)| > level under a linear forcing fc: t0 when
-    already above, else where |a_g| reaches level (NaN if it does not before t_stop)."""
-    a = f_accel(fc, t0)
-    if abs(a) > level:
-        return t0
-    slope = fc[6]
-    if slope == 0.0:
-        return math.nan
-    target = level if slope > 0.0 else -level
-    t = t0 + (target - a) / slope
-    return t if t < t_stop else math.nan
-
-
-@njit(cache=True)
 def _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, dt):
     """The block at rest: 0 no ground motion left (rests to the end), 1 the segment ends
     first, 2 it lifts (a harmonic's exceedance from its formula, a line's from the line)
@@ -102,10 +88,10 @@ def _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, dt):
             kind, t_stop = 0, mo[5]
     else:
         if kind_fc == LINEAR:
-            t_up = _linear_exceedance(fc, t, blk[B_UPLIFT], seg_end)
+            t_up = linear_exceedance(fc, t, blk[B_UPLIFT], seg_end)
         else:
-            t_up = next_exceedance(t, blk[B_UPLIFT], fc[1], fc[2], fc[3], min(mo[4], mo[5]))
-        if math.isnan(t_up) or t_up >= seg_end:
+            t_up = sine_exceedance(t, blk[B_UPLIFT], fc[1], fc[2], fc[3], min(mo[4], mo[5]))
+        if t_up < 0.0 or t_up >= seg_end:  # -1: none
             kind, t_stop = 1, seg_end
         else:
             kind, t_stop = 2, t_up
@@ -177,8 +163,10 @@ def _segment(blk, st, cnt, mo, se, fc, seg_end, can_stop, samples, pc, acc):
                 return GOING
         if cnt[PIECES] >= se[0]:
             return FAILED_STEPS
-        if cnt[PIECES] % CLOCK_EVERY == CLOCK_EVERY - 1 and clock() > se[2]:
-            return FAILED_WALL
+        if cnt[PIECES] % CLOCK_EVERY == CLOCK_EVERY - 1:
+            guard = poll(se[2])
+            if guard != GO_ON:
+                return FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
         code = _piece(blk, st, cnt, fc, seg_end, can_stop, se, samples, pc, acc)
         if code != GOING:
             return code

@@ -39,6 +39,21 @@ def f_accel(fc, t):
 
 
 @njit(cache=True)
+def linear_exceedance(fc, t0, level, t_stop):
+    """First t in [t0, t_stop) with |a_g(t)| > level [m/s^2] under a linear forcing fc:
+    t0 when already above, else where |a_g| reaches level (-1 if not before t_stop [s])."""
+    a = f_accel(fc, t0)
+    if abs(a) > level:
+        return t0
+    slope = fc[6]
+    if slope == 0.0:
+        return -1.0
+    target = level if slope > 0.0 else -level
+    t = t0 + (target - a) / slope
+    return t if t < t_stop else -1.0
+
+
+@njit(cache=True)
 def f_peak(fc, t, h):
     """Bound of |a_g| on [t, t + h] [m/s^2]."""
     kind = int(fc[0])

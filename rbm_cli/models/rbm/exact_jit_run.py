@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
-from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel
+from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.exact_jit_peaks import NOTES, new_notes, note_interval, settle_peaks
 from rbm_cli.models.rbm.exact_jit_piece import (
     cross,
@@ -192,21 +192,6 @@ def _handle(mdl, pc, row, s, se):
 
 
 @njit(cache=True)
-def _linear_exceedance(fc, t0, level, t_stop):
-    """First t in [t0, t_stop) with |a_g(t)| > level under a linear forcing fc: t0 when
-    already above, else where |a_g| reaches level (-1 if it does not before t_stop)."""
-    a = f_accel(fc, t0)
-    if abs(a) > level:
-        return t0
-    slope = fc[6]
-    if slope == 0.0:
-        return -1.0
-    target = level if slope > 0.0 else -level
-    t = t0 + (target - a) / slope
-    return t if t < t_stop else -1.0
-
-
-@njit(cache=True)
 def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
     """A rigid monolith at rest (exact._leave_rest): 0 no ground motion left (rests to
     the end), 1 the segment ends first, 2 it lifts (a harmonic's exceedance from its
@@ -220,7 +205,7 @@ def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
             kind, t_stop = 0, mo[5]
     else:
         if kind_fc == LINEAR:
-            t_up = _linear_exceedance(fc, t, mdl.uplift_level, seg_end)
+            t_up = linear_exceedance(fc, t, mdl.uplift_level, seg_end)
         else:
             t_up = sine_exceedance(t, mdl.uplift_level, fc[1], fc[2], fc[3], min(mo[4], mo[5]))
         if t_up < 0.0 or t_up >= seg_end:  # -1: none

@@ -204,7 +204,7 @@ def _segment(
         stop_ok = can_stop and housner_energy(y[0], y[1], blk.alpha, blk.p) < blk.barrier * (
             1.0 - STOP_MARGIN
         )
-        stepper = _METHODS[solver.method]
+        stepper = _METHODS[step_method(solver)]  # auto: DOP853
         integ = stepper(eqs.rhs, run.t, y, seg_end, rtol=solver.rtol, atol=blk.atol)
         integ.knots = motion.knots if motion.clipped else None  # a record's samples
         kind = _step_to_event(blk, run, eqs, integ, stop_ok)

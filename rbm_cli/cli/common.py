@@ -104,31 +104,40 @@ def compile_notice(cfg) -> None:
 
 
 def first_use(cfg):
-    """The config one run is integrated with. On a first use (the compiled kernel not in
-    numba's cache) the kernel compiles in a background process and this run is integrated
-    by the Python loop, the same method and tolerances (the returned config says
-    ``solver.implementation: python``, so the run's summary does too); with
-    RBM_BACKGROUND_COMPILE=0, or when no background compile can start, the kernel
-    compiles here first, as a note says."""
+    """The config one run is integrated with. On a first use (the compiled kernel, or the
+    rigid block's compiled closed form, not in numba's cache) it compiles in a background
+    process and this run is integrated by the Python loop (the returned config says
+    ``solver.implementation: python``, so the run's summary does too): the same method and
+    tolerances for the kernel, the step integrator DOP853 for the closed form. With
+    RBM_BACKGROUND_COMPILE=0, or when no background compile can start, it compiles here
+    first, as a note says (the kernel's)."""
     from rbm_cli.models.methods import compiled_code
 
-    if compiled_code(cfg) != "kernel":  # Python, or the closed form (compiles in seconds)
+    code = compiled_code(cfg)
+    if code is None:  # Python, or a model without compiled code
         return cfg
     from rbm_cli.models.rbm import compile_ahead
-    from rbm_cli.models.rbm.kernel import needs_compile
 
-    if not (compile_ahead.compiling_elsewhere() or needs_compile()):
+    if code == "closed-form":
+        from rbm_cli.models.rbm.closed_form import needs_compile
+
+        first = needs_compile()
+        what = "the rigid block's compiled closed form is compiling in the background (first"
+        how = "about 6 s); this run uses the Python step integrator (DOP853)"
+    else:
+        from rbm_cli.models.rbm.kernel import needs_compile
+
+        first = compile_ahead.compiling_elsewhere() or needs_compile()
+        what = "the compiled integrator is compiling in the background (first"
+        how = "about 20 s); this run uses the Python integrator (the same method and tolerances)"
+    if not first:
         return cfg
-    if compile_ahead.start():
-        click.echo(
-            "note: the compiled integrator is compiling in the background (first use only,"
-            " about 20 s); this run uses the Python integrator (the same method and"
-            " tolerances)",
-            err=True,
-        )
+    if compile_ahead.start(code):
+        click.echo(f"note: {what} use only, {how}", err=True)
         solver = dataclasses.replace(cfg.solver, implementation="python")
         return dataclasses.replace(cfg, solver=solver)
-    click.echo("note: compiling the integrator (first use only, about 20 s)", err=True)
+    if code == "kernel":
+        click.echo("note: compiling the integrator (first use only, about 20 s)", err=True)
     return cfg
 
 

@@ -69,14 +69,17 @@ def compiled_code(config: Config) -> str | None:
     return "closed-form" if method == "closed-form" else "kernel"
 
 
-def load_closed_form() -> float:
+def load_closed_form(wait=None) -> float:
     """Compile (or load from numba's cache) the block's closed form in this process, e.g.
     before a sweep's workers start, so that they load it instead of each compiling it;
-    returns the time it took [s]."""
+    returns the time it took [s]. wait: called first when the closed form is not in the
+    cache (compile_ahead.wait: a compile an earlier `rbm run` started, not a second one)."""
     import time
 
-    from rbm_cli.models.rbm.closed_form import warm_up
+    from rbm_cli.models.rbm.closed_form import needs_compile, warm_up
 
     start = time.perf_counter()
+    if wait is not None and needs_compile():
+        wait()
     warm_up()
     return time.perf_counter() - start

@@ -384,9 +384,10 @@ def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str |
     codes = {compiled_code(p.config) for p in points} - {None}
     if not (todo and codes):
         return 0.0
-    if codes == {"closed-form"}:  # the block's closed form only: no kernel to load
-        return load_closed_form()
     from rbm_cli.models.rbm.compile_ahead import wait
+
+    if codes == {"closed-form"}:  # the block's closed form only: no kernel to load
+        return load_closed_form(wait)
     from rbm_cli.models.rbm.kernel import needs_compile, warm_up
 
     if backend == "dask" and scheduler and needs_compile() is False:

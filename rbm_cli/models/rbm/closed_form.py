@@ -206,6 +206,14 @@ def integrate_closed_form(
                            record=record, output_dt=output_dt, early_stop=early_stop)  # fmt: skip
 
 
+def needs_compile() -> bool | None:
+    """Whether the closed form has no usable on-disk cache (kernel.cache_empty): its first
+    use then compiles it (about 6 s)."""
+    from rbm_cli.models.rbm.kernel import cache_empty
+
+    return cache_empty(run_block)
+
+
 def warm_up() -> None:
     """Compile (or load from the cache) the closed form once, e.g. in a worker: a run
     under a harmonic and one under a record (their forcings take other branches)."""

@@ -1,4 +1,5 @@
-"""First use without the wait: the kernel compiles in a process of its own.
+"""First use without the wait: the kernel (or the rigid block's closed form) compiles in a
+process of its own.
 
 The compiled kernel takes 15-20 s to compile on a fresh installation (45-60 s on a loaded
 machine), once; numba then keeps it in its on-disk cache. ``rbm run`` on an empty cache
@@ -14,6 +15,10 @@ exits (the lock belongs to the open file, not to a process: the parent's copy cl
 child's keeps it). A compile that dies releases the lock with its process; the next use
 then compiles in the foreground. The child's output goes to ``rbm-compile.log`` beside the
 lock.
+
+The rigid block's compiled closed form (the default `auto` there) is started the same way
+(``start("closed-form")``); its first run is answered by the Python step integrator
+(DOP853, the same tolerances as the step kernel).
 
 ``RBM_BACKGROUND_COMPILE=0`` turns this off: the first run compiles in the foreground.
 """
@@ -80,10 +85,15 @@ def compiling_elsewhere() -> bool:
         os.close(fd)  # closing releases a lock taken here
 
 
-def start() -> bool:
-    """Start the background compile, unless one already runs. True when a compile runs in
-    another process after the call; False when none could be started (switched off, no
-    cache folder, not writable): the caller then compiles in the foreground."""
+#: What a background compile can compile: its warm_up's module.
+TARGETS = {"kernel": "rbm_cli.models.rbm.kernel", "closed-form": "rbm_cli.models.rbm.closed_form"}
+
+
+def start(target: str = "kernel") -> bool:
+    """Start the background compile of target (TARGETS), unless a compile already runs.
+    True when a compile runs in another process after the call; False when none could be
+    started (switched off, no cache folder, not writable): the caller then compiles in the
+    foreground."""
     if os.environ.get(ENV_SWITCH, "1").strip() == "0":
         return False
     fd = _open_lock()
@@ -95,7 +105,7 @@ def start() -> bool:
         folder = cache_folder()
         with open(folder / LOG_NAME, "ab") as log:
             subprocess.Popen(
-                [sys.executable, "-m", __name__, str(fd)],
+                [sys.executable, "-m", __name__, str(fd), target],
                 pass_fds=(fd,),
                 stdin=subprocess.DEVNULL,
                 stdout=log,
@@ -119,20 +129,21 @@ def wait(poll_s: float = POLL_S) -> float:
     return time.perf_counter() - start_t
 
 
-def _main(fd: int) -> None:
-    """The background process: compile (or load) the kernel into the cache, holding the
-    lock (fd) until it exits."""
+def _main(fd: int, target: str = "kernel") -> None:
+    """The background process: compile (or load) the target (TARGETS) into the cache,
+    holding the lock (fd) until it exits."""
+    import importlib
+
     try:
         os.nice(10)  # leave the CPU to the run that started it
     except OSError:
         pass
-    from rbm_cli.models.rbm.kernel import warm_up
-
+    warm_up = importlib.import_module(TARGETS[target]).warm_up
     start_t = time.perf_counter()
     warm_up()
-    print(f"rbm: kernel compiled in {time.perf_counter() - start_t:.1f} s (pid {os.getpid()})")
+    print(f"rbm: {target} compiled in {time.perf_counter() - start_t:.1f} s (pid {os.getpid()})")
     os.close(fd)
 
 
 if __name__ == "__main__":
-    _main(int(sys.argv[1]))
+    _main(int(sys.argv[1]), *sys.argv[2:3])

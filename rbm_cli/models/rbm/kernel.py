@@ -121,16 +121,21 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
 
 def needs_compile() -> bool | None:
     """Whether the kernel has no usable on-disk cache: its first use then compiles it
-    (about 15-20 s, once per installation).
+    (about 15-20 s, once per installation). See cache_empty."""
+    return cache_empty(run_kernel)
+
+
+def cache_empty(dispatcher) -> bool | None:
+    """Whether a compiled function has no usable on-disk cache.
 
     Returns
     -------
-    bool or None  True: numba's cache index of run_kernel is missing, stale (source
-        or numba changed) or empty; False: it holds a compiled kernel; None: cannot
+    bool or None  True: numba's cache index of the function is missing, stale (source
+        or numba changed) or empty; False: it holds a compiled version; None: cannot
         tell (numba's cache internals are not the ones read here, or caching is off).
     """
     try:
-        index = run_kernel._cache._cache_file
+        index = dispatcher._cache._cache_file
         overloads = index._load_index()
     except Exception:  # numba's private cache API changed: say so, change nothing else
         return None
@@ -155,6 +160,7 @@ def warm_up() -> None:
 
 __all__ = [
     "PreparedModel",
+    "cache_empty",
     "integrate_compiled",
     "model_arrays",
     "needs_compile",

@@ -223,3 +223,22 @@ def package_dispatchers() -> list:
                 if hasattr(obj, "_cache"):
                     found.append(obj)
     return found
+
+
+def cache_empty(dispatcher) -> bool | None:
+    """Whether a compiled function has no usable on-disk cache.
+
+    Returns
+    -------
+    bool or None  True: numba's cache index of the function is missing, stale (source
+        or numba changed) or empty; False: it holds a compiled version; None: cannot
+        tell (numba's cache internals are not the ones read here, or caching is off).
+    """
+    try:
+        index = dispatcher._cache._cache_file
+        overloads = index._load_index()
+    except Exception:  # numba's private cache API changed: say so, change nothing else
+        return None
+    if not isinstance(overloads, dict):
+        return None
+    return not overloads

@@ -23,11 +23,12 @@ from typing import NamedTuple
 
 import numpy as np
 
+from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import CLOSED_FORM_KINDS, G
 from rbm_cli.models.events import EVENT_EPS, REST_RATE
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.rbm import closed_form_jit_run as cr
+from rbm_cli.models.rbm import run_codes as cr
 from rbm_cli.models.rbm.closed_form_jit_run import run_block
 from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, HARMONIC
 from rbm_cli.models.rbm.forcing_arrays import record_arrays
@@ -207,10 +208,8 @@ def integrate_closed_form(
 
 
 def needs_compile() -> bool | None:
-    """Whether the closed form has no usable on-disk cache (kernel.cache_empty): its first
-    use then compiles it (about 6 s)."""
-    from rbm_cli.models.rbm.kernel import cache_empty
-
+    """Whether the closed form has no usable on-disk cache (compile_cache.cache_empty): its
+    first use then compiles it (about 6 s)."""
     return cache_empty(run_block)
 
 

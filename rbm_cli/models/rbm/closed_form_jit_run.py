@@ -40,9 +40,18 @@ from rbm_cli.models.rbm.closed_form_jit import (
 from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.kernel_ground import sine_exceedance
 from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
+from rbm_cli.models.rbm.run_codes import (
+    AT_REST_END,
+    COLLAPSED,
+    FAILED_EVENTS,
+    FAILED_STEPS,
+    FAILED_WALL,
+    GOING,
+    INTERRUPTED,
+    STOPPED_EARLY,
+    SURVIVED,
+)
 
-GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
-FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
 T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE = range(10)
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)
 #: Energy margin of the early stop [fraction of the barrier] (housner_state.STOP_MARGIN).

@@ -15,7 +15,12 @@ from typing import NamedTuple
 import numpy as np
 
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.rbm.exact_jit_run import (
+from rbm_cli.models.rbm.exact_jit_run import run_exact
+from rbm_cli.models.rbm.exact_jit_state import ExactModel, exact_model, new_cache
+from rbm_cli.models.rbm.exact_motion import check_exact
+from rbm_cli.models.rbm.forcing_arrays import motion_arrays, record_arrays  # noqa: F401
+from rbm_cli.models.rbm.kernel_guard import arm, disarm
+from rbm_cli.models.rbm.run_codes import (
     AT_REST_END,
     COLLAPSED,
     FAILED_EVENTS,
@@ -23,12 +28,7 @@ from rbm_cli.models.rbm.exact_jit_run import (
     FAILED_WALL,
     INTERRUPTED,
     STOPPED_EARLY,
-    run_exact,
 )
-from rbm_cli.models.rbm.exact_jit_state import ExactModel, exact_model, new_cache
-from rbm_cli.models.rbm.exact_motion import check_exact
-from rbm_cli.models.rbm.forcing_arrays import motion_arrays, record_arrays  # noqa: F401
-from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 

@@ -33,9 +33,18 @@ from rbm_cli.models.rbm.exact_jit_search import SCRATCH, next_point
 from rbm_cli.models.rbm.exact_jit_state import energy1, friction
 from rbm_cli.models.rbm.kernel_ground import sine_exceedance
 from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
+from rbm_cli.models.rbm.run_codes import (
+    AT_REST_END,
+    COLLAPSED,
+    FAILED_EVENTS,
+    FAILED_STEPS,
+    FAILED_WALL,
+    GOING,
+    INTERRUPTED,
+    STOPPED_EARLY,
+    SURVIVED,
+)
 
-GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
-FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
 #: Steps between two polls of the wall clock and Ctrl-C (kernel_guard.poll).

@@ -28,6 +28,7 @@ import time
 
 import numpy as np
 
+from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.kernel_guard import arm, disarm, poll
 from rbm_cli.models.rbm.kernel_inputs import (
@@ -121,27 +122,8 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
 
 def needs_compile() -> bool | None:
     """Whether the kernel has no usable on-disk cache: its first use then compiles it
-    (about 15-20 s, once per installation). See cache_empty."""
+    (about 15-20 s, once per installation). See base.compile_cache.cache_empty."""
     return cache_empty(run_kernel)
-
-
-def cache_empty(dispatcher) -> bool | None:
-    """Whether a compiled function has no usable on-disk cache.
-
-    Returns
-    -------
-    bool or None  True: numba's cache index of the function is missing, stale (source
-        or numba changed) or empty; False: it holds a compiled version; None: cannot
-        tell (numba's cache internals are not the ones read here, or caching is off).
-    """
-    try:
-        index = dispatcher._cache._cache_file
-        overloads = index._load_index()
-    except Exception:  # numba's private cache API changed: say so, change nothing else
-        return None
-    if not isinstance(overloads, dict):
-        return None
-    return not overloads
 
 
 def warm_up() -> None:
@@ -160,7 +142,6 @@ def warm_up() -> None:
 
 __all__ = [
     "PreparedModel",
-    "cache_empty",
     "integrate_compiled",
     "model_arrays",
     "needs_compile",

@@ -90,3 +90,15 @@ class Outcome:
             self.stop("failed", "g + a_v(t) <= 0: the ground drops faster than gravity and"
                       " the column leaves it (excitation.vertical)", t_lift)  # fmt: skip
         return self
+
+
+def sample_buffer(t_end: float, output_dt: float, record: bool, n: int) -> np.ndarray:
+    """The rows (t [s], theta [n] [rad], rate [n] [rad/s]) a compiled run fills every
+    output_dt [s] up to t_end [s]; none unless record."""
+    rows = int(math.floor(t_end / output_dt + 1e-9)) + 2 if record else 0
+    return np.zeros((rows, 1 + 2 * n))
+
+
+def sample_rows(samples: np.ndarray, count: int, n: int) -> list:
+    """Outcome.samples from the first count rows of a sample_buffer."""
+    return [(float(r[0]), r[1 : 1 + n].copy(), r[1 + n :].copy()) for r in samples[:count]]

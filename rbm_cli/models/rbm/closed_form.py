@@ -18,7 +18,6 @@ its cache; base/compile_cache keys that cache on these modules' sources).
 from __future__ import annotations
 
 import math
-import time
 from typing import NamedTuple
 
 import numpy as np
@@ -27,11 +26,11 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import CLOSED_FORM_KINDS, G
 from rbm_cli.models.events import EVENT_EPS, REST_RATE
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm import run_codes as cr
 from rbm_cli.models.rbm.closed_form_jit_run import run_block
 from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, HARMONIC
-from rbm_cli.models.rbm.forcing_arrays import record_arrays
+from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings
 from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
@@ -165,13 +164,8 @@ def run_closed_form(
     (t, [theta], [rate]) every output_dt [s] when record.
     """
     seg_t, seg_fc = seg if seg is not None else block_segments(motion)
-    mo = np.array([1.0 if motion.is_pulse else 0.0, motion.amplitude, motion.omega,
-                   motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
-    deadline = time.monotonic() + float(solver.max_wall_time)
-    se = np.array([solver.max_steps, solver.max_events, deadline, float(early_stop),
-                   float(record), output_dt], dtype=float)  # fmt: skip
-    n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
-    samples = np.zeros((n_max, 3))
+    mo, se = run_settings(motion, solver, early_stop, record, output_dt)
+    samples = sample_buffer(motion.t_end, output_dt, record, 1)
     armed = arm()  # Ctrl-C reaches the run through poll (kernel_guard)
     try:
         code, st, cnt = run_block(block.params, seg_t, seg_fc, mo, se, float(theta0),
@@ -185,7 +179,7 @@ def run_closed_form(
     out.n_events = int(cnt[4]) if block.rbm else out.n_uplifts + out.n_impacts
     _messages(block, code, out, solver)
     if record:
-        out.samples = [(float(s[0]), s[1:2].copy(), s[2:3].copy()) for s in samples[: int(st[8])]]
+        out.samples = sample_rows(samples, int(st[8]), 1)
     return out
 
 

@@ -34,6 +34,7 @@ import math
 
 from numba import njit
 
+from rbm_cli.models.rbm.brent import brent_step
 from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, LINEAR, f_phase
 
 #: A piece: start time t0 [s], side s, C [rad], omega [rad/s], phi0 [rad], q0 [rad],
@@ -136,31 +137,11 @@ def brent(pc, which, shift, xa, xb, acc):
         return xcur
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
     for _ in range(200):
-        if fpre != 0.0 and fcur != 0.0 and (fpre < 0.0) != (fcur < 0.0):
-            xblk, fblk = xpre, fpre
-            spre = scur = xcur - xpre
-        if abs(fblk) < abs(fcur):
-            xpre, xcur, xblk = xcur, xblk, xcur
-            fpre, fcur, fblk = fcur, fblk, fcur
-        delta = 0.5 * (XTOL + RTOL * abs(xcur))
-        sbis = 0.5 * (xblk - xcur)
-        if fcur == 0.0 or abs(sbis) < delta:
+        done, xpre, xcur, xblk, fpre, fblk, spre, scur = brent_step(
+            xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, XTOL, RTOL
+        )
+        if done:
             return xcur
-        if abs(spre) > delta and abs(fcur) < abs(fpre):
-            if xpre == xblk:
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)
-            else:
-                dpre = (fpre - fcur) / (xpre - xcur)
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
-                spre, scur = scur, stry
-            else:
-                spre, scur = sbis, sbis
-        else:
-            spre, scur = sbis, sbis
-        xpre, fpre = xcur, fcur
-        xcur += scur if abs(scur) > delta else (delta if sbis > 0.0 else -delta)
         fcur = _value(pc, which, shift, xcur)
         acc[A_EVALS] += 1
     return xcur

@@ -39,17 +39,15 @@ from rbm_cli.models.rbm.closed_form_jit import (
 )
 from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.kernel_ground import sine_exceedance
-from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
 from rbm_cli.models.rbm.run_codes import (
     AT_REST_END,
     COLLAPSED,
     FAILED_EVENTS,
     FAILED_STEPS,
-    FAILED_WALL,
     GOING,
-    INTERRUPTED,
     STOPPED_EARLY,
     SURVIVED,
+    guard_code,
 )
 
 T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE = range(10)
@@ -173,9 +171,9 @@ def _segment(blk, st, cnt, mo, se, fc, seg_end, can_stop, samples, pc, acc):
         if cnt[PIECES] >= se[0]:
             return FAILED_STEPS
         if cnt[PIECES] % CLOCK_EVERY == CLOCK_EVERY - 1:
-            guard = poll(se[2])
-            if guard != GO_ON:
-                return FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
+            code = guard_code(se[2])
+            if code != GOING:
+                return code
         code = _piece(blk, st, cnt, fc, seg_end, can_stop, se, samples, pc, acc)
         if code != GOING:
             return code

@@ -9,16 +9,15 @@ The modes of every set of law pieces met are cached across the runs of one colum
 from __future__ import annotations
 
 import math
-import time
 from typing import NamedTuple
 
 import numpy as np
 
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact_jit_run import run_exact
 from rbm_cli.models.rbm.exact_jit_state import ExactModel, exact_model, new_cache
 from rbm_cli.models.rbm.exact_motion import check_exact
-from rbm_cli.models.rbm.forcing_arrays import motion_arrays, record_arrays  # noqa: F401
+from rbm_cli.models.rbm.forcing_arrays import motion_arrays, run_settings
 from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.models.rbm.run_codes import (
     AT_REST_END,
@@ -96,13 +95,8 @@ def integrate_exact_compiled(
     if prepared is None:
         prepared = prepare_exact(model)
     n = model.n
-    mo = np.array([1.0 if motion.is_pulse else 0.0, motion.amplitude, motion.omega,
-                   motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
-    deadline = time.monotonic() + float(solver.max_wall_time)
-    se = np.array([solver.max_steps, solver.max_events, deadline, float(early_stop),
-                   float(record), output_dt], dtype=float)  # fmt: skip
-    n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
-    samples = np.zeros((n_max, 1 + 2 * n))
+    mo, se = run_settings(motion, solver, early_stop, record, output_dt)
+    samples = sample_buffer(motion.t_end, output_dt, record, n)
     armed = arm()  # Ctrl-C reaches the run through poll (kernel_guard)
     try:
         code, st, cnt, maxima, fric = run_exact(
@@ -113,9 +107,7 @@ def integrate_exact_compiled(
         disarm(armed)
     out = _outcome(code, st, cnt, maxima, fric, solver, n)
     if record:
-        out.samples = [
-            (s[0], s[1 : 1 + n].copy(), s[1 + n :].copy()) for s in samples[: int(st[5])]
-        ]
+        out.samples = sample_rows(samples, int(st[5]), n)
     return out
 
 

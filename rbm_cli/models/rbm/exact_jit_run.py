@@ -32,17 +32,15 @@ from rbm_cli.models.rbm.exact_jit_piece import (
 from rbm_cli.models.rbm.exact_jit_search import SCRATCH, next_point
 from rbm_cli.models.rbm.exact_jit_state import energy1, friction
 from rbm_cli.models.rbm.kernel_ground import sine_exceedance
-from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
 from rbm_cli.models.rbm.run_codes import (
     AT_REST_END,
     COLLAPSED,
     FAILED_EVENTS,
     FAILED_STEPS,
-    FAILED_WALL,
     GOING,
-    INTERRUPTED,
     STOPPED_EARLY,
     SURVIVED,
+    guard_code,
 )
 
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
@@ -116,9 +114,7 @@ def _budget(s, se):
     if s.cnt[STEPS] > se[0]:
         return FAILED_STEPS
     if s.cnt[STEPS] % CLOCK_EVERY == 0:
-        guard = poll(se[2])
-        if guard != GO_ON:
-            return FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
+        return guard_code(se[2])
     return GOING
 
 

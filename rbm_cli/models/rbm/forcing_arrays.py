@@ -7,6 +7,8 @@ FORCING_SIZE): its forcing (exact_jit_modal: zero, harmonic or linear).
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, LINEAR, ZERO, forcing_array
@@ -59,3 +61,18 @@ def motion_arrays(
         check_exact(model, motion.kind, motion.has_vertical)
         return record_arrays(motion)
     return segment_arrays(resolve_segments(model, motion, segments))
+
+
+def run_settings(
+    motion: GroundMotion, solver, early_stop: bool, record: bool, output_dt: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """(mo, se) of one run of a compiled closed-form loop: the motion
+    mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and the settings
+    se = [max_steps, max_events, deadline (monotonic clock, from solver.max_wall_time),
+    early_stop, record, output_dt]."""
+    mo = np.array([1.0 if motion.is_pulse else 0.0, motion.amplitude, motion.omega,
+                   motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
+    deadline = time.monotonic() + float(solver.max_wall_time)
+    se = np.array([solver.max_steps, solver.max_events, deadline, float(early_stop),
+                   float(record), output_dt], dtype=float)  # fmt: skip
+    return mo, se

@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.kernel_guard import arm, disarm, poll
 from rbm_cli.models.rbm.kernel_inputs import (
     PreparedModel,
@@ -72,8 +72,7 @@ def integrate_compiled(
     if prepared is None:
         prepared = prepare_kernel(model)
     n = model.n
-    n_max = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
-    samples = np.zeros((n_max, 1 + 2 * n))
+    samples = sample_buffer(motion.t_end, output_dt, record, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)
     # a RunTask, as a plain tuple (kernel_inputs)
@@ -97,9 +96,7 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
         n_events=int(n_ev),
     )  # fmt: skip
     if record:
-        out.samples = [
-            (float(r[0]), r[1 : 1 + n].copy(), r[1 + n :].copy()) for r in samples[:n_out]
-        ]
+        out.samples = sample_rows(samples, n_out, n)
     if code == COLLAPSED:
         out.collapse(float(t_col), int(c_if))
     elif code == STOPPED_EARLY:

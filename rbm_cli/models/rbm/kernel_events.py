@@ -12,6 +12,7 @@ import numpy as np
 from numba import njit
 
 from rbm_cli.base.detmath import dot, matvec
+from rbm_cli.models.rbm.brent import brent_step
 from rbm_cli.models.rbm.kernel_rk import TAB_NP
 from rbm_cli.models.rbm.kernel_vertical import add_moving, moving_rate, moving_value
 
@@ -89,34 +90,11 @@ def _brentq(mc, xa, xb, t_old, h, coef, base, mv):
     if fcur == 0.0:
         return xcur
     for _ in range(MAXITER):
-        if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
-            xblk, fblk = xpre, fpre
-            spre = scur = xcur - xpre
-        if abs(fblk) < abs(fcur):
-            xpre, xcur, xblk = xcur, xblk, xcur
-            fpre, fcur, fblk = fcur, fblk, fcur
-        delta = (XTOL + RTOL * abs(xcur)) / 2.0
-        sbis = (xblk - xcur) / 2.0
-        if fcur == 0.0 or abs(sbis) < delta:
+        done, xpre, xcur, xblk, fpre, fblk, spre, scur = brent_step(
+            xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, XTOL, RTOL
+        )
+        if done:
             return xcur
-        if abs(spre) > delta and abs(fcur) < abs(fpre):
-            if xpre == xblk:
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)
-            else:
-                dpre = (fpre - fcur) / (xpre - xcur)
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
-                spre, scur = scur, stry
-            else:
-                spre, scur = sbis, sbis
-        else:
-            spre, scur = sbis, sbis
-        xpre, fpre = xcur, fcur
-        if abs(scur) > delta:
-            xcur += scur
-        else:
-            xcur += delta if sbis > 0 else -delta
         fcur = _row_val(mc, xcur, t_old, h, coef, base, mv)
     return xcur
 

@@ -13,7 +13,7 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import GridConfig
 from rbm_cli.study.domain import boundary, compare, read_domain
-from rbm_cli.study.sweep import JOURNAL, grid_cells
+from rbm_cli.study.sweep import JOURNAL, config_hash, grid_cells
 
 from .paths import CONFIGS
 
@@ -162,3 +162,33 @@ def test_sweep_killed_with_sigkill_then_resumed(tmp_path):
     assert f"({n_cells - n_before} run, {n_before} resumed)" in resumed.stdout
     straight = run_sweep(load_config(cfg_path), tmp_path / "straight", jobs=2)
     assert (folder / "domain.csv").read_bytes() == (straight.folder / "domain.csv").read_bytes()
+
+
+@pytest.mark.parametrize("started, resumed", [("DOP853", "auto"), ("auto", "DOP853")])
+def test_a_resume_keeps_the_method_its_journal_was_started_with(tmp_path, started, resumed):
+    """`auto` and `DOP853` hash the same (stored domains keep their hashes), yet on the
+    rigid block `auto` runs the closed form and `DOP853` the step kernel, whose peaks
+    differ in the last digits. A journal started under one and resumed under the other
+    finishes by the method it was started with: the domain is byte for byte a straight
+    run of the journal's config, and meta.json names that one method."""
+    base = load_config(CONFIGS / "spanos_koh_slender.yaml")
+
+    def method(name):
+        return dataclasses.replace(base, solver=dataclasses.replace(base.solver, method=name))
+
+    first, second = method(started), method(resumed)
+    assert config_hash(first) == config_hash(second)
+    straight = {m: run_sweep(method(m), tmp_path / m, jobs=1).folder for m in (started, resumed)}
+    domains = {m: (folder / "domain.csv").read_bytes() for m, folder in straight.items()}
+    assert domains[started] != domains[resumed]  # the two methods tell apart
+    with pytest.raises(RbmError, match="stopped after 2 chunks"):
+        run_sweep(first, tmp_path / "cut", jobs=1, stop_after=2)
+    notes = []
+    summary = run_sweep(second, tmp_path / "cut", jobs=1, resume=True, notify=notes.append)
+    assert 0 < summary.n_resumed < summary.n_cells
+    assert any(f"resumed with solver.method {started}," in n for n in notes), notes
+    assert (summary.folder / "domain.csv").read_bytes() == domains[started]
+    meta = json.loads((summary.folder / "meta.json").read_text())
+    expected = json.loads((straight[started] / "meta.json").read_text())["solver_method"]
+    assert meta["solver_method"] == expected
+    assert meta["solver_method"] == ("closed-form" if started == "auto" else "DOP853")

@@ -5,7 +5,8 @@ A sweep of config <name> writes OUTPUT/<name>/:
 - ``.sweep.lock``: held (``flock``) by the one sweep that writes the folder. The kernel
   releases it when that process ends, however it ends, so a killed sweep leaves no stale
   lock; a second sweep into the folder is refused in one line.
-- ``domain.partial.jsonl``, the journal: a header line (the config's hash), then one
+- ``domain.partial.jsonl``, the journal: a header line (the config's hash and its
+  solver.method as written, which a resume keeps: rbm_cli.study.sweep), then one
   JSON row per finished cell, each carrying the hash too, appended and fsync'ed chunk by
   chunk. Every row read back is validated (types, ranges, status values, status and
   collapsed agreeing, the cell in the grid, the hash); a row that fails is not trusted but
@@ -63,6 +64,7 @@ class JournalRead:
     rejected: int = 0  # lines that failed validation (run again)
     first_problem: str = ""
     cut: bool = False  # the last line was cut (no newline: a kill while writing)
+    solver_method: str | None = None  # the header's solver.method (None: not recorded)
 
 
 def _umask() -> int:
@@ -244,6 +246,8 @@ class SweepStore:
                 if isinstance(row.get("config_hash"), str):
                     out.hashes.add(row["config_hash"])
                     legacy = legacy or row["config_hash"] == digest
+                    if row["config_hash"] == digest and isinstance(row.get("solver_method"), str):
+                        out.solver_method = row["solver_method"]
                 continue
             if isinstance(row, dict) and isinstance(row.get("config_hash"), str):
                 out.hashes.add(row["config_hash"])
@@ -274,15 +278,20 @@ class SweepStore:
         _fsync_dir(self.folder)
         return target
 
-    def start_journal(self, digest: str, n_cells: int, resume_command: str) -> None:
+    def start_journal(
+        self, digest: str, n_cells: int, resume_command: str, solver_method: str | None = None
+    ) -> None:
         """A new journal (header line) and state file, replacing none: the caller has
-        made sure no journal is here (or set it aside)."""
+        made sure no journal is here (or set it aside). solver_method: the config's
+        solver.method as written (auto, DOP853, ...), kept for the resume."""
         header = {
             "rbm_journal": JOURNAL_FORMAT,
             "config_hash": digest,
             "n_cells": n_cells,
             "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         }
+        if solver_method is not None:
+            header["solver_method"] = solver_method
         self._write_small(self.journal, json.dumps(header) + "\n")
         self.write_state(digest, n_cells, resume_command)
 

@@ -44,7 +44,7 @@ from rbm_cli.study.cells import (
 from rbm_cli.study.parallel import run_chunks
 from rbm_cli.study.robustness import Member, member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
-from rbm_cli.study.sweep_folder import prepare_folder, publish_result, sweep_meta
+from rbm_cli.study.sweep_folder import as_started, prepare_folder, publish_result, sweep_meta
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -202,8 +202,8 @@ def run_sweep(
     jobs : int  Worker processes (joblib); 1 runs in this process
     backend : str  joblib backend: loky (default), threading, sequential or
         dask (a Dask distributed cluster at `scheduler`)
-    resume : bool  Finish an interrupted sweep of the same config; on a finished
-        folder of the same config, do nothing (the summary says already_finished)
+    resume : bool  Finish an interrupted sweep of the same config, by its journal's
+        solver.method; on a finished folder of it, do nothing (summary: already_finished)
     force : bool  Allow grids of more than MAX_CELLS cells; set aside (never delete)
         an unfinished journal, or a finished result of another config, and start again
     progress : callable(done, total)  Called before the first cell runs (after the compile;
@@ -212,8 +212,7 @@ def run_sweep(
     ensemble : int  Runs per cell (>1 adds the collapse_fraction column; see
         rbm_cli.study.robustness for the perturbations)
     notify : callable(str)  One-line notes (a journal recovered, lines not trusted...)
-    resume_command : str  The command that resumes this sweep (stored in the state
-        file and quoted in messages); default: a generic one
+    resume_command : str  The command that resumes it (state file, messages; default generic)
     figure : callable(DataFrame, Config) -> Figure  Draws domain.png (rbm_cli.api.run_sweep
         passes rbm_cli.report.domain_figure.domain_figure: the sweep does not plot)
 
@@ -231,10 +230,11 @@ def run_sweep(
     resume_command = resume_command or f"rbm sweep CONFIG.yaml -o {output} --resume"
     note = notify or (lambda text: None)
     with SweepStore(folder) as store:
-        done = prepare_folder(store, config, points, cells, digest, ensemble, resume, force,
-                              note, resume_command)  # fmt: skip
+        done, started = prepare_folder(store, config, points, cells, digest, ensemble, resume,
+                                       force, note, resume_command)  # fmt: skip
         if done is None:
             return _finished_summary(folder, n_cells)
+        config, points = as_started(config, points, started, note)
         todo = [c for c in cells if key(c) not in done]
         run = _Run(store, config, points, cells, digest, ensemble, resume_command, done)
         compile_s, wall = run.run(todo, jobs, backend, scheduler, progress, stop_after)

@@ -2,11 +2,13 @@
 
 prepare_folder decides, from what the folder holds, what a new sweep may do with it:
 finish the journal (resume), start one, or refuse; it never deletes a finished cell.
+as_started keeps a resumed sweep on the method its journal was started with;
 publish_result writes the result files and publishes them in one step.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -20,7 +22,7 @@ import pandas as pd
 
 from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import Config
+from rbm_cli.config.types import Config, hash_form
 from rbm_cli.study.cells import grid_points, key, max_drums
 from rbm_cli.study.domain import boundary, csv_text
 from rbm_cli.study.provenance import provenance
@@ -29,9 +31,10 @@ from rbm_cli.study.store import FINALS, JOURNAL, STATE
 
 
 def prepare_folder(store, config, points, cells, digest, ensemble, resume, force, note, command):
-    """The finished rows to keep (resume), {} for a new sweep, None if the folder
-    already holds this config's finished result and resume is asked. Refuses (RbmError)
-    whatever would lose finished work."""
+    """(rows, method): the finished rows to keep (resume), {} for a new sweep, None if the
+    folder already holds this config's finished result and resume is asked; and on a
+    resume the solver.method the journal was started with (None: not recorded). Refuses
+    (RbmError) whatever would lose finished work."""
     folder = store.folder
     if store.journal.exists():
         grid = {key(c) for c in cells}
@@ -40,8 +43,9 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
         ours = digest in read.hashes or store.state_hash() == digest
         n = len(read.rows) if ours else read.rejected  # rows of the other config
         if not read.rows and not read.rejected and (ours or not read.hashes):
-            store.start_journal(digest, len(cells), command)  # it held no cell: start over
-            return {}
+            # it held no cell: start over
+            store.start_journal(digest, len(cells), command, config.solver.method)
+            return {}, None
         whose = "of this config" if ours else "of another config"
         if not resume and not force:
             hint = "add --resume to finish it" if ours else "use another -o folder"
@@ -69,13 +73,13 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
             if store.state_hash() != digest:
                 note("the state file was missing or unreadable: recovered from the journal")
                 store.write_state(digest, len(cells), command)
-            return dict(read.rows)
+            return dict(read.rows), read.solver_method
     else:
         finished = store.finished_hash()
         if finished not in (None, digest) and _same_settings(folder, config, ensemble):
             finished = digest  # made before a setting with a default was added to configs
         if finished == digest and resume:
-            return None
+            return None, None
         if finished is not None and finished != digest:
             if not force:
                 act = "nothing to resume" if resume else "it is kept"
@@ -90,8 +94,26 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
                 )
             where = store.set_aside(FINALS)
             note(f"the finished domain of another config was moved to {where}")
-    store.start_journal(digest, len(cells), command)
-    return {}
+    store.start_journal(digest, len(cells), command, config.solver.method)
+    return {}, None
+
+
+def as_started(config, points, method: str | None, note) -> tuple:
+    """(config, grid points) a resumed sweep runs: with the solver.method its journal was
+    started with, where the config now spells the same hash another way (`auto` for
+    `DOP853` or back, rbm_cli.config.types.hash_form). The cells still to do then run by
+    the method the journal's cells ran by, and the domain is the one a straight run of
+    the journal's config gives."""
+    if method is None or method == config.solver.method:
+        return config, points
+    other = dataclasses.replace(config, solver=dataclasses.replace(config.solver, method=method))
+    if hash_form(other) != hash_form(config):
+        return config, points
+    note(
+        f"resumed with solver.method {method}, as its journal was started (the config says"
+        f" {config.solver.method}): the same domain as a straight run of the journal's config"
+    )
+    return other, grid_points(other)
 
 
 def publish_result(store, figure, rows, df, fields, meta, resume_command) -> None:

@@ -121,3 +121,44 @@ def test_the_gap_is_integration_error():
         assert rbm.status == lin.status == "survived"
         gaps.append(abs(rbm.max_rotation_ratio - lin.max_ratio[0]))
     assert gaps[0] > 1e-7 and gaps[1] < gaps[0] / 10, gaps
+
+
+def test_a_restart_at_theta_zero_is_not_taken_for_an_impact():
+    """The paper's tapered column as a rigid monolith under the synthetic record rdk_01 at
+    0.9 g, restitution 1: the block rocks through impacts at rates down to ~6e-4 rad/s.
+    housner-linear, with the mapped (alpha, p), started each piece after an impact at
+    theta = 0, where s theta's round-off has either sign; when it was positive, the root
+    of s theta next to the start was taken for the next impact (three within 3e-14 s, then
+    a million, and the run 'failed' on its piece budget). Now both closed forms (Python,
+    compiled) collapse after the RBM's 174 impacts, at the same time as each other; and
+    the compiled one, given the RBM's convention for where an impact is placed (s theta =
+    -eps, then theta = 0, instead of s theta = 0), at the RBM step integrator's time. The
+    two conventions' collapse times differ by ~1e-4 s after 174 impacts."""
+    from rbm_cli.config.load import parse_config
+    from rbm_cli.config.types import SolverConfig
+    from rbm_cli.models.rbm.closed_form import Block, linear_block, run_closed_form
+    from rbm_cli.models.rbm.closed_form_jit import B_AT_ZERO
+
+    cfg = parse_config({
+        "name": "restart",
+        "column": {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "drums": 1},
+        "interface": {"stiffness": "rigid", "restitution": 1.0},
+        "excitation": {"type": "record", "file": str(CONFIGS / "records/synthetic/rdk_01.AT2")},
+        "solver": {"method": "DOP853"},
+    })  # fmt: skip
+    rbm = simulate(cfg, 0.9, None)
+    assert rbm.status == "collapsed"
+    alpha, p = linear_rocking_parameters(model_from_config(cfg).column)
+    motion = make_ground_motion(cfg.excitation, 0.9, None)
+    python = housner_linear_run(alpha, p, motion, restitution=1.0)
+    block = linear_block(alpha, p, 1.0)
+    compiled = run_closed_form(block, motion, 0.0, 0.0, SolverConfig())
+    params = block.params.copy()
+    params[B_AT_ZERO] = 0.0
+    rbm_convention = run_closed_form(block._replace(params=params), motion, 0.0, 0.0,
+                                     SolverConfig())  # fmt: skip
+    for lin in (python, compiled, rbm_convention):
+        assert lin.status == "collapsed", lin.message
+        assert lin.n_impacts == rbm.n_impacts == 174
+    assert abs(python.t_collapse - compiled.t_collapse) <= 1e-8
+    assert abs(rbm_convention.t_collapse - rbm.t_collapse_s) <= 1e-7

@@ -152,12 +152,13 @@ def impact_time(pc, blk, a, b, fa, acc):
     """The impact time in [a, b], s theta(b) + eps <= 0 < s theta(a) + eps. The RBM's
     convention (blk[B_AT_ZERO] 0, the step kernel's and the exact integrator's): where s
     theta reaches -eps (the state is then projected onto theta = 0). housner-linear's
-    (housner_linear_piece.PieceScanner.impact): the root of s theta if s theta(a) > 0,
-    else of s theta + eps then two Newton steps to s theta = 0."""
+    (housner_linear_piece.PieceScanner.impact): the root of s theta if s theta(a) > eps,
+    else (s theta(a) within round-off of 0) of s theta + eps then two Newton steps to
+    s theta = 0."""
     eps = blk[B_EPS]
     if blk[B_AT_ZERO] == 0.0:
         return brent(pc, 0, eps, a, b, acc)
-    if fa > 0.0:
+    if fa > eps:
         return brent(pc, 0, 0.0, a, b, acc)
     tau = brent(pc, 0, eps, a, b, acc)
     for _ in range(2):

@@ -22,8 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import pandas as pd
-
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import Config, hash_form
@@ -44,9 +42,10 @@ from rbm_cli.study.cells import (
 from rbm_cli.study.parallel import run_chunks
 from rbm_cli.study.robustness import Member, member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
-from rbm_cli.study.sweep_folder import prepare_folder, publish_result, sweep_meta
+from rbm_cli.study.sweep_folder import prepare_folder, publish_result, status_counts, sweep_meta
 
 if TYPE_CHECKING:
+    import pandas as pd
     from matplotlib.figure import Figure
 
 #: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s).
@@ -215,7 +214,8 @@ def run_sweep(
     resume_command : str  The command that resumes this sweep (stored in the state
         file and quoted in messages); default: a generic one
     figure : callable(DataFrame, Config) -> Figure  Draws domain.png (rbm_cli.api.run_sweep
-        passes rbm_cli.report.domain_figure.domain_figure: the sweep does not plot)
+        passes rbm_cli.report.domain_figure.domain_figure: the sweep does not plot); one
+        with a ``from_rows`` method gets the rows (rbm_cli.study.sweep_folder.draw_figure)
 
     Raises
     ------
@@ -239,13 +239,12 @@ def run_sweep(
         run = _Run(store, config, points, cells, digest, ensemble, resume_command, done)
         compile_s, wall = run.run(todo, jobs, backend, scheduler, progress, stop_after)
         rows = [done[key(c)] for c in cells]
-        df = pd.DataFrame(rows, columns=list(fields))
-        counts = df["status"].value_counts().to_dict()
+        counts = status_counts(rows)
         meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble, folder)
         meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler,
                     compile_time_s=compile_s)  # fmt: skip
         try:
-            publish_result(store, lambda: figure(df, config), rows, df, fields, meta,
+            publish_result(store, figure, config, rows, fields, meta,
                            resume_command)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None

@@ -16,26 +16,26 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from rbm_cli import __version__
 from rbm_cli.base.errors import ConfigError, RbmError
-from rbm_cli.config import parse_config
-from rbm_cli.config.load import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ
+from rbm_cli.config.load import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, parse_config
 from rbm_cli.config.load import load_config as _load_file
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import RunResult
-from rbm_cli.report.domain_figure import domain_figure
-from rbm_cli.report.domain_figure import draw_domain_on as _draw_domain
+from rbm_cli.report.figure_process import domain_figure
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import history_frame
 from rbm_cli.study.domain import read_domain
 from rbm_cli.study.simulate import simulate
 from rbm_cli.study.sweep import SweepInterrupted, SweepSummary
 from rbm_cli.study.sweep import run_sweep as _run_sweep
+
+if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` never does
+    import pandas as pd
 
 __all__ = [
     "CellRun",
@@ -206,8 +206,7 @@ class CellRun:
     def history(self) -> pd.DataFrame | None:
         """history.csv's table (None unless recorded): t_s [s], ag_m_s2 [m/s^2] and ug_m [m]
         (ground), u1_m..u{n+1}_m (nodes, relative to the ground) [m], theta1_rad.. [rad]."""
-        h = self.result.history
-        return None if h is None else history_frame(h)
+        return None if self.result.history is None else history_frame(self.result.history)
 
 
 def run(
@@ -282,10 +281,9 @@ def run_sweep(
     figure_process=None,
     **kwargs,
 ) -> SweepSummary:
-    """Run a config's grid into OUTPUT/<name>/ (domain.csv, boundary.csv, domain.png,
-    meta.json): rbm_cli.study.sweep.run_sweep with rbm_cli.report.domain_figure (or
-    `figure`; the CLI's rbm_cli.report.figure_process draws the former in its child).
-    Same parameters; :func:`sweep` returns the domain itself."""
+    """Run a config's grid into OUTPUT/<name>/ (domain.csv, boundary.csv, domain.png, meta.json):
+    rbm_cli.study.sweep.run_sweep with the domain figure (or `figure`; the CLI's figure_process
+    draws the former in its child). Same parameters; :func:`sweep` returns the domain itself."""
     draw = figure if figure is not None else domain_figure
     if figure_process is not None and draw is figure_process.draws:
         draw = figure_process.figure
@@ -368,8 +366,10 @@ def plot_domain(
     >>> import rbm
     >>> ax = rbm.plot_domain(rbm.read_domain("out/block/domain.csv"))  # doctest: +SKIP
     """
+    from rbm_cli.report.domain_figure import draw_domain_on  # matplotlib, pandas: when drawn
+
     cfg = None if config is None else _as_config(config)
-    return _draw_domain(df, ax, cfg, dimensionless=dimensionless, layout=layout, **options)
+    return draw_domain_on(df, ax, cfg, dimensionless=dimensionless, layout=layout, **options)
 
 
 def plot_history(run: CellRun | RunResult, ax=None):

@@ -136,7 +136,7 @@ def test_a_restart_at_theta_zero_is_not_taken_for_an_impact():
     two conventions' collapse times differ by ~1e-4 s after 174 impacts."""
     from rbm_cli.config.load import parse_config
     from rbm_cli.config.types import SolverConfig
-    from rbm_cli.models.rbm.closed_form import Block, linear_block, run_closed_form
+    from rbm_cli.models.rbm.closed_form import linear_block, run_closed_form
     from rbm_cli.models.rbm.closed_form_jit import B_AT_ZERO
 
     cfg = parse_config({

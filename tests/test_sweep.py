@@ -12,7 +12,7 @@ from rbm_cli.api import run_sweep
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import GridConfig
-from rbm_cli.study.domain import boundary, compare, read_domain
+from rbm_cli.study.domain import boundary, boundary_table, compare, csv_text, read_domain
 from rbm_cli.study.sweep import JOURNAL, config_hash, grid_cells
 
 from .paths import CONFIGS
@@ -113,6 +113,43 @@ def test_boundary_and_compare_on_synthetic_domains():
     # at 2 Hz b has no collapse: its boundary is one step above the grid (0.5)
     assert cmp.max_shift_g == pytest.approx(0.1)
     assert compare(a, a).n_differ == 0 and compare(a, a).max_shift_g == 0.0
+
+
+def test_boundary_from_rows_without_pandas():
+    """boundary.csv from a sweep's rows in plain Python (issue 18): one line per point and
+    frequency, sorted, empty where nothing collapses or nothing survives below; a failed
+    cell is neither; a record's (no frequency) is one line. boundary(df) is the same rule."""
+
+    def cell(size, f, a, status):
+        return {"column.size": size, "frequency_hz": f, "amplitude_g": a, "status": status}
+
+    rows = [
+        cell(2.0, 2.0, a, s)
+        for a, s in ((0.1, "survived"), (0.2, "collapsed"), (0.3, "survived"), (0.4, "collapsed"))
+    ]
+    rows += [
+        cell(2.0, 1.0, a, s) for a, s in ((0.4, "survived"), (0.2, "failed"), (0.1, "survived"))
+    ]
+    rows += [cell(1.0, 1.0, 0.3, "collapsed"), cell(1.0, 1.0, 0.1, "failed")]
+    fields = ("column.size", "frequency_hz", "amplitude_g", "status")
+    expected = (
+        "column.size,frequency_hz,lowest_unsafe_g,highest_safe_g\n"
+        "1,1,0.3,\n"  # nothing survived below 0.3 g (0.1 g failed)
+        "2,1,,0.4\n"  # nothing collapsed
+        "2,2,0.2,0.1\n"  # the 0.3 g survivor above the lowest collapse is not safe
+    )
+    columns, lines = boundary_table(rows, fields)
+    assert csv_text(lines, columns) == expected
+    bnd = boundary(pd.DataFrame(rows, columns=list(fields)))
+    assert csv_text(bnd.to_dict("records"), tuple(bnd.columns)) == expected
+    record = [
+        {"frequency_hz": None, "amplitude_g": a, "status": s}
+        for a, s in ((0.3, "collapsed"), (0.1, "survived"), (0.2, "survived"))
+    ]
+    columns, lines = boundary_table(record, ("frequency_hz", "amplitude_g", "status"))
+    assert csv_text(lines, columns) == "frequency_hz,lowest_unsafe_g,highest_safe_g\n,0.3,0.2\n"
+    read = pd.DataFrame(record).astype({"frequency_hz": float})  # as read: NaN, not None
+    assert boundary(read)["lowest_unsafe_g"].tolist() == [0.3]
 
 
 def test_sweep_killed_with_sigkill_then_resumed(tmp_path):

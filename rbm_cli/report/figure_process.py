@@ -5,7 +5,9 @@ compiled kernel (~0.5 s), and drawing domain.png needs matplotlib and pandas imp
 (~0.4 s) and the figure drawn (~0.2 s). `rbm sweep` forks one child as it starts, before
 either import: the child imports what the figure needs while this process runs the
 cells, then draws the figure it is sent and exits. On two processors the two costs
-overlap instead of adding up. The figure is the same: the child runs
+overlap instead of adding up. The sweep sends the child its rows (dicts) and columns, and
+the child builds the DataFrame (rbm_cli.study.domain.domain_frame): the sweep's process
+never imports pandas. The figure is the same: the child runs
 rbm_cli.report.domain_figure.domain_figure and savefig with the sweep's arguments.
 
 The child ignores SIGINT (a Ctrl-C in the terminal reaches the whole process group;
@@ -59,12 +61,23 @@ def _read(fd: int):
     return None if data is None else pickle.loads(data)
 
 
-def _draw(request) -> None:
-    """The work of the child (and of this process when no child can): domain.png."""
-    from rbm_cli.report.domain_figure import domain_figure
+def domain_figure(df, config):
+    """rbm_cli.report.domain_figure.domain_figure(df, config), imported when a figure is
+    drawn (matplotlib and pandas with it): the function the child draws with."""
+    from rbm_cli.report.domain_figure import domain_figure as draw
 
-    df, config, path, kwargs = request
-    domain_figure(df, config).savefig(path, **kwargs)
+    return draw(df, config)
+
+
+def _draw(request) -> None:
+    """The work of the child (and of this process when no child can): domain.png of a
+    DataFrame (``kind`` 'frame') or of (rows, fields) (``kind`` 'rows', the sweep's)."""
+    kind, table, config, path, kwargs = request
+    if kind == "rows":
+        from rbm_cli.study.domain import domain_frame
+
+        table = domain_frame(*table)
+    domain_figure(table, config).savefig(path, **kwargs)
 
 
 def _serve(requests: int, replies: int) -> None:
@@ -72,6 +85,9 @@ def _serve(requests: int, replies: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     import matplotlib.backends.backend_agg  # noqa: F401  (savefig's canvas for png)
     import matplotlib.figure  # noqa: F401
+    import pandas  # noqa: F401
+
+    import rbm_cli.report.domain_figure  # noqa: F401
 
     request = _read(requests)
     if request is None:  # the sweep ended without a figure, or died
@@ -89,16 +105,12 @@ def _serve(requests: int, replies: int) -> None:
 
 
 class FigureProcess:
-    """The child that draws a sweep's domain.png; :meth:`figure` is the sweep's ``figure``
+    """The child that draws a sweep's domain.png; :attr:`figure` is the sweep's ``figure``
     argument (rbm_cli.study.sweep.run_sweep) in place of :attr:`draws`, the function the
     child runs. Use as a context manager, or call close."""
 
-    @property
-    def draws(self):
-        """The function the child draws with (rbm_cli.report.domain_figure.domain_figure)."""
-        from rbm_cli.report.domain_figure import domain_figure
-
-        return domain_figure
+    #: The function the child draws with (this module's lazy domain_figure).
+    draws = staticmethod(domain_figure)
 
     def __init__(self, pid: int, requests: int, replies: int):
         self.pid, self._requests, self._replies = pid, requests, replies
@@ -111,10 +123,6 @@ class FigureProcess:
             return None
         if threading.active_count() > 1:  # fork copies one thread: not with others running
             return None
-        # imported here, before the fork, as the sweep imports it anyway: the child
-        # shares it (pandas) and imports only matplotlib, the one thing the sweep does not
-        import rbm_cli.report.domain_figure  # noqa: F401
-
         req_r, req_w = os.pipe()
         rep_r, rep_w = os.pipe()
         for stream in (sys.stdout, sys.stderr):
@@ -140,13 +148,15 @@ class FigureProcess:
         os.close(rep_w)
         return cls(pid, req_w, rep_r)
 
-    def figure(self, df, config) -> _Remote:
-        """What the sweep calls for domain.png: an object whose savefig has the child
-        draw domain_figure(df, config) and save it."""
-        return _Remote(self, df, config)
+    @property
+    def figure(self) -> _Painter:
+        """What the sweep calls for domain.png: ``figure(df, config)`` or (the sweep's)
+        ``figure.from_rows(rows, fields, config)``, an object whose savefig has the child
+        draw domain_figure of that domain and save it."""
+        return _Painter(self)
 
-    def _savefig(self, df, config, path, kwargs) -> None:
-        request = (df, config, os.fspath(path), kwargs)
+    def _savefig(self, kind, table, config, path, kwargs) -> None:
+        request = (kind, table, config, os.fspath(path), kwargs)
         if self.pid is None:
             return _draw(request)
         try:
@@ -185,14 +195,30 @@ class FigureProcess:
         self.close()
 
 
+class _Painter:
+    """FigureProcess.figure: a domain (a DataFrame, or rows and their fields) to a figure
+    the child draws."""
+
+    def __init__(self, owner: FigureProcess):
+        self._owner = owner
+
+    def __call__(self, df, config) -> _Remote:
+        return _Remote(self._owner, "frame", df, config)
+
+    def from_rows(self, rows: list[dict], fields: tuple[str, ...], config) -> _Remote:
+        """The figure of a sweep's rows (dicts with the columns ``fields``): the child builds
+        the DataFrame (rbm_cli.study.domain.domain_frame), not this process."""
+        return _Remote(self._owner, "rows", (rows, tuple(fields)), config)
+
+
 class _Remote:
     """A figure to be drawn by the child: the one method the sweep calls is savefig."""
 
-    def __init__(self, owner: FigureProcess, df, config):
-        self._owner, self._df, self._config = owner, df, config
+    def __init__(self, owner: FigureProcess, kind: str, table, config):
+        self._owner, self._kind, self._table, self._config = owner, kind, table, config
 
     def savefig(self, path, **kwargs) -> None:
-        self._owner._savefig(self._df, self._config, path, kwargs)
+        self._owner._savefig(self._kind, self._table, self._config, path, kwargs)
 
 
 __all__ = ["ENV", "FigureProcess"]

@@ -11,9 +11,9 @@ import shutil
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from rbm_cli import __version__
 from rbm_cli.base.files import (
@@ -28,6 +28,9 @@ from rbm_cli.base.files import (
     write_json_atomic,
 )
 from rbm_cli.models.result import History, RunResult
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Number of deformed shapes drawn in shapes.png.
 N_SHAPES = 6
@@ -59,8 +62,10 @@ def history_frame(history: History) -> pd.DataFrame:
     """history.csv as a table: t_s, ag_m_s2, ug_m, u1_m..u{n+1}_m, theta1_rad..thetan_rad.
 
     The u columns are node displacements relative to the ground [m]; the theta
-    columns absolute drum rotations [rad].
+    columns absolute drum rotations [rad]. (pandas is imported here, not with the module.)
     """
+    import pandas as pd
+
     u = np.atleast_2d(np.asarray(history.node_displacements, dtype=float))
     theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
     data: dict[str, np.ndarray] = {

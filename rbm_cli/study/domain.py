@@ -1,7 +1,10 @@
 """Safe-unsafe domains as tables: rows, CSV text, boundary, comparison.
 
 A domain is a pandas DataFrame with the columns of SPEC section 5
-(:data:`rbm_cli.models.result.CSV_FIELDS`), one row per (amplitude, frequency) cell.
+(:data:`rbm_cli.models.result.CSV_FIELDS`), one row per (amplitude, frequency) cell, or
+the list of its rows (dicts) a sweep makes. pandas is imported where a DataFrame is built
+or read, not with this module: a sweep writes domain.csv and boundary.csv from its rows
+(:func:`csv_text`, :func:`boundary_rows`) without it (issue 18).
 """
 
 from __future__ import annotations
@@ -9,13 +12,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import CSV_FIELDS, STATUSES
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Columns a domain CSV must have for plotting and comparing.
 REQUIRED = ("amplitude_g", "frequency_hz", "status")
@@ -43,6 +49,14 @@ def format_row(row: dict, fields=CSV_FIELDS) -> str:
 
 def csv_text(rows: list[dict], fields=CSV_FIELDS) -> str:
     return ",".join(fields) + "\n" + "".join(format_row(r, fields) + "\n" for r in rows)
+
+
+def domain_frame(rows: list[dict], fields=CSV_FIELDS) -> pd.DataFrame:
+    """The DataFrame of a domain's rows (dicts) with the columns ``fields`` (pandas is
+    imported here, when a table is asked for)."""
+    import pandas as pd
+
+    return pd.DataFrame(rows, columns=list(fields))
 
 
 def _key_text(value) -> str:
@@ -78,6 +92,8 @@ def keys_of(df: pd.DataFrame) -> list[tuple[str, ...]]:
 
 def read_domain(path: str | Path) -> pd.DataFrame:
     """Read a domain CSV; a missing file or missing columns is an RbmError."""
+    import pandas as pd
+
     path = Path(path)
     if not path.is_file():
         raise RbmError(f"domain file not found: {path}")
@@ -109,6 +125,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
     finite > 0 [Hz], status one of STATUSES, and each cell once. Raises an
     RbmError naming the first bad line (the header is line 1); converts the two
     numeric columns to float in place."""
+    import pandas as pd
 
     def got(value) -> str:
         return "an empty field" if pd.isna(value) else repr(str(value))
@@ -153,6 +170,8 @@ def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
     """collapsed is 0 or 1 on every row and says what status says (collapsed <=> 1):
     compare counts cells from collapsed and draws boundaries from status, so a row where
     they disagree would make the two disagree quietly (issue 14). Converts it to int."""
+    import pandas as pd
+
     raw = df["collapsed"]
     x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
     bad = ~np.isin(x, (0.0, 1.0))
@@ -186,25 +205,59 @@ def _group_row(by: list[str], values) -> dict:
     return {c: (freq(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
 
 
+def _missing(value) -> bool:
+    """None or NaN: an empty field (a record's frequency)."""
+    return value is None or (isinstance(value, float | np.floating) and math.isnan(value))
+
+
+def _line_order(values: tuple):
+    """Sort key of a boundary line's group values: each in ascending order, empty last (as
+    pandas' groupby(sort=True, dropna=False))."""
+    return tuple((True, 0.0) if _missing(v) else (False, v) for v in values)
+
+
+def _lowest_highest(cells: list[tuple]) -> tuple[float, float]:
+    """(lowest collapsed amplitude, highest survived one below it) [g] of one line's
+    (status, amplitude_g) pairs; NaN where there is none."""
+    unsafe = [a for s, a in cells if s == "collapsed" and not _missing(a)]
+    low = float(min(unsafe)) if unsafe else math.nan
+    safe = [a for s, a in cells if s == "survived" and not _missing(a)]
+    if math.isfinite(low):
+        safe = [a for a in safe if a < low]
+    return low, (float(max(safe)) if safe else math.nan)
+
+
+def boundary_table(rows: list[dict], columns) -> tuple[tuple[str, ...], list[dict]]:
+    """The boundary of a domain given as rows (dicts) with the domain's ``columns``: its
+    columns (the axis columns, frequency_hz, lowest_unsafe_g, highest_safe_g) and its rows
+    (:func:`boundary` says what they hold), in plain Python: a sweep writes boundary.csv
+    from its rows without pandas (issue 18)."""
+    by = (*axis_columns(columns), "frequency_hz")
+    lines: dict[tuple, tuple[tuple, list]] = {}
+    for row in rows:
+        values = tuple(row.get(c) for c in by)
+        ident = tuple(None if _missing(v) else v for v in values)  # NaN != NaN
+        lines.setdefault(ident, (values, []))[1].append((row.get("status"), row.get("amplitude_g")))
+    out = []
+    for values, cells in sorted(lines.values(), key=lambda line: _line_order(line[0])):
+        low, high = _lowest_highest(cells)
+        out.append({**_group_row(list(by), values), "lowest_unsafe_g": low, "highest_safe_g": high})
+    return (*by, "lowest_unsafe_g", "highest_safe_g"), out
+
+
 def boundary(df: pd.DataFrame) -> pd.DataFrame:
     """Lowest unsafe (collapsed) amplitude per frequency, and the highest safe one below it.
 
     Returns a DataFrame sorted by frequency with columns frequency_hz,
     lowest_unsafe_g (NaN where nothing collapses) and highest_safe_g (largest
     survived amplitude below lowest_unsafe_g; NaN if none). A domain with axes over
-    config keys has one line per point and frequency, the axis columns first.
+    config keys has one line per point and frequency, the axis columns first. The rows
+    are :func:`boundary_table`'s, the one implementation of the rule.
     """
-    by, groups = _groups(df)
-    rows = []
-    for values, grp in groups:
-        unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
-        low = float(unsafe.min()) if len(unsafe) else math.nan
-        safe = grp.loc[grp["status"] == "survived", "amplitude_g"]
-        if math.isfinite(low):
-            safe = safe[safe < low]
-        high = float(safe.max()) if len(safe) else math.nan
-        rows.append({**_group_row(by, values), "lowest_unsafe_g": low, "highest_safe_g": high})
-    return pd.DataFrame(rows, columns=[*by, "lowest_unsafe_g", "highest_safe_g"])
+    import pandas as pd
+
+    columns, rows = boundary_table(df.to_dict("records"), df.columns)
+    return pd.DataFrame(rows, columns=list(columns))
 
 
 @dataclass(frozen=True)
@@ -255,6 +308,7 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
     grid), so a boundary that leaves the grid counts as a finite shift. Cells are
     matched on amplitude, frequency and the values of any axes over config keys.
     """
+    import pandas as pd
 
     def flags(df):
         return dict(zip(keys_of(df), df["collapsed"].astype(int), strict=True))

@@ -22,8 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import pandas as pd
-
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import Config, hash_form
@@ -42,11 +40,18 @@ from rbm_cli.study.cells import (
     tasks,
 )
 from rbm_cli.study.parallel import run_chunks
-from rbm_cli.study.robustness import Member, member_config, members, summarise
+from rbm_cli.study.robustness import member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
-from rbm_cli.study.sweep_folder import as_started, prepare_folder, publish_result, sweep_meta
+from rbm_cli.study.sweep_folder import (
+    as_started,
+    prepare_folder,
+    publish_result,
+    status_counts,
+    sweep_meta,
+)
 
 if TYPE_CHECKING:
+    import pandas as pd
     from matplotlib.figure import Figure
 
 #: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s).
@@ -76,12 +81,6 @@ def config_hash(config: Config) -> str:
     rbm_cli.config.types.hash_form gives it (hashes of stored domains stay valid)."""
     text = json.dumps(hash_form(config), sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-def ensemble_member(config: Config, a: float, member: Member) -> tuple[Config, float]:
-    """(config, amplitude [g]) of an ensemble member (rbm_cli.study.robustness.members)
-    of the cell at amplitude a [g]."""
-    return member_config(config, a, member)
 
 
 def _run_cell(config: Config, a: float, f: float | None, runner) -> dict:
@@ -119,7 +118,7 @@ def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict
         a, f, _ = cell
         row = add_point(_run_cell(config, a, f, runner), config, cell, scales)
         if ensemble > 1:
-            runs = [row] + [_run_cell(*ensemble_member(config, a, m), f, runner) for m in others]
+            runs = [row] + [_run_cell(*member_config(config, a, m), f, runner) for m in others]
             flags = [r["collapsed"] for r in runs if r["status"] != "failed"]
             fraction, robust = summarise(flags, len(runs) - len(flags))
             row["collapse_fraction"], row["robust"] = fraction, robust
@@ -214,7 +213,8 @@ def run_sweep(
     notify : callable(str)  One-line notes (a journal recovered, lines not trusted...)
     resume_command : str  The command that resumes it (state file, messages; default generic)
     figure : callable(DataFrame, Config) -> Figure  Draws domain.png (rbm_cli.api.run_sweep
-        passes rbm_cli.report.domain_figure.domain_figure: the sweep does not plot)
+        passes rbm_cli.report.domain_figure.domain_figure: the sweep does not plot); one
+        with a ``from_rows`` method gets the rows (rbm_cli.study.sweep_folder.draw_figure)
 
     Raises
     ------
@@ -239,13 +239,12 @@ def run_sweep(
         run = _Run(store, config, points, cells, digest, ensemble, resume_command, done)
         compile_s, wall = run.run(todo, jobs, backend, scheduler, progress, stop_after)
         rows = [done[key(c)] for c in cells]
-        df = pd.DataFrame(rows, columns=list(fields))
-        counts = df["status"].value_counts().to_dict()
+        counts = status_counts(rows)
         meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble, folder)
         meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler,
                     compile_time_s=compile_s)  # fmt: skip
         try:
-            publish_result(store, lambda: figure(df, config), rows, df, fields, meta,
+            publish_result(store, figure, config, rows, fields, meta,
                            resume_command)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None

@@ -14,17 +14,17 @@ import json
 import os
 import platform
 import sys
+from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config, hash_form
 from rbm_cli.study.cells import grid_points, key, max_drums
-from rbm_cli.study.domain import boundary, csv_text
+from rbm_cli.study.domain import boundary_table, csv_text, domain_frame
 from rbm_cli.study.provenance import provenance
 from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
 from rbm_cli.study.store import FINALS, JOURNAL, STATE
@@ -116,18 +116,20 @@ def as_started(config, points, method: str | None, note) -> tuple:
     return other, grid_points(other)
 
 
-def publish_result(store, figure, rows, df, fields, meta, resume_command) -> None:
-    """domain.png (``figure()`` draws it), boundary.csv, domain.csv and meta.json (with
-    the others' SHA-256), published in one step; a failure keeps the journal and says
-    how to finish."""
-    bnd = boundary(df)
+def publish_result(store, figure, config, rows, fields, meta, resume_command) -> None:
+    """domain.png (the sweep's ``figure`` of the rows: :func:`draw_figure`), boundary.csv,
+    domain.csv and meta.json (with the others' SHA-256), published in one step; a failure
+    keeps the journal and says how to finish. The CSV files are written from the rows
+    (dicts with the columns ``fields``), without pandas."""
+    columns, lines = boundary_table(rows, fields)
     texts = {
         "domain.csv": csv_text(rows, fields),
-        "boundary.csv": csv_text(bnd.to_dict("records"), tuple(bnd.columns)),
+        "boundary.csv": csv_text(lines, columns),
     }
 
     def png(path: Path) -> None:
-        figure().savefig(path, format="png", dpi=150, bbox_inches="tight")
+        drawn = draw_figure(figure, rows, fields, config)
+        drawn.savefig(path, format="png", dpi=150, bbox_inches="tight")
 
     def text(name: str) -> Callable[[Path], None]:
         return lambda path: path.write_text(texts[name], encoding="utf-8")
@@ -162,6 +164,24 @@ def publish_result(store, figure, rows, df, fields, meta, resume_command) -> Non
         ) from None
 
 
+def status_counts(rows: list[dict]) -> dict[str, int]:
+    """meta.json's status_counts: cells per status, the most frequent first (ties in the
+    order of their first row), as pandas' value_counts gives them."""
+    counts = Counter(row["status"] for row in rows if row.get("status") is not None)
+    return dict(sorted(counts.items(), key=lambda item: -item[1]))
+
+
+def draw_figure(figure, rows: list[dict], fields: tuple[str, ...], config: Config):
+    """domain.png's figure (an object with savefig): ``figure.from_rows(rows, fields,
+    config)`` where the figure takes the rows (the CLI's figure process, which builds the
+    DataFrame in its own process: the sweep's process does not import pandas, issue 18),
+    else ``figure(DataFrame, config)`` with the DataFrame built here, now."""
+    from_rows = getattr(figure, "from_rows", None)
+    if from_rows is not None:
+        return from_rows(rows, fields, config)
+    return figure(domain_frame(rows, fields), config)
+
+
 def _same_settings(folder: Path, config, ensemble: int) -> bool:
     """Whether meta.json's resolved config equals this config on every key both have
     (a finished domain made before a config key with a default existed has another hash
@@ -185,8 +205,8 @@ def _common_equal(a, b) -> bool:
 def _version(name: str) -> str:
     """A library's version without importing it here: its ``__version__`` if it is
     imported, else its installed distribution's (the same string; a sweep that ran in
-    this process never imports joblib, and its figure may be drawn in another process,
-    rbm_cli.report.figure_process, issue 18)."""
+    this process never imports joblib nor pandas, and its figure may be drawn in another
+    process, rbm_cli.report.figure_process, issue 18)."""
     module = sys.modules.get(name)
     if module is not None:
         return module.__version__
@@ -203,7 +223,7 @@ def _versions() -> dict:
         "python": platform.python_version(),
         "numpy": np.__version__,
         "scipy": scipy.__version__,
-        "pandas": pd.__version__,
+        "pandas": _version("pandas"),
         "joblib": _version("joblib"),
         "matplotlib": _version("matplotlib"),
     }

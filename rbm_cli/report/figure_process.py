@@ -1,27 +1,37 @@
-"""domain.png drawn by a process of its own, forked when a sweep starts (issue 18).
+"""Figures drawn by a process of their own, forked as `rbm sweep` or `rbm run` starts
+(issue 18).
 
-A sweep of cheap cells is mostly fixed cost: this process imports numba and loads the
-compiled kernel (~0.5 s), and drawing domain.png needs matplotlib and pandas imported
-(~0.4 s) and the figure drawn (~0.2 s). `rbm sweep` forks one child as it starts, before
-either import: the child imports what the figure needs while this process runs the
-cells, then draws the figure it is sent and exits. On two processors the two costs
-overlap instead of adding up. The sweep sends the child its rows (dicts) and columns, and
-the child builds the DataFrame (rbm_cli.study.domain.domain_frame): the sweep's process
-never imports pandas. The figure is the same: the child runs
-rbm_cli.report.domain_figure.domain_figure and savefig with the sweep's arguments.
+A sweep of cheap cells, or one run, is mostly fixed cost: this process imports numba and
+loads the compiled kernel or closed form (~0.5 s), and the figures need matplotlib (and
+for a domain pandas) imported (~0.4 s) and drawn (~0.2-0.6 s). The command forks one
+child as it starts, before either import: the child imports what its figures need
+(:data:`DOMAIN_IMPORTS`, :data:`RUN_IMPORTS`) while this process runs the cells, then
+runs the one call it is sent and exits. On two processors the two costs overlap instead
+of adding up.
+
+One protocol for both commands: the request is a module-level function (pickled by
+reference) and its arguments; the reply is its return value or its exception, raised
+here. The sweep sends rbm_cli.report.domain_figure's figure of its rows (dicts) and
+columns, which the child turns into a DataFrame (rbm_cli.study.domain.domain_frame) and
+saves to the path it is given: the sweep's process never imports pandas. A run sends
+rbm_cli.report.run_figures.run_pngs of its history and gets back the bytes of history.png
+and shapes.png (the child writes no file; the run folder writes them, see
+rbm_cli.report.run_folder.write_run): the run's process imports neither matplotlib nor
+pandas.
 
 The child ignores SIGINT (a Ctrl-C in the terminal reaches the whole process group;
-only the sweep acts on it), reads its one request from a pipe, and exits when the pipe
-closes (its sweep ended or was killed, even by kill -9). The sweep kills and reaps it
+only the command acts on it), reads its one request from a pipe, and exits when the pipe
+closes (its command ended or was killed, even by kill -9). The command kills and reaps it
 when it ends without a figure to draw, or is interrupted while the child draws (before
 the staging folder the figure is written into is removed). No fork (another platform,
-threads running, RBM_FIGURE_PROCESS=0, fork failing) or a child that died: the figure is
-drawn in this process, as a library call of rbm_cli.api.run_sweep always does.
+threads running, RBM_FIGURE_PROCESS=0, fork failing) or a child that died: the call runs
+in this process, as a library call of rbm_cli.api.run_sweep always does.
 """
 
 from __future__ import annotations
 
 import contextlib
+import importlib
 import os
 import pickle
 import signal
@@ -29,8 +39,17 @@ import struct
 import sys
 import threading
 
-#: Environment switch: "0" draws in the sweep's own process.
+#: Environment switch: "0" draws in the command's own process.
 ENV = "RBM_FIGURE_PROCESS"
+#: What the child of `rbm sweep` imports before its request: domain.png's modules.
+DOMAIN_IMPORTS = (
+    "matplotlib.backends.backend_agg",  # savefig's canvas for png
+    "matplotlib.figure",
+    "pandas",
+    "rbm_cli.report.domain_figure",
+)
+#: What the child of `rbm run` imports: history.png's and shapes.png's (no pandas).
+RUN_IMPORTS = ("matplotlib.backends.backend_agg", "matplotlib.figure", "rbm_cli.report.run_figures")
 _LEN = struct.Struct("<Q")
 
 
@@ -69,10 +88,9 @@ def domain_figure(df, config):
     return draw(df, config)
 
 
-def _draw(request) -> None:
-    """The work of the child (and of this process when no child can): domain.png of a
-    DataFrame (``kind`` 'frame') or of (rows, fields) (``kind`` 'rows', the sweep's)."""
-    kind, table, config, path, kwargs = request
+def _draw(kind, table, config, path, kwargs) -> None:
+    """domain.png of a DataFrame (``kind`` 'frame') or of (rows, fields) (``kind`` 'rows',
+    the sweep's), saved to ``path``: what the sweep's child (or this process) runs."""
     if kind == "rows":
         from rbm_cli.study.domain import domain_frame
 
@@ -80,34 +98,36 @@ def _draw(request) -> None:
     domain_figure(table, config).savefig(path, **kwargs)
 
 
-def _serve(requests: int, replies: int) -> None:
-    """The child: import what a figure needs, then draw the one figure asked for."""
+def _call(request):
+    function, args, kwargs = request
+    return function(*args, **kwargs)
+
+
+def _serve(requests: int, replies: int, imports: tuple[str, ...]) -> None:
+    """The child: import ``imports``, then run the one call asked for and send its result."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    import matplotlib.backends.backend_agg  # noqa: F401  (savefig's canvas for png)
-    import matplotlib.figure  # noqa: F401
-    import pandas  # noqa: F401
-
-    import rbm_cli.report.domain_figure  # noqa: F401
-
+    for name in imports:
+        importlib.import_module(name)
     request = _read(requests)
-    if request is None:  # the sweep ended without a figure, or died
+    if request is None:  # the command ended without a figure, or died
         return
     try:
-        _draw(request)
-        reply = None
-    except Exception as exc:  # the sweep reports it (publish_result)
+        reply = ("done", _call(request), None)
+    except Exception as exc:  # the command raises it (the sweep: publish_result)
         try:
-            reply = pickle.loads(pickle.dumps(exc))
+            error = pickle.loads(pickle.dumps(exc))
         except Exception:
-            reply = RuntimeError(f"{type(exc).__name__}: {exc}")
+            error = RuntimeError(f"{type(exc).__name__}: {exc}")
+        reply = ("done", None, error)
     with contextlib.suppress(OSError):
-        _write(replies, ("done", reply))
+        _write(replies, reply)
 
 
 class FigureProcess:
-    """The child that draws a sweep's domain.png; :attr:`figure` is the sweep's ``figure``
-    argument (rbm_cli.study.sweep.run_sweep) in place of :attr:`draws`, the function the
-    child runs. Use as a context manager, or call close."""
+    """The child that draws a command's figures: :meth:`submit` a call, then take its
+    :meth:`result` (or :meth:`call`, both at once); for a sweep, :attr:`figure` is the
+    ``figure`` argument of rbm_cli.study.sweep.run_sweep in place of :attr:`draws`, the
+    function the child runs. One call per child. Use as a context manager, or call close."""
 
     #: The function the child draws with (this module's lazy domain_figure).
     draws = staticmethod(domain_figure)
@@ -115,10 +135,12 @@ class FigureProcess:
     def __init__(self, pid: int, requests: int, replies: int):
         self.pid, self._requests, self._replies = pid, requests, replies
         self._replied = False
+        self._request = None
 
     @classmethod
-    def start(cls) -> FigureProcess | None:
-        """Fork the child, or None where it cannot or should not be (see the module)."""
+    def start(cls, imports: tuple[str, ...] = DOMAIN_IMPORTS) -> FigureProcess | None:
+        """Fork the child, which imports the modules ``imports`` (names) as it starts, or
+        None where it cannot or should not be (see the module)."""
         if os.environ.get(ENV) == "0" or not hasattr(os, "fork"):
             return None
         if threading.active_count() > 1:  # fork copies one thread: not with others running
@@ -139,7 +161,7 @@ class FigureProcess:
             try:
                 os.close(req_w)
                 os.close(rep_r)
-                _serve(req_r, rep_w)
+                _serve(req_r, rep_w, imports)
             except BaseException:
                 code = 1
             finally:
@@ -155,25 +177,52 @@ class FigureProcess:
         draw domain_figure of that domain and save it."""
         return _Painter(self)
 
-    def _savefig(self, kind, table, config, path, kwargs) -> None:
-        request = (kind, table, config, os.fspath(path), kwargs)
+    def submit(self, function, *args, **kwargs) -> None:
+        """Send the child ``function(*args, **kwargs)`` (a module-level function, pickled by
+        reference) and return at once; :meth:`result` waits for it. It blocks only while
+        the child, still importing, has not read a request larger than the pipe holds."""
+        self._request = (function, args, kwargs)
         if self.pid is None:
-            return _draw(request)
+            return
         try:
-            _write(self._requests, request)
-            reply = _read(self._replies)
-        except OSError:
-            reply = None
-        except BaseException:  # Ctrl-C while it draws: it stops before the folder goes
+            _write(self._requests, self._request)
+        except OSError:  # the child is gone: result() runs it here
+            self.close()
+        except BaseException:  # Ctrl-C
             self.close()
             raise
-        self._replied = reply is not None
-        self.close()
-        if reply is None:  # the child is gone: draw here
-            return _draw(request)
-        error = reply[1]
+
+    def result(self):
+        """The return value of the call submitted (its exception raised here), once the child
+        has sent it; the child is then reaped. Run here if there is no child, or it died."""
+        request, self._request = self._request, None
+        if request is None:
+            raise RuntimeError("FigureProcess.result without a call submitted")
+        reply = None
+        if self.pid is not None:
+            try:
+                reply = _read(self._replies)
+            except OSError:
+                reply = None
+            except BaseException:  # Ctrl-C while it draws: stopped before the folder goes
+                self.close()
+                raise
+            self._replied = reply is not None
+            self.close()
+        if reply is None:  # no child, or it is gone: run here
+            return _call(request)
+        _, value, error = reply
         if error is not None:
             raise error
+        return value
+
+    def call(self, function, *args, **kwargs):
+        """``function(*args, **kwargs)`` run by the child (see :meth:`submit`)."""
+        self.submit(function, *args, **kwargs)
+        return self.result()
+
+    def _savefig(self, kind, table, config, path, kwargs) -> None:
+        self.call(_draw, kind, table, config, os.fspath(path), kwargs)
 
     def close(self) -> None:
         """Stop the child (killed unless it has replied and is exiting) and reap it."""

@@ -100,6 +100,47 @@ def test_the_child_runs_a_call_and_raises_its_error_here():
     assert proc.pid is None
 
 
+def _whoami(tag: str) -> tuple[str, int, int]:
+    return tag, os.getpid(), os.getppid()
+
+
+def _fail(tag: str) -> None:
+    raise KeyError(tag)
+
+
+def test_calls_side_by_side_run_in_the_child_and_its_grandchildren():
+    """submit_all: the first call in the child, each other one in a grandchild of it (at
+    the same time), values in order; every grandchild reaped by the child."""
+    with started() as proc:
+        child = proc.pid
+        proc.submit_all([(_whoami, ("a",)), (_whoami, ("b",)), (_whoami, ("c",))])
+        values = proc.result()
+    assert [v[0] for v in values] == ["a", "b", "c"]
+    assert values[0][1] == child  # the first: the child itself
+    grandchildren = [pid for _, pid, _ in values[1:]]
+    assert len(set(grandchildren)) == 2 and child not in grandchildren
+    assert all(ppid == child for _, _, ppid in values[1:])
+    assert gone(child) and all(gone(pid) for pid in grandchildren)
+
+
+@pytest.mark.parametrize("where", [0, 1], ids=["child", "grandchild"])
+def test_an_error_side_by_side_is_raised_here(where):
+    calls = [(_whoami, ("a",)), (_whoami, ("b",))]
+    calls[where] = (_fail, ("boom",))
+    with started() as proc:
+        proc.submit_all(calls)
+        with pytest.raises(KeyError, match="boom"):
+            proc.result()
+
+
+def test_calls_side_by_side_without_a_child_run_here(monkeypatch):
+    monkeypatch.setenv("RBM_FIGURE_PROCESS", "0")
+    assert FigureProcess.start(RUN_IMPORTS) is None
+    proc = FigureProcess(None, -1, -1)  # what a child that died leaves: pid None
+    proc.submit_all([(_whoami, ("a",)), (_whoami, ("b",))])
+    assert [v[:2] for v in proc.result()] == [("a", os.getpid()), ("b", os.getpid())]
+
+
 def test_the_child_ignores_sigint():
     with started() as proc:
         status = Path(f"/proc/{proc.pid}/status")

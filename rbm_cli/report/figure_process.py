@@ -98,27 +98,87 @@ def _draw(kind, table, config, path, kwargs) -> None:
     domain_figure(table, config).savefig(path, **kwargs)
 
 
-def _call(request):
-    function, args, kwargs = request
+def _call(call):
+    function, args, kwargs = call
     return function(*args, **kwargs)
 
 
-def _serve(requests: int, replies: int, imports: tuple[str, ...]) -> None:
-    """The child: import ``imports``, then run the one call asked for and send its result."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    for name in imports:
-        importlib.import_module(name)
-    request = _read(requests)
-    if request is None:  # the command ended without a figure, or died
-        return
+def _outcome(run) -> tuple:
+    """("done", run(), None), or ("done", None, its exception) where the exception can be
+    pickled (else a RuntimeError naming it): a reply."""
     try:
-        reply = ("done", _call(request), None)
+        return ("done", run(), None)
     except Exception as exc:  # the command raises it (the sweep: publish_result)
         try:
             error = pickle.loads(pickle.dumps(exc))
         except Exception:
             error = RuntimeError(f"{type(exc).__name__}: {exc}")
-        reply = ("done", None, error)
+        return ("done", None, error)
+
+
+def _fork_call(call, inherited: tuple[int, ...]):
+    """Run ``call`` in a grandchild forked now (this child's imports are done, so the fork
+    is cheap) and return a function that waits for its value: one figure drawn beside
+    another on two processors. No fork: the function runs the call here."""
+    read, write = os.pipe()
+    try:
+        pid = os.fork()
+    except OSError:
+        os.close(read)
+        os.close(write)
+        return lambda: _call(call)
+    if pid == 0:  # pragma: no cover - the grandchild (ends by os._exit, whatever happens)
+        code = 0
+        try:
+            for fd in (read, *inherited):  # the command's pipes are the child's alone
+                os.close(fd)
+            _write(write, _outcome(lambda: _call(call)))
+        except BaseException:  # its child died (the pipe): nothing to send it
+            code = 1
+        finally:
+            os._exit(code)
+    os.close(write)
+
+    def value():
+        try:
+            reply = _read(read)
+        finally:
+            os.close(read)
+            os.waitpid(pid, 0)
+        if reply is None:
+            raise RuntimeError(f"the process drawing {call[0].__name__} died")
+        if reply[2] is not None:
+            raise reply[2]
+        return reply[1]
+
+    return value
+
+
+def _run_calls(calls: list, inherited: tuple[int, ...]) -> list:
+    """The values of ``calls`` run in the child: the first here, each other one at the same
+    time in a grandchild of its own (which closes ``inherited``, the child's pipes to the
+    command); every grandchild waited for before any error is raised."""
+    pending = [_fork_call(call, inherited) for call in calls[1:]]
+    try:
+        values = [_call(calls[0])]
+    finally:
+        outcomes = [_outcome(value) for value in pending]  # (each grandchild reaped)
+    for _, value, error in outcomes:
+        if error is not None:
+            raise error
+        values.append(value)
+    return values
+
+
+def _serve(requests: int, replies: int, imports: tuple[str, ...]) -> None:
+    """The child: import ``imports``, then run the calls asked for and send their values."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for name in imports:
+        importlib.import_module(name)
+    calls = _read(requests)
+    if calls is None:  # the command ended without a figure, or died
+        return
+    reply = _outcome(lambda: _run_calls(calls, (requests, replies)))
     with contextlib.suppress(OSError):
         _write(replies, reply)
 
@@ -135,7 +195,8 @@ class FigureProcess:
     def __init__(self, pid: int, requests: int, replies: int):
         self.pid, self._requests, self._replies = pid, requests, replies
         self._replied = False
-        self._request = None
+        self._calls: list | None = None
+        self._many = False
 
     @classmethod
     def start(cls, imports: tuple[str, ...] = DOMAIN_IMPORTS) -> FigureProcess | None:
@@ -179,24 +240,36 @@ class FigureProcess:
 
     def submit(self, function, *args, **kwargs) -> None:
         """Send the child ``function(*args, **kwargs)`` (a module-level function, pickled by
-        reference) and return at once; :meth:`result` waits for it. It blocks only while
-        the child, still importing, has not read a request larger than the pipe holds."""
-        self._request = (function, args, kwargs)
+        reference) and return at once; :meth:`result` waits for its value."""
+        self._send([(function, args, kwargs)], many=False)
+
+    def submit_all(self, calls: list[tuple]) -> None:
+        """Send the child ``calls``, (function, args) pairs, and return at once: the child
+        runs the first and forks a grandchild for each other one, all at the same time
+        (figures drawn on as many processors); :meth:`result` waits for the list of their
+        values."""
+        self._send([(function, tuple(args), {}) for function, args in calls], many=True)
+
+    def _send(self, calls: list[tuple], many: bool) -> None:
+        """The request; it blocks only while the child, still importing, has not read a
+        request larger than the pipe holds."""
+        self._calls, self._many = calls, many
         if self.pid is None:
             return
         try:
-            _write(self._requests, self._request)
-        except OSError:  # the child is gone: result() runs it here
+            _write(self._requests, calls)
+        except OSError:  # the child is gone: result() runs them here
             self.close()
         except BaseException:  # Ctrl-C
             self.close()
             raise
 
     def result(self):
-        """The return value of the call submitted (its exception raised here), once the child
-        has sent it; the child is then reaped. Run here if there is no child, or it died."""
-        request, self._request = self._request, None
-        if request is None:
+        """The value of the call submitted (the list of values for submit_all), its
+        exception raised here, once the child has sent it; the child is then reaped. Run
+        here, one after the other, if there is no child or it died."""
+        calls, self._calls = self._calls, None
+        if calls is None:
             raise RuntimeError("FigureProcess.result without a call submitted")
         reply = None
         if self.pid is not None:
@@ -210,11 +283,12 @@ class FigureProcess:
             self._replied = reply is not None
             self.close()
         if reply is None:  # no child, or it is gone: run here
-            return _call(request)
-        _, value, error = reply
-        if error is not None:
-            raise error
-        return value
+            values = [_call(call) for call in calls]
+        else:
+            _, values, error = reply
+            if error is not None:
+                raise error
+        return values if self._many else values[0]
 
     def call(self, function, *args, **kwargs):
         """``function(*args, **kwargs)`` run by the child (see :meth:`submit`)."""

@@ -19,6 +19,9 @@ from rbm_cli.models.result import History
 #: Number of deformed shapes drawn in shapes.png.
 N_SHAPES = 6
 
+#: The files :func:`run_pngs` draws, in the order of :func:`run_png_calls`.
+RUN_PNGS = ("history.png", "shapes.png")
+
 #: savefig's arguments for the run's figures (those of base.files.save_figure_atomic).
 SAVEFIG = {"format": "png", "dpi": 150, "bbox_inches": "tight"}
 
@@ -141,6 +144,18 @@ def png_bytes(fig) -> bytes:
     return buffer.getvalue()
 
 
+def history_png(history: History, t_collapse: float | None, summary: dict) -> bytes:
+    """history.png of one run (see :func:`run_pngs` for the arguments)."""
+    figure = _history_figure(history, t_collapse, run_title(summary), _run_column(summary))
+    return png_bytes(figure)
+
+
+def shapes_png(history: History, t_collapse: float | None, summary: dict, widths, elevations):
+    """shapes.png of one run (see :func:`run_pngs` for the arguments), as bytes."""
+    figure = _shapes_figure(history, widths, elevations, t_collapse, run_title(summary))
+    return png_bytes(figure)
+
+
 def run_pngs(history: History, t_collapse: float | None, summary: dict, widths, elevations):
     """{'history.png': bytes, 'shapes.png': bytes} of one run.
 
@@ -153,7 +168,14 @@ def run_pngs(history: History, t_collapse: float | None, summary: dict, widths, 
     widths : (n+1,) Column widths at the nodes [m]
     elevations : (n+1,) Node elevations [m]
     """
-    title = run_title(summary)
-    history_png = png_bytes(_history_figure(history, t_collapse, title, _run_column(summary)))
-    shapes = _shapes_figure(history, widths, elevations, t_collapse, title)
-    return {"history.png": history_png, "shapes.png": png_bytes(shapes)}
+    calls = run_png_calls(history, t_collapse, summary, widths, elevations)
+    return {name: function(*args) for name, (function, args) in zip(RUN_PNGS, calls, strict=True)}
+
+
+def run_png_calls(history: History, t_collapse, summary: dict, widths, elevations) -> list:
+    """The (function, args) pairs that draw :data:`RUN_PNGS` (see :func:`run_pngs`): for
+    rbm_cli.report.figure_process.FigureProcess.submit_all, which draws them side by side."""
+    return [
+        (history_png, (history, t_collapse, summary)),
+        (shapes_png, (history, t_collapse, summary, widths, elevations)),
+    ]

@@ -31,9 +31,11 @@ from rbm_cli.base.files import (
 from rbm_cli.models.result import History, RunResult
 from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figures, here before)
     N_SHAPES,
+    RUN_PNGS,
     _history_figure,
     _run_column,
     _shapes_figure,
+    run_png_calls,
     run_pngs,
     run_title,
     shape_instants,
@@ -151,9 +153,9 @@ def write_run(
     ``out_dir/name/folder``, which then replaces its files (or is renamed into
     place). Nothing is left behind if writing fails. With a ``figure_process``
     (rbm_cli.report.figure_process.FigureProcess, `rbm run`'s), its child draws the
-    figures (:func:`rbm_cli.report.run_figures.run_pngs`) while this process writes
-    history.csv, and sends back the PNG files' bytes, written here: the child writes
-    nothing, and this process imports neither matplotlib nor pandas.
+    figures side by side (:func:`rbm_cli.report.run_figures.run_png_calls`) while this
+    process writes history.csv, and sends back the PNG files' bytes, written here: the
+    child writes no file, and this process imports neither matplotlib nor pandas.
 
     Parameters
     ----------
@@ -195,9 +197,12 @@ def write_run(
     try:
         figures = (result.history, t_collapse, summary, widths, elevations)
         if figure_process is not None:  # drawn by the child while history.csv is written
-            figure_process.submit(run_pngs, *figures)
+            figure_process.submit_all(run_png_calls(*figures))
         write_chunks_atomic(staging / "history.csv", history_csv(result.history))
-        pngs = figure_process.result() if figure_process is not None else run_pngs(*figures)
+        if figure_process is not None:
+            pngs = dict(zip(RUN_PNGS, figure_process.result(), strict=True))
+        else:
+            pngs = run_pngs(*figures)
         for png, data in pngs.items():
             write_chunks_atomic(staging / png, [data])
         write_json_atomic(staging / "summary.json", summary)

@@ -123,6 +123,30 @@ def test_calls_side_by_side_run_in_the_child_and_its_grandchildren():
     assert gone(child) and all(gone(pid) for pid in grandchildren)
 
 
+def _pid_then_sleep(path: str) -> None:
+    Path(path).write_text(str(os.getpid()))
+    time.sleep(60)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG")
+def test_a_grandchild_dies_with_the_child(tmp_path):
+    """The command kills the child while a grandchild draws (Ctrl-C): the grandchild, in a
+    call of 60 s, is gone within seconds, not when its call ends."""
+    path = tmp_path / "pid"
+    proc = started()
+    proc.submit_all([(time.sleep, (60.0,)), (_pid_then_sleep, (str(path),))])
+    deadline = time.monotonic() + 30
+    while not (path.is_file() and path.read_text()) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    grandchild = int(path.read_text())
+    assert not gone(grandchild)
+    proc.close()
+    deadline = time.monotonic() + 5
+    while not gone(grandchild) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert gone(grandchild)
+
+
 @pytest.mark.parametrize("where", [0, 1], ids=["child", "grandchild"])
 def test_an_error_side_by_side_is_raised_here(where):
     calls = [(_whoami, ("a",)), (_whoami, ("b",))]

@@ -14,10 +14,14 @@ reference) and its arguments; the reply is its return value or its exception, ra
 here. The sweep sends rbm_cli.report.domain_figure's figure of its rows (dicts) and
 columns, which the child turns into a DataFrame (rbm_cli.study.domain.domain_frame) and
 saves to the path it is given: the sweep's process never imports pandas. A run sends
-rbm_cli.report.run_figures.run_pngs of its history and gets back the bytes of history.png
-and shapes.png (the child writes no file; the run folder writes them, see
+the two calls of rbm_cli.report.run_figures.run_png_calls and gets back the bytes of
+history.png and shapes.png (the child writes no file; the run folder writes them, see
 rbm_cli.report.run_folder.write_run): the run's process imports neither matplotlib nor
-pandas.
+pandas. Several calls sent together (:meth:`FigureProcess.submit_all`) run side by side:
+the first in the child, each other one in a grandchild the child forks once its imports
+are done (a cheap fork), which sends its value back to the child through a pipe of its own
+and is reaped by it. A grandchild ignores SIGINT too, and on Linux dies with the child
+(elsewhere it ends once its call is done, its reply finding the pipe closed).
 
 The child ignores SIGINT (a Ctrl-C in the terminal reaches the whole process group;
 only the command acts on it), reads its one request from a pipe, and exits when the pipe
@@ -116,11 +120,26 @@ def _outcome(run) -> tuple:
         return ("done", None, error)
 
 
+def _die_with_parent(parent: int) -> None:
+    """Have the kernel kill this process when its parent dies (Linux's PR_SET_PDEATHSIG),
+    so a grandchild never outlives the child the command killed; elsewhere it ends once its
+    call is done, its reply finding the pipe closed."""
+    if not sys.platform.startswith("linux"):
+        return
+    with contextlib.suppress(Exception):
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG
+    if os.getppid() != parent:  # the child died before that was set
+        os._exit(1)
+
+
 def _fork_call(call, inherited: tuple[int, ...]):
     """Run ``call`` in a grandchild forked now (this child's imports are done, so the fork
     is cheap) and return a function that waits for its value: one figure drawn beside
     another on two processors. No fork: the function runs the call here."""
     read, write = os.pipe()
+    parent = os.getpid()
     try:
         pid = os.fork()
     except OSError:
@@ -130,6 +149,7 @@ def _fork_call(call, inherited: tuple[int, ...]):
     if pid == 0:  # pragma: no cover - the grandchild (ends by os._exit, whatever happens)
         code = 0
         try:
+            _die_with_parent(parent)
             for fd in (read, *inherited):  # the command's pipes are the child's alone
                 os.close(fd)
             _write(write, _outcome(lambda: _call(call)))

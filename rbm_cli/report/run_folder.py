@@ -136,6 +136,14 @@ def run_summary(
     return json_ready(summary)
 
 
+def _pngs(figure_process, figures: tuple) -> dict[str, bytes]:
+    """{file name: PNG bytes} of the run's figures: the figure child's (their calls
+    submitted to it, see :func:`write_run`), or drawn here without one."""
+    if figure_process is None:
+        return run_pngs(*figures)
+    return dict(zip(RUN_PNGS, figure_process.result(), strict=True))
+
+
 def write_run(
     out_dir: str | os.PathLike,
     name: str,
@@ -199,11 +207,7 @@ def write_run(
         if figure_process is not None:  # drawn by the child while history.csv is written
             figure_process.submit_all(run_png_calls(*figures))
         write_chunks_atomic(staging / "history.csv", history_csv(result.history))
-        if figure_process is not None:
-            pngs = dict(zip(RUN_PNGS, figure_process.result(), strict=True))
-        else:
-            pngs = run_pngs(*figures)
-        for png, data in pngs.items():
+        for png, data in _pngs(figure_process, figures).items():
             write_chunks_atomic(staging / png, [data])
         write_json_atomic(staging / "summary.json", summary)
         if target.is_dir():

@@ -23,6 +23,7 @@ from rbm_cli.study.cells import grid_cells, grid_points
 from rbm_cli.study.store import JOURNAL
 
 from .paths import CONFIGS
+from .processes import parent_modules
 
 pytestmark = pytest.mark.timeout(240)
 
@@ -248,17 +249,9 @@ excitation: {type: harmonic, duration: 10.0}
 grid: {amplitudes: [0.2, 0.5, 1.2], frequencies: [0.5, 2.0]}
 """
 
-#: `rbm sweep ARGS` in this interpreter; at exit the sweep's own process (not the figure's
-#: forked child) prints whether it imported pandas and ran the sweep's module.
-PARENT_MODULES = """\
-import atexit, os, sys
-parent = os.getpid()
-atexit.register(lambda: os.getpid() == parent and print(
-    "MODULES", "pandas" in sys.modules, "rbm_cli.study.sweep" in sys.modules))
-sys.argv = ["rbm", *sys.argv[1:]]
-from rbm_cli.cli.main import main
-main()
-"""
+#: `rbm sweep ARGS`: at exit its own process prints whether it imported pandas and ran
+#: the sweep's module.
+PARENT_MODULES = parent_modules("pandas", "rbm_cli.study.sweep")
 
 
 @pytest.mark.parametrize("extra", [[], ["--ensemble", "2"]], ids=["plain", "ensemble"])

@@ -29,6 +29,8 @@ from rbm_cli.cli.main import cli
 from rbm_cli.config.load import load_config
 from rbm_cli.study.store import JOURNAL, STATE, SweepStore
 
+from .processes import LONG
+
 pytestmark = pytest.mark.timeout(120)
 
 SMALL = """\
@@ -350,15 +352,6 @@ def test_case07_density_1e308_is_refused_in_one_line(tmp_path):
     path.write_text(SMALL.replace("depth: 1.0}", "depth: 1.0, density: 1e308}"))
     res = invoke("run", path, "-a", 0.5, "-f", 1, "-o", tmp_path)
     one_line_error(res, "column.density must be in [1, 100000]")
-
-
-LONG = """\
-name: long
-column: {height: 5.0, base_width: 0.96, top_width: 0.66, drums: 8}
-interface: {stiffness: {normal: 5e9}}
-excitation: {type: harmonic, duration: 10000}
-solver: {max_steps: 1e9, max_events: 1e9}
-"""
 
 
 @pytest.fixture(scope="module")

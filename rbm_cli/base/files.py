@@ -14,7 +14,7 @@ import math
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -100,6 +100,14 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
     """Write text (UTF-8), atomically."""
     with _atomic_target(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def write_chunks_atomic(path: str | os.PathLike, chunks: Iterable[str | bytes]) -> Path:
+    """Write text (UTF-8) or bytes given in pieces (a long CSV, a PNG), atomically."""
+    with _atomic_target(path) as tmp, open(tmp, "wb") as fh:
+        for chunk in chunks:
+            fh.write(chunk.encode("utf-8") if isinstance(chunk, str) else chunk)
     return Path(path)
 
 

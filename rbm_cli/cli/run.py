@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import sys
 from pathlib import Path
@@ -125,11 +126,6 @@ def run(
         rbm run configs/harmonic_multidrum.yaml -a 0.3 -f 2 -o /tmp/rbm-out
         rbm run my_record.yaml --amplitude 0.4     (excitation.type: record)
     """
-    from rbm_cli.api import run as run_cell
-    from rbm_cli.base.files import check_writable_dir
-    from rbm_cli.physics.column import build_column
-    from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
-
     cfg = load(config)
     kind = cfg.excitation.type
     amplitude_g, frequency_hz = _check_excitation(kind, amplitude, frequency)
@@ -145,6 +141,27 @@ def run(
             f"--dt {output_dt:g} s gives {samples:.3g} samples over {cfg.excitation.duration:g} s"
             f" (at most {MAX_SAMPLES:,}): use a larger --dt"
         )
+
+    from rbm_cli.report.figure_process import RUN_IMPORTS, FigureProcess
+
+    # before numba and matplotlib are imported: the child imports the figures' while this
+    # process loads the integrator and runs (issue 18)
+    with FigureProcess.start(RUN_IMPORTS) or contextlib.nullcontext() as painter:
+        result, folder = _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter)
+    _print_summary(result, folder)
+    if result.status == "failed":
+        reason = " ".join(str(result.message).split()) or "no reason given"
+        click.echo(f"Error: run failed: {reason}", err=True)
+        sys.exit(EXIT_RUN_FAILED)
+
+
+def _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter):
+    """The body of `rbm run` once its inputs are checked: (RunResult, run folder). painter:
+    the FigureProcess that draws history.png and shapes.png, or None to draw them here."""
+    from rbm_cli.api import run as run_cell
+    from rbm_cli.base.files import check_writable_dir
+    from rbm_cli.physics.column import build_column
+    from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
 
     try:
         check_writable_dir(Path(output) / cfg.name)
@@ -163,22 +180,19 @@ def run(
         folder = write_run(
             output,
             cfg.name,
-            run_folder_name(amplitude_g, frequency_hz, kind),
+            run_folder_name(amplitude_g, frequency_hz, cfg.excitation.type),
             result,
             summary,
             widths=column.widths,
             elevations=list(column.bottoms) + [column.height],
+            figure_process=painter,
         )
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except KeyboardInterrupt:
         raise Interrupted("interrupted (Ctrl-C): no run folder was written") from None
 
-    _print_summary(result, folder)
-    if result.status == "failed":
-        reason = " ".join(str(result.message).split()) or "no reason given"
-        click.echo(f"Error: run failed: {reason}", err=True)
-        sys.exit(EXIT_RUN_FAILED)
+    return result, folder
 
 
 # --------------------------------------------------------------------------- info

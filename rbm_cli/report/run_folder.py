@@ -6,10 +6,11 @@ written (atomic writers in :mod:`rbm_cli.base.files`).
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -17,24 +18,31 @@ import numpy as np
 
 from rbm_cli import __version__
 from rbm_cli.base.files import (
+    FLOAT_FORMAT,
     OutputError,
     check_writable_dir,
     current_umask,
     json_ready,
     make_dirs,
     remove_stale_staging,
-    save_figure_atomic,
-    write_csv_atomic,
+    write_chunks_atomic,
     write_json_atomic,
 )
 from rbm_cli.models.result import History, RunResult
+from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figures, here before)
+    N_SHAPES,
+    RUN_PNGS,
+    _history_figure,
+    _run_column,
+    _shapes_figure,
+    run_png_calls,
+    run_pngs,
+    run_title,
+    shape_instants,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
-
-#: Number of deformed shapes drawn in shapes.png.
-N_SHAPES = 6
-
 
 # --------------------------------------------------------------------------- folders
 
@@ -58,14 +66,10 @@ def run_folder_name(amplitude_g: float, frequency_hz: float | None, excitation_t
 # --------------------------------------------------------------------------- one run
 
 
-def history_frame(history: History) -> pd.DataFrame:
-    """history.csv as a table: t_s, ag_m_s2, ug_m, u1_m..u{n+1}_m, theta1_rad..thetan_rad.
-
-    The u columns are node displacements relative to the ground [m]; the theta
-    columns absolute drum rotations [rad]. (pandas is imported here, not with the module.)
-    """
-    import pandas as pd
-
+def history_columns(history: History) -> dict[str, np.ndarray]:
+    """The columns of history.csv: t_s [s], ag_m_s2 [m/s2], ug_m [m], u1_m..u{n+1}_m [m]
+    (node displacements relative to the ground), theta1_rad..thetan_rad [rad] (absolute
+    drum rotations); -0.0 made 0.0, so the file never shows "-0"."""
     u = np.atleast_2d(np.asarray(history.node_displacements, dtype=float))
     theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
     data: dict[str, np.ndarray] = {
@@ -77,24 +81,36 @@ def history_frame(history: History) -> pd.DataFrame:
         data[f"u{i + 1}_m"] = u[:, i]
     for i in range(theta.shape[1]):
         data[f"theta{i + 1}_rad"] = theta[:, i]
-    # + 0.0 turns -0.0 into 0.0, so the file never shows "-0"
-    return pd.DataFrame({k: v + 0.0 for k, v in data.items()})
+    return {k: v + 0.0 for k, v in data.items()}
 
 
-def shape_instants(t: Sequence[float], count: int = N_SHAPES) -> list[int]:
-    """Indices of ``count`` instants evenly spaced up to the last sample, which is included.
+def history_frame(history: History) -> pd.DataFrame:
+    """history.csv as a table (the columns of :func:`history_columns`; pandas is imported
+    here, not with the module)."""
+    import pandas as pd
 
-    The first instant is one step (t_end / count) after the start, since at
-    t = 0 a column starting from rest shows nothing.
-    """
-    t = np.asarray(t, dtype=float)
-    if t.size == 0:
-        return []
-    targets = np.linspace(t[0], t[-1], count + 1)[1:]
-    idx = sorted({int(np.argmin(np.abs(t - target))) for target in targets})
-    if idx[-1] != t.size - 1:
-        idx.append(t.size - 1)
-    return idx
+    return pd.DataFrame(history_columns(history))
+
+
+def history_csv(history: History, rows_per_chunk: int = 4096) -> Iterator[str]:
+    """The text of history.csv in pieces, without pandas: the file
+    ``history_frame(history).to_csv(index=False, float_format="%.12g", lineterminator="\\n")``
+    writes (base.files.write_csv_atomic), floats with 12 significant digits, empty for NaN."""
+    columns = history_columns(history)
+    yield ",".join(columns) + "\n"
+    table = np.column_stack(list(columns.values())) if columns else np.empty((0, 0))
+    line = ",".join([FLOAT_FORMAT] * table.shape[1]) + "\n"
+    for start in range(0, table.shape[0], rows_per_chunk):
+        block = table[start : start + rows_per_chunk]
+        rows = block.tolist()
+        if np.isnan(block).any():  # pandas writes NaN as an empty field
+            yield "".join(_csv_line(row) for row in rows)
+        else:
+            yield "".join([line % tuple(row) for row in rows])
+
+
+def _csv_line(row: list[float]) -> str:
+    return ",".join("" if math.isnan(v) else FLOAT_FORMAT % v for v in row) + "\n"
 
 
 def run_summary(
@@ -120,99 +136,12 @@ def run_summary(
     return json_ready(summary)
 
 
-def run_title(summary: dict) -> str | None:
-    """'<config name>: A = <a> g, f = <f> Hz' (or ': free motion') from a summary.json
-    made by :func:`run_summary`; None if the summary does not hold them."""
-    try:
-        name = summary["config_written"]["name"]
-        inputs = summary["inputs"]
-        kind = summary["config_written"].get("excitation", {}).get("type", "harmonic")
-        if kind == "free":
-            return f"{name}: free motion"
-        amplitude, frequency = float(inputs["amplitude_g"]), float(inputs["frequency_hz"])
-        cell = f"A = {amplitude:.4g} g, f = {frequency:.4g} Hz"
-    except (KeyError, TypeError, ValueError, AttributeError):
-        return None
-    return f"{name} ({kind}): {cell}"
-
-
-def _run_column(summary: dict):
-    """(Column, formulation, collapse ratio) of the config a summary.json holds, or None."""
-    from rbm_cli.base.errors import RbmError
-    from rbm_cli.config.load import parse_config
-    from rbm_cli.physics.column import build_column
-
-    try:
-        config = parse_config(summary["config_written"])
-        column = build_column(config.column, config.interface)
-    except (KeyError, TypeError, ValueError, RbmError):
-        return None
-    return column, config.interface.formulation, config.collapse.ratio
-
-
-def _history_figure(
-    history: History,
-    t_collapse: float | None,
-    title: str | None = None,
-    joints: tuple | None = None,
-):
-    """history.png: base and top displacement, top relative to base, and for more than
-    one drum each joint's rotation over its limit (``joints`` = (Column, formulation,
-    collapse ratio), see :func:`rbm_cli.report.plots.plot_joint_rotations`)."""
-    from matplotlib.figure import Figure
-
-    from rbm_cli.report.plots import plot_history, plot_joint_rotations, plot_top_relative
-
-    multi = joints is not None and joints[0].n > 1
-    fig = Figure(figsize=(9.0, 8.5 if multi else 6.0))
-    axes = fig.subplots(3 if multi else 2, 1, sharex=True)
-    plot_history(history, ax=axes[0], t_collapse=t_collapse)
-    plot_top_relative(history, ax=axes[1], t_collapse=t_collapse)
-    if multi:
-        column, formulation, ratio = joints
-        plot_joint_rotations(
-            history,
-            column.rotation_capacity,
-            ax=axes[2],
-            formulation=formulation,
-            collapse_ratio=ratio,
-            t_collapse=t_collapse,
-        )
-        axes[2].set_title("joint rotations against their limits", fontsize="medium")
-    for ax in axes[:-1]:
-        ax.set_xlabel("")
-    for ax in axes:  # legends beside the axes, so every panel has the same width
-        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small")
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
-
-
-def _shapes_figure(
-    history: History, widths, elevations, t_collapse: float | None, title: str | None = None
-):
-    from matplotlib.figure import Figure
-
-    from rbm_cli.report.plots import plot_shapes
-
-    fig = Figure(figsize=(10.0, 5.0))
-    ax = fig.subplots()
-    plot_shapes(
-        history,
-        widths,
-        shape_instants(history.t),
-        ax=ax,
-        elevations=elevations,
-        t_collapse=t_collapse,
-    )
-    x0, x1 = ax.get_xlim()
-    y0, y1 = ax.get_ylim()
-    fig.set_size_inches(10.0, float(np.clip(9.0 * (y1 - y0) / (x1 - x0) + 1.0, 3.0, 8.0)))
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+def _pngs(figure_process, figures: tuple) -> dict[str, bytes]:
+    """{file name: PNG bytes} of the run's figures: the figure child's (their calls
+    submitted to it, see :func:`write_run`), or drawn here without one."""
+    if figure_process is None:
+        return run_pngs(*figures)
+    return dict(zip(RUN_PNGS, figure_process.result(), strict=True))
 
 
 def write_run(
@@ -224,12 +153,17 @@ def write_run(
     *,
     widths,
     elevations,
+    figure_process=None,
 ) -> Path:
     """Write history.csv, history.png, shapes.png and summary.json of one run.
 
     The files are written into a hidden staging folder beside the destination
     ``out_dir/name/folder``, which then replaces its files (or is renamed into
-    place). Nothing is left behind if writing fails.
+    place). Nothing is left behind if writing fails. With a ``figure_process``
+    (rbm_cli.report.figure_process.FigureProcess, `rbm run`'s), its child draws the
+    figures side by side (:func:`rbm_cli.report.run_figures.run_png_calls`) while this
+    process writes history.csv, and sends back the PNG files' bytes, written here: the
+    child writes no file, and this process imports neither matplotlib nor pandas.
 
     Parameters
     ----------
@@ -241,6 +175,8 @@ def write_run(
         figures' title (config and cell) and the column's rotation limits come from it
     widths : (n+1,) Column widths at the nodes [m]
     elevations : (n+1,) Node elevations [m]
+    figure_process : FigureProcess or None  The child that draws the figures; None: drawn
+        in this process
 
     Returns
     -------
@@ -267,14 +203,12 @@ def write_run(
     except OSError as exc:
         raise OutputError(f"cannot write in output folder {parent}: {exc.strerror}") from None
     try:
-        write_csv_atomic(staging / "history.csv", history_frame(result.history))
-        title = run_title(summary)
-        figure = _history_figure(result.history, t_collapse, title, _run_column(summary))
-        save_figure_atomic(figure, staging / "history.png")
-        save_figure_atomic(
-            _shapes_figure(result.history, widths, elevations, t_collapse, title),
-            staging / "shapes.png",
-        )
+        figures = (result.history, t_collapse, summary, widths, elevations)
+        if figure_process is not None:  # drawn by the child while history.csv is written
+            figure_process.submit_all(run_png_calls(*figures))
+        write_chunks_atomic(staging / "history.csv", history_csv(result.history))
+        for png, data in _pngs(figure_process, figures).items():
+            write_chunks_atomic(staging / png, [data])
         write_json_atomic(staging / "summary.json", summary)
         if target.is_dir():
             for item in staging.iterdir():

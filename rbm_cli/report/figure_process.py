@@ -108,16 +108,16 @@ def _call(call):
 
 
 def _outcome(run) -> tuple:
-    """("done", run(), None), or ("done", None, its exception) where the exception can be
-    pickled (else a RuntimeError naming it): a reply."""
+    """(run(), None), or (None, its exception) where the exception can be pickled (else a
+    RuntimeError naming it): a reply."""
     try:
-        return ("done", run(), None)
+        return (run(), None)
     except Exception as exc:  # the command raises it (the sweep: publish_result)
         try:
             error = pickle.loads(pickle.dumps(exc))
         except Exception:
             error = RuntimeError(f"{type(exc).__name__}: {exc}")
-        return ("done", None, error)
+        return (None, error)
 
 
 def _die_with_parent(parent: int) -> None:
@@ -167,9 +167,9 @@ def _fork_call(call, inherited: tuple[int, ...]):
             os.waitpid(pid, 0)
         if reply is None:
             raise RuntimeError(f"the process drawing {call[0].__name__} died")
-        if reply[2] is not None:
-            raise reply[2]
-        return reply[1]
+        if reply[1] is not None:
+            raise reply[1]
+        return reply[0]
 
     return value
 
@@ -183,7 +183,7 @@ def _run_calls(calls: list, inherited: tuple[int, ...]) -> list:
         values = [_call(calls[0])]
     finally:
         outcomes = [_outcome(value) for value in pending]  # (each grandchild reaped)
-    for _, value, error in outcomes:
+    for value, error in outcomes:
         if error is not None:
             raise error
         values.append(value)
@@ -305,7 +305,7 @@ class FigureProcess:
         if reply is None:  # no child, or it is gone: run here
             values = [_call(call) for call in calls]
         else:
-            _, values, error = reply
+            values, error = reply
             if error is not None:
                 raise error
         return values if self._many else values[0]

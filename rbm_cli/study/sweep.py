@@ -240,7 +240,7 @@ def run_sweep(
         compile_s, wall = run.run(todo, jobs, backend, scheduler, progress, stop_after)
         rows = [done[key(c)] for c in cells]
         counts = status_counts(rows)
-        meta = sweep_meta(config, digest, len(cells), len(todo), counts, ensemble, folder)
+        meta = sweep_meta(config, points, digest, len(cells), len(todo), counts, ensemble, folder)
         meta.update(wall_time_s=wall, jobs=jobs, backend=backend, scheduler=scheduler,
                     compile_time_s=compile_s)  # fmt: skip
         try:

@@ -229,22 +229,18 @@ def _versions() -> dict:
     }
 
 
-def solver_methods(config) -> str:
+def solver_methods(points) -> str:
     """The method(s) the sweep's cells ran with (solver.method, `auto` resolved at each
     point of the grid: rbm_cli.models.methods.resolve_method), e.g. 'closed-form' or
     'closed-form, DOP853' when the points differ."""
     from rbm_cli.models.methods import resolve_method
 
-    try:
-        configs = [p.config for p in grid_points(config)] or [config]
-    except RbmError:  # not a sweep's config (checked before the sweep runs)
-        configs = [config]
-    return ", ".join(dict.fromkeys(resolve_method(c) for c in configs))
+    return ", ".join(dict.fromkeys(resolve_method(p.config) for p in points))
 
 
 def sweep_meta(
-    config: Config, digest: str, n_cells: int, n_run: int, counts: dict, ensemble: int,
-    folder: Path | None = None,
+    config: Config, points: list, digest: str, n_cells: int, n_run: int, counts: dict,
+    ensemble: int, folder: Path | None = None,
 ):  # fmt: skip
     """meta.json's record of a sweep (wall time, workers and compile time added after).
     ``config_dir``: the folder the config's relative paths (records) are taken from,
@@ -259,7 +255,7 @@ def sweep_meta(
         "config_written": config.written,
         "config_dir": where,
         "config_hash": digest,
-        "solver_method": solver_methods(config),
+        "solver_method": solver_methods(points),
         "versions": _versions(),
         "wall_time_s": None,
         "jobs": None,

@@ -131,14 +131,8 @@ def _messages(block: Block, code: int, out: Outcome, solver) -> None:
         out.stopped_early()
     elif code == cr.AT_REST_END and not block.rbm:
         out.message = "at rest in free motion: stopped"
-    elif code == cr.FAILED_STEPS:
-        out.out_of_steps(solver, t)
-    elif code == cr.FAILED_EVENTS:
-        out.out_of_events(solver, t)
-    elif code == cr.FAILED_WALL:
-        out.out_of_time(solver, t)
-    elif code == cr.INTERRUPTED:  # pragma: no cover - disarm() raises first
-        raise KeyboardInterrupt
+    else:
+        cr.end_by_budget(out, code, solver)
     if out.status != "failed" and not math.isfinite(out.max_top):
         out.stop("failed", "numerical failure: non-finite state", t)
 

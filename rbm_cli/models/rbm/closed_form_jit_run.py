@@ -17,6 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
+from rbm_cli.models.housner_state import STOP_MARGIN
 from rbm_cli.models.rbm.closed_form_jit import (
     A_EVALS,
     A_FRICTION,
@@ -45,6 +46,7 @@ from rbm_cli.models.rbm.run_codes import (
     FAILED_EVENTS,
     FAILED_STEPS,
     GOING,
+    POLL_PIECES,
     STOPPED_EARLY,
     SURVIVED,
     guard_code,
@@ -52,10 +54,6 @@ from rbm_cli.models.rbm.run_codes import (
 
 T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE = range(10)
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)
-#: Energy margin of the early stop [fraction of the barrier] (housner_state.STOP_MARGIN).
-STOP_MARGIN = 1e-9
-#: Pieces between two polls of the wall clock and Ctrl-C (kernel_guard.poll).
-CLOCK_EVERY = 64
 
 
 @njit(cache=True)
@@ -170,7 +168,7 @@ def _segment(blk, st, cnt, mo, se, fc, seg_end, can_stop, samples, pc, acc):
                 return GOING
         if cnt[PIECES] >= se[0]:
             return FAILED_STEPS
-        if cnt[PIECES] % CLOCK_EVERY == CLOCK_EVERY - 1:
+        if cnt[PIECES] % POLL_PIECES == POLL_PIECES - 1:
             code = guard_code(se[2])
             if code != GOING:
                 return code

@@ -22,11 +22,8 @@ from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.models.rbm.run_codes import (
     AT_REST_END,
     COLLAPSED,
-    FAILED_EVENTS,
-    FAILED_STEPS,
-    FAILED_WALL,
-    INTERRUPTED,
     STOPPED_EARLY,
+    end_by_budget,
 )
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
@@ -60,14 +57,8 @@ def _outcome(code, st, cnt, maxima, fric, solver, n: int) -> Outcome:
         out.collapse(float(st[3]), int(cnt[5]))
     elif code == STOPPED_EARLY:
         out.stopped_early()
-    elif code == FAILED_STEPS:
-        out.out_of_steps(solver, t)
-    elif code == FAILED_EVENTS:
-        out.out_of_events(solver, t)
-    elif code == FAILED_WALL:
-        out.out_of_time(solver, t)
-    elif code == INTERRUPTED:  # pragma: no cover - disarm() raises first
-        raise KeyboardInterrupt
+    elif end_by_budget(out, code, solver):
+        pass
     elif code != AT_REST_END and not math.isfinite(out.max_top):
         out.stop("failed", "numerical failure: non-finite state", t)
     return out

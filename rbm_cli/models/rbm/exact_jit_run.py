@@ -38,6 +38,7 @@ from rbm_cli.models.rbm.run_codes import (
     FAILED_EVENTS,
     FAILED_STEPS,
     GOING,
+    POLL_PIECES,
     STOPPED_EARLY,
     SURVIVED,
     guard_code,
@@ -45,8 +46,6 @@ from rbm_cli.models.rbm.run_codes import (
 
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
-#: Steps between two polls of the wall clock and Ctrl-C (kernel_guard.poll).
-CLOCK_EVERY = 64
 
 #: Work arrays of a run: the point pool, mode and family bounds, the peak refinement's
 #: reference counts, free list and stack, and the noted intervals (exact_jit_peaks).
@@ -113,7 +112,7 @@ def _budget(s, se):
     """A failure code when a budget is exceeded, else GOING."""
     if s.cnt[STEPS] > se[0]:
         return FAILED_STEPS
-    if s.cnt[STEPS] % CLOCK_EVERY == 0:
+    if s.cnt[STEPS] % POLL_PIECES == 0:
         return guard_code(se[2])
     return GOING
 

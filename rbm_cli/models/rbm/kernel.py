@@ -49,6 +49,7 @@ from rbm_cli.models.rbm.kernel_rk import (
     STOPPED_EARLY,
 )
 from rbm_cli.models.rbm.kernel_step import run_kernel
+from rbm_cli.models.rbm.run_codes import end_by_budget
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -104,16 +105,10 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
     elif code == FAILED_STEP:
         out.stop("failed", "integrator: Required step size is less than spacing between "
                  "numbers.", t_end)  # fmt: skip
-    elif code == FAILED_STEPS:
-        out.out_of_steps(solver, t_end)
-    elif code == FAILED_EVENTS:
-        out.out_of_events(solver, t_end)
-    elif code == FAILED_WALL:
-        out.out_of_time(solver, t_end)
     elif code == FAILED_NONFINITE:
         out.stop("failed", "the state became NaN or infinite (non-finite arithmetic)", t_end)
-    elif code == INTERRUPTED:  # pragma: no cover - disarm() raises first
-        raise KeyboardInterrupt
+    else:
+        end_by_budget(out, code, solver, (FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED))
     return out
 
 

@@ -47,7 +47,10 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
             store.start_journal(digest, len(cells), command, config.solver.method,
                                 config.record_files())  # fmt: skip
             return {}, None
+        changed = "" if ours else changed_records(read.records, config)
         whose = "of this config" if ours else "of another config"
+        if changed:
+            whose = f"started before {changed} changed"
         if not resume and not force:
             hint = "add --resume to finish it" if ours else "use another -o folder"
             raise RbmError(
@@ -56,7 +59,6 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
             )
         if not resume or (not ours and read.hashes):
             if resume:
-                changed = changed_records(read.records, config)
                 if changed:
                     raise RbmError(
                         f"{store.journal}: {changed} changed since the sweep was started, so"

@@ -465,3 +465,24 @@ def test_a_missing_dask_is_refused_before_the_journal(tmp_path, monkeypatch):
     res = invoke("sweep", path, "-o", tmp_path / "out", "--backend", "dask")
     one_line_error(res, "pip install 'rbm[dask]'")
     assert not (tmp_path / "out").exists()
+
+
+# ------------------------------------------------------------ the store's own leftovers
+
+
+def test_temporary_files_a_kill_left_are_removed_by_the_next_sweep(tmp_path):
+    """Defect (found by the suite fault injection): a kill between the write of the state
+    file's (or the journal header's) temporary copy and its rename left
+    .domain.partial.json.<random>.tmp in the folder for good. The next sweep, holding the
+    folder's lock, removes those and nothing else."""
+    path = tmp_path / "b.yaml"
+    path.write_text("name: b\n" + BLOCK + "grid: {amplitudes: [0.1], frequencies: [1]}\n")
+    folder = tmp_path / "out" / "b"
+    folder.mkdir(parents=True)
+    stale = [folder / ".domain.partial.json.1p2w9_lr.tmp", folder / ".domain.partial.jsonl.x.tmp"]
+    mine = [folder / ".notes.tmp", folder / "domain.partial.json.tmp", folder / "keep.tmp"]
+    for item in stale + mine:
+        item.write_text("{}")
+    assert invoke("sweep", path, "-o", tmp_path / "out", "--jobs", "1", "--quiet").exit_code == 0
+    assert [p.exists() for p in stale] == [False, False]
+    assert all(p.exists() for p in mine)

@@ -184,11 +184,17 @@ class SweepStore:
             self._lock_fd = None
 
     def _remove_stale_staging(self) -> None:
-        """Staging folders of publications that did not finish (a kill): with the lock
-        held, none can be in use."""
+        """Staging folders of publications that did not finish, and temporary copies of the
+        journal's header or the state file that a kill left before their rename: with the
+        lock held, none can be in use."""
         for item in self.folder.glob(STAGING_PREFIX + "*"):
             if item.is_dir() and not item.is_symlink():
                 shutil.rmtree(item, ignore_errors=True)
+        for name in (JOURNAL, STATE):
+            for item in self.folder.glob(f".{name}.*.tmp"):
+                if item.is_file() and not item.is_symlink():
+                    with contextlib.suppress(OSError):
+                        item.unlink()
 
     # ---------------------------------------------------------------- what the folder holds
     def finished_hash(self) -> str | None:

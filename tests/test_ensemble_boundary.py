@@ -232,3 +232,26 @@ def test_stored_boundaries_are_their_ensembles(name):
     files = json.loads((folder / "meta.json").read_text()).get("files", {})
     for file, digest in files.items():
         assert hashlib.sha256((folder / file).read_bytes()).hexdigest() == digest, file
+
+
+@pytest.mark.parametrize("bad", ["abc", "1.5", "-0.25", "inf"])
+def test_a_collapse_fraction_out_of_range_is_one_line(tmp_path, bad):
+    """Defect: the boundary of an ensemble is drawn from collapse_fraction, but a domain.csv
+    whose collapse_fraction was text gave a ValueError traceback in `rbm plot-domain`, and
+    one outside [0, 1] was drawn as if it were a fraction. Both are refused in one line
+    naming the line and the value; an empty one (every member failed) is accepted."""
+    rows = hand_rows()
+    rows[7]["collapse_fraction"] = bad
+    path = tmp_path / "domain.csv"
+    path.write_text(csv_text(rows, tuple(rows[0])), encoding="utf-8")
+    for command in (["plot-domain", str(path), "-o", str(tmp_path / "d.png")],
+                    ["compare", str(path), str(path)]):  # fmt: skip
+        res = CliRunner().invoke(cli, command)
+        assert res.exit_code == 2, res.output
+        assert "Traceback" not in res.output and len(res.output.strip().splitlines()) == 1
+        assert "line 9" in res.output and "collapse_fraction" in res.output
+        assert repr(bad) in res.output
+    assert not (tmp_path / "d.png").exists()
+    rows[7]["collapse_fraction"] = None  # written empty
+    path.write_text(csv_text(rows, tuple(rows[0])), encoding="utf-8")
+    assert CliRunner().invoke(cli, ["compare", str(path), str(path)]).exit_code == 0

@@ -599,8 +599,9 @@ def part_rbm_e(jobs: int) -> None:
 
 
 def _boundary(df) -> dict:
-    """Lowest collapsed amplitude per frequency [g] (None: none), from domain.boundary."""
-    b = boundary(df)
+    """Lowest collapsed amplitude per frequency [g] (None: none), from domain.boundary, by
+    the rows' status (an ensemble's member 0: without its fraction, not the majority's)."""
+    b = boundary(df.drop(columns=["collapse_fraction"], errors="ignore"))
     return {
         float(f): None if np.isnan(a) else float(a)
         for f, a in zip(b["frequency_hz"], b["lowest_unsafe_g"], strict=True)

@@ -214,8 +214,14 @@ def test_collapse_fraction_colours_points_with_colourbar():
     # colours follow the fraction: collapsed cells (fraction 1) share one colour
     assert len(np.unique(np.asarray(unsafe.get_facecolors()), axis=0)) == 1
     assert len(np.unique(np.asarray(safe.get_edgecolors()), axis=0)) > 1
+    # the boundary is the majority's: at 2.5 Hz member 0 survives 1.0 g, which half of
+    # the members (fraction 0.5) collapse; member 0's own boundary is drawn beside it
     np.testing.assert_allclose(
-        _line(ax, "boundary").get_ydata(), [0.3, 0.4, 0.6, 0.8, math.nan], equal_nan=True
+        _line(ax, "boundary").get_ydata(), [0.3, 0.4, 0.6, 0.8, 1.0], equal_nan=True
+    )
+    np.testing.assert_allclose(
+        _line(ax, "boundary-member0").get_ydata(), [0.3, 0.4, 0.6, 0.8, math.nan],
+        equal_nan=True,
     )
 
 

@@ -3,7 +3,9 @@ point, or an overlay of the points' boundaries; in physical or dimensionless axe
 uplift level and the closed forms where they apply.
 
 Every artist carries a gid, as in plot_domain.py: 'safe', 'unsafe', 'failed', 'boundary'
-(one per panel), 'boundary-<k>' (the k-th point's line of an overlay), 'compare-<k>',
+(one per panel), 'boundary-member0' (an ensemble's member 0, one per panel),
+'boundary-<k>' (the k-th point's line of an overlay), 'member0-<k>' (its member 0's line
+in an ensemble), 'compare-<k>',
 'static' (or 'static-<k>' when the points' levels differ), 'housner', 'linear' (or
 'linear-<k>', the k-th point's own curve in physical overlays).
 
@@ -32,10 +34,12 @@ from rbm_cli.physics.column import build_column
 from rbm_cli.report.domain_view import DomainView, Point, row_configs
 from rbm_cli.report.plot_domain import (
     CURVE_POINTS,
+    MAJORITY_LABEL,
     draw_cells,
     draw_domain,
     finish_axes,
     fraction_colorbar,
+    is_ensemble,
     legend_beside,
     plot_levels,
 )
@@ -45,6 +49,9 @@ from rbm_cli.study.domain import boundary
 LOG_MARKER = 3.0
 #: Opacity of the cells under an overlay's lines.
 FAINT = 0.22
+#: An overlaid ensemble's member 0 boundary: thin, no marks (the majority's: marks "o").
+OVERLAY_MEMBER0 = dict(linewidth=0.9, linestyle=(0, (3, 1, 1, 1, 1, 1)), zorder=4)
+OVERLAY_MEMBER0_LABEL = "member 0's boundary of each point (thin, no marks)"
 #: Styles of the level and curves (as plot_domain.py draws them against frequency).
 STATIC = dict(color="0.3", linestyle="--", linewidth=1.0)
 HOUSNER = dict(color="tab:purple", linestyle="-.", linewidth=1.3)
@@ -229,12 +236,18 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
     for artist in (*ax.lines, *ax.collections):
         artist.set_alpha(FAINT)
     colours = point_colours(len(view.points), numeric)
+    ensemble = is_ensemble(rows)
     for k, (point, colour) in enumerate(zip(view.points, colours, strict=True)):
         bnd = boundary(view.plane(point.rows))
-        ax.plot(bnd["frequency_hz"].to_numpy(float), bnd["lowest_unsafe_g"].to_numpy(float),
+        f = bnd["frequency_hz"].to_numpy(float)
+        ax.plot(f, bnd["lowest_unsafe_g"].to_numpy(float),
                 color=colour, linewidth=1.5, marker="o", markersize=3.5, label=point.label,
                 linestyle=("-", "--", "-.")[k // 10 % 3] if not numeric else "-",
                 gid=f"boundary-{k}", zorder=4)  # fmt: skip
+        if ensemble:
+            ax.plot(f, bnd["member0_lowest_unsafe_g"].to_numpy(float), color=colour,
+                    label=OVERLAY_MEMBER0_LABEL if k == 0 else "_", gid=f"member0-{k}",
+                    **OVERLAY_MEMBER0)  # fmt: skip
     tops = [
         _overlay_levels(ax, view, point, k, colour)
         for k, (point, colour) in enumerate(zip(view.points, colours, strict=True))
@@ -245,7 +258,15 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
     levels = [lv for t in tops for lv in t[0][1]]
     finish_axes(ax, [plane], max(levels) if levels else None, [], view.labels, legend=False)
     _finish_x(ax, view)
-    legend_beside(ax)
+    handles = None
+    if ensemble:  # the points' lines are the majority's: the legend says so first
+        from matplotlib.lines import Line2D
+
+        handles, _ = ax.get_legend_handles_labels()
+        majority = Line2D([], [], color="0.2", linewidth=1.5, marker="o", markersize=3.5,
+                          label=f"lines with marks: each point's {MAJORITY_LABEL}")  # fmt: skip
+        handles = [majority, *handles]
+    legend_beside(ax, handles=handles)
 
 
 def _overlay_levels(ax, view: DomainView, point: Point, k: int, colour):

@@ -3,8 +3,10 @@
 A pure plot function: it takes ``ax=None`` (a new figure is made if omitted)
 and returns the axes; it never saves or shows (the CLI and the sweep do).
 Every artist it draws carries a ``gid`` ('safe', 'unsafe', 'failed',
-'boundary', 'compare-<k>', 'static', 'housner', 'linear'), so callers and
-tests can find them.
+'boundary', 'boundary-member0', 'compare-<k>', 'static', 'housner', 'linear'), so
+callers and tests can find them. In an ensemble domain (a collapse_fraction column)
+'boundary' is the majority's and 'boundary-member0' member 0's
+(:func:`rbm_cli.study.domain.boundary`).
 """
 
 from __future__ import annotations
@@ -16,14 +18,17 @@ import pandas as pd
 
 from rbm_cli.physics.closed_forms import halfsine_threshold_curves
 from rbm_cli.physics.column import Column
-from rbm_cli.study.domain import boundary
+from rbm_cli.study.domain import MAJORITY, boundary
 
 __all__ = [
+    "MAJORITY_LABEL",
+    "MEMBER0_LABEL",
     "boundary",
     "draw_cells",
     "draw_domain",
     "finish_axes",
     "fraction_colorbar",
+    "is_ensemble",
     "legend_beside",
     "plot_domain",
     "plot_levels",
@@ -40,6 +45,11 @@ FRACTION_LABEL = "fraction of ensemble members that collapsed [-]"
 FRACTION_TITLE = "marker: member 0's outcome\ncolour: fraction collapsed"
 #: Label of the boundary line of a domain.
 BOUNDARY_LABEL = "boundary (lowest collapsed amplitude)"
+#: Labels of an ensemble's two boundary lines: the majority's and member 0's.
+MAJORITY_LABEL = f"boundary of the majority (collapse fraction >= {MAJORITY:g})"
+MEMBER0_LABEL = "member 0's boundary (its own outcome)"
+#: Style of member 0's boundary line (the majority's is solid).
+MEMBER0_STYLE = dict(linestyle=":", linewidth=1.6)
 #: Marker size range [points] and its share of the grid spacing on screen.
 MARKER_MAX, MARKER_MIN, MARKER_SHARE = 5.0, 1.5, 0.75
 #: z-order of the cells: above the boundary and level lines.
@@ -161,11 +171,21 @@ def fraction_colorbar(fig, axes, cax=None) -> None:
                  fraction=0.06, aspect=40)  # fmt: skip
 
 
-def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str) -> None:
-    """The boundary as a line under the cells (no markers of its own)."""
+def is_ensemble(df: pd.DataFrame) -> bool:
+    """A domain of an ensemble sweep: its boundary is the majority's."""
+    return "collapse_fraction" in df.columns
+
+
+def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str, member0=None) -> None:
+    """The boundary as a line under the cells (no markers of its own); ``member0``: the
+    label of member 0's boundary of an ensemble, drawn dotted beside the majority's."""
     bnd = boundary(df)
-    ax.plot(bnd["frequency_hz"].to_numpy(float), bnd["lowest_unsafe_g"].to_numpy(float),
-            color=colour, linewidth=1.4, label=label, gid=gid, zorder=2)  # fmt: skip
+    f = bnd["frequency_hz"].to_numpy(float)
+    ax.plot(f, bnd["lowest_unsafe_g"].to_numpy(float), color=colour, linewidth=1.4,
+            label=label, gid=gid, zorder=2)  # fmt: skip
+    if member0 is not None and "member0_lowest_unsafe_g" in bnd.columns:
+        ax.plot(f, bnd["member0_lowest_unsafe_g"].to_numpy(float), color=colour,
+                label=member0, gid=f"{gid}-member0", zorder=2, **MEMBER0_STYLE)  # fmt: skip
 
 
 def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
@@ -192,11 +212,14 @@ def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
     )
 
 
-def _labels(labels: Sequence[str] | None, n_compare: int) -> list[str]:
-    """The legend labels of the boundaries: the domain's, then one per compared domain.
+def _labels(labels: Sequence[str] | None, domains: list[pd.DataFrame]) -> tuple[list, str]:
+    """The legend labels of the boundaries (the domain's, then one per compared domain),
+    and of member 0's boundary of an ensemble domain.
 
     Alone, the domain's line is the BOUNDARY_LABEL (what the line is; the figure's title
-    names the study). With compared domains each line is '<name>: boundary'."""
+    names the study), or for an ensemble the MAJORITY_LABEL. With compared domains each
+    line is '<name>: boundary', '<name>: boundary of the majority' for an ensemble."""
+    n_compare = len(domains) - 1
     if labels is None:
         labels = ["domain 1"] + [f"domain {k + 2}" for k in range(n_compare)]
     labels = list(labels)
@@ -206,8 +229,10 @@ def _labels(labels: Sequence[str] | None, n_compare: int) -> list[str]:
             f"domain), got {len(labels)}"
         )
     if n_compare == 0:
-        return [BOUNDARY_LABEL]
-    return [f"{name}: boundary" for name in labels]
+        return [MAJORITY_LABEL if is_ensemble(domains[0]) else BOUNDARY_LABEL], MEMBER0_LABEL
+    texts = [f"{name}: boundary" + (" of the majority" if is_ensemble(d) else "")
+             for name, d in zip(labels, domains, strict=True)]  # fmt: skip
+    return texts, f"{labels[0]}: {MEMBER0_LABEL}"
 
 
 def finish_axes(
@@ -294,10 +319,10 @@ def draw_domain(
     """Cells of ``df`` and the boundaries of it and of ``compare`` (see :func:`plot_domain`),
     from its amplitude_g and frequency_hz columns; returns the ensemble's legend proxies."""
     compare = list(compare)
-    labels = _labels(labels, len(compare))
+    texts, member0 = _labels(labels, [df, *compare])
     proxies = draw_cells(ax, df, colorbar, size)
-    _plot_boundary(ax, df, "black", labels[0], "boundary")
-    for k, (other, label) in enumerate(zip(compare, labels[1:], strict=True)):
+    _plot_boundary(ax, df, "black", texts[0], "boundary", member0 if is_ensemble(df) else None)
+    for k, (other, label) in enumerate(zip(compare, texts[1:], strict=True)):
         colour = COMPARE_COLOURS[k % len(COMPARE_COLOURS)]
         _plot_boundary(ax, other, colour, label, f"compare-{k}")
     return proxies
@@ -355,9 +380,12 @@ def plot_domain(
     Alone, the domain's line is labelled "boundary (lowest collapsed amplitude)";
     with compared domains each line is "<label>: boundary". The boundary is the
     lowest collapsed amplitude per frequency (:func:`rbm_cli.study.domain.boundary`;
-    gaps where nothing collapses). The closed forms use the mapping of SPEC
-    section 2 (:func:`rbm_cli.physics.closed_forms.linear_rocking_parameters`): the
-    rigid RBM monolith is the piecewise-linear block with alpha = B_1/H.
+    gaps where nothing collapses). In an ensemble domain it is the majority's (a cell
+    collapsed where collapse_fraction >= 0.5), labelled so, and member 0's boundary is
+    drawn beside it, dotted in the same colour, labelled "member 0's boundary". The
+    closed forms use the mapping of SPEC section 2
+    (:func:`rbm_cli.physics.closed_forms.linear_rocking_parameters`): the rigid RBM
+    monolith is the piecewise-linear block with alpha = B_1/H.
     The amplitude axis starts at 0 and stops just above the largest amplitude
     of the grids, so a steep closed-form curve does not squash the domain.
     """

@@ -4,7 +4,10 @@ A domain is a pandas DataFrame with the columns of SPEC section 5
 (:data:`rbm_cli.models.result.CSV_FIELDS`), one row per (amplitude, frequency) cell, or
 the list of its rows (dicts) a sweep makes. pandas is imported where a DataFrame is built
 or read, not with this module: a sweep writes domain.csv and boundary.csv from its rows
-(:func:`csv_text`, :func:`boundary_rows`) without it (issue 18).
+(:func:`csv_text`, :func:`boundary_table`) without it (issue 18).
+
+The boundary (boundary.csv) is rbm_cli.study.boundary_lines': its table, the order of its
+lines and, for an ensemble, the majority's rule. This module names them too.
 """
 
 from __future__ import annotations
@@ -19,6 +22,13 @@ import numpy as np
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import CSV_FIELDS, STATUSES
+from rbm_cli.study.boundary_lines import BOUNDARY_FIELDS as BOUNDARY_FIELDS
+from rbm_cli.study.boundary_lines import MAJORITY as MAJORITY
+from rbm_cli.study.boundary_lines import MEMBER0_FIELDS as MEMBER0_FIELDS
+from rbm_cli.study.boundary_lines import axis_columns as axis_columns
+from rbm_cli.study.boundary_lines import boundary as boundary
+from rbm_cli.study.boundary_lines import boundary_table as boundary_table
+from rbm_cli.study.boundary_lines import line_ident, line_order, line_row
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -76,11 +86,6 @@ def cell_key(amplitude_g: float, frequency_hz: float | None, *values) -> tuple[s
 def row_key(row, paths: tuple[str, ...] = ()) -> tuple[str, ...]:
     """The cell identity of a domain or journal row whose point is in the columns ``paths``."""
     return cell_key(row.get("amplitude_g"), row.get("frequency_hz"), *(row.get(p) for p in paths))
-
-
-def axis_columns(columns) -> tuple[str, ...]:
-    """The columns of a domain that hold its point's axes: named by a dotted config path."""
-    return tuple(c for c in columns if "." in str(c))
 
 
 def keys_of(df: pd.DataFrame) -> list[tuple[str, ...]]:
@@ -154,6 +159,8 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
         )
     if "collapsed" in df.columns:
         _check_collapsed(df, path, got)
+    if "collapse_fraction" in df.columns:
+        _check_fraction(df, path, got)
     seen: dict[tuple[str, ...], int] = {}
     paths = axis_columns(df.columns)
     for i, key in enumerate(keys_of(df)):
@@ -164,6 +171,24 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
                 f" (amplitude {key[0]} g, frequency {key[1] or 'none'} Hz{point})"
             )
         seen[key] = i
+
+
+def _check_fraction(df: pd.DataFrame, path: Path, got) -> None:
+    """collapse_fraction is a number in [0, 1] or empty (every member failed): the boundary
+    of an ensemble is drawn from it. Converts it to float in place."""
+    import pandas as pd
+
+    raw = df["collapse_fraction"]
+    x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
+    with np.errstate(invalid="ignore"):
+        bad = (np.isnan(x) & raw.notna().to_numpy()) | np.isinf(x) | (x < 0.0) | (x > 1.0)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RbmError(
+            f"{path}: line {i + 2}: collapse_fraction must be a number in [0, 1] or empty"
+            f" (every member failed), got {got(raw.iloc[i])}"
+        )
+    df["collapse_fraction"] = x
 
 
 def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
@@ -191,73 +216,10 @@ def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
 
 def _groups(df: pd.DataFrame):
     """(group columns, groupby) of a domain's boundary lines: one per point of its axes
-    and frequency (NaN frequency kept: a record's)."""
+    and frequency (NaN frequency kept: a record's), in the order the rows first hold them
+    (:func:`line_order` orders them: an axis may mix strings and numbers)."""
     by = [*axis_columns(df.columns), "frequency_hz"]
-    return by, df.groupby(by if len(by) > 1 else by[0], sort=True, dropna=False)
-
-
-def _group_row(by: list[str], values) -> dict:
-    values = values if isinstance(values, tuple) else (values,)
-
-    def freq(v) -> float:
-        return math.nan if v is None else float(v)
-
-    return {c: (freq(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
-
-
-def _missing(value) -> bool:
-    """None or NaN: an empty field (a record's frequency)."""
-    return value is None or (isinstance(value, float | np.floating) and math.isnan(value))
-
-
-def _line_order(values: tuple):
-    """Sort key of a boundary line's group values: each in ascending order, empty last (as
-    pandas' groupby(sort=True, dropna=False))."""
-    return tuple((True, 0.0) if _missing(v) else (False, v) for v in values)
-
-
-def _lowest_highest(cells: list[tuple]) -> tuple[float, float]:
-    """(lowest collapsed amplitude, highest survived one below it) [g] of one line's
-    (status, amplitude_g) pairs; NaN where there is none."""
-    unsafe = [a for s, a in cells if s == "collapsed" and not _missing(a)]
-    low = float(min(unsafe)) if unsafe else math.nan
-    safe = [a for s, a in cells if s == "survived" and not _missing(a)]
-    if math.isfinite(low):
-        safe = [a for a in safe if a < low]
-    return low, (float(max(safe)) if safe else math.nan)
-
-
-def boundary_table(rows: list[dict], columns) -> tuple[tuple[str, ...], list[dict]]:
-    """The boundary of a domain given as rows (dicts) with the domain's ``columns``: its
-    columns (the axis columns, frequency_hz, lowest_unsafe_g, highest_safe_g) and its rows
-    (:func:`boundary` says what they hold), in plain Python: a sweep writes boundary.csv
-    from its rows without pandas (issue 18)."""
-    by = (*axis_columns(columns), "frequency_hz")
-    lines: dict[tuple, tuple[tuple, list]] = {}
-    for row in rows:
-        values = tuple(row.get(c) for c in by)
-        ident = tuple(None if _missing(v) else v for v in values)  # NaN != NaN
-        lines.setdefault(ident, (values, []))[1].append((row.get("status"), row.get("amplitude_g")))
-    out = []
-    for values, cells in sorted(lines.values(), key=lambda line: _line_order(line[0])):
-        low, high = _lowest_highest(cells)
-        out.append({**_group_row(list(by), values), "lowest_unsafe_g": low, "highest_safe_g": high})
-    return (*by, "lowest_unsafe_g", "highest_safe_g"), out
-
-
-def boundary(df: pd.DataFrame) -> pd.DataFrame:
-    """Lowest unsafe (collapsed) amplitude per frequency, and the highest safe one below it.
-
-    Returns a DataFrame sorted by frequency with columns frequency_hz,
-    lowest_unsafe_g (NaN where nothing collapses) and highest_safe_g (largest
-    survived amplitude below lowest_unsafe_g; NaN if none). A domain with axes over
-    config keys has one line per point and frequency, the axis columns first. The rows
-    are :func:`boundary_table`'s, the one implementation of the rule.
-    """
-    import pandas as pd
-
-    columns, rows = boundary_table(df.to_dict("records"), df.columns)
-    return pd.DataFrame(rows, columns=list(columns))
+    return by, df.groupby(by if len(by) > 1 else by[0], sort=False, dropna=False)
 
 
 @dataclass(frozen=True)
@@ -288,6 +250,7 @@ def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
     by, groups = _groups(df)
     out = {}
     for values, grp in groups:
+        values = values if isinstance(values, tuple) else (values,)
         amps = np.sort(grp["amplitude_g"].to_numpy(float))
         unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
         if len(unsafe):
@@ -295,8 +258,8 @@ def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
         else:
             step = float(np.min(np.diff(amps))) if len(amps) > 1 else 0.0
             edge = float(amps[-1]) + step
-        row = _group_row(by, values)
-        out[tuple(_key_text(row[c]) for c in by)] = (row, edge)
+        row = line_row(by, values)
+        out[tuple(_key_text(row[c]) for c in by)] = (row, edge, line_ident(values))
     return by, out
 
 
@@ -319,14 +282,13 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
     by, ea = _edges(a)
     _, eb = _edges(b)
     rows = []
-    for k in sorted(ea.keys() & eb.keys(), key=lambda k: ea[k][0]["frequency_hz"]):
-        row, edge_a = ea[k]
+    order = line_order([line[2] for line in ea.values()])
+    for k in sorted(ea.keys() & eb.keys(), key=lambda k: order(ea[k][2])):
+        row, edge_a, _ = ea[k]
         rows.append({**row, "boundary_a_g": edge_a, "boundary_b_g": eb[k][1],
                      "shift_g": eb[k][1] - edge_a})  # fmt: skip
     columns = [*by, "boundary_a_g", "boundary_b_g", "shift_g"]
     shifts = pd.DataFrame(rows, columns=columns)
-    if len(by) > 1 and len(shifts):
-        shifts = shifts.sort_values(by, kind="stable").reset_index(drop=True)
     max_shift = float(shifts["shift_g"].abs().max()) if len(shifts) else 0.0
     return Comparison(
         n_common=len(common),

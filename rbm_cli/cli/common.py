@@ -95,9 +95,17 @@ def first_use(cfg) -> None:
     code = compiled_code(cfg)
     if code is None:
         return
+    import gc
+
     from rbm_cli.models.rbm.compile_ahead import compile_once
 
-    compile_once(code, notify=lambda text: click.echo(f"note: {text}", err=True))
+    collecting = gc.isenabled()
+    gc.enable()  # a compile's garbage is collected (peak 0.46 GB instead of 0.73 GB)
+    try:
+        compile_once(code, notify=lambda text: click.echo(f"note: {text}", err=True))
+    finally:
+        if not collecting:
+            gc.disable()  # work_starts then freezes what the load made, as before
 
 
 def one_line(exc: BaseException) -> str:

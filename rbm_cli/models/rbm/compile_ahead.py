@@ -1,12 +1,12 @@
 """First use: the compiled code is compiled before the first run, one compile at a time.
 
-The compiled kernel takes 15-20 s to compile on a fresh installation (45-60 s on a loaded
-machine), the exact integrator about as long, the rigid block's compiled closed form a few
-seconds, once; numba then keeps them in its on-disk cache. The first `rbm run` or
-`rbm sweep` that needs one of them compiles it in its own process before its first cell
-(:func:`compile_once`) and answers with it: the code every later run loads from the cache,
-so the same answer the first time as every time after (a cell in chaotic motion is not
-answered the same by two integrators, whose round-off differs). The command says on
+Compiling takes time, once per installation: the kernel about 50 s on two shared cores
+(less on a fast idle machine, more on a busy one), the exact integrator about 80 s, the
+rigid block's closed form 6-10 s; numba then keeps them in its on-disk cache. The first
+`rbm run` or `rbm sweep` that needs one of them compiles it in its own process before its
+first cell (:func:`compile_once`) and answers with it: the code every later run loads from
+the cache, so the same answer the first time as every time after (a cell in chaotic motion
+is not answered the same by two integrators, whose round-off differs). The command says on
 stderr what it waits for and roughly how long (the ``notify`` of :func:`compile_once`).
 
 One compile at a time: a process that finds the code missing from the cache takes an
@@ -46,9 +46,9 @@ NAMES = {
     "closed-form": "the rigid block's closed form",
     "exact": "the exact integrator",
 }
-#: About how long a first compile takes [s], on two cores at a load of about 2 (measured;
-#: about half of it on an idle machine).
-ABOUT_S = {"kernel": 40, "closed-form": 10, "exact": 60}
+#: About how long a first compile takes [s]: measured on two shared cores at a load of 1-2
+#: (kernel 45-57 s, exact integrator 76 s, closed form 6-10 s).
+ABOUT_S = {"kernel": 50, "closed-form": 10, "exact": 80}
 
 
 def _module(target: str):

@@ -304,6 +304,7 @@ def _unreadable_copies(tmp_path):
 
 
 @pytest.mark.skipif(AS_ROOT, reason=ROOT_REASON)
+@pytest.mark.may_skip(reason=ROOT_REASON)
 @pytest.mark.parametrize("which", COMMANDS)
 def test_unreadable_file_chmod(tmp_path, which, monkeypatch):
     config, csv = _unreadable_copies(tmp_path)
@@ -385,6 +386,7 @@ def test_run_into_a_file(good, blocker, deeper):
 
 
 @pytest.mark.skipif(AS_ROOT, reason=ROOT_REASON)
+@pytest.mark.may_skip(reason=ROOT_REASON)
 @pytest.mark.parametrize("command", ["sweep", "run"])
 def test_read_only_output_folder(good, tmp_path, command):
     locked = tmp_path / "locked"

@@ -1,7 +1,11 @@
 """domain.png drawn by a child forked as `rbm sweep` starts (issue 18,
 rbm_cli.report.figure_process): the same file as drawn in the sweep's own process, a
 child that is not asked is killed and reaped, one that died is replaced by drawing here,
-and a drawing error is the sweep's error."""
+and a drawing error is the sweep's error.
+
+Each test forks the child in the test's own process, which FigureProcess refuses while
+other threads run: they run in a fresh interpreter (tests/conftest.py), where they must
+fork."""
 
 from __future__ import annotations
 
@@ -22,6 +26,7 @@ from .paths import CONFIGS
 pytestmark = [
     pytest.mark.timeout(240),
     pytest.mark.skipif(not hasattr(os, "fork"), reason="forks"),
+    pytest.mark.fresh_interpreter,
 ]
 
 
@@ -42,8 +47,7 @@ def gone(pid: int) -> bool:
 
 def started() -> FigureProcess:
     proc = FigureProcess.start()
-    if proc is None:
-        pytest.skip("no fork here (threads running)")
+    assert proc is not None, "no figure child was forked (threads running?)"
     return proc
 
 

@@ -82,6 +82,7 @@ def here(tmp_path_factory) -> bytes:
 
 
 @needs_x86_linux
+@pytest.mark.may_skip(reason="the variants are x86-64 settings: another Linux machine skips")
 @pytest.mark.parametrize("name", sorted(_variants()))
 def test_other_machines_pass_the_regression_rule_with_the_same_bytes(name, tmp_path, here):
     env = dict(os.environ, **_variants()[name])

@@ -2,7 +2,10 @@
 rbm_cli.report.figure_process): the run's own process imports neither matplotlib nor
 pandas, the run folder is the same byte for byte as drawn here (history.csv written without
 pandas is pandas' file), a dead child is replaced by drawing here, and no child outlives
-its run (killed by kill -9, or Ctrl-C to the terminal's process group)."""
+its run (killed by kill -9, or Ctrl-C to the terminal's process group).
+
+The tests that fork the child in the test's own process (which FigureProcess refuses while
+other threads run) run in a fresh interpreter (tests/conftest.py), where they must fork."""
 
 from __future__ import annotations
 
@@ -45,8 +48,7 @@ def gone(pid: int) -> bool:
 
 def started() -> FigureProcess:
     proc = FigureProcess.start(RUN_IMPORTS)
-    if proc is None:
-        pytest.skip("no fork here (threads running)")
+    assert proc is not None, "no figure child was forked (threads running?)"
     return proc
 
 
@@ -74,6 +76,7 @@ def _write(tmp_path, name, two_drums, figure_process=None) -> dict[str, bytes]:
 FILES = ["history.csv", "history.png", "shapes.png", "summary.json"]
 
 
+@pytest.mark.fresh_interpreter
 def test_the_child_draws_the_same_run_folder(tmp_path, two_drums):
     here = _write(tmp_path, "here", two_drums)
     proc = started()
@@ -83,6 +86,7 @@ def test_the_child_draws_the_same_run_folder(tmp_path, two_drums):
     assert sorted(child) == FILES and child == here
 
 
+@pytest.mark.fresh_interpreter
 def test_a_dead_child_is_replaced_by_drawing_here(tmp_path, two_drums):
     here = _write(tmp_path, "here", two_drums)
     proc = started()
@@ -91,6 +95,7 @@ def test_a_dead_child_is_replaced_by_drawing_here(tmp_path, two_drums):
     assert proc.pid is None
 
 
+@pytest.mark.fresh_interpreter
 def test_the_child_runs_a_call_and_raises_its_error_here():
     """One protocol: a module-level function and its arguments, its value or its error."""
     with started() as proc:
@@ -108,6 +113,7 @@ def _fail(tag: str) -> None:
     raise KeyError(tag)
 
 
+@pytest.mark.fresh_interpreter
 def test_calls_side_by_side_run_in_the_child_and_its_grandchildren():
     """submit_all: the first call in the child, each other one in a grandchild of it (at
     the same time), values in order; every grandchild reaped by the child."""
@@ -128,6 +134,7 @@ def _pid_then_sleep(path: str) -> None:
     time.sleep(60)
 
 
+@pytest.mark.fresh_interpreter
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG")
 def test_a_grandchild_dies_with_the_child(tmp_path):
     """The command kills the child while a grandchild draws (Ctrl-C): the grandchild, in a
@@ -147,6 +154,7 @@ def test_a_grandchild_dies_with_the_child(tmp_path):
     assert gone(grandchild)
 
 
+@pytest.mark.fresh_interpreter
 @pytest.mark.parametrize("where", [0, 1], ids=["child", "grandchild"])
 def test_an_error_side_by_side_is_raised_here(where):
     calls = [(_whoami, ("a",)), (_whoami, ("b",))]
@@ -165,6 +173,7 @@ def test_calls_side_by_side_without_a_child_run_here(monkeypatch):
     assert [v[:2] for v in proc.result()] == [("a", os.getpid()), ("b", os.getpid())]
 
 
+@pytest.mark.fresh_interpreter
 def test_the_child_ignores_sigint():
     with started() as proc:
         status = Path(f"/proc/{proc.pid}/status")

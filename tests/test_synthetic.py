@@ -224,6 +224,7 @@ def test_suite_reproducible_and_prefix_stable(tmp_path):
         assert r2.acceleration.tobytes() == r3.acceleration.tobytes()
 
 
+@pytest.mark.may_skip(reason="a numpy built without those CPU features cannot disable them")
 def test_suite_same_bits_without_avx(tmp_path):
     """numpy's exp/log change bits when its AVX dispatch is off; the suite must not."""
     env = dict(os.environ, NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL AVX512_SPR")

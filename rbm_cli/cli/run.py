@@ -201,7 +201,7 @@ def _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter):
     try:
         check_writable_dir(Path(output) / cfg.name)
         column = build_column(cfg.column, cfg.interface)
-        cfg = first_use(cfg)
+        first_use(cfg)  # compiled before the run: the answer of every later run
         work_starts()
         result = run_cell(cfg, amplitude_g, frequency_hz, output_dt=output_dt).result
         summary = run_summary(

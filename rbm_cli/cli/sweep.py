@@ -11,7 +11,6 @@ from rbm_cli.cli.common import (
     Interrupted,
     UserError,
     cli,
-    compile_notice,
     config_argument,
     load,
     one_line,
@@ -111,8 +110,6 @@ def _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensembl
     from rbm_cli.api import SweepInterrupted, run_sweep
     from rbm_cli.cli.progress import Progress
 
-    if not quiet:
-        compile_notice(cfg)
     reporter = None if quiet else Progress(cfg.name)
 
     def progress(done: int, total: int) -> None:  # first called once the kernel is loaded
@@ -171,7 +168,7 @@ def _print_sweep_summary(summary, jobs: int) -> None:
         )
         return
     compiled = (
-        f" (+ {duration(summary.compile_s)} loading the integrator)"
+        f" (+ {duration(summary.compile_s)} {summary.compile_what or 'loading the integrator'})"
         if (summary.compile_s >= 1.0)
         else ""
     )

@@ -57,29 +57,16 @@ def step_method(solver: SolverConfig) -> str:
 
 
 def compiled_code(config: Config) -> str | None:
-    """Which compiled code the cells of this config run: 'kernel' (the step kernel, or the
-    exact integrator's), 'closed-form' (the block's closed form: closed_form.warm_up), or
-    None (Python, or a model without compiled code)."""
+    """Which compiled code the cells of this config run: 'kernel' (the step kernel),
+    'exact' (the compiled exact integrator), 'closed-form' (the block's closed form), or
+    None (Python, or a model without compiled code): a target of
+    rbm_cli.models.rbm.compile_ahead."""
     method = resolve_method(config)
     compiled = config.solver.implementation == "compiled"
     if config.model == "housner-linear":
         return "closed-form" if compiled and config.excitation.vertical is None else None
     if config.model != "rbm" or not compiled:
         return None
-    return "closed-form" if method == "closed-form" else "kernel"
-
-
-def load_closed_form(wait=None) -> float:
-    """Compile (or load from numba's cache) the block's closed form in this process, e.g.
-    before a sweep's workers start, so that they load it instead of each compiling it;
-    returns the time it took [s]. wait: called first when the closed form is not in the
-    cache (compile_ahead.wait: a compile an earlier `rbm run` started, not a second one)."""
-    import time
-
-    from rbm_cli.models.rbm.closed_form import needs_compile, warm_up
-
-    start = time.perf_counter()
-    if wait is not None and needs_compile():
-        wait()
-    warm_up()
-    return time.perf_counter() - start
+    if method in ("closed-form", "exact"):
+        return method
+    return "kernel"

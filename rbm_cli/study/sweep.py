@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import Config, hash_form
-from rbm_cli.models.methods import compiled_code, load_closed_form
+from rbm_cli.models.methods import compiled_code
 from rbm_cli.models.result import CSV_FIELDS
 from rbm_cli.study.cells import (
     Cell,
@@ -72,6 +72,7 @@ class SweepSummary:
     n_failed: int
     wall_time_s: float
     compile_s: float = 0.0  # compiling (or loading) the kernel, left out of wall_time_s
+    compile_what: str = ""  # what compile_s was spent on ("compiling the integrator", ...)
     already_finished: bool = False  # resume on a folder that holds this config's result
     workers: int | None = None  # the cells ran in this process (0), on N workers, or ? (None)
 
@@ -244,7 +245,7 @@ def run_sweep(
             return _finished_summary(folder, n_cells)
         config, points = as_started(config, points, started, note)
         todo = [c for c in cells if key(c) not in done]
-        run = _Run(store, config, points, cells, digest, ensemble, resume_command, done)
+        run = _Run(store, config, points, cells, digest, ensemble, resume_command, done, note=note)
         compile_s, wall = run.run(todo, jobs, backend, scheduler, progress, stop_after)
         rows = [done[key(c)] for c in cells]
         counts = status_counts(rows)
@@ -256,10 +257,11 @@ def run_sweep(
                            resume_command)  # fmt: skip
         except KeyboardInterrupt:
             raise SweepInterrupted(folder, len(done), n_cells, resume_command) from None
-    return _summary(folder, len(cells), len(todo), counts, wall, compile_s, run.placed)
+    return _summary(folder, len(cells), len(todo), counts, wall, compile_s, run)
 
 
-def _summary(folder, n_cells, n_run, counts, wall, compile_s, placed=None) -> SweepSummary:
+def _summary(folder, n_cells, n_run, counts, wall, compile_s, run=None) -> SweepSummary:
+    """The summary of a sweep (run: the _Run that ran its cells, None if none ran)."""
     return SweepSummary(
         folder=folder,
         n_cells=n_cells,
@@ -270,7 +272,8 @@ def _summary(folder, n_cells, n_run, counts, wall, compile_s, placed=None) -> Sw
         n_failed=int(counts.get("failed", 0)),
         wall_time_s=wall,
         compile_s=compile_s,
-        workers=(placed or {}).get("workers"),
+        compile_what=run.compiled if run else "",
+        workers=run.placed.get("workers") if run else None,
     )
 
 
@@ -287,6 +290,8 @@ class _Run:
     resume_command: str
     done: dict
     placed: dict = dataclasses.field(default_factory=dict)  # where the cells ran (parallel)
+    note: Callable[[str], None] = lambda text: None  # what the compile waits for
+    compiled: str = ""  # what the compile time was spent on (_warm_up)
 
     def cells_kept(self) -> int:
         """Cells kept after a Ctrl-C, counted from the journal: Ctrl-C may land between a
@@ -300,7 +305,7 @@ class _Run:
         """Run the cells still to do; (compile time, wall time) [s]."""
         n_cells = len(self.cells)
         try:
-            compile_s = _warm_up(self.points, todo, backend, scheduler)
+            compile_s, self.compiled = _warm_up(self.points, todo, backend, scheduler, self.note)
             start = time.perf_counter()
             chunks = tasks(self.config, self.points, todo, jobs)
             if stop_after is not None:
@@ -383,23 +388,20 @@ def _probe_first(chunks: list) -> list:
     return pieces + chunks[1:]
 
 
-def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | None) -> float:
-    """Compile (or load) the kernel once here, if this process runs cells (every backend
-    but a Dask scheduler's; loky runs its first chunks here) or if it must be compiled
-    (then workers load it from numba's cache instead of each compiling it); its time [s],
-    which the sweep's wall time and ETA leave out (a background compile: waited for)."""
-    codes = {compiled_code(p.config) for p in points} - {None}
+def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | None,
+             note: Callable[[str], None]) -> tuple[float, str]:  # fmt: skip
+    """Compile (or load) the compiled code of the cells once here, if this process runs
+    cells (every backend but a Dask scheduler's; loky runs its first chunks here) or if it
+    must be compiled (then workers load it from numba's cache instead of each compiling it):
+    compile_ahead.compile_once, which waits for a compile another process runs instead of
+    compiling a second time, and tells note what it waits for before it waits. Returns its
+    time [s], which the sweep's wall time and ETA leave out, and what it was spent on."""
+    codes = sorted({compiled_code(p.config) for p in points} - {None})
     if not (todo and codes):
-        return 0.0
-    from rbm_cli.models.rbm.compile_ahead import wait
+        return 0.0, ""
+    from rbm_cli.models.rbm.compile_ahead import compile_once, needs_compile
 
-    if codes == {"closed-form"}:  # the block's closed form only: no kernel to load
-        return load_closed_form(wait)
-    from rbm_cli.models.rbm.kernel import needs_compile, warm_up
-
-    if backend == "dask" and scheduler and needs_compile() is False:
-        return 0.0  # no cell runs here, and the workers find the kernel in the cache
-    start = time.perf_counter()
-    wait()  # a compile an earlier `rbm run` started in the background: not a second one
-    warm_up()
-    return time.perf_counter() - start
+    if backend == "dask" and scheduler and all(needs_compile(c) is False for c in codes):
+        return 0.0, ""  # no cell runs here, and the workers find it in numba's cache
+    spent = [compile_once(code, note) for code in codes]
+    return sum(s for s, _ in spent), " and ".join(what for _, what in spent)

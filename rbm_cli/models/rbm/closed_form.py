@@ -197,7 +197,7 @@ def integrate_closed_form(
 
 def needs_compile() -> bool | None:
     """Whether the closed form has no usable on-disk cache (compile_cache.cache_empty): its
-    first use then compiles it (about 6 s)."""
+    first use then compiles it (6-10 s)."""
     return cache_empty(run_block)
 
 

@@ -1,61 +1,80 @@
-"""First use without the wait: the kernel (or the rigid block's closed form) compiles in a
-process of its own.
+"""First use: the compiled code is compiled before the first run, one compile at a time.
 
-The compiled kernel takes 15-20 s to compile on a fresh installation (45-60 s on a loaded
-machine), once; numba then keeps it in its on-disk cache. ``rbm run`` on an empty cache
-does not wait for it: it starts this module as a detached process (its own session, so a
-Ctrl-C in the terminal does not reach it, at low priority) that compiles the kernel into
-the cache, and answers its own run with the Python integrator, the same method with the
-same tolerances (tests/test_kernel.py holds the two to the same steps). A sweep started
-while the compile runs waits for it instead of compiling a second time.
+Compiling takes time, once per installation: the kernel about 50 s on two shared cores
+(less on a fast idle machine, more on a busy one), the exact integrator about 80 s, the
+rigid block's closed form 6-10 s; numba then keeps them in its on-disk cache. The first
+`rbm run` or `rbm sweep` that needs one of them compiles it in its own process before its
+first cell (:func:`compile_once`) and answers with it: the code every later run loads from
+the cache, so the same answer the first time as every time after (a cell in chaotic motion
+is not answered the same by two integrators, whose round-off differs). The command says on
+stderr what it waits for and roughly how long (the ``notify`` of :func:`compile_once`).
 
-One compile at a time: the starting process takes an exclusive ``flock`` on a lock file
-beside the kernel's cache and hands the open file to the child, which holds it until it
-exits (the lock belongs to the open file, not to a process: the parent's copy closes, the
-child's keeps it). A compile that dies releases the lock with its process; the next use
-then compiles in the foreground. The child's output goes to ``rbm-compile.log`` beside the
-lock.
-
-The rigid block's compiled closed form (the default `auto` there) is started the same way
-(``start("closed-form")``); its first run is answered by the Python step integrator
-(DOP853, the same tolerances as the step kernel).
-
-``RBM_BACKGROUND_COMPILE=0`` turns this off: the first run compiles in the foreground.
+One compile at a time: a process that finds the code missing from the cache takes an
+exclusive ``flock`` on a lock file beside the cache (:data:`LOCK_NAME`) and holds it while
+it compiles. Another process that needs the code meanwhile (a sweep started beside a first
+run) finds the lock taken, says that it waits, and once the lock is free loads what the
+first one compiled instead of compiling it a second time. A compile that dies releases the
+lock with its process; the process that waited then compiles it itself. Without a lock
+file (numba's private cache API is not the one read here, or the cache folder is not
+writable) each process compiles its own.
 """
 
 from __future__ import annotations
 
 import fcntl
+import importlib
 import os
-import subprocess
-import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
-#: The lock file's name, in the kernel's cache folder.
+#: The lock file's name, in the folder of numba's cache of the compiled code.
 LOCK_NAME = "rbm-compile.lock"
-#: The compile's log, beside the lock.
-LOG_NAME = "rbm-compile.log"
-#: Environment variable: "0" compiles in the foreground.
-ENV_SWITCH = "RBM_BACKGROUND_COMPILE"
 #: Poll interval while waiting for a compile elsewhere [s].
 POLL_S = 0.1
 
+#: What can be compiled (rbm_cli.models.methods.compiled_code): the module of its
+#: needs_compile and warm_up, and its compiled function whose cache folder holds the lock.
+TARGETS = {
+    "kernel": ("rbm_cli.models.rbm.kernel", "run_kernel"),
+    "closed-form": ("rbm_cli.models.rbm.closed_form", "run_block"),
+    "exact": ("rbm_cli.models.rbm.exact_jit", "run_exact"),
+}
+#: What each is called in a note.
+NAMES = {
+    "kernel": "the integrator",
+    "closed-form": "the rigid block's closed form",
+    "exact": "the exact integrator",
+}
+#: About how long a first compile takes [s]: measured on two shared cores at a load of 1-2
+#: (kernel 45-57 s, exact integrator 76 s, closed form 6-10 s).
+ABOUT_S = {"kernel": 50, "closed-form": 10, "exact": 80}
 
-def cache_folder() -> Path | None:
-    """The folder of numba's cache of the kernel (None if numba's private cache API is not
-    the one read here, or caching is off)."""
-    from rbm_cli.models.rbm.kernel_step import run_kernel
 
+def _module(target: str):
+    return importlib.import_module(TARGETS[target][0])
+
+
+def needs_compile(target: str) -> bool | None:
+    """Whether target (TARGETS) has no usable on-disk cache: True, False, or None when it
+    cannot be told (base.compile_cache.cache_empty)."""
+    return _module(target).needs_compile()
+
+
+def cache_folder(target: str = "kernel") -> Path | None:
+    """The folder of numba's cache of target (TARGETS); None if numba's private cache API is
+    not the one read here, or caching is off. The kernel's, the closed form's and the exact
+    integrator's modules share one folder, so one lock."""
+    module_name, function = TARGETS[target]
     try:
-        return Path(run_kernel._cache._cache_path)
-    except Exception:  # numba's private cache API changed: no background compile
+        return Path(getattr(importlib.import_module(module_name), function)._cache._cache_path)
+    except Exception:  # numba's private cache API changed: no lock
         return None
 
 
-def _open_lock() -> int | None:
+def _open_lock(target: str) -> int | None:
     """An open file descriptor of the lock file (None if it cannot be made)."""
-    folder = cache_folder()
+    folder = cache_folder(target)
     if folder is None:
         return None
     try:
@@ -74,76 +93,49 @@ def _try_lock(fd: int) -> bool:
     return True
 
 
-def compiling_elsewhere() -> bool:
-    """Whether another process holds the compile lock (a background compile runs)."""
-    fd = _open_lock()
-    if fd is None:
-        return False
+def compile_once(
+    target: str, notify: Callable[[str], None] | None = None, poll_s: float = POLL_S
+) -> tuple[float, str]:
+    """Compile target into numba's cache, or load it from there, in this process, one
+    compile at a time (see the module). Interruptible: Ctrl-C raises KeyboardInterrupt, and
+    the lock is released.
+
+    Parameters
+    ----------
+    target : str  'kernel', 'closed-form' or 'exact' (TARGETS)
+    notify : callable(str), optional  Called with one line before a wait: "compiling
+        <what> (first use only, about N s)", or "waiting for <what> to compile in another
+        rbm process (first use only, about N s)"; not called when the code is in the cache.
+    poll_s : float  Interval between two looks at the lock while another process holds
+        it [s]
+
+    Returns
+    -------
+    (seconds, what)  The time it took [s] and what it was spent on: "compiling <what>",
+        "waiting for <what> to compile" or "loading <what>".
+    """
+    module, name = _module(target), NAMES[target]
+    say = notify or (lambda text: None)
+    about = f"(first use only, about {ABOUT_S[target]} s)"
+    start = time.perf_counter()
+    needs = module.needs_compile()
+    waited = False
+    fd = _open_lock(target) if needs is not False else None
     try:
-        return not _try_lock(fd)
+        if fd is not None and not _try_lock(fd):
+            say(f"waiting for {name} to compile in another rbm process {about}")
+            while not _try_lock(fd):
+                time.sleep(poll_s)
+            waited = True
+            needs = module.needs_compile()  # False: that process compiled it
+        if needs:  # (after a wait too: that compile died)
+            say(f"compiling {name} {about}")
+        module.warm_up()
     finally:
-        os.close(fd)  # closing releases a lock taken here
-
-
-#: What a background compile can compile: its warm_up's module.
-TARGETS = {"kernel": "rbm_cli.models.rbm.kernel", "closed-form": "rbm_cli.models.rbm.closed_form"}
-
-
-def start(target: str = "kernel") -> bool:
-    """Start the background compile of target (TARGETS), unless a compile already runs.
-    True when a compile runs in another process after the call; False when none could be
-    started (switched off, no cache folder, not writable): the caller then compiles in the
-    foreground."""
-    if os.environ.get(ENV_SWITCH, "1").strip() == "0":
-        return False
-    fd = _open_lock()
-    if fd is None:
-        return False
-    try:
-        if not _try_lock(fd):
-            return True  # another process compiles
-        folder = cache_folder()
-        with open(folder / LOG_NAME, "ab") as log:
-            subprocess.Popen(
-                [sys.executable, "-m", __name__, str(fd), target],
-                pass_fds=(fd,),
-                stdin=subprocess.DEVNULL,
-                stdout=log,
-                stderr=log,
-                start_new_session=True,
-                close_fds=True,
-            )
-        return True
-    except OSError:
-        return False
-    finally:
-        os.close(fd)  # the child's copy of the open file keeps the lock
-
-
-def wait(poll_s: float = POLL_S) -> float:
-    """Wait until no other process compiles; the time waited [s]. Interruptible (Ctrl-C
-    raises KeyboardInterrupt between polls)."""
-    start_t = time.perf_counter()
-    while compiling_elsewhere():
-        time.sleep(poll_s)
-    return time.perf_counter() - start_t
-
-
-def _main(fd: int, target: str = "kernel") -> None:
-    """The background process: compile (or load) the target (TARGETS) into the cache,
-    holding the lock (fd) until it exits."""
-    import importlib
-
-    try:
-        os.nice(10)  # leave the CPU to the run that started it
-    except OSError:
-        pass
-    warm_up = importlib.import_module(TARGETS[target]).warm_up
-    start_t = time.perf_counter()
-    warm_up()
-    print(f"rbm: {target} compiled in {time.perf_counter() - start_t:.1f} s (pid {os.getpid()})")
-    os.close(fd)
-
-
-if __name__ == "__main__":
-    _main(int(sys.argv[1]), *sys.argv[2:3])
+        if fd is not None:
+            os.close(fd)  # releases the lock
+    if needs:
+        what = f"compiling {name}"
+    else:
+        what = f"waiting for {name} to compile" if waited else f"loading {name}"
+    return time.perf_counter() - start, what

@@ -13,6 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact_jit_run import run_exact
 from rbm_cli.models.rbm.exact_jit_state import ExactModel, exact_model, new_cache
@@ -100,6 +101,12 @@ def integrate_exact_compiled(
     if record:
         out.samples = sample_rows(samples, int(st[5]), n)
     return out
+
+
+def needs_compile() -> bool | None:
+    """Whether the exact integrator has no usable on-disk cache (compile_cache.cache_empty):
+    its first use then compiles it."""
+    return cache_empty(run_exact)
 
 
 def warm_up() -> None:

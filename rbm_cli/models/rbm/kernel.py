@@ -114,7 +114,7 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
 
 def needs_compile() -> bool | None:
     """Whether the kernel has no usable on-disk cache: its first use then compiles it
-    (about 15-20 s, once per installation). See base.compile_cache.cache_empty."""
+    (about 50 s on two shared cores, once per installation). See base.compile_cache.cache_empty."""
     return cache_empty(run_kernel)
 
 

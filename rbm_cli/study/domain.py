@@ -153,7 +153,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
             f" got {got(df['status'].iloc[i])}"
         )
     if "collapsed" in df.columns:
-        _check_collapsed(df, path, got)
+        check_collapsed(df, path, got)
     seen: dict[tuple[str, ...], int] = {}
     paths = axis_columns(df.columns)
     for i, key in enumerate(keys_of(df)):
@@ -166,12 +166,15 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
         seen[key] = i
 
 
-def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
+def check_collapsed(df: pd.DataFrame, path: Path, got=None) -> None:
     """collapsed is 0 or 1 on every row and says what status says (collapsed <=> 1):
     compare counts cells from collapsed and draws boundaries from status, so a row where
-    they disagree would make the two disagree quietly (issue 14). Converts it to int."""
+    they disagree would make the two disagree quietly (issue 14); a fragility fit would
+    count a failed run as a collapse. Converts it to int. RbmError naming the file and the
+    first bad line (the header is line 1); ``got(value)`` shows a bad value."""
     import pandas as pd
 
+    got = got or (lambda value: "an empty field" if pd.isna(value) else repr(str(value)))
     raw = df["collapsed"]
     x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
     bad = ~np.isin(x, (0.0, 1.0))

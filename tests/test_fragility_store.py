@@ -19,6 +19,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -260,3 +261,23 @@ def test_random_kills_leave_no_mix_and_no_leftovers(tmp_path, sets):
         assert res.exit_code == 0 and hidden(folder) == [], res.output
         shutil.rmtree(folder)
     assert seen["old"] == 0  # the first move had been made: only the new set can be whole
+
+
+def test_with_threads_running_the_set_is_moved_without_a_fork(tmp_path, sets, monkeypatch):
+    """A program with Python threads running (a notebook, a server) is not forked (fork
+    copies one thread): the moves are made in its own process, signals held, and the set
+    is published whole all the same."""
+    folder = folder_with_old_set(tmp_path, sets)
+    forks = []
+    monkeypatch.setattr(os, "fork", lambda: forks.append(1) or pytest.fail("forked"))
+    stop = threading.Event()
+    worker = threading.Thread(target=stop.wait)
+    worker.start()
+    try:
+        res = CliRunner().invoke(cli, ["fragility", str(folder / "domain.csv"),
+                                       "--resamples", "20"])  # fmt: skip
+    finally:
+        stop.set()
+        worker.join()
+    assert res.exit_code == 0, res.output
+    assert forks == [] and whole(folder, sets[1]) == "new" and hidden(folder) == []

@@ -117,7 +117,9 @@ def _bootstrap(runs, hits, log_levels, start, n_resamples, seed, grid, progress=
     ``progress(done, total)`` is called after each resample."""
     rng = np.random.default_rng(seed)
     n_rec = runs.shape[0]
-    thetas, betas, curves = [], [], []
+    thetas, betas = np.empty(n_resamples), np.empty(n_resamples)
+    curves = np.empty((n_resamples, grid.size))  # filled in place: no list of arrays copied
+    used_fits = 0
     for done in range(1, n_resamples + 1):
         weights = np.bincount(rng.integers(0, n_rec, n_rec), minlength=n_rec).astype(float)
         n = weights @ runs
@@ -128,12 +130,12 @@ def _bootstrap(runs, hits, log_levels, start, n_resamples, seed, grid, progress=
         except RbmError:
             fit = None
         if fit is not None:
-            thetas.append(fit.median_g)
-            betas.append(fit.beta)
-            curves.append(collapse_probability(grid, fit.median_g, fit.beta))
+            thetas[used_fits], betas[used_fits] = fit.median_g, fit.beta
+            curves[used_fits] = collapse_probability(grid, fit.median_g, fit.beta)
+            used_fits += 1
         if progress is not None:
             progress(done, n_resamples)
-    return np.array(thetas), np.array(betas), np.array(curves).reshape(len(curves), grid.size)
+    return thetas[:used_fits], betas[:used_fits], curves[:used_fits]
 
 
 def fragility(

@@ -153,7 +153,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
             f" got {got(df['status'].iloc[i])}"
         )
     if "collapsed" in df.columns:
-        check_collapsed(df, path, got)
+        _check_collapsed(df, path, got)
     seen: dict[tuple[str, ...], int] = {}
     paths = axis_columns(df.columns)
     for i, key in enumerate(keys_of(df)):
@@ -166,15 +166,12 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
         seen[key] = i
 
 
-def check_collapsed(df: pd.DataFrame, path: Path, got=None) -> None:
+def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
     """collapsed is 0 or 1 on every row and says what status says (collapsed <=> 1):
     compare counts cells from collapsed and draws boundaries from status, so a row where
-    they disagree would make the two disagree quietly (issue 14); a fragility fit would
-    count a failed run as a collapse. Converts it to int. RbmError naming the file and the
-    first bad line (the header is line 1); ``got(value)`` shows a bad value."""
+    they disagree would make the two disagree quietly (issue 14). Converts it to int."""
     import pandas as pd
 
-    got = got or (lambda value: "an empty field" if pd.isna(value) else repr(str(value)))
     raw = df["collapsed"]
     x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
     bad = ~np.isin(x, (0.0, 1.0))
@@ -377,3 +374,16 @@ def domain_config(domain_csv: str | Path) -> Config | None:
         return None
     base = meta.parent / where if isinstance(where, str) else None  # relative record paths
     return parse_config(written, source=str(meta), base_dir=base)
+
+
+def check_collapsed(df: pd.DataFrame, path: str | Path) -> None:
+    """The rule `rbm compare` applies (:func:`read_domain`), for other readers of a domain
+    (`rbm fragility`, which would count a failed run marked collapsed as a collapse):
+    collapsed is 0 or 1 on every row, and 1 exactly when status is collapsed. Converts it
+    to int in place; RbmError naming the file and the first bad line (header: line 1)."""
+    import pandas as pd
+
+    def got(value) -> str:
+        return "an empty field" if pd.isna(value) else repr(str(value))
+
+    _check_collapsed(df, Path(path), got)

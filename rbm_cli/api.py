@@ -25,6 +25,8 @@ from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.load import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, parse_config
 from rbm_cli.config.load import load_config as _load_file
 from rbm_cli.config.types import Config
+from rbm_cli.config.validate import describe, fmt, is_number
+from rbm_cli.config.written import plain_copy
 from rbm_cli.models.result import RunResult
 from rbm_cli.report.figure_process import domain_figure
 from rbm_cli.report.plots import plot_history as _plot_history
@@ -88,17 +90,10 @@ def load_config(source: str | os.PathLike | Mapping[str, Any]) -> Config:
     >>> cfg = rbm.load_config("configs/spanos_koh_slender.yaml")  # doctest: +SKIP
     """
     if isinstance(source, Mapping):
-        return parse_config(_plain(source), "<dict>")
+        return parse_config(source, "<dict>")
     if isinstance(source, str | os.PathLike):
         return _load_file(source)
     raise ConfigError(f"a config is a YAML file's path or a mapping, got {type(source).__name__}")
-
-
-def _plain(data: Any) -> Any:
-    """``data`` with numpy arrays as lists (parse_config reads numpy scalars itself)."""
-    if isinstance(data, Mapping):
-        return {k: _plain(v) for k, v in data.items()}
-    return [_plain(v) for v in data] if isinstance(data, list | tuple | np.ndarray) else data
 
 
 def _as_config(config: Config | str | os.PathLike | Mapping[str, Any]) -> Config:
@@ -135,11 +130,28 @@ def with_values(config: Config, changes: Mapping[str, Any]) -> Config:
     """
     if config.written is None:
         raise ConfigError(f"config {config.name} keeps no written mapping: use rbm.load_config")
+    if not isinstance(changes, Mapping):
+        raise ConfigError(f"changes must be a mapping {{key path: value}}, got {describe(changes)}")
     written = copy.deepcopy(config.written)
-    for path, value in changes.items():
-        _set(written, path, _plain(value))
-    told = ", ".join(f"{path} = {value!r}" for path, value in changes.items())
-    return parse_config(written, f"{config.name} with {told}" if told else config.name)
+    told = ", ".join(f"{path} = {_shown(value)}" for path, value in changes.items())
+    source = f"{config.name} with {told}" if told else config.name
+    try:
+        for path, value in changes.items():
+            _set(written, path, plain_copy(value))
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
+    return parse_config(written, source)
+
+
+def _shown(value: Any) -> str:
+    """A value as a message shows it: numbers as written (a numpy number as its number),
+    anything else by its repr, cut to 60 characters."""
+    if isinstance(value, np.generic | np.ndarray) and np.ndim(value) == 0:
+        value = value.item()
+    if is_number(value):
+        return fmt(value)
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def with_value(config: Config, path: str, value: Any) -> Config:
@@ -156,7 +168,7 @@ def with_value(config: Config, path: str, value: Any) -> Config:
     >>> rbm.with_value(cfg, "column.height", -1.0)
     Traceback (most recent call last):
     ...
-    rbm_cli.base.errors.ConfigError: block with column.height = -1.0: column.height must be a number > 0 [m], got -1
+    rbm_cli.base.errors.ConfigError: block with column.height = -1: column.height must be a number > 0 [m], got -1
     """  # noqa: E501
     return with_values(config, {path: value})
 
@@ -249,25 +261,70 @@ def run(
     'collapsed'
     """
     cfg = _as_config(config)
-    if cfg.excitation.type == "free":
-        amplitude_g, frequency_hz = 0.0, 0.0
-    checks = [("amplitude_g", amplitude_g, AMPLITUDE_RANGE_G, "g")]
-    if cfg.excitation.type != "record":  # a record has no frequency
-        checks.append(("frequency_hz", frequency_hz, FREQUENCY_RANGE_HZ, "Hz"))
-    for name, value, (lo, hi), unit in checks:
-        if value is None:
-            raise RbmError(f"{name} [{unit}] is required for excitation.type {cfg.excitation.type}")
-        if cfg.excitation.type != "free" and not (_finite(value) and lo <= value <= hi):
-            raise RbmError(f"{name} must be a number in [{lo:g}, {hi:g}] [{unit}], got {value!r}")
-    if output_dt is not None and not (_finite(output_dt) and output_dt > 0.0):
-        raise RbmError(f"output_dt must be a number > 0 [s], got {output_dt!r}")
-    f = None if cfg.excitation.type == "record" else float(frequency_hz)
-    result = simulate(cfg, float(amplitude_g), f, record=record, output_dt=output_dt)
+    amplitude_g, frequency_hz = check_cell(cfg, amplitude_g, frequency_hz)
+    output_dt = check_output_dt(cfg, output_dt)
+    result = simulate(cfg, amplitude_g, frequency_hz, record=record, output_dt=output_dt)
     return CellRun(config=cfg, result=result)
 
 
+#: Most samples a run's history may have (duration / output_dt).
+MAX_HISTORY_SAMPLES = 10_000_000
+
+
+def check_cell(config: Config, amplitude_g: Any, frequency_hz: Any) -> tuple[float, float | None]:
+    """(amplitude [g], frequency [Hz] or None) of one cell of ``config``, checked: numbers
+    (not booleans) in the grid's ranges; a record has no frequency, ``free`` neither
+    (both 0).
+
+    Raises
+    ------
+    RbmError  One line naming the argument, its range and the value given
+    """
+    kind = config.excitation.type
+    if kind == "free":
+        return 0.0, 0.0
+    checks = [("amplitude_g", amplitude_g, AMPLITUDE_RANGE_G, "g")]
+    if kind != "record":
+        checks.append(("frequency_hz", frequency_hz, FREQUENCY_RANGE_HZ, "Hz"))
+    for name, value, (lo, hi), unit in checks:
+        if value is None:
+            raise RbmError(f"{name} [{unit}] is required for excitation.type {kind}")
+        if not (_finite(value) and lo <= value <= hi):
+            raise RbmError(
+                f"{name} must be a number in [{lo:g}, {hi:g}] [{unit}], got {_shown(value)}"
+            )
+    return float(amplitude_g), None if kind == "record" else float(frequency_hz)
+
+
+def check_output_dt(config: Config, output_dt: Any) -> float | None:
+    """The history's sampling interval [s], checked: None (the default), or a number > 0
+    that gives at most :data:`MAX_HISTORY_SAMPLES` samples over the run.
+
+    Raises
+    ------
+    RbmError  One line naming the problem
+    """
+    if output_dt is None:
+        return None
+    if not (_finite(output_dt) and output_dt > 0.0):
+        raise RbmError(f"output_dt must be a number > 0 [s], got {_shown(output_dt)}")
+    samples = config.excitation.duration / float(output_dt)
+    if samples > MAX_HISTORY_SAMPLES:
+        raise RbmError(
+            f"output_dt {fmt(float(output_dt))} s gives {samples:.3g} samples over"
+            f" {fmt(config.excitation.duration)} s (at most {MAX_HISTORY_SAMPLES:,}):"
+            " use a larger output_dt"
+        )
+    return float(output_dt)
+
+
 def _finite(value: Any) -> bool:
-    return isinstance(value, int | float | np.number) and math.isfinite(value)
+    """A finite real number: int, float or a numpy number (a 0-d array's), not a boolean."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        return False
+    return not isinstance(value, np.complexfloating) and math.isfinite(value)
 
 
 # --------------------------------------------------------------------------- sweeps

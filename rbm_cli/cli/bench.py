@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.cli.common import UserError, cli, one_line
+from rbm_cli.cli.common import UserError, check_output, cli, one_line
 
 
 @cli.command()
@@ -16,6 +16,7 @@ from rbm_cli.cli.common import UserError, cli, one_line
               help="Default method on 10 x 10 sub-grids against the stored references; "
               "exit 1 if it misses an accuracy target.")  # fmt: skip
 @click.option("-o", "--output", default="bench", show_default=True, metavar="DIR",
+              callback=check_output,
               help="Folder for bench.csv and bench.png.")  # fmt: skip
 @click.option("-j", "--jobs", type=click.IntRange(min=1), default=2, show_default=True,
               help="Parallel workers.")  # fmt: skip

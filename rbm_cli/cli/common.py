@@ -22,8 +22,6 @@ EXIT_USER_ERROR = 2
 EXIT_RUN_FAILED = 1
 #: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
 EXIT_INTERRUPTED = 130
-#: Most samples `rbm run --dt` may record (a history of 10^7 rows is ~2 GB of CSV).
-MAX_SAMPLES = 10_000_000
 
 
 class UserError(click.ClickException):

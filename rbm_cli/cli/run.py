@@ -12,7 +12,6 @@ import click
 from rbm_cli.base.errors import RbmError
 from rbm_cli.cli.common import (
     EXIT_RUN_FAILED,
-    MAX_SAMPLES,
     Interrupted,
     UserError,
     cli,
@@ -133,14 +132,8 @@ def run(
         click.echo("note: excitation.type is 'free': --amplitude/--frequency are ignored", err=True)
     if kind == "record" and frequency is not None:
         click.echo("note: excitation.type is 'record': --frequency is ignored", err=True)
-    if output_dt is not None and not (math.isfinite(output_dt) and output_dt > 0.0):
-        raise UserError(f"--dt must be a finite number > 0 [s], got {output_dt:g}")
-    if output_dt is not None and cfg.excitation.duration / output_dt > MAX_SAMPLES:
-        samples = cfg.excitation.duration / output_dt
-        raise UserError(
-            f"--dt {output_dt:g} s gives {samples:.3g} samples over {cfg.excitation.duration:g} s"
-            f" (at most {MAX_SAMPLES:,}): use a larger --dt"
-        )
+    _check_output_dt(cfg, output_dt)
+    _say_which_point(cfg)
 
     from rbm_cli.report.figure_process import RUN_IMPORTS, FigureProcess
 
@@ -153,6 +146,48 @@ def run(
         reason = " ".join(str(result.message).split()) or "no reason given"
         click.echo(f"Error: run failed: {reason}", err=True)
         sys.exit(EXIT_RUN_FAILED)
+
+
+def _check_output_dt(cfg, output_dt: float | None) -> None:
+    """--dt checked as the library checks output_dt (rbm_cli.api.check_output_dt)."""
+    from rbm_cli.api import check_output_dt
+
+    try:
+        check_output_dt(cfg, output_dt)
+    except RbmError as exc:
+        raise UserError(one_line(exc).replace("output_dt", "--dt")) from None
+
+
+def _say_which_point(cfg) -> None:
+    """A note when the config's grid has axes over config keys (a suite of records, a
+    column.height axis...): one run is the config's own point, named here."""
+    axes = cfg.grid.axes
+    if not axes:
+        return
+    n_points = math.prod(len(axis.points) for axis in axes)
+    own = ", ".join(f"{path} = {_value_at(cfg, path)}" for path in cfg.grid.axis_paths)
+    click.echo(
+        f"note: the grid has {n_points} points over {', '.join(cfg.grid.axis_paths)};"
+        f" this run is the config's own point ({own}): set another value in the config"
+        " to run it, or sweep them all with rbm sweep",
+        err=True,
+    )
+
+
+def _value_at(cfg, path: str) -> str:
+    """The value a run of the config takes for a grid axis's key path, as written."""
+    from rbm_cli.config.grid import VIRTUAL_PATHS
+
+    if path in VIRTUAL_PATHS:
+        return "as written"
+    if path in ("excitation.file", "excitation.vertical"):  # a suite's first record
+        return str(getattr(cfg.excitation, path.split(".")[1]))
+    node = cfg.written or {}
+    for key in path.split("."):
+        node = node.get(key) if isinstance(node, dict) else None
+    if node is None:
+        return "its default"
+    return str(node) if not isinstance(node, dict) else "as written"
 
 
 def _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter):

@@ -33,6 +33,7 @@ import dataclasses
 import hashlib
 import math
 import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -48,6 +49,7 @@ from rbm_cli.config.types import (
     RECORD_SCALES,
     RECORD_UNITS,
     ExcitationConfig,
+    G,
     InitialConfig,
 )
 from rbm_cli.config.validate import (
@@ -163,15 +165,41 @@ def record_file(
             f"{key} must be one record file (a path to a PEER NGA .AT2 or a .csv, as a"
             f" string), got {describe(value)}"
         )
-    path = resolve_record_path(value, base_dir)
     try:
-        t, acc, _ = read_file(path, units)
-        digest = _digest(path)
+        path = resolve_record_path(value, base_dir)
+        signature = _signature(path)
+        found = _READ.get((signature, units))
+        if found is None:
+            t, acc, _ = read_file(path, units)
+            found = (_digest(path), float(t[-1]), float(np.max(np.abs(acc))))
+            if signature is not None:
+                if len(_READ) >= _READ_SIZE:
+                    _READ.pop(next(iter(_READ)))
+                _READ[(signature, units)] = found
     except RbmError as exc:
         raise ConfigError(f"{key}: {_one_line(str(exc))}") from None
     except OSError as exc:
-        raise ConfigError(f"{key}: {path}: cannot read ({exc.strerror or exc})") from None
-    return RecordFile(value, str(path), digest, float(t[-1]), float(np.max(np.abs(acc))))
+        raise ConfigError(f"{key}: {value}: cannot read ({exc.strerror or exc})") from None
+    return RecordFile(value, str(path), *found)
+
+
+#: Records read in this process, by file and units: (SHA-256, end [s], PGA [m/s^2]). The
+#: points of a grid name the same file again and again; a file is read again when its
+#: size, modification time or inode changed.
+_READ: dict = {}
+_READ_SIZE = 256
+
+
+def _signature(path: Path) -> tuple | None:
+    """What says a file is unchanged since it was read: (path, inode, size, mtime [ns],
+    ctime [ns]); None for anything but a regular file (read_file refuses it)."""
+    try:
+        info = os.stat(path)
+    except OSError:
+        return None
+    if not stat.S_ISREG(info.st_mode):
+        return None
+    return (str(path), info.st_ino, info.st_size, info.st_mtime_ns, info.st_ctime_ns)
 
 
 def with_record(
@@ -200,11 +228,25 @@ def with_record(
     )
 
 
+#: Smallest PGA a record scaled to the grid's PGA may have [g]: below it the scale factor
+#: (up to 1000 g / PGA) leaves the range where its arithmetic is sound, and the record
+#: holds no ground motion worth scaling (a recording's noise floor is far above it).
+MIN_SCALABLE_PGA_G = 1e-6
+
+
 def _check_scalable(rec: RecordFile, scale: str, key: str) -> None:
-    if scale == "pga" and not rec.pga > 0.0:
+    if scale != "pga":
+        return
+    if not rec.pga > 0.0:
         raise ConfigError(
             f"{key}: {rec.path}: every acceleration is 0, so it cannot be scaled to a PGA"
             " (excitation.scale: pga); use excitation.scale: factor"
+        )
+    if rec.pga < MIN_SCALABLE_PGA_G * G:
+        raise ConfigError(
+            f"{key}: {rec.path}: its PGA is {rec.pga / G:.3g} g, too small to be scaled to a"
+            f" PGA (at least {MIN_SCALABLE_PGA_G:g} g with excitation.scale: pga): check"
+            " excitation.units, or use excitation.scale: factor"
         )
 
 

@@ -47,8 +47,21 @@ LINKED = "linked"
 VIRTUAL_PATHS = {"column.size": "m", "column.slenderness": ""}
 #: Keys that cannot vary over a grid: the folder name, the grid itself.
 FIXED_KEYS = ("name", "grid")
+#: Top-level keys of one value, which cannot be an axis either (a domain holds one model).
+TOP_SCALARS = ("model",)
+#: Sections, which vary by the keys inside them (one named as an example).
+SECTIONS = {
+    "column": "column.height",
+    "interface": "interface.restitution",
+    "excitation": "excitation.file",
+    "collapse": "collapse.ratio",
+    "solver": "solver.rtol",
+}
 #: Largest number of points of the non-excitation axes together (each is one config).
 MAX_POINTS = 10_000
+#: Most cells a grid may have, with or without ``--force`` (a sweep keeps a row per cell in
+#: memory, about 2 kB each; 10^6 cells are days of runs at 0.1-1 s a cell).
+MAX_CELLS = 1_000_000
 PATH_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
 
 
@@ -69,7 +82,15 @@ def parse_grid(raw: Any) -> GridConfig:
             ("frequencies", "Hz", True, FREQUENCY_RANGE_HZ),
         )
     )
-    return GridConfig(amplitudes_g=amplitudes, frequencies_hz=frequencies, axes=parse_axes(g))
+    grid = GridConfig(amplitudes_g=amplitudes, frequencies_hz=frequencies, axes=parse_axes(g))
+    if grid.n_cells > MAX_CELLS:  # counted before any point is built
+        sizes = [len(amplitudes), len(frequencies)] + [len(a.points) for a in grid.axes]
+        shown = " x ".join(f"{n:,}" for n in sizes if n)
+        raise ConfigError(
+            f"grid: {shown} = {grid.n_cells:,} cells, more than the {MAX_CELLS:,} a sweep"
+            " can hold: split it into several configs"
+        )
+    return grid
 
 
 def parse_axes(raw: Mapping[str, Any]) -> tuple[Axis, ...]:
@@ -112,7 +133,18 @@ def _path(key: Any, where: str) -> str:
         )
     if key.split(".")[0] in FIXED_KEYS:
         raise ConfigError(f"{where}: {key} cannot vary over a grid")
+    if key in TOP_SCALARS:
+        raise ConfigError(
+            f"{where}: {key} cannot vary over a grid (a domain holds one model): sweep one"
+            " config per model and draw them together with rbm plot-domain A.csv --compare"
+            " B.csv"
+        )
     if "." not in key:
+        if key in SECTIONS:
+            raise ConfigError(
+                f"{where}: the whole {key} section cannot vary over a grid: give a key inside"
+                f" it by its dotted path, such as {SECTIONS[key]}"
+            )
         raise ConfigError(
             f"unknown key {key!r} in grid (allowed: amplitudes, frequencies, {LINKED},"
             " or a config key by its dotted path such as column.height)"
@@ -186,6 +218,7 @@ __all__ = [
     "AMPLITUDE_RANGE_G",
     "FREQUENCY_RANGE_HZ",
     "LINKED",
+    "MAX_CELLS",
     "MAX_POINTS",
     "VIRTUAL_PATHS",
     "parse_axes",
@@ -200,18 +233,35 @@ RECORD_SUFFIXES = (".at2", ".csv")
 GLOB_CHARS = "*?["
 
 
+#: Grid paths whose values are record files: each value may be a file, a folder or a glob.
+RECORD_PATHS = ("excitation.file", "excitation.vertical")
+
+
 def hoist_suite(top: Mapping[str, Any], base_dir: str | os.PathLike | None) -> dict:
-    """A config mapping whose ``excitation.file`` names several records (a list, a folder
-    or a glob) turned into a grid axis ``excitation.file`` over each file (sorted for a
-    folder or a glob; relative to ``base_dir`` as written), the excitation keeping the
-    first so that it validates as one record. Any other mapping comes back as it is."""
+    """A config mapping with its suites of records spelt out as grid axes.
+
+    ``excitation.file`` naming several records (a list, a folder or a glob) becomes a grid
+    axis ``excitation.file`` over each file (sorted for a folder or a glob; relative to
+    ``base_dir`` as written), the excitation keeping the first so that it validates as one
+    record. A folder or a glob given as a value of a grid axis over ``excitation.file`` or
+    ``excitation.vertical`` is replaced by its files in the same way, in the order written.
+    Any other mapping comes back as it is."""
+    top = dict(top)
+    base = Path(base_dir or ".")
+    grid = top.get("grid")
+    if isinstance(grid, Mapping):
+        grid = dict(grid)
+        for path in RECORD_PATHS:
+            if path in grid:
+                grid[path] = _axis_files(grid[path], f"grid.{path}", base)
+        _refuse_linked_suites(grid.get(LINKED), base)
+        top["grid"] = grid
     excitation = top.get("excitation")
     if not isinstance(excitation, Mapping) or "file" not in excitation:
-        return dict(top)
-    files = _suite_files(excitation["file"], Path(base_dir or "."))
+        return top
+    files = _suite_files(excitation["file"], base)
     if files is None:
-        return dict(top)
-    grid = top.get("grid")
+        return top
     grid = dict(grid) if isinstance(grid, Mapping) else {}
     if "excitation.file" in grid:
         raise ConfigError(
@@ -221,9 +271,49 @@ def hoist_suite(top: Mapping[str, Any], base_dir: str | os.PathLike | None) -> d
     return {**top, "excitation": {**excitation, "file": files[0]}, "grid": grid}
 
 
-def _suite_files(value: Any, base: Path) -> list[str] | None:
+def _axis_files(value: Any, where: str, base: Path) -> Any:
+    """An axis's record values with each folder or glob replaced by its files (a value
+    that is neither a string nor a list is left to the axis's own checks)."""
+    single = isinstance(value, str)
+    if not single and not isinstance(value, list | tuple):
+        return value
+    out: list = []
+    named: dict[str, Any] = {}
+    for i, item in enumerate([value] if single else value):
+        at = where if single else join(where, i)
+        files = _suite_files(item, base, at) if isinstance(item, str) else None
+        for f in [item] if files is None else files:
+            if isinstance(f, str) and f in named:
+                raise ConfigError(
+                    f"{at}: {f!r} is named twice (by {named[f]!r} and {item!r}): list each"
+                    " record once"
+                )
+            named[f] = item
+            out.append(f)
+    return out[0] if single and len(out) == 1 else out
+
+
+def _refuse_linked_suites(linked: Any, base: Path) -> None:
+    """A folder or glob in a linked axis of records is refused: its length would not be
+    known where the other linked lists are written."""
+    if not isinstance(linked, list | tuple):
+        return
+    for i, group in enumerate(linked):
+        if not isinstance(group, Mapping):
+            continue
+        for path in RECORD_PATHS:
+            values = group.get(path)
+            items = values if isinstance(values, list | tuple) else [values]
+            for item in items:
+                if isinstance(item, str) and _suite_files(item, base, path) is not None:
+                    raise ConfigError(
+                        f"{join(join(f'grid.{LINKED}', i), path)}: {item!r} is a folder or a"
+                        " pattern: a linked axis lists each record file by name"
+                    )
+
+
+def _suite_files(value: Any, base: Path, where: str = "excitation.file") -> list[str] | None:
     """The files of a suite, or None for one file (left to the excitation's own checks)."""
-    where = "excitation.file"
     if isinstance(value, list | tuple):
         if not value:
             raise ConfigError(f"{where} must not be an empty list")
@@ -234,17 +324,33 @@ def _suite_files(value: Any, base: Path) -> list[str] | None:
     if not isinstance(value, str) or not value.strip():
         return None
     if any(c in value for c in GLOB_CHARS):
-        found = sorted(Path(p) for p in glob.glob(os.path.join(base, value)) if Path(p).is_file())
+        try:
+            matches = glob.glob(os.path.join(base, value))
+        except (OSError, ValueError) as exc:
+            raise ConfigError(f"{where}: the pattern {value!r} cannot be read: {exc}") from None
+        found = sorted(Path(p) for p in matches if _is_record(Path(p)))
         if not found:
             raise ConfigError(f"{where}: the pattern {value!r} matches no file (in {base})")
         return [_relative(p, base) for p in found]
-    folder = base / value
-    if not folder.is_dir():
-        return None
-    found = sorted(p for p in folder.iterdir() if p.suffix.lower() in RECORD_SUFFIXES)
+    folder = base / os.path.expanduser(value)
+    try:
+        if not folder.is_dir():
+            return None
+        found = sorted(p for p in folder.iterdir() if _is_record(p))
+    except OSError as exc:
+        raise ConfigError(f"{where}: {value!r}: cannot read ({exc.strerror or exc})") from None
     if not found:
-        raise ConfigError(f"{where}: the folder {value!r} holds no .AT2 or .csv record")
-    return [_relative(p, base) for p in found if p.is_file()]
+        raise ConfigError(f"{where}: the folder {value!r} holds no .AT2 or .csv record file")
+    return [_relative(p, base) for p in found]
+
+
+def _is_record(path: Path) -> bool:
+    """A file of a folder or a glob that is read as a record: a regular file (a folder
+    named x.AT2 is not) with the suffix .AT2 or .csv (any case)."""
+    try:
+        return path.suffix.lower() in RECORD_SUFFIXES and path.is_file()
+    except OSError:
+        return False
 
 
 def _relative(path: Path, base: Path) -> str:

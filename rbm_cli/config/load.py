@@ -22,7 +22,13 @@ from typing import Any
 
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.excitation import excitation_section
-from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, hoist_suite, parse_grid
+from rbm_cli.config.grid import (
+    AMPLITUDE_RANGE_G,
+    FREQUENCY_RANGE_HZ,
+    RECORD_PATHS,
+    hoist_suite,
+    parse_grid,
+)
 from rbm_cli.config.interface import interface_section
 from rbm_cli.config.points import expand
 from rbm_cli.config.types import (
@@ -161,15 +167,32 @@ def parse_config(
     ------
     ConfigError  One line: ``<source>: <key path> must be <allowed>, got <value>``.
     """
-    written = plain_copy(data)  # numpy numbers (a notebook's) read as the numbers they are
     try:
+        written = plain_copy(data)  # numpy numbers (a notebook's) read as the numbers they are
         config = _config(written, base_dir)
         folder = os.getcwd() if base_dir is None else os.path.abspath(base_dir)
         config = dataclasses.replace(config, written=written, base_dir=folder)
-        expand(config, parse_config, base_dir=folder)  # every grid point validates, or one line
+        points = expand(config, parse_config, base_dir=folder)  # each validates, or one line
+        records = _axis_records(config, points)
+        if records:
+            config = dataclasses.replace(
+                config, grid=dataclasses.replace(config.grid, records=records)
+            )
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
     return config
+
+
+def _axis_records(config: Config, points) -> tuple[tuple[str, str, str], ...]:
+    """(key path, file as written, SHA-256) of each record file an axis of the grid names,
+    in grid order, each once (rbm_cli.config.types.GridConfig.records)."""
+    paths = [p for p in config.grid.axis_paths if p in RECORD_PATHS]
+    out: dict = {}
+    for point in points:
+        for entry in point.config.record_files():
+            if entry[0] in paths:
+                out.setdefault(entry, None)
+    return tuple(out)
 
 
 def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:

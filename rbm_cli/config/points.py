@@ -17,7 +17,7 @@ from typing import Any
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.grid import EXCITATION_AXES, point_label
 from rbm_cli.config.types import Config
-from rbm_cli.config.validate import is_number
+from rbm_cli.config.validate import describe, is_number
 
 #: Column lengths a ``column.size`` axis scales [m] (``drums`` when it lists heights).
 COLUMN_LENGTHS = ("height", "base_width", "top_width", "depth")
@@ -110,7 +110,7 @@ def _column(data: dict, path: str, value: Any) -> dict | None:
     if not isinstance(column, Mapping) or not is_number(column.get("height")):
         return None
     if not (is_number(value) and value > 0):
-        raise ConfigError(f"{path} must be a number > 0, got {value!r}")
+        raise ConfigError(f"{path} must be a number > 0, got {describe(value)}")
     return column
 
 

@@ -11,7 +11,9 @@ Memory is bounded: about 2 x 8 bytes a sample plus one block of lines; files of 
 
 from __future__ import annotations
 
+import os
 import re
+import stat
 from collections.abc import Iterator
 from itertools import chain
 from pathlib import Path
@@ -44,34 +46,77 @@ def read_file(
     ``units`` are those of a CSV's values (an ``.AT2`` is in g: ``m/s2`` is refused).
     Every problem raises an RbmError in one line naming the file (and the line).
     """
-    kind = (fmt or path.suffix.lstrip(".")).lower()
-    if kind not in ("at2", "csv"):
-        raise RbmError(f"{path}: unknown record format {kind!r} (expected .AT2 or .csv)")
     if units not in UNITS:
         raise RbmError(f"{path}: units must be 'g' or 'm/s2', got {units!r}")
     check_file(path)
+    kind = (fmt or path.suffix.lstrip(".")).lower()
+    if kind not in ("at2", "csv"):
+        raise RbmError(f"{path}: unknown record format {kind!r} (expected .AT2 or .csv)")
+    if kind == "at2" and UNITS[units] != UNITS["g"]:
+        raise RbmError(f"{path}: an .AT2 file is in g; units {units!r} do not apply")
+    _check_text(path)
     if kind == "at2":
-        if UNITS[units] != UNITS["g"]:
-            raise RbmError(f"{path}: an .AT2 file is in g; units {units!r} do not apply")
-        t, values_g, title = read_at2(path)
-        return t, values_g * UNITS["g"], title
-    t, values = read_csv(path)
-    return t, values * UNITS[units], ""
+        t, values, title = read_at2(path)
+    else:
+        (t, values), title = read_csv(path), ""
+    _check_peak(path, t, values, UNITS[units])
+    return t, values * UNITS[units], title
+
+
+#: Largest acceleration a record may hold [g] (the grid's largest amplitude): beyond it
+#: the file is not a ground motion (wrong units?) and its arithmetic is not sound.
+MAX_ACCELERATION_G = 1e3
+
+
+def _check_peak(path: Path, t: np.ndarray, values: np.ndarray, unit: float) -> None:
+    """Refuse a record whose largest |acceleration| is above MAX_ACCELERATION_G (checked in
+    the file's units, before the conversion could overflow)."""
+    k = int(np.argmax(np.abs(values)))
+    limit = MAX_ACCELERATION_G * G / unit
+    if abs(values[k]) > limit:
+        raise RbmError(
+            f"{path}: the acceleration at t = {t[k]:.6g} s is {values[k]:.6g} (in the file's"
+            f" units), more than {MAX_ACCELERATION_G:g} g: not a ground motion (check"
+            " excitation.units)"
+        )
 
 
 def check_file(path: Path) -> None:
-    """Refuse a missing, unreadable, folder or too large record file."""
+    """Refuse a missing or unreadable file, a folder, anything but a regular file (a FIFO
+    would block the read, a device such as /dev/zero never end it) and a file larger
+    than MAX_FILE_BYTES; the file is not opened (its status is read, symbolic links
+    followed)."""
+    shown = str(path)
+    if any(ord(c) < 32 or ord(c) == 127 for c in shown):
+        raise RbmError(
+            f"{shown!r}: a record file's name must not hold control characters (tab, new"
+            " line, carriage return...): rename it"
+        )
     try:
-        size = path.stat().st_size
+        info = os.stat(path)
     except FileNotFoundError:
         raise RbmError(f"{path}: no such file") from None
     except OSError as exc:
-        raise RbmError(f"{path}: cannot read ({exc.strerror})") from None
-    if path.is_dir():
+        raise RbmError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    if stat.S_ISDIR(info.st_mode):
         raise RbmError(f"{path}: is a folder, not a record file")
-    if size > MAX_FILE_BYTES:
+    if not stat.S_ISREG(info.st_mode):
+        raise RbmError(f"{path}: not a regular file (a pipe, socket or device): not a record")
+    if info.st_size > MAX_FILE_BYTES:
         raise RbmError(
-            f"{path}: {size} bytes, more than the {MAX_FILE_BYTES} bytes a record may have"
+            f"{path}: {info.st_size} bytes, more than the {MAX_FILE_BYTES} bytes a record may have"
+        )
+
+
+def _check_text(path: Path) -> None:
+    """Refuse a file that is not UTF-8 text: NUL bytes (UTF-16, a binary file) in its
+    first block."""
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in head:
+        raise RbmError(
+            f"{path}: not UTF-8 text (it holds NUL bytes: UTF-16 or a binary file); save it"
+            " as UTF-8 text"
         )
 
 

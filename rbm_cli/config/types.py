@@ -217,11 +217,28 @@ class GridConfig:
     amplitudes_g: tuple[float, ...] = ()
     frequencies_hz: tuple[float, ...] = ()
     axes: tuple[Axis, ...] = ()
+    #: The record files the axes name (a suite): (key path, file as written, SHA-256 of its
+    #: bytes), so that a record's content, not only its name, is in the config's hash.
+    records: tuple[tuple[str, str, str], ...] = ()
 
     @property
     def axis_paths(self) -> tuple[str, ...]:
         """The config key paths the grid varies beside amplitude and frequency."""
         return tuple(p for axis in self.axes for p in axis.paths)
+
+    @property
+    def n_points(self) -> int:
+        """Points of the axes over config keys (1 without such axes)."""
+        n = 1
+        for axis in self.axes:
+            n *= len(axis.points)
+        return n
+
+    @property
+    def n_cells(self) -> int:
+        """Cells of the grid, counted without listing them: amplitudes x frequencies (one
+        where the excitation has none) x the points of the other axes."""
+        return len(self.amplitudes_g) * max(1, len(self.frequencies_hz)) * self.n_points
 
 
 @dataclass(frozen=True)
@@ -292,9 +309,25 @@ class Config:
         out.pop("written", None)
         out.pop("base_dir", None)
         out["excitation"] = self.excitation.resolved()
-        if not out["grid"]["axes"]:  # a plain grid resolves (and hashes) as it always did
-            del out["grid"]["axes"]
+        for key in ("axes", "records"):  # a plain grid resolves (and hashes) as it always did
+            if not out["grid"][key]:
+                del out["grid"][key]
         return out
+
+    def record_files(self) -> tuple[tuple[str, str, str], ...]:
+        """Every record file the config names, by content: (key path, file as written,
+        SHA-256), the excitation's own (``excitation.file``, ``excitation.vertical``) then
+        those of the grid's axes."""
+        e = self.excitation
+        own = tuple(
+            (f"excitation.{key}", written, digest)
+            for key, written, digest in (
+                ("file", e.file, e.file_sha256),
+                ("vertical", e.vertical, e.vertical_sha256),
+            )
+            if e.type == "record" and written is not None and digest is not None
+        )
+        return own + tuple(r for r in self.grid.records if r not in own)
 
 
 def hash_form(config: Config) -> dict:

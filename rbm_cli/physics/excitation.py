@@ -72,16 +72,17 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
     if path is None:
         raise RbmError("excitation.file is required for type record")
     rec = load_record(str(path), excitation.units, excitation.file_sha256)
-    if excitation.scale == "pga":
-        factor = amplitude_g * G / rec.pga
-    else:
-        factor = float(amplitude_g)
-    knots, values, vertical = rec.t, rec.acceleration * factor, None
+    with np.errstate(all="ignore"):  # checked below, with the file named
+        if excitation.scale == "pga":
+            factor = amplitude_g * G / rec.pga
+        else:
+            factor = float(amplitude_g)
+        knots, values, vertical = rec.t, _scaled(rec, factor, path), None
     end = rec.duration
     if excitation.vertical is not None:
         path = excitation.vertical_path or excitation.vertical
         ver = load_record(str(path), excitation.units, excitation.vertical_sha256)
-        knots, values, vertical = merge_records(rec.t, values, ver.t, ver.acceleration * factor)
+        knots, values, vertical = merge_records(rec.t, values, ver.t, _scaled(ver, factor, path))
         end = max(end, ver.duration)
         vertical.setflags(write=False)
     values.setflags(write=False)
@@ -99,6 +100,26 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
         name=rec.name,
         vertical=vertical,
     )
+
+
+#: Largest peak acceleration of a scaled record [g]: the grid's largest amplitude.
+MAX_SCALED_PGA_G = 1e3
+
+
+def _scaled(record: Record, factor: float, path) -> np.ndarray:
+    """The record's accelerations times ``factor`` [m/s^2], checked finite and at most
+    MAX_SCALED_PGA_G in peak (a factor from a tiny PGA, or a large factor on a large
+    record, would run a motion no column meets and arithmetic that is not sound)."""
+    with np.errstate(all="ignore"):
+        values = record.acceleration * factor
+        peak = float(np.max(np.abs(values))) if values.size else 0.0
+    if not (math.isfinite(factor) and math.isfinite(peak) and peak <= MAX_SCALED_PGA_G * G):
+        shown = f"{peak / G:.4g} g" if math.isfinite(peak) else "not finite"
+        raise RbmError(
+            f"{path}: scaled by {factor:.4g}, its peak acceleration is {shown} (at most"
+            f" {MAX_SCALED_PGA_G:g} g): lower the amplitude"
+        )
+    return values
 
 
 def _limits(t: float, ts: np.ndarray, vs: np.ndarray) -> tuple[float, float]:

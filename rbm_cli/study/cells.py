@@ -46,10 +46,7 @@ def grid_cells(config: Config, points: list[GridPoint] | None = None) -> list[Ce
 
 def count_cells(config: Config) -> int:
     """The number of cells, counted without listing them."""
-    n = len(config.grid.amplitudes_g) * len(frequencies(config))
-    for axis in config.grid.axes:
-        n *= len(axis.points)
-    return n
+    return config.grid.n_cells
 
 
 def key(cell: Cell) -> tuple[str, ...]:

@@ -261,13 +261,29 @@ def _stop(executor) -> None:
         worker.join(timeout=WATCH_INTERVAL_S)
 
 
+#: What a missing dask says (the check before a sweep starts, and the imports).
+NO_DASK = "--backend dask needs dask's distributed scheduler: pip install 'rbm[dask]'"
+
+
+def check_dask_installed() -> None:
+    """Refuse the dask backend where dask.distributed is not installed (one line), before
+    a sweep writes anything: a journal whose resume command repeats a backend that cannot
+    run would be of no use."""
+    import importlib.util
+
+    try:
+        found = all(importlib.util.find_spec(name) for name in ("dask", "distributed"))
+    except (ImportError, ValueError):
+        found = False
+    if not found:
+        raise RbmError(NO_DASK)
+
+
 def _dask_client(scheduler: str | None):
     try:
         from dask.distributed import Client
     except ImportError:
-        raise RbmError(
-            "--backend dask needs dask's distributed scheduler: pip install 'rbm[dask]'"
-        ) from None
+        raise RbmError(NO_DASK) from None
     if not scheduler:
         return Client(processes=False)
     probe_dask(scheduler)
@@ -284,9 +300,7 @@ def probe_dask(address: str) -> None:
     try:
         from distributed.comm import connect
     except ImportError:
-        raise RbmError(
-            "--backend dask needs dask's distributed scheduler: pip install 'rbm[dask]'"
-        ) from None
+        raise RbmError(NO_DASK) from None
 
     async def probe() -> None:
         comm = await connect(address, timeout=DASK_PROBE_TIMEOUT_S / 2)

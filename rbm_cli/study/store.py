@@ -65,6 +65,7 @@ class JournalRead:
     first_problem: str = ""
     cut: bool = False  # the last line was cut (no newline: a kill while writing)
     solver_method: str | None = None  # the header's solver.method (None: not recorded)
+    records: list | None = None  # the header's record files [key, file, SHA-256] (None: none)
 
 
 def _umask() -> int:
@@ -183,11 +184,17 @@ class SweepStore:
             self._lock_fd = None
 
     def _remove_stale_staging(self) -> None:
-        """Staging folders of publications that did not finish (a kill): with the lock
-        held, none can be in use."""
+        """Staging folders of publications that did not finish, and temporary copies of the
+        journal's header or the state file that a kill left before their rename: with the
+        lock held, none can be in use."""
         for item in self.folder.glob(STAGING_PREFIX + "*"):
             if item.is_dir() and not item.is_symlink():
                 shutil.rmtree(item, ignore_errors=True)
+        for name in (JOURNAL, STATE):
+            for item in self.folder.glob(f".{name}.*.tmp"):
+                if item.is_file() and not item.is_symlink():
+                    with contextlib.suppress(OSError):
+                        item.unlink()
 
     # ---------------------------------------------------------------- what the folder holds
     def finished_hash(self) -> str | None:
@@ -243,6 +250,8 @@ class SweepStore:
                     out.first_problem = out.first_problem or f"line {number}: not JSON text"
                 continue
             if isinstance(row, dict) and "rbm_journal" in row:  # the header
+                if isinstance(row.get("records"), list):
+                    out.records = row["records"]
                 if isinstance(row.get("config_hash"), str):
                     out.hashes.add(row["config_hash"])
                     legacy = legacy or row["config_hash"] == digest
@@ -279,11 +288,24 @@ class SweepStore:
         return target
 
     def start_journal(
-        self, digest: str, n_cells: int, resume_command: str, solver_method: str | None = None
+        self,
+        digest: str,
+        n_cells: int,
+        resume_command: str,
+        solver_method: str | None = None,
+        records: Sequence | None = None,
     ) -> None:
         """A new journal (header line) and state file, replacing none: the caller has
         made sure no journal is here (or set it aside). solver_method: the config's
-        solver.method as written (auto, DOP853, ...), kept for the resume."""
+        solver.method as written (auto, DOP853, ...), kept for the resume; records: the
+        record files the config names (key path, file, SHA-256), kept so that a resume
+        over a changed record can name it.
+
+        Raises
+        ------
+        RbmError  The journal cannot be written (a full disk, a read-only folder): one
+            line; no journal or state file is left
+        """
         header = {
             "rbm_journal": JOURNAL_FORMAT,
             "config_hash": digest,
@@ -292,8 +314,19 @@ class SweepStore:
         }
         if solver_method is not None:
             header["solver_method"] = solver_method
-        self._write_small(self.journal, json.dumps(header) + "\n")
-        self.write_state(digest, n_cells, resume_command)
+        if records:
+            header["records"] = [list(r) for r in records]
+        try:
+            self._write_small(self.journal, json.dumps(header) + "\n")
+            self.write_state(digest, n_cells, resume_command)
+        except OSError as exc:
+            for path in (self.journal, self.state):
+                with contextlib.suppress(OSError):
+                    path.unlink()
+            raise RbmError(
+                f"cannot start the sweep's journal in {self.folder}:"
+                f" {exc.strerror or exc}; nothing was run"
+            ) from None
 
     def write_state(self, digest: str, n_cells: int, resume_command: str) -> None:
         state = {"config_hash": digest, "n_cells": n_cells, "resume": resume_command}

@@ -141,17 +141,25 @@ def _check_request(
         raise RbmError(
             f"the grid has {n_cells:,} cells (more than {MAX_CELLS:,}); use --force to run it"
         )
-    if jobs < 1:
-        raise RbmError(f"--jobs must be >= 1, got {jobs}")
-    if ensemble < 1:
-        raise RbmError(f"--ensemble must be >= 1, got {ensemble}")
-    if backend not in BACKENDS:
+    for name, value in (("jobs", jobs), ("ensemble", ensemble)):
+        if not (_is_int(value) and value >= 1):
+            raise RbmError(f"--{name} must be a whole number >= 1, got {value!r}")
+    if not isinstance(backend, str) or backend not in BACKENDS:
         raise RbmError(f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
-    if backend == "dask" and scheduler:
-        from rbm_cli.study.parallel import probe_dask
+    if backend == "dask":
+        from rbm_cli.study.parallel import check_dask_installed, probe_dask
 
-        probe_dask(scheduler)  # an address that is not a Dask scheduler: one line, bounded
+        check_dask_installed()
+        if scheduler:
+            probe_dask(scheduler)  # an address that is not a Dask scheduler: one line, bounded
     return n_cells
+
+
+def _is_int(value) -> bool:
+    """A whole number: an int or a numpy integer, not a boolean."""
+    import numbers
+
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
 
 
 def _check_points(points: list[GridPoint]) -> list[GridPoint]:

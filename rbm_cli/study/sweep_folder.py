@@ -44,9 +44,13 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
         n = len(read.rows) if ours else read.rejected  # rows of the other config
         if not read.rows and not read.rejected and (ours or not read.hashes):
             # it held no cell: start over
-            store.start_journal(digest, len(cells), command, config.solver.method)
+            store.start_journal(digest, len(cells), command, config.solver.method,
+                                config.record_files())  # fmt: skip
             return {}, None
+        changed = "" if ours else changed_records(read.records, config)
         whose = "of this config" if ours else "of another config"
+        if changed:
+            whose = f"started before {changed} changed"
         if not resume and not force:
             hint = "add --resume to finish it" if ours else "use another -o folder"
             raise RbmError(
@@ -55,6 +59,12 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
             )
         if not resume or (not ours and read.hashes):
             if resume:
+                if changed:
+                    raise RbmError(
+                        f"{store.journal}: {changed} changed since the sweep was started, so"
+                        " its finished cells would mix two records: put the file back, or run"
+                        " without --resume and with --force to set the journal aside"
+                    )
                 raise RbmError(
                     f"{store.journal} was made with a different config: use another -o folder,"
                     " or run without --resume and with --force to set it aside"
@@ -72,7 +82,13 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
                 )
             if store.state_hash() != digest:
                 note("the state file was missing or unreadable: recovered from the journal")
-                store.write_state(digest, len(cells), command)
+                try:
+                    store.write_state(digest, len(cells), command)
+                except OSError as exc:
+                    raise RbmError(
+                        f"cannot write the sweep's state file in {folder}:"
+                        f" {exc.strerror or exc}; the journal is kept: make room, then resume"
+                    ) from None
             return dict(read.rows), read.solver_method
     else:
         finished = store.finished_hash()
@@ -83,8 +99,14 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
         if finished is not None and finished != digest:
             if not force:
                 act = "nothing to resume" if resume else "it is kept"
+                changed = changed_records(_finished_records(folder), config)
+                whose = (
+                    f"a finished domain made before {changed} changed"
+                    if changed
+                    else "the finished domain of another config"
+                )
                 raise RbmError(
-                    f"{folder} holds the finished domain of another config ({act}): use"
+                    f"{folder} holds {whose} ({act}): use"
                     " another -o folder, or --force (without --resume) to set it aside"
                     " (to superseded/) and run this config"
                 )
@@ -94,8 +116,49 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
                 )
             where = store.set_aside(FINALS)
             note(f"the finished domain of another config was moved to {where}")
-    store.start_journal(digest, len(cells), command, config.solver.method)
+    store.start_journal(digest, len(cells), command, config.solver.method,
+                        config.record_files())  # fmt: skip
     return {}, None
+
+
+def changed_records(before, config: Config) -> str:
+    """The record files of ``config`` whose content differs from ``before`` (a journal's or
+    a finished domain's list of [key path, file, SHA-256]), named for a message ('' when
+    none is known to differ)."""
+    if not isinstance(before, list):
+        return ""
+    now = {(r[0], r[1]): r[2] for r in config.record_files()}
+    names = []
+    for entry in before:
+        if not (isinstance(entry, list | tuple) and len(entry) == 3):
+            continue
+        key_path, written, digest = entry
+        current = now.get((key_path, written))
+        if current is not None and current != digest:
+            names.append(f"{written} (SHA-256 {str(digest)[:12]}... then, {current[:12]}... now)")
+    if not names:
+        return ""
+    shown = "; ".join(names[:3]) + (f"; and {len(names) - 3} more" if len(names) > 3 else "")
+    return f"the record file {shown}" if len(names) == 1 else f"the record files {shown}"
+
+
+def _finished_records(folder: Path) -> list | None:
+    """The record files of the finished domain in ``folder`` (meta.json's config), or None."""
+    try:
+        config = json.loads((folder / "meta.json").read_text(encoding="utf-8"))["config"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not isinstance(config, dict):
+        return None
+    excitation, grid = config.get("excitation"), config.get("grid")
+    out = []
+    if isinstance(excitation, dict):
+        for key in ("file", "vertical"):
+            if excitation.get(key) is not None:
+                out.append([f"excitation.{key}", excitation[key], excitation.get(f"{key}_sha256")])
+    if isinstance(grid, dict) and isinstance(grid.get("records"), list):
+        out += grid["records"]
+    return out
 
 
 def as_started(config, points, method: str | None, note) -> tuple:
@@ -193,7 +256,12 @@ def _same_settings(folder: Path, config, ensemble: int) -> bool:
     except (OSError, ValueError, KeyError, AttributeError, TypeError):
         return False
     current = json.loads(json.dumps(config.resolved(), default=str))
-    return members == ensemble and isinstance(stored, dict) and _common_equal(stored, current)
+    if not isinstance(stored, dict) or members != ensemble:
+        return False
+    records = current.get("grid", {}).get("records")
+    if records is not None and records != (stored.get("grid") or {}).get("records"):
+        return False  # the records of a suite are compared by content, never left out
+    return _common_equal(stored, current)
 
 
 def _common_equal(a, b) -> bool:

@@ -307,7 +307,7 @@ def _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, pct, progress=No
         nan_pair = (math.nan, math.nan)
         lower, upper = np.full((2, grid.size), np.nan)
         return _Band(lower, upper, nan_pair, nan_pair, int(thetas.size))
-    lower, upper = np.percentile(curves, pct, axis=0)
+    lower, upper = np.percentile(curves, pct, axis=0, overwrite_input=True)  # no sorted copy
     return _Band(
         lower,
         upper,

@@ -165,6 +165,15 @@ def test_degenerate_data_flagged(tmp_path, collapsed, fragment):
     assert any("no fit" in t.get_text() for t in ax.texts)
 
 
+def test_one_intensity_has_no_curve():
+    """Runs at one intensity were called 'separated' ('survive up to 0.3 g and collapse
+    from 0.3 g'): a curve through one fraction has no dispersion, and says so."""
+    with pytest.raises(RbmError) as info:
+        fit_lognormal([0.3] * 4, [1, 0, 1, 0])
+    assert "all runs are at one intensity (0.3 g, 2 of 4 collapsed)" in str(info.value)
+    assert "collapse from" not in str(info.value)
+
+
 @pytest.mark.parametrize(
     ("change", "fragment"),
     [
@@ -175,7 +184,12 @@ def test_degenerate_data_flagged(tmp_path, collapsed, fragment):
         (lambda d: d.assign(status=["ok"] * 4), "row 1 (record 'a'): status must be one of"),
         (lambda d: d.assign(status=["collapsed"] * 4), "row 1 (record 'a'): status 'collapsed'"),
         (lambda d: d.assign(record=["a", "a", "a", "b"]), "row 2: a second run of record 'a'"),
-        (lambda d: d.assign(status=["failed"] * 4), "all 4 runs failed"),
+        (lambda d: d.assign(status=["failed"] * 4, collapsed=0), "all 4 runs failed"),
+        # a failed run is not a collapse: collapsed 1 beside it is refused, as compare does
+        (
+            lambda d: d.assign(status=["survived", "failed", "collapsed", "survived"]),
+            "row 2 (record 'b'): status 'failed' but collapsed = 1",
+        ),
         (lambda d: d.iloc[:0], "no rows"),
     ],
 )

@@ -15,6 +15,10 @@ import hashlib
 import json
 import math
 import os
+import resource
+import signal
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -24,9 +28,11 @@ from click.testing import CliRunner
 from matplotlib.collections import PolyCollection
 from scipy.stats import norm
 
-from rbm_cli.base.files import publish_files_atomic
+from rbm_cli.base.errors import RbmError
+from rbm_cli.cli import fragility as fragility_command
 from rbm_cli.cli.main import cli
 from rbm_cli.report import fragility_run
+from rbm_cli.study.fragility import MAX_RESAMPLES
 
 from .paths import RESULTS
 
@@ -282,6 +288,13 @@ def _bad_intensity(tmp_path):
     return write_domain(tmp_path, df)
 
 
+def _failed_but_collapsed(tmp_path):
+    df, _ = suite(n_records=3)
+    df.loc[30, "status"] = "failed"  # rec001 at 0.55 g: a failed run that says it collapsed
+    df.loc[30, "collapsed"] = 1
+    return write_domain(tmp_path, df)
+
+
 @pytest.mark.parametrize(
     ("make", "needles"),
     [
@@ -294,6 +307,7 @@ def _bad_intensity(tmp_path):
         (_one_empty, ("line 6", "record field is empty")),
         (_twice, ("a second run of record 'rec000'",)),
         (_bad_intensity, ("row 8", "amplitude_g must be a number > 0")),
+        (_failed_but_collapsed, ("line 32", "status 'failed' but collapsed 1")),
     ],
 )
 def test_bad_domain_is_refused_in_one_line(tmp_path, make, needles):
@@ -328,17 +342,30 @@ def test_output_that_is_a_file_is_refused(tmp_path):
     assert (tmp_path / "f").read_text() == "a file"
 
 
-def test_publish_is_all_or_nothing(tmp_path):
-    """A failure while staging leaves every existing file as it was and no temporary file."""
-    (tmp_path / "a.csv").write_text("old a")
-    with pytest.raises(TypeError):
-        publish_files_atomic(tmp_path, {"a.csv": "new a", "b.json": None, "c.png": b"c"})
-    assert sorted(os.listdir(tmp_path)) == ["a.csv"]
-    assert (tmp_path / "a.csv").read_text() == "old a"
-    paths = publish_files_atomic(tmp_path, {"a.csv": "new a", "c.png": b"\x89PNG"})
-    assert [p.name for p in paths] == ["a.csv", "c.png"]
-    assert (tmp_path / "a.csv").read_text() == "new a"
-    assert oct((tmp_path / "c.png").stat().st_mode & 0o777) != oct(0o600)  # not mkstemp's
+def test_a_write_that_fails_leaves_the_folder_as_it_was(tmp_path):
+    """A file that cannot be written whole (here: a file size limit, as a full disk) ends
+    the command in one line, exit 2, with the folder's earlier set as it was and nothing
+    of the failed run left behind."""
+    df, _ = suite(n_records=20)
+    domain = write_domain(tmp_path / "s", df)
+    assert invoke("fragility", domain, "--resamples", 0).exit_code == 0
+    before = {p.name: p.read_bytes() for p in (tmp_path / "s").iterdir()}
+    df.loc[df["record"] == "rec000", "max_rotation_ratio"] *= 0.5  # another IDA figure
+    df.to_csv(domain, index=False, float_format="%.12g")
+    before["domain.csv"] = Path(domain).read_bytes()
+
+    def small_files():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # EFBIG instead of a kill
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))  # the PNGs are larger
+
+    command = [sys.executable, "-m", "rbm_cli", "fragility", domain, "--resamples", "0"]
+    proc = subprocess.run(command, capture_output=True, text=True, preexec_fn=small_files,
+                          env={**os.environ, "PYTHONPATH": str(Path(__file__).parents[1])},
+                          timeout=120)  # fmt: skip
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "cannot write the fragility files (File too large)" in lines[0], lines[0]
+    assert {p.name: p.read_bytes() for p in (tmp_path / "s").iterdir()} == before
 
 
 def test_compare_draws_each_domain_fitted_in_one_figure(tmp_path, figures):
@@ -367,3 +394,156 @@ def test_compare_draws_each_domain_fitted_in_one_figure(tmp_path, figures):
     # the doubled suite's median is twice the first's (scaling the intensities scales it)
     assert medians[0] == pytest.approx(summary["median_g"], rel=0.02)
     assert medians[1] == pytest.approx(2 * summary["median_g"], rel=0.02)
+
+
+def test_failed_run_marked_collapsed_is_refused_as_compare_refuses_it(tmp_path):
+    """A row whose status is failed but whose collapsed is 1 was fitted as a collapse by
+    `rbm fragility` while `rbm compare` refused it. Both refuse it now, in the same words,
+    naming the line."""
+    domain = _failed_but_collapsed(tmp_path)
+    res = invoke("fragility", domain)
+    assert_refused(res, "line 32", "status 'failed' but collapsed 1")
+    other = invoke("compare", domain, domain)
+    assert other.exit_code == 2 and other.output == res.output
+
+
+# --------------------------------------------------------------------------- thin suites
+
+
+def stored_suite() -> pd.DataFrame:
+    return pd.read_csv(RESULTS / "suite_multidrum" / "domain.csv", dtype={"record": str},
+                       keep_default_na=False, na_values=[""])  # fmt: skip
+
+
+def test_one_record_gives_a_fit_without_a_band(tmp_path, figures):
+    """A suite of one record once got a bootstrap band of zero width (every resample is
+    that record: '0.5346-0.5346 g', as if certain). Its fit is shown, with no band and no
+    intervals, and a note (output, fragility.json, the figure) that a band needs two
+    records or more."""
+    df = stored_suite()
+    one = df[df["record"] == "rdk_13"]  # collapses at 0.6 and 0.9 g, survives between
+    assert one["collapsed"].nunique() == 2
+    domain = write_domain(tmp_path / "one", one)
+    res = invoke("fragility", domain, "--resamples", 200)
+    assert res.exit_code == 0, res.output
+    assert "records: 1," in res.output and "median " in res.output
+    assert " %: " not in res.output  # no interval printed
+    note = [line for line in res.output.splitlines() if line.startswith("note: ")]
+    assert len(note) == 1 and "1 record" in note[0] and "need 2 or more" in note[0], res.output
+    summary = json.loads((tmp_path / "one" / "fragility.json").read_text())
+    assert summary["fitted"] is True and summary["note"] == note[0].removeprefix("note: ")
+    assert summary["median_ci_g"] == [None, None] and summary["beta_ci"] == [None, None]
+    assert summary["n_resamples"] == 0 and summary["n_resamples_used"] == 0
+    curve = pd.read_csv(tmp_path / "one" / "fragility_curve.csv")
+    assert curve["lower"].isna().all() and curve["upper"].isna().all()
+    ax = figures[0].axes[0]
+    assert not [c for c in ax.collections if c.get_gid() == "band"]
+    assert any("1 record" in t.get_text() for t in ax.texts)
+
+
+def test_one_intensity_is_not_presented_as_a_fit(tmp_path):
+    """With every run at one intensity the command said 'all runs survive up to 0.5 g and
+    collapse from 0.5 g' as if a curve had been fitted. It says plainly that a curve needs
+    two intensities, and gives the one fraction observed."""
+    df = stored_suite()
+    level = df[df["amplitude_g"] == 0.5]
+    k, n = int(level["collapsed"].sum()), len(level)
+    assert 0 < k < n  # mixed outcomes: the case a separated-outcomes message got wrong
+    domain = write_domain(tmp_path / "level", level)
+    res = invoke("fragility", domain)
+    assert res.exit_code == 0, res.output
+    assert f"no fit: all runs are at one intensity (0.5 g, {k} of {n} collapsed)" in res.output
+    assert "two intensities or more" in res.output
+    assert "collapse from" not in res.output and "median" not in res.output
+    summary = json.loads((tmp_path / "level" / "fragility.json").read_text())
+    assert summary["fitted"] is False and summary["median_g"] is None
+    table = pd.read_csv(tmp_path / "level" / "fragility.csv")
+    assert table["fraction"].tolist() == [k / n]
+
+
+# --------------------------------------------------------------------------- the bootstrap's cost
+
+
+def _no_fit_domain(tmp_path) -> str:
+    """A domain that has no fit (every run survives), so no bootstrap runs: a version
+    without the bounds below ends at once instead of resampling for days."""
+    df, _ = suite(n_records=5)
+    df = df[df["amplitude_g"] < 0.05 + 1e-9].copy()
+    df["status"], df["collapsed"] = "survived", 0
+    return write_domain(tmp_path / "s", df)
+
+
+@pytest.mark.parametrize("n", [MAX_RESAMPLES + 1, 1_000_000_000])
+def test_resamples_above_the_maximum_are_refused(tmp_path, n):
+    """--resamples 1000000000 once ran for about 12 days with no word. Above the
+    documented maximum it is refused in one line; --help states the maximum."""
+    domain = _no_fit_domain(tmp_path)
+    assert_refused(invoke("fragility", domain, "--resamples", n), "--resamples",
+                   f"{MAX_RESAMPLES:,}")  # fmt: skip
+    assert os.listdir(tmp_path / "s") == ["domain.csv"]
+    helped = " ".join(invoke("fragility", "--help").output.split())
+    assert f"at most {MAX_RESAMPLES:,}" in helped
+
+
+@pytest.mark.parametrize(
+    ("option", "value"),
+    [
+        ("n_resamples", True),
+        ("n_resamples", math.nan),
+        ("n_resamples", -1),
+        ("n_resamples", 2.5),
+        ("n_resamples", MAX_RESAMPLES + 1),
+        ("n_resamples", 10**12),
+        ("seed", True),
+        ("seed", math.nan),
+        ("seed", -1),
+        ("seed", 2**64),
+        ("seed", "7"),
+        ("ci_percentiles", (True, 95.0)),
+        ("ci_percentiles", (math.nan, 95.0)),
+        ("ci_percentiles", (5.0, math.inf)),
+        ("ci_percentiles", (-1.0, 50.0)),
+        ("ci_percentiles", (5.0,)),
+        ("ci_percentiles", "5 95"),
+        ("ci_percentiles", (np.float64(95.0), np.float64(5.0))),
+    ],
+)
+def test_api_refuses_bad_options_in_one_line(tmp_path, option, value):
+    """run_fragility (the API path) accepted a bool, ran into a TypeError on nan, and had
+    no bound: each bad value is refused in one line naming the option, nothing written."""
+    domain = _no_fit_domain(tmp_path)
+    with pytest.raises(RbmError) as info:
+        fragility_run.run_fragility(domain, **{option: value})
+    text = str(info.value)
+    assert option in text and "\n" not in text and "np.float64" not in text, text
+    assert os.listdir(tmp_path / "s") == ["domain.csv"]
+
+
+def test_progress_of_a_long_bootstrap_on_stderr(tmp_path, monkeypatch):
+    """The bootstrap said nothing however long it ran. Past a few seconds (here: from the
+    start) its progress is on stderr, the resamples of the compared domain counted too."""
+    monkeypatch.setattr(fragility_command, "PROGRESS_AFTER_S", 0.0)
+    a = write_domain(tmp_path / "a", suite(seed=1, n_records=20)[0])
+    b = write_domain(tmp_path / "b", suite(seed=2, n_records=20)[0])
+    res = CliRunner().invoke(cli, ["fragility", a, "--compare", b, "--resamples", "30"])
+    assert res.exit_code == 0, res.output
+    assert "bootstrap: 60/60 resamples (100 %)" in res.stderr
+    assert "resamples" not in res.stdout
+
+
+def test_api_progress_and_ctrl_c_during_the_bootstrap(tmp_path):
+    """progress(done, total) follows the bootstrap to its end; a Ctrl-C during it (here
+    raised from the callback) leaves the folder's set as it was, and no hidden file."""
+    domain = write_domain(tmp_path / "s", suite(seed=3, n_records=20)[0])
+    calls = []
+    fragility_run.run_fragility(domain, n_resamples=25, progress=lambda d, t: calls.append((d, t)))
+    assert calls == [(d, 25) for d in range(1, 26)]
+    before = {p.name: p.read_bytes() for p in (tmp_path / "s").iterdir()}
+
+    def interrupt(done, total):
+        if done == 10:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        fragility_run.run_fragility(domain, n_resamples=25, seed=1, progress=interrupt)
+    assert {p.name: p.read_bytes() for p in (tmp_path / "s").iterdir()} == before

@@ -125,36 +125,6 @@ def save_figure_atomic(fig, path: str | os.PathLike, dpi: int = 150) -> Path:
     return path
 
 
-def publish_files_atomic(folder: str | os.PathLike, contents: dict[str, str | bytes]) -> list[Path]:
-    """Write several files into ``folder`` as one step: all staged, then all moved into place.
-
-    Every file is first written in full to a temporary name in ``folder``; only when all
-    are written are they moved onto their names (one :func:`os.replace` each, in the order
-    given). A failure while staging removes the staged files and leaves every existing
-    file as it was; nothing else in ``folder`` is touched. Text is written as UTF-8.
-
-    Returns the paths written, in the order of ``contents``.
-    """
-    folder = Path(folder)
-    staged: list[tuple[Path, Path]] = []
-    try:
-        for name, data in contents.items():
-            target = folder / name
-            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
-            staged.append((Path(tmp), target))
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(data.encode("utf-8") if isinstance(data, str) else data)
-            os.chmod(tmp, 0o666 & ~current_umask())  # mkstemp makes 0o600 files
-        for tmp, target in staged:
-            os.replace(tmp, target)
-    except BaseException:
-        for tmp, _ in staged:
-            with contextlib.suppress(OSError):
-                tmp.unlink()
-        raise
-    return [target for _, target in staged]
-
-
 def check_writable_dir(path: str | os.PathLike) -> Path:
     """Check, without creating anything, that ``path`` is or can become a writable folder.
 

@@ -4,11 +4,19 @@ rbm_cli.report.fragility_run)."""
 from __future__ import annotations
 
 import math
+import time
 
 import click
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.cli.common import UserError, check_output, cli, one_line
+from rbm_cli.cli.common import Interrupted, UserError, check_output, cli, one_line
+from rbm_cli.cli.progress import Progress, duration
+
+#: Most --resamples (rbm_cli.study.fragility.MAX_RESAMPLES, which refuses more; written
+#: here so that `rbm --help` does not import the fit).
+MAX_RESAMPLES_SHOWN = "100,000"
+#: Seconds of bootstrap before its progress is shown (a short one says nothing).
+PROGRESS_AFTER_S = 2.0
 
 
 @cli.command()
@@ -16,9 +24,10 @@ from rbm_cli.cli.common import UserError, check_output, cli, one_line
 @click.option("-o", "--output", default=None, metavar="DIR", callback=check_output,
               help="Folder for the files  [default: the domain's folder]")  # fmt: skip
 @click.option("--resamples", type=click.IntRange(min=0), default=500, show_default=True,
-              help="Bootstrap resamples of the records (0: no band, no intervals).")  # fmt: skip
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
-              help="Seed of the bootstrap.")  # fmt: skip
+              help="Bootstrap resamples of the records (0: no band, no intervals; at most "
+              f"{MAX_RESAMPLES_SHOWN}, a few minutes).")  # fmt: skip
+@click.option("--seed", type=click.IntRange(min=0, max=2**64 - 1), default=0, show_default=True,
+              help="Seed of the bootstrap (0 to 2^64 - 1).")  # fmt: skip
 @click.option("--intensity-column", default=None, metavar="NAME",
               help="Column of the intensity  [default: intensity_g, amplitude_g or "
               "intensity, the first present]")  # fmt: skip
@@ -35,12 +44,14 @@ def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> 
     per record and intensity, with its record's name). Per intensity: records,
     collapses and the fraction; the lognormal fragility P = Phi(ln(x/median)/beta)
     fitted by maximum likelihood on the per-record outcomes (Baker 2015), with a
-    bootstrap over records for the intervals and the band. Failed runs are left
-    out and counted.
+    bootstrap over records for the intervals and the band (it needs 2 records or
+    more; progress on stderr when it takes more than a few seconds). Failed runs
+    are left out and counted. A curve needs runs at 2 intensities or more.
 
     Writes fragility.csv, fragility_curve.csv, fragility.json, fragility.png and
     ida.png (peak rotation ratio against intensity, a line per record), all
-    moved into place together at the end.
+    moved into place together at the end: a Ctrl-C or a kill leaves the old set
+    or the new one, never a mix. One run writes a folder at a time.
 
     \b
     Example:
@@ -50,13 +61,26 @@ def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> 
             --compare results/suite_monolithic/domain.csv -o docs/figures/suite
     """
     from rbm_cli.report.fragility_run import run_fragility
+    from rbm_cli.study.fragility import MAX_RESAMPLES
 
+    if resamples > MAX_RESAMPLES:
+        raise UserError(
+            f"--resamples must be at most {MAX_RESAMPLES:,} (each is a refit), got {resamples:,}"
+        )
+    progress = _BootstrapProgress("bootstrap")
     try:
         made = run_fragility(domain, output, n_resamples=resamples, seed=seed,
-                             intensity_column=intensity_column,
-                             ci_percentiles=tuple(ci), compare=others)  # fmt: skip
+                             intensity_column=intensity_column, ci_percentiles=tuple(ci),
+                             compare=others, progress=progress)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
+    except KeyboardInterrupt:
+        raise Interrupted(
+            "interrupted (Ctrl-C): the fragility files are as they were, or all new if it "
+            "came as they were moved into place"
+        ) from None
+    finally:
+        progress.close()
     res = made.result
     click.echo(f"records: {res.n_records}, runs: {res.n_runs} (failed, left out: "
                f"{res.n_failed}), intensities: {len(res.table)}")  # fmt: skip
@@ -67,6 +91,8 @@ def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> 
         median = f"{res.fit.median_g:.4g} g" + _interval(res.median_ci_g, lo, hi, " g")
         beta = f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
         click.echo(f"median {median}, dispersion beta {beta}")
+        if res.note:
+            click.echo(f"note: {res.note}")
     folder = made.paths[0].parent
     click.echo(f"output: {folder}/ " + ", ".join(p.name for p in made.paths))
 
@@ -75,3 +101,25 @@ def _interval(ci: tuple[float, float], lo: float, hi: float, unit: str) -> str:
     if not all(math.isfinite(v) for v in ci):
         return ""
     return f" ({lo:g}-{hi:g} %: {ci[0]:.4g}-{ci[1]:.4g}{unit})"
+
+
+class _BootstrapProgress(Progress):
+    """The bootstrap's progress on stderr (a bar on a terminal, plain lines otherwise),
+    once it has run for PROGRESS_AFTER_S."""
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.monotonic()
+        if self.start is None:
+            self.start, self.done0 = now, 0
+        if self.drawn or now - self.start >= PROGRESS_AFTER_S:
+            super().__call__(done, total)
+
+    def text(self, now: float) -> str:
+        rate = self.rate(now)
+        left = self.total - self.done
+        eta = duration(left / rate) if rate > 0 else "?"
+        pct = 100.0 * self.done / self.total if self.total else 100.0
+        return (
+            f"{self.label}: {self.done:,}/{self.total:,} resamples ({pct:.0f} %), "
+            f"ETA {eta if left else '0 s'}"
+        )

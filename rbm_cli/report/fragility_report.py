@@ -17,7 +17,7 @@ from pathlib import Path
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.base.files import publish_files_atomic
+from rbm_cli.report.fragility_store import FragilityFolder
 from rbm_cli.study.fragility import METHOD, FragilityResult
 from rbm_cli.study.outcomes import intensity_column as find_intensity_column
 
@@ -76,8 +76,9 @@ def write_fragility(result: FragilityResult, folder: str | os.PathLike) -> list[
     result : FragilityResult
         From :func:`rbm_cli.study.fragility.fragility`
     folder : str or os.PathLike
-        Created if missing; the three files are staged in full, then moved into place
-        together (:func:`rbm_cli.base.files.publish_files_atomic`)
+        Created if missing; locked against a fragility run into it, the three files are
+        staged in full, then moved into place together
+        (:class:`rbm_cli.report.fragility_store.FragilityFolder`)
 
     Returns
     -------
@@ -90,15 +91,8 @@ def write_fragility(result: FragilityResult, folder: str | os.PathLike) -> list[
     (the fitted probability), band_lower, band_upper (the bootstrap band), one row per
     intensity. Undefined values (no fit, no runs at a level) are empty cells.
     """
-    folder = Path(folder)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise RbmError(f"{folder}: cannot create the output folder ({exc.strerror})") from None
-    try:
-        return publish_files_atomic(folder, fragility_texts(result))
-    except OSError as exc:
-        raise RbmError(f"{folder}: cannot write the fragility files ({exc.strerror})") from None
+    with FragilityFolder(folder) as store:
+        return store.publish(fragility_texts(result))
 
 
 # --------------------------------------------------------------------------- figures
@@ -147,11 +141,11 @@ def plot_fragility(
     color = _plot_observed(ax, result.table, prefix, color, counts)
     if result.fit is not None:
         _plot_fit(ax, result, prefix, color)
-    else:
+    if result.fit is None or result.note:
         ax.text(
             0.02,
             0.95,
-            f"{prefix}no fit: {result.note}",
+            f"{prefix}{'no fit: ' if result.fit is None else ''}{result.note}",
             transform=ax.transAxes,
             fontsize=7,
             va="top",

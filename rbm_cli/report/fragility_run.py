@@ -6,33 +6,33 @@ fragility and IDA figures (:mod:`rbm_cli.report.fragility_report`) and publishes
 
     fragility.png, ida.png, fragility.csv, fragility_curve.csv, fragility.json
 
-into the output folder (default: the domain's folder) as one step: everything is computed
-and rendered in memory, staged in full under temporary names, then moved onto the five
-names (:func:`rbm_cli.base.files.publish_files_atomic`). A failure before that leaves the
-folder as it was; no other file is touched, none deleted. fragility.json names the domain
-and its SHA-256, so files left beside a domain swept again show whose they are. The CLI
-calls this; the API can call the same.
+into the output folder (default: the domain's folder) as one step: the options and the
+domains are checked first (a refusal writes nothing); then, with the folder locked against
+another fragility run, everything is computed and rendered in memory, staged whole in a
+hidden folder and moved onto the five names together, fragility.json last
+(:class:`rbm_cli.report.fragility_store.FragilityFolder`: a Ctrl-C or a kill leaves the
+old set or the new one, never a mix; what a killed run leaves is removed by the next).
+No other file is touched, none deleted. fragility.json names the domain and the SHA-256
+of the bytes fitted, so files left beside a domain swept again show whose they are. The
+CLI calls this; the API can call the same.
 """
 
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
-from rbm_cli.base.errors import RbmError
-from rbm_cli.base.files import check_writable_dir, make_dirs, publish_files_atomic
+from rbm_cli.base.files import check_writable_dir
 from rbm_cli.report.fragility_report import fragility_texts, plot_fragility, plot_ida
-from rbm_cli.study.fragility import FragilityResult, fragility
-from rbm_cli.study.outcomes import read_suite_domain
-
-#: The files :func:`run_fragility` writes, in the order they are moved into place.
-FILES = ("fragility.png", "ida.png", "fragility.csv", "fragility_curve.csv", "fragility.json")
+from rbm_cli.report.fragility_store import FILES, FragilityFolder
+from rbm_cli.study.fragility import FragilityResult, check_options, fragility
+from rbm_cli.study.outcomes import prepare_outcomes, read_suite_domain_hashed
 
 #: Bootstrap resamples of the records by default.
 DEFAULT_RESAMPLES = 500
@@ -63,6 +63,7 @@ def run_fragility(
     intensity_column: str | None = None,
     ci_percentiles: tuple[float, float] = (5.0, 95.0),
     compare: tuple[str | os.PathLike, ...] = (),
+    progress: Callable[[int, int], None] | None = None,
 ) -> FragilityRun:
     """Fragility of a record-suite domain: fit, files and figures.
 
@@ -75,17 +76,21 @@ def run_fragility(
     output : str or os.PathLike, optional
         Folder of the files (created if missing); default the domain's folder
     n_resamples : int
-        Bootstrap resamples of the records (0: no band, no intervals)
+        Bootstrap resamples of the records (0: no band, no intervals), at most
+        :data:`rbm_cli.study.fragility.MAX_RESAMPLES` (100,000: a few minutes)
     seed : int
-        Seed of the bootstrap (numpy PCG64), >= 0
+        Seed of the bootstrap (numpy PCG64), 0 to 2**64 - 1
     intensity_column : str, optional
         Column of the intensity (default: the first of intensity_g, amplitude_g, intensity)
     ci_percentiles : (float, float)
-        Percentiles of the bootstrap that bound the intervals and the band
+        Percentiles of the bootstrap that bound the intervals and the band [%]
     compare : sequence of paths
         Other record-suite domains (e.g. another column under the same suite), fitted with
         the same options and drawn in fragility.png beside this one, each labelled by its
         folder's name; their own files are not written
+    progress : callable, optional
+        ``progress(done, total)`` after each bootstrap resample, of this domain and of the
+        compared ones together
 
     Returns
     -------
@@ -96,43 +101,61 @@ def run_fragility(
     RbmError
         One line: a missing or unreadable file, not a domain, a domain without records
         (an amplitude x frequency sweep), bad rows (:func:`rbm_cli.study.outcomes.
-        prepare_outcomes`), bad options, an output folder that cannot be written.
-        Nothing is written then.
+        prepare_outcomes`), bad options (:func:`rbm_cli.study.fragility.check_options`),
+        an output folder that cannot be written, or that another fragility run is
+        writing. The folder's fragility files are as they were then.
     """
+    check_options(n_resamples, seed, ci_percentiles)
     domain = Path(domain_csv)
-    df = read_suite_domain(domain)
-    result = fragility(
-        df,
-        n_resamples=n_resamples,
-        seed=seed,
-        ci_percentiles=ci_percentiles,
-        intensity_column=intensity_column,
-    )
+    df, digest = read_suite_domain_hashed(domain)
+    prepare_outcomes(df, intensity_column)  # its rows, checked before anything is made
+    if isinstance(compare, str | os.PathLike):
+        compare = (compare,)
+    frames = [(Path(p), read_suite_domain_hashed(Path(p))[0]) for p in compare]
+    for _, frame in frames:
+        prepare_outcomes(frame, intensity_column)
     folder = Path(output) if output is not None else domain.parent
     check_writable_dir(folder)
+    options = dict(n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
+                   intensity_column=intensity_column)  # fmt: skip
+    parts = len(frames) + 1
+    with FragilityFolder(folder) as store:
+        result = fragility(df, **options, progress=_part(progress, 0, parts))
+        others = []
+        for k, (path, frame) in enumerate(frames, start=1):
+            others.append((_name(path), fragility(frame, **options,
+                                                  progress=_part(progress, k, parts))))  # fmt: skip
+        source = {
+            "domain": os.path.relpath(domain.resolve(), folder.resolve()),
+            "domain_sha256": digest,  # of the bytes fitted: which domain.csv these are of
+        }
+        label, contents = _contents(domain, df, result, others, source)
+        paths = store.publish({name: contents[name] for name in FILES})
+    return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label)
+
+
+def _part(progress, k: int, parts: int):
+    """progress(done, total) of the k-th of ``parts`` bootstraps of equal length, as one."""
+    if progress is None:
+        return None
+    return lambda done, total: progress(k * total + done, parts * total)
+
+
+def _contents(domain: Path, df, result, others, source: dict) -> tuple[str, dict]:
+    """The intensity's label and the set's files, by name (figures rendered to PNG bytes;
+    ``source``: fragility.json's entries naming the domain)."""
     meta = _meta(domain)
     label = intensity_label(result.intensity_column, meta)
     title = f"{meta.get('name') or domain.parent.name or domain.stem}: " \
         f"{result.n_records} records, {len(result.table)} intensities"  # fmt: skip
-    others = [(_name(Path(p)), _fit_other(p, n_resamples, seed, intensity_column,
-                                          ci_percentiles)) for p in compare]  # fmt: skip
     names = ", ".join([_name(domain)] + [n for n, _ in others])
     frag_title = f"fragility under one suite: {names}" if others else title
     contents = {
         "fragility.png": _png(fragility_figure(result, label, frag_title, _name(domain), others)),
         "ida.png": _png(ida_figure(df, result.intensity_column, label, title)),
     }
-    source = {
-        "domain": os.path.relpath(domain.resolve(), folder.resolve()),
-        "domain_sha256": _sha256(domain),  # which domain.csv these files are of
-    }
     contents.update(fragility_texts(result, extra=source))
-    make_dirs(folder)
-    try:
-        paths = publish_files_atomic(folder, {name: contents[name] for name in FILES})
-    except OSError as exc:
-        raise RbmError(f"{folder}: cannot write the fragility files ({exc.strerror})") from None
-    return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label)
+    return label, contents
 
 
 def intensity_label(column: str, meta: dict | None = None) -> str:
@@ -150,12 +173,6 @@ def intensity_label(column: str, meta: dict | None = None) -> str:
 def _name(domain: Path) -> str:
     """A domain's label: its sweep's name (meta.json), else its folder's name."""
     return str(_meta(domain).get("name") or domain.parent.name or domain.stem)
-
-
-def _fit_other(path, n_resamples, seed, intensity_column, ci) -> FragilityResult:
-    """The fit of a compared domain (same options as the main one)."""
-    return fragility(read_suite_domain(Path(path)), n_resamples=n_resamples, seed=seed,
-                     ci_percentiles=ci, intensity_column=intensity_column)  # fmt: skip
 
 
 #: Colours of the fitted domains in one figure, the main one first.
@@ -195,13 +212,6 @@ def _png(fig, dpi: int = 150) -> bytes:
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
     return buffer.getvalue()
-
-
-def _sha256(path: Path) -> str:
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError as exc:
-        raise RbmError(f"cannot read {path}: {exc.strerror or exc}") from None
 
 
 def _meta(domain: Path) -> dict:

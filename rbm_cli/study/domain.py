@@ -336,3 +336,16 @@ def domain_config(domain_csv: str | Path) -> Config | None:
         return None
     base = meta.parent / where if isinstance(where, str) else None  # relative record paths
     return parse_config(written, source=str(meta), base_dir=base)
+
+
+def check_collapsed(df: pd.DataFrame, path: str | Path) -> None:
+    """The rule `rbm compare` applies (:func:`read_domain`), for other readers of a domain
+    (`rbm fragility`, which would count a failed run marked collapsed as a collapse):
+    collapsed is 0 or 1 on every row, and 1 exactly when status is collapsed. Converts it
+    to int in place; RbmError naming the file and the first bad line (header: line 1)."""
+    import pandas as pd
+
+    def got(value) -> str:
+        return "an empty field" if pd.isna(value) else repr(str(value))
+
+    _check_collapsed(df, Path(path), got)

@@ -77,8 +77,10 @@ def _start(log_x, n, k) -> np.ndarray:
     return np.array([mx - mz / slope, -math.log(slope)])
 
 
-def _fit_counts(log_x, n, k, start=None) -> LognormalFit:
-    """MLE from counts per level; RbmError when no finite, increasing fit exists."""
+def fit_counts(log_x, n, k, start=None) -> LognormalFit:
+    """MLE from counts per level: ln of each intensity [ln g], runs and collapses there
+    (``start``: the (ln theta, ln beta) to start from); RbmError, one line, when no finite,
+    increasing fit exists (no collapse, only collapses, one intensity, separated outcomes)."""
     total_k, total_n = float(np.sum(k)), float(np.sum(n))
     if total_n == 0:
         raise RbmError("fragility: no runs to fit")
@@ -89,6 +91,12 @@ def _fit_counts(log_x, n, k, start=None) -> LognormalFit:
     if total_k == total_n:
         raise RbmError(
             "fragility: every record collapsed at every intensity: the median lies below them"
+        )
+    if np.unique(log_x[n > 0]).size < 2:
+        x = math.exp(float(np.max(log_x[n > 0])))
+        raise RbmError(
+            f"fragility: all runs are at one intensity ({x:.6g} g, {total_k:.0f} of "
+            f"{total_n:.0f} collapsed): a lognormal curve needs runs at two intensities or more"
         )
     survived, collapsed = n - k > 0, k > 0
     if np.max(log_x[survived]) <= np.min(log_x[collapsed]):
@@ -139,7 +147,8 @@ def fit_lognormal(intensity_g, collapsed) -> LognormalFit:
     Raises
     ------
     RbmError
-        No collapse, only collapses, or outcomes separated by intensity (the likelihood
+        No collapse, only collapses, all runs at one intensity (a curve through one
+        fraction has no dispersion), or outcomes separated by intensity (the likelihood
         then has no maximum: beta -> 0 or theta -> 0 or infinity), or collapse not
         increasing with intensity.
 
@@ -174,4 +183,4 @@ def fit_lognormal(intensity_g, collapsed) -> LognormalFit:
     levels, inverse = np.unique(x, return_inverse=True)
     n = np.bincount(inverse, minlength=levels.size).astype(float)
     k = np.bincount(inverse, weights=c, minlength=levels.size)
-    return _fit_counts(np.log(levels), n, k)
+    return fit_counts(np.log(levels), n, k)

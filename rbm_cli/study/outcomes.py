@@ -2,17 +2,22 @@
 
 The input of a fragility analysis and of an IDA figure: one row per run of a record scaled
 to an intensity [g]. ``failed`` runs (the integrator gave up) are neither collapses nor
-survivals: they are left out and counted.
+survivals: they are left out and counted (their ``collapsed`` is 0, as on every row whose
+status is not ``collapsed``: the rule `rbm compare` applies, :func:`rbm_cli.study.domain.
+check_collapsed`).
 """
 
 from __future__ import annotations
 
+import hashlib
+import io
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.study.domain import check_collapsed
 
 #: Intensity columns looked for, in order, when none is named.
 INTENSITY_COLUMNS = ("intensity_g", "amplitude_g", "intensity")
@@ -32,8 +37,9 @@ def prepare_outcomes(df: pd.DataFrame, name: str | None = None) -> tuple[pd.Data
     Returns a table with columns record (str), x (intensity [g]), collapsed (0/1; 0 for
     failed runs) and failed (bool), one row per input row in order. Raises RbmError, one
     line naming the row, on: a missing column, an intensity that is not a number > 0,
-    collapsed not 0/1 (non-failed rows), an unknown status, status and collapsed
-    disagreeing, two runs of one record at one intensity, no rows, only failed runs.
+    collapsed not 0/1, an unknown status, status and collapsed disagreeing (collapsed is 1
+    exactly when status is collapsed: a failed run is not a collapse), two runs of one
+    record at one intensity, no rows, only failed runs.
     """
     if not isinstance(df, pd.DataFrame):
         raise RbmError("fragility: the input must be a table (pandas DataFrame)")
@@ -60,13 +66,11 @@ def prepare_outcomes(df: pd.DataFrame, name: str | None = None) -> tuple[pd.Data
             raise RbmError(
                 f"{where}: status must be one of {', '.join(STATUSES)}, got {status[i]!r}"
             )
-        if failed[i]:
-            continue
         if collapsed[i] not in (0.0, 1.0):
             raise RbmError(f"{where}: collapsed must be 0 or 1, got {df['collapsed'].iat[i]!r}")
         if status is not None and (status[i] == "collapsed") != (collapsed[i] == 1.0):
             raise RbmError(f"{where}: status {status[i]!r} but collapsed = {int(collapsed[i])}")
-    rows["x"], rows["collapsed"], rows["failed"] = x, np.nan_to_num(collapsed), failed
+    rows["x"], rows["collapsed"], rows["failed"] = x, collapsed, failed
     dup = rows.duplicated(["record", "x"])
     if dup.any():
         i = int(np.argmax(dup.to_numpy()))
@@ -102,6 +106,15 @@ def level_table(rows: pd.DataFrame) -> pd.DataFrame:
 def read_suite_domain(path: str | Path) -> pd.DataFrame:
     """Read the ``domain.csv`` of a record-suite sweep (records x intensities).
 
+    The table of :func:`read_suite_domain_hashed` (see there).
+    """
+    return read_suite_domain_hashed(path)[0]
+
+
+def read_suite_domain_hashed(path: str | Path) -> tuple[pd.DataFrame, str]:
+    """Read the ``domain.csv`` of a record-suite sweep (records x intensities), and the
+    SHA-256 of the very bytes read (a domain swept again meanwhile cannot be named).
+
     Parameters
     ----------
     path : str or pathlib.Path  The domain CSV (one row per run; SPEC section 5 columns
@@ -109,22 +122,27 @@ def read_suite_domain(path: str | Path) -> pd.DataFrame:
 
     Returns
     -------
-    pandas.DataFrame  The rows as written, ``record`` as text; checked further by
-        :func:`prepare_outcomes` (intensities, collapsed, status, one run per record and
-        intensity)
+    pandas.DataFrame  The rows as written, ``record`` as text, ``collapsed`` 0/1 agreeing
+        with ``status``; checked further by :func:`prepare_outcomes` (intensities, status,
+        one run per record and intensity)
+    str  The SHA-256 of the file's bytes (hex)
 
     Raises
     ------
     RbmError  One line naming the file (and the line, header = line 1): missing or
         unreadable file, not a domain (no ``status`` column, or no rows), a domain of an
         amplitude x frequency sweep (no ``record`` column, or every record field empty),
-        an empty record field on some line.
+        an empty record field on some line, a ``collapsed`` that is not 0 or 1 or says
+        otherwise than ``status`` (as `rbm compare` refuses it).
     """
     path = Path(path)
     if not path.is_file():
         raise RbmError(f"domain file not found: {path}")
     try:
-        df = pd.read_csv(path, dtype={"record": str}, keep_default_na=False, na_values=[""])
+        data = path.read_bytes()
+        df = pd.read_csv(
+            io.BytesIO(data), dtype={"record": str}, keep_default_na=False, na_values=[""]
+        )
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         reason = " ".join(str(exc).split())
         raise RbmError(f"cannot read {path} as a domain CSV: {reason}") from None
@@ -143,4 +161,6 @@ def read_suite_domain(path: str | Path) -> pd.DataFrame:
         )
     if empty.any():
         raise RbmError(f"{path}: line {int(np.argmax(empty)) + 2}: the record field is empty")
-    return df
+    if "collapsed" in df.columns:
+        check_collapsed(df, path)
+    return df, hashlib.sha256(data).hexdigest()

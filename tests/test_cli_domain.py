@@ -48,7 +48,7 @@ def test_sweep_writes_the_four_files(small, tmp_path):
 @pytest.mark.parametrize(
     "args,needle",
     [
-        (["--jobs", "0"], "--jobs must be >= 1"),
+        (["--jobs", "0"], "--jobs must be a whole number >= 1"),
         (["--scheduler", "tcp://127.0.0.1:1"], "--scheduler needs --backend dask"),
     ],
 )

@@ -220,7 +220,8 @@ def test_collapse_fraction_colours_points_with_colourbar():
         _line(ax, "boundary").get_ydata(), [0.3, 0.4, 0.6, 0.8, 1.0], equal_nan=True
     )
     np.testing.assert_allclose(
-        _line(ax, "boundary-member0").get_ydata(), [0.3, 0.4, 0.6, 0.8, math.nan],
+        _line(ax, "boundary-member0").get_ydata(),
+        [0.3, 0.4, 0.6, 0.8, math.nan],
         equal_nan=True,
     )
 

@@ -16,7 +16,7 @@ After every step every domain.csv in the folder and in superseded/ must be the d
 one version of the records, byte for byte (a straight sweep's): a file that mixes the two
 versions, or a resume that ran over a changed record, counts as ``mixed`` and must stay 0.
 
-    pytest tests/test_faults_suite.py                                  # small: ~1 min
+    pytest tests/test_faults_suite.py                                  # small: ~15 s
     RBM_SUITE_FAULT_TRIALS=60 pytest -m stress tests/test_faults_suite.py -s  # large
 
 The figures of the last large run are in docs/stability.md.
@@ -94,6 +94,7 @@ class Harness:
         assert self.references["original"] != self.references["other"]
         self.put("original")
         self.tally = Tally()
+        self.after_journal = False  # kill at any time, before the journal too
 
     def put(self, version: str) -> None:
         (self.rec / CHANGED).write_bytes(self.versions[version])
@@ -124,8 +125,14 @@ class Harness:
         )  # fmt: skip
 
     def kill(self, out: Path, *extra: str) -> None:
-        """A sweep killed (its process group, SIGKILL) after a random delay."""
+        """A sweep killed (its process group, SIGKILL) after a random delay (counted from
+        when its journal appears if ``self.after_journal``)."""
         proc = self.start(out, *extra)
+        if self.after_journal:
+            limit = time.monotonic() + 120
+            while not (out / "suite" / JOURNAL).exists() and proc.poll() is None:
+                assert time.monotonic() < limit, "the sweep never started its journal"
+                time.sleep(0.01)
         deadline = time.monotonic() + self.rng.uniform(0.3, 6.0)
         while time.monotonic() < deadline and proc.poll() is None:
             time.sleep(0.02)
@@ -204,8 +211,11 @@ class Harness:
         return any(entry[1].endswith(CHANGED) and entry[2] == sha for entry in header["records"])
 
 
-def run_trials(tmp_path: Path, trials: int, budget_s: float, seed: int, log=None) -> Tally:
+def run_trials(
+    tmp_path: Path, trials: int, budget_s: float, seed: int, log=None, after_journal=False
+) -> Tally:
     harness = Harness(tmp_path, random.Random(seed))
+    harness.after_journal = after_journal
     start = time.monotonic()
     for k in range(trials):
         if time.monotonic() - start > budget_s:
@@ -234,10 +244,10 @@ def compiled():
 
 @pytest.mark.timeout(400)
 def test_suite_fault_injection_small(tmp_path, compiled):
-    """Two trials in the default run: a kill, a changed record, refusals, then a restore
-    or a --force."""
-    tally = run_trials(tmp_path, 2, 60.0, seed=25)
-    assert tally.trials >= 1 and tally.refused >= 2
+    """One trial in the default run: a kill once the journal is started, a changed
+    record, two refusals, then a restore or a --force."""
+    tally = run_trials(tmp_path, 1, 60.0, seed=25, after_journal=True)
+    assert tally.trials == 1 and tally.refused == 2
     _assert_clean(tally)
 
 

@@ -324,14 +324,14 @@ import numpy as np
 from rbm_cli.physics.column import build_column
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
 from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.models.rbm.kernel import integrate_compiled
+from rbm_cli.models.rbm.kernel import integrate
 from rbm_cli.physics.equations import build_model
 with np.errstate(all="ignore"):
     geometry = ColumnConfig(height=4.0, base_width=1.0, top_width=1.0, depth=1.0,
                             density=1e308, drum_heights=(4.0,))
     model = build_model(build_column(geometry, InterfaceConfig()))
     motion = GroundMotion("harmonic", 0.5 * 9.81, 2 * np.pi, 0.0, 10.0, 10.0)
-    out = integrate_compiled(model, motion, np.zeros(1), np.zeros(1), SolverConfig())
+    out = integrate(model, motion, np.zeros(1), np.zeros(1), SolverConfig())
 print(out.status, out.message)
 """
 

@@ -24,10 +24,10 @@ numba's own checks stay (its version, the file's stamp). The stamp is set by a c
 locator placed first in numba's list (:func:`key_numba_cache`); it wraps the locator numba
 would have chosen (``NUMBA_CACHE_DIR``, ``__pycache__`` beside the source, the user-wide
 folder), so the cache lives where it did. numba's list is read when a function is
-decorated: every module with compiled functions must call :func:`key_numba_cache` before
-its first decorator (``base/detmath.py`` does; ``models/rbm/__init__.py`` does for the
-kernel's modules); functions decorated earlier get the stamp afterwards, when still
-unused. tests/test_kernel_cache.py checks that every compiled function has it.
+decorated: :mod:`rbm_cli.base.jit`, whose ``jit`` decorates every compiled function of the
+package, calls :func:`key_numba_cache` when it is imported, before any decorator runs;
+functions decorated earlier get the stamp afterwards, when still unused.
+tests/test_kernel_cache.py checks that every compiled function has it.
 
 numba's cache internals are private (``numba.core.caching``); if they change, the key is
 not set (:func:`key_numba_cache` returns False) and numba's own check is what remains. So
@@ -234,6 +234,8 @@ def cache_empty(dispatcher) -> bool | None:
         or numba changed) or empty; False: it holds a compiled version; None: cannot
         tell (numba's cache internals are not the ones read here, or caching is off).
     """
+    if not hasattr(dispatcher, "py_func"):
+        return False  # not compiled (RBM_JIT=0): nothing to load
     try:
         index = dispatcher._cache._cache_file
         overloads = index._load_index()

@@ -26,15 +26,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from rbm_cli.base.compile_cache import key_numba_cache
-
-key_numba_cache()  # numba's cache of what follows is keyed on every compiled source
+from rbm_cli.base.jit import jit, plain
 
 
 # ---------------------------------------------------------------- linear algebra
-@njit(cache=True)
+@jit
 def dot(x, y):
     """sum_i x_i y_i, summed in index order."""
     s = 0.0
@@ -43,7 +40,7 @@ def dot(x, y):
     return s
 
 
-@njit(cache=True)
+@jit
 def matvec(a, x, out):
     """out = a @ x (summed in index order), in place; returns out."""
     for i in range(a.shape[0]):
@@ -54,7 +51,7 @@ def matvec(a, x, out):
     return out
 
 
-@njit(cache=True)
+@jit
 def matmul(a, b):
     """a @ b (each entry summed in index order), a new array."""
     n, k = a.shape
@@ -69,7 +66,7 @@ def matmul(a, b):
     return out
 
 
-@njit(cache=True)
+@jit
 def _inverse(a):
     """Gauss-Jordan elimination with partial pivoting; (inverse, ok)."""
     n = a.shape[0]
@@ -101,11 +98,10 @@ def _inverse(a):
     return inv, True
 
 
-#: Multiply-adds up to which inverse and product run the Python body of their compiled
-#: loop (``py_func``): the same IEEE operations in the same order (no FMA, no reordering
-#: in either), so the same bits, without loading numba's compiled code, or compiling it on
-#: a first use, for the small matrices of a column's assembly (issue 18: a first run on an
-#: empty cache no longer compiles them before its Python integration). ~5 ms of Python.
+#: Multiply-adds up to which inverse and product run their loop uncompiled
+#: (``rbm_cli.base.jit.plain``): the same IEEE operations in the same order (no FMA, no
+#: reordering in either), so the same bits, without loading numba's compiled code for the
+#: small matrices of a column's assembly. ~5 ms of Python.
 PYTHON_WORK = 20_000
 
 
@@ -116,7 +112,7 @@ def inverse(a: np.ndarray) -> np.ndarray:
     matrix with infinite or NaN entries gives a non-finite inverse, as LAPACK's does.
     """
     a2 = np.ascontiguousarray(a, dtype=float)
-    inv, ok = (_inverse.py_func if a2.shape[0] ** 3 <= PYTHON_WORK else _inverse)(a2)
+    inv, ok = (plain(_inverse) if a2.shape[0] ** 3 <= PYTHON_WORK else _inverse)(a2)
     if not ok:
         raise np.linalg.LinAlgError("singular matrix")
     return inv
@@ -129,7 +125,7 @@ def product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     va, vb = a2.ndim == 1, b2.ndim == 1
     x, y = a2.reshape(1, -1) if va else a2, b2.reshape(-1, 1) if vb else b2
     work = x.shape[0] * x.shape[1] * y.shape[1]
-    out = (matmul.py_func if work <= PYTHON_WORK else matmul)(x, y)
+    out = (plain(matmul) if work <= PYTHON_WORK else matmul)(x, y)
     if va and vb:
         return out[0, 0]
     if va:
@@ -166,7 +162,7 @@ _NO_REDUCTION = 0.7853984832763671
 _TINY = 1.4901161193847656e-08  # 2^-26
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def sin(x):
     """sin(x) by fdlibm's algorithm: within 1 ulp, the same bits everywhere.
 
@@ -245,14 +241,14 @@ _QS4 = 7.70381505559019352791e-02
 _NEAR_ONE = 0.9749999046325684  # high word 0x3fef3333
 
 
-@njit(cache=True)
+@jit
 def _r(z):
     p = z * (_PS0 + z * (_PS1 + z * (_PS2 + z * (_PS3 + z * (_PS4 + z * _PS5)))))
     q = 1.0 + z * (_QS1 + z * (_QS2 + z * (_QS3 + z * _QS4)))
     return p / q
 
 
-@njit(cache=True)
+@jit
 def asin(x):
     """asin(x) by fdlibm's algorithm: within 1 ulp, the same bits everywhere."""
     ax = abs(x)
@@ -296,7 +292,7 @@ _P5 = 4.13813679705723846039e-08
 _SQRT_HALF = 0.7071067811865476
 
 
-@njit(cache=True)
+@jit
 def log(x):
     """Natural logarithm by fdlibm's algorithm (x reduced to [sqrt(2)/2, sqrt(2))
     by frexp, which is exact): within 1 ulp, the same bits everywhere."""
@@ -324,7 +320,7 @@ def log(x):
     return s * (hfsq + r) + dk * _LN2_LO - hfsq + f + dk * _LN2_HI
 
 
-@njit(cache=True)
+@jit
 def exp(x):
     """e^x by fdlibm's algorithm: within 1 ulp, the same bits everywhere."""
     if x != x:
@@ -357,15 +353,13 @@ def exp(x):
 
 
 def pow_pos_python(x: float, y: float) -> float:
-    """pow_pos run as Python (the py_func of it, of exp and of log), for the Python
+    """pow_pos run as Python (rbm_cli.base.jit.plain), for the Python
     integrator: the same IEEE operations in the same order, so the same bits, and a first
     run on an empty cache does not compile them (issue 18)."""
-    if x == 0.0 or y in (-0.125, 0.125):
-        return pow_pos.py_func(x, y)
-    return exp.py_func(y * log.py_func(x))  # pow_pos's last line
+    return plain(pow_pos)(x, y)
 
 
-@njit(cache=True)
+@jit
 def pow_pos(x, y):
     """x^y for x >= 0 as exp(y log x), the same bits everywhere: the error of log
     is scaled by |y log x|, so within ~16 ulp where that is below ~40 (the step-size

@@ -5,10 +5,10 @@ caller evaluates its function at the point a step returns."""
 
 from __future__ import annotations
 
-from numba import njit
+from rbm_cli.base.jit import jit
 
 
-@njit(cache=True)
+@jit
 def brent_step(xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, xtol, rtol):
     """One step from the bracket state, f(xcur) = fcur just evaluated.
 

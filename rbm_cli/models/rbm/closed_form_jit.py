@@ -32,8 +32,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.brent import brent_step
 from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, LINEAR, f_phase
 
@@ -67,7 +66,7 @@ MAX_HALVINGS = 40
 MIN_WIDTH = 1e-12
 
 
-@njit(cache=True)
+@jit
 def start_piece(blk, t, theta, rate, side, fc, pc):
     """Fill pc with the piece through (theta [rad], rate [rad/s]) at t [s] on side s
     under the forcing fc (exact_jit_modal)."""
@@ -92,7 +91,7 @@ def start_piece(blk, t, theta, rate, side, fc, pc):
     pc[FA], pc[FB] = (blk[B_FA], blk[B_FB]) if friction else (0.0, 0.0)
 
 
-@njit(cache=True)
+@jit
 def point(pc, tau):
     """At t0 + tau: s theta [rad], s theta' [rad/s], c1 e^(p tau), c2 e^(-p tau), the
     friction demand's signed value fa a_g + fb (theta - s alpha) [-] (the shear ratio of
@@ -114,7 +113,7 @@ def point(pc, tau):
     return pc[ALPHA] + s * dev, s * rate, e1, e2, demand, demand_rate, s * accel
 
 
-@njit(cache=True)
+@jit
 def _value(pc, which, shift, tau):
     """s theta + shift (which 0), s theta' (which 1) or the friction demand's rate
     (which 2) at t0 + tau."""
@@ -124,7 +123,7 @@ def _value(pc, which, shift, tau):
     return g if which == 1 else dr
 
 
-@njit(cache=True)
+@jit
 def brent(pc, which, shift, xa, xb, acc):
     """Root in [xa, xb] of _value(pc, which, shift, .), which changes sign there (scipy's
     brentq, Brent 1973, xtol XTOL and rtol RTOL); evaluations counted in acc."""
@@ -147,7 +146,7 @@ def brent(pc, which, shift, xa, xb, acc):
     return xcur
 
 
-@njit(cache=True)
+@jit
 def impact_time(pc, blk, a, b, fa, acc):
     """The impact time in [a, b], s theta(b) + eps <= 0 < s theta(a) + eps. The RBM's
     convention (blk[B_AT_ZERO] 0, the step kernel's and the exact integrator's): where s
@@ -170,7 +169,7 @@ def impact_time(pc, blk, a, b, fa, acc):
     return tau
 
 
-@njit(cache=True)
+@jit
 def _interval(pc, blk, a, b, fa, ga, fb, gb, acc):
     """The first event in a certified interval [a, b] (at most one zero of the rate),
     from its end values (s theta, s theta') and its extremum; the peak kept in acc.
@@ -202,7 +201,7 @@ def _interval(pc, blk, a, b, fa, ga, fb, gb, acc):
     return NONE, b
 
 
-@njit(cache=True)
+@jit
 def _friction(pc, a, b, da, db, dra, drb, acc):
     """Raise acc's friction demand to the largest |demand| on [a, b]: its ends' (da, db)
     and, where its rate (dra, drb) changes sign, the extremum's (Brent on the rate)."""
@@ -216,7 +215,7 @@ def _friction(pc, a, b, da, db, dra, drb, acc):
         acc[A_FRICTION] = best
 
 
-@njit(cache=True)
+@jit
 def scan_piece(pc, blk, tau_max, acc):
     """The piece's first event before tau_max [s] (from its start), or its end:
     (kind, tau). acc gets the peak (the largest s theta on [0, tau], with the time of an

@@ -15,8 +15,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.housner_state import STOP_MARGIN
 from rbm_cli.models.rbm.closed_form_jit import (
     A_EVALS,
@@ -56,7 +56,7 @@ T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE = ran
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)
 
 
-@njit(cache=True)
+@jit
 def energy(blk, theta, rate):
     """Energy per unit inertia [rad^2/s^2]: rate^2 / 2 + p^2 (alpha |theta| - theta^2 / 2)."""
     a = abs(theta)
@@ -64,7 +64,7 @@ def energy(blk, theta, rate):
     return 0.5 * rate * rate + p * p * (blk[B_ALPHA] * a - 0.5 * a * a)
 
 
-@njit(cache=True)
+@jit
 def _emit(pc, st, samples, t_stop, dt, rest):
     """Record the samples due up to t_stop [s], every dt [s]: the piece's, or zeros."""
     while st[NEXT_OUT] <= t_stop + 1e-12 and int(st[N_OUT]) < samples.shape[0]:
@@ -79,7 +79,7 @@ def _emit(pc, st, samples, t_stop, dt, rest):
         st[NEXT_OUT] = (st[N_OUT]) * dt
 
 
-@njit(cache=True)
+@jit
 def _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, dt):
     """The block at rest: 0 no ground motion left (rests to the end), 1 the segment ends
     first, 2 it lifts (a harmonic's exceedance from its formula, a line's from the line)
@@ -110,7 +110,7 @@ def _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, dt):
     return kind
 
 
-@njit(cache=True)
+@jit
 def _event(blk, st, cnt, kind, se):
     """Apply the event that ended a piece at st[T]. Returns a code."""
     cnt[EVENTS] += 1
@@ -127,7 +127,7 @@ def _event(blk, st, cnt, kind, se):
     return GOING
 
 
-@njit(cache=True)
+@jit
 def _piece(blk, st, cnt, fc, seg_end, can_stop, se, samples, pc, acc):
     """One piece from the current state up to its first event, a peak of free motion
     below the barrier (can_stop) or seg_end [s]. Returns a code."""
@@ -156,7 +156,7 @@ def _piece(blk, st, cnt, fc, seg_end, can_stop, se, samples, pc, acc):
     return GOING
 
 
-@njit(cache=True)
+@jit
 def _segment(blk, st, cnt, mo, se, fc, seg_end, can_stop, samples, pc, acc):
     """Run up to seg_end [s] under the forcing fc. Returns a code."""
     while st[T] < seg_end:
@@ -178,7 +178,7 @@ def _segment(blk, st, cnt, mo, se, fc, seg_end, can_stop, samples, pc, acc):
     return GOING
 
 
-@njit(cache=True)
+@jit
 def run_block(blk, seg_t, seg_fc, mo, se, theta0, rate0, samples):
     """One run from (theta0 [rad], rate0 [rad/s]) at t = 0. Returns (code, st, cnt)."""
     side = 1.0 if theta0 > 0.0 else -1.0 if theta0 < 0.0 else (-1.0 if rate0 < 0.0 else 1.0)

@@ -13,8 +13,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.exact_bounds import ENVELOPE_RATIO, HYPERBOLIC_LIMIT, SAFETY
 from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, LINEAR, basis1, f_accel, f_peak, f_phase
 
@@ -22,7 +22,7 @@ CURV, FULL, THIRD, FAST, ENV, OSC_A, OSC_B, RATE_A, RATE_B = range(9)
 MB_ROWS = 9
 
 
-@njit(cache=True)
+@jit
 def _particular(lam, f, g, fc, ag_a, ag_b, sin_a, cos_a, sin_b, cos_b):
     """(p, p') of an eligible mode at both ends of an interval (exact_bounds.particular),
     from the forcing's sines at both ends (harmonic) or its values ag_a, ag_b (linear)."""
@@ -42,7 +42,7 @@ def _particular(lam, f, g, fc, ag_a, ag_b, sin_a, cos_a, sin_b, cos_b):
     return p_a, dp_a, p_b, dp_b
 
 
-@njit(cache=True)
+@jit
 def _mode(lam, q, v, big, dbig, h):
     """(bound of |q''|, bound of |q'''|) of one mode on [a, a + h] by its majorants:
     hyperbolic (lam <= 0, or lam h^2 < HYPERBOLIC_LIMIT) and, for lam > 0, the energy's."""
@@ -64,7 +64,7 @@ def _mode(lam, q, v, big, dbig, h):
     return alam * qmax + big, alam * vmax + dbig
 
 
-@njit(cache=True)
+@jit
 def mode_bounds(lam, f, g, elig, w, fc, t, q, v, h, qb, vb, mb):
     """Fill mb (MB_ROWS, n) with the modes' bounds on [t, t + h] (exact_bounds.mode_bounds)
     from (q, v) at t and (qb, vb) at t + h. Returns whether some mode is fast."""
@@ -112,7 +112,7 @@ def mode_bounds(lam, f, g, elig, w, fc, t, q, v, h, qb, vb, mb):
     return any_fast
 
 
-@njit(cache=True)
+@jit
 def family_bounds(gf, absgf, mb, any_fast, fb):
     """Family-level bounds into fb (8, families): |Gf| @ CURV (FULL when no mode is fast),
     FULL, THIRD, ENV, and the fast oscillations Gf @ OSC_A, OSC_B, RATE_A, RATE_B (a row's
@@ -135,7 +135,7 @@ def family_bounds(gf, absgf, mb, any_fast, fb):
         fb[3, k], fb[4, k], fb[5, k], fb[6, k], fb[7, k] = en, oa, ob, ra, rb
 
 
-@njit(cache=True)
+@jit
 def lower2(va, vb, ra, rb, curv, h):
     """Lower bound over [0, h] of a function with end values va, vb, end rates ra, rb and
     |second derivative| <= curv (exact_search._lower)."""
@@ -145,7 +145,7 @@ def lower2(va, vb, ra, rb, curv, h):
     return max(interp, max(left, right))
 
 
-@njit(cache=True)
+@jit
 def upper_abs2(va, vb, ra, rb, curv, h):
     """Upper bound of |value| over [0, h] (exact_search._upper_abs)."""
     interp = max(abs(va), abs(vb)) + curv * (h * h / 8.0)
@@ -154,7 +154,7 @@ def upper_abs2(va, vb, ra, rb, curv, h):
     return min(interp, min(left, right))
 
 
-@njit(cache=True)
+@jit
 def row_lower(sgn, off, k, fa, fb_, da, db, fb, any_fast, h):
     """Lower bound on [a, b] of the event row sgn * F[k] + off, from the family values fa,
     fb_ and rates da, db at both ends and the family bounds fb (NaN counts as no bound)."""
@@ -169,7 +169,7 @@ def row_lower(sgn, off, k, fa, fb_, da, db, fb, any_fast, h):
     return full
 
 
-@njit(cache=True)
+@jit
 def track_upper(k, fa, fb_, da, db, fb, any_fast, h):
     """Upper bound of |F[k]| on [a, b] (a tracked quantity)."""
     full = upper_abs2(fa, fb_, da, db, fb[1, k], h)

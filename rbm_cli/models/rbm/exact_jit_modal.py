@@ -10,8 +10,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.exact_modal import RESONANCE_BAND, SERIES_TERMS
 
 ZERO, HARMONIC, LINEAR = 0, 1, 2
@@ -27,7 +27,7 @@ def forcing_array(forcing) -> np.ndarray:
     )  # fmt: skip
 
 
-@njit(cache=True)
+@jit
 def f_accel(fc, t):
     """a_g(t) [m/s^2]."""
     kind = int(fc[0])
@@ -38,7 +38,7 @@ def f_accel(fc, t):
     return 0.0
 
 
-@njit(cache=True)
+@jit
 def linear_exceedance(fc, t0, level, t_stop):
     """First t in [t0, t_stop) with |a_g(t)| > level [m/s^2] under a linear forcing fc:
     t0 when already above, else where |a_g| reaches level (-1 if not before t_stop [s])."""
@@ -53,7 +53,7 @@ def linear_exceedance(fc, t0, level, t_stop):
     return t if t < t_stop else -1.0
 
 
-@njit(cache=True)
+@jit
 def f_peak(fc, t, h):
     """Bound of |a_g| on [t, t + h] [m/s^2]."""
     kind = int(fc[0])
@@ -64,7 +64,7 @@ def f_peak(fc, t, h):
     return 0.0
 
 
-@njit(cache=True)
+@jit
 def f_phase(fc, t):
     """Phase [rad] of a harmonic forcing seen from t: a_g(t + tau) = A sin(om tau + phase)."""
     return np.fmod(fc[2] * t + fc[3], 2.0 * math.pi)  # exact, as math.fmod
@@ -76,7 +76,7 @@ _INV_FACT = np.array(
 )
 
 
-@njit(cache=True)
+@jit
 def _terms(az):
     """Terms of the series enough for |z| = az <= 1 (the next one below 1e-17 relative)."""
     if az < 1e-6:
@@ -88,7 +88,7 @@ def _terms(az):
     return 10
 
 
-@njit(cache=True)
+@jit
 def _series(z, first, terms):
     """sum_k (-z)^k / (2k + first)!, k < terms (Horner)."""
     out = _INV_FACT[first, terms - 1]
@@ -97,7 +97,7 @@ def _series(z, first, terms):
     return out
 
 
-@njit(cache=True)
+@jit
 def basis1(lam, tau):
     """(C, S, S2, S3) of one mode at tau [s] (exact_modal.basis)."""
     z = lam * tau * tau
@@ -116,13 +116,13 @@ def basis1(lam, tau):
     return c, s, (c - 1.0) / (k * k), (s - tau) / (k * k)
 
 
-@njit(cache=True)
+@jit
 def near_resonance(lam, om):
     """Whether a mode takes the resonance-stable form of the harmonic response."""
     return lam > 0.0 and abs(math.sqrt(lam) - om) < RESONANCE_BAND * om
 
 
-@njit(cache=True)
+@jit
 def harmonic_near(lam, tau, om, phase, c, s):
     """(Y, Y') of q'' + lam q = sin(om tau + phase) from rest, resonance-stable form
     (exact_modal.harmonic_response)."""
@@ -138,7 +138,7 @@ def harmonic_near(lam, tau, om, phase, c, s):
     return y, dy
 
 
-@njit(cache=True)
+@jit
 def advance(lam, q, v, f, g, fc, t, tau, qn, vn):
     """(q, v) at t + tau [s] from (q, v) at t, into (qn, vn) (exact_modal.advance)."""
     kind = int(fc[0])

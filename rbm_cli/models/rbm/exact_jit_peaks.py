@@ -15,8 +15,8 @@ from __future__ import annotations
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.exact_jit_bounds import track_upper
 from rbm_cli.models.rbm.exact_jit_piece import eval_point, make_piece, set_point
 from rbm_cli.models.rbm.exact_jit_search import bounds_of, refine_peaks
@@ -29,7 +29,7 @@ NOTES = 2048
 Notes = namedtuple("Notes", "t h q v k side seg up count")
 
 
-@njit(cache=True)
+@jit
 def new_notes(n, cap):
     return Notes(np.zeros(cap), np.zeros(cap), np.zeros((cap, n)), np.zeros((cap, n)),
                  np.zeros((cap, n), dtype=np.int64), np.zeros((cap, n), dtype=np.int64),
@@ -37,7 +37,7 @@ def new_notes(n, cap):
                  np.zeros(1, dtype=np.int64))  # fmt: skip
 
 
-@njit(cache=True)
+@jit
 def _excess(notes, i, maxima):
     """How far note i's upper bounds exceed the maxima (<= 0: nothing to refine)."""
     out = -np.inf
@@ -46,7 +46,7 @@ def _excess(notes, i, maxima):
     return out
 
 
-@njit(cache=True)
+@jit
 def _compact(notes, maxima):
     """Drop the notes whose upper bounds no longer exceed the maxima."""
     j = 0
@@ -60,7 +60,7 @@ def _compact(notes, maxima):
     notes.count[0] = j
 
 
-@njit(cache=True)
+@jit
 def note_interval(pc, pts, maxima, mb, fb, fresh, notes, side, k, seg, wk):
     """Raise the maxima to the values at points 0 and 1 and note the interval between
     them if a peak inside may exceed them. Returns the evaluations spent (refinement when
@@ -92,7 +92,7 @@ def note_interval(pc, pts, maxima, mb, fb, fresh, notes, side, k, seg, wk):
     return 0
 
 
-@njit(cache=True)
+@jit
 def _any_fast(mb, n):
     for j in range(n):
         if mb[3, j] != 0.0:
@@ -100,7 +100,7 @@ def _any_fast(mb, n):
     return False
 
 
-@njit(cache=True)
+@jit
 def settle_peaks(mdl, cache, notes, seg_fc, maxima, wk):
     """Refine the noted intervals that may still exceed the maxima, largest excess first.
     Returns the evaluations."""

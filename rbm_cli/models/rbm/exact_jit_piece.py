@@ -14,8 +14,8 @@ from __future__ import annotations
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.events import BIG, EVENT_EPS
 from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, advance, f_accel
 
@@ -29,12 +29,12 @@ Piece = namedtuple("Piece", "lam phi tom f g elig w gf absgf sgn off fam silent 
 
 
 # ------------------------------------------------------------------ law pieces
-@njit(cache=True)
+@jit
 def zero_active(i, k, pending, rigid):
     return rigid[i] or pending[i]
 
 
-@njit(cache=True)
+@jit
 def piece_bounds(i, side, k, pending, rigid, edges, nedges):
     """(lo, hi) [rad] of interface i's current piece (events.Pieces.bounds)."""
     ki = k[i]
@@ -47,7 +47,7 @@ def piece_bounds(i, side, k, pending, rigid, edges, nedges):
     return -end, -start
 
 
-@njit(cache=True)
+@jit
 def locate(x, rate, side, k, pending, rigid, edges, nedges):
     """Pieces at law arguments x [rad] and their rates (events.Pieces.locate)."""
     for i in range(x.size):
@@ -64,7 +64,7 @@ def locate(x, rate, side, k, pending, rigid, edges, nedges):
         pending[i] = kk > 0 and not rigid[i]
 
 
-@njit(cache=True)
+@jit
 def cross(i, going_up, side, k, pending, awaiting, rigid, silent):
     """Move interface i to its next piece (events.Pieces.cross): 0 uplift, 1 kink, 2 impact."""
     s, ki = side[i], k[i]
@@ -89,7 +89,7 @@ def cross(i, going_up, side, k, pending, awaiting, rigid, silent):
 
 
 # ------------------------------------------------------------------ modes (cached)
-@njit(cache=True)
+@jit
 def _slot(keys, used, k):
     """Slot of the key k in the open-addressing table: where it is, or the free slot
     where it goes."""
@@ -110,7 +110,7 @@ def _slot(keys, used, k):
     return i
 
 
-@njit(cache=True)
+@jit
 def modes(mdl, cache, k):
     """Slot of the cache holding the modes of the pieces k (computed when absent: the
     pencil (K, M) through the Cholesky factor M = L L^T, eigh of L^-1 K L^-T)."""
@@ -142,7 +142,7 @@ def modes(mdl, cache, k):
 
 
 # ------------------------------------------------------------------ a piece
-@njit(cache=True)
+@jit
 def _rows(mdl, side, k, pending, awaiting):
     """(sgn, off, fam, silent) of the event rows of the current pieces."""
     n = side.size
@@ -169,7 +169,7 @@ def _rows(mdl, side, k, pending, awaiting):
     return sgn, off, fam, silent
 
 
-@njit(cache=True)
+@jit
 def make_piece(mdl, cache, side, k, pending, awaiting, fc):
     """The linear piece of the current law pieces under the forcing fc."""
     n = side.size
@@ -197,7 +197,7 @@ def point_size(n: int) -> int:
     return 1 + 2 * n + 3 * (2 * n + 1)
 
 
-@njit(cache=True)
+@jit
 def _derived(pc, pts, i):
     """Family values and rates of point i from its (t, q, v), and the second derivatives
     of the tracked families (the peaks' rows, n and above)."""
@@ -221,7 +221,7 @@ def _derived(pc, pts, i):
         pts[i, of + 2 * nf + r] = ff
 
 
-@njit(cache=True)
+@jit
 def eval_family(pc, pts, src, tau, k, second):
     """(F_k, F_k', and F_k'' if second else 0) tau [s] after point src, through the
     scratch point's (q, v) only (SCRATCH_SLOT)."""
@@ -242,7 +242,7 @@ def eval_family(pc, pts, src, tau, k, second):
     return fv, dv, ff
 
 
-@njit(cache=True)
+@jit
 def set_point(pc, pts, i, t, q, v):
     """Point i at time t [s] with modal (q, v)."""
     n = pc.n
@@ -252,7 +252,7 @@ def set_point(pc, pts, i, t, q, v):
     _derived(pc, pts, i)
 
 
-@njit(cache=True)
+@jit
 def eval_point(pc, pts, src, tau, dst):
     """Point dst, tau [s] after point src."""
     n = pc.n
@@ -263,7 +263,7 @@ def eval_point(pc, pts, src, tau, dst):
     _derived(pc, pts, dst)
 
 
-@njit(cache=True)
+@jit
 def row_at(pc, pts, i, r):
     """(value, rate) of event row r at point i."""
     of = 1 + 2 * pc.n

@@ -15,8 +15,8 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
 from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.exact_jit_peaks import NOTES, new_notes, note_interval, settle_peaks
@@ -55,7 +55,7 @@ Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes")
 State = namedtuple("State", "theta rate side k pending awaiting maxima fric st cnt")
 
 
-@njit(cache=True)
+@jit
 def _emit(pc, pts, s, samples, t_stop, dt):
     """Record the samples due up to t_stop [s], every dt [s], from point 0 of the piece."""
     n = s.theta.size
@@ -69,7 +69,7 @@ def _emit(pc, pts, s, samples, t_stop, dt):
         s.st[NEXT_OUT] += dt
 
 
-@njit(cache=True)
+@jit
 def _emit_rest(s, samples, t_stop, dt):
     """Record zeros (a rigid block at rest) for the samples due up to t_stop [s]."""
     while s.st[NEXT_OUT] <= t_stop + 1e-12 and int(s.st[N_OUT]) < samples.shape[0]:
@@ -80,7 +80,7 @@ def _emit_rest(s, samples, t_stop, dt):
         s.st[NEXT_OUT] += dt
 
 
-@njit(cache=True)
+@jit
 def _accel_and_friction(mdl, pc, pts, i, fric):
     """Friction demand at point i (the step integrators' step ends)."""
     n = pc.n
@@ -91,7 +91,7 @@ def _accel_and_friction(mdl, pc, pts, i, fric):
     friction(mdl, pc.phi @ from_modes, ag, fric)
 
 
-@njit(cache=True)
+@jit
 def _passed_peak(mdl, pc, pts):
     """Early stop of free motion between points 0 and 1 (exact._passed_peak)."""
     if math.isnan(mdl.barrier):
@@ -107,7 +107,7 @@ def _passed_peak(mdl, pc, pts):
     return energy1(mdl, theta, rate) < mdl.barrier * (1.0 - 1e-9)
 
 
-@njit(cache=True)
+@jit
 def _budget(s, se):
     """A failure code when a budget is exceeded, else GOING."""
     if s.cnt[STEPS] > se[0]:
@@ -117,7 +117,7 @@ def _budget(s, se):
     return GOING
 
 
-@njit(cache=True)
+@jit
 def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
     """Advance through the piece to its first event or seg_end [s] (exact._march).
     Returns the event row, -1 at seg_end, or -(a terminal code)."""
@@ -156,7 +156,7 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
     return row
 
 
-@njit(cache=True)
+@jit
 def _handle(mdl, pc, row, s, se):
     """Apply the event of a row at the state (exact._handle). Returns a code."""
     n = s.theta.size
@@ -195,7 +195,7 @@ def _handle(mdl, pc, row, s, se):
     return GOING
 
 
-@njit(cache=True)
+@jit
 def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
     """A rigid monolith at rest (exact._leave_rest): 0 no ground motion left (rests to
     the end), 1 the segment ends first, 2 it lifts (a harmonic's exceedance from its
@@ -229,7 +229,7 @@ def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
     return kind
 
 
-@njit(cache=True)
+@jit
 def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
     """Run up to seg_end [s] under the forcing fc (exact._segment). Returns a code."""
     while s.st[T] < seg_end:
@@ -251,7 +251,7 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
     return GOING
 
 
-@njit(cache=True)
+@jit
 def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, stack):
     """One run (exact.integrate_exact). Returns (code, st, cnt, maxima, friction)."""
     n = theta0.size

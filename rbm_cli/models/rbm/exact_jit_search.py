@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
-
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.exact_bounds import (
     MIN_STEP,
     PEAK_RTOL,
@@ -33,7 +32,7 @@ RESERVED = 3
 SCRATCH = 2
 
 
-@njit(cache=True)
+@jit
 def bounds_of(pc, pts, ia, ib, mb, fb):
     """Mode and family bounds of the interval between points ia and ib; any fast mode."""
     n = pc.n
@@ -45,7 +44,7 @@ def bounds_of(pc, pts, ia, ib, mb, fb):
     return fast
 
 
-@njit(cache=True)
+@jit
 def _value(pc, pts, ia, x, r, kind):
     """(value, derivative) at x [s] after point ia: of event row r (kind 0) or of the rate
     of family r (kind 1)."""
@@ -56,10 +55,10 @@ def _value(pc, pts, ia, x, r, kind):
     return dv, ff
 
 
-_hermite_root = njit(cache=True)(hermite_root)
+_hermite_root = jit(hermite_root)
 
 
-@njit(cache=True)
+@jit
 def _newton(pc, pts, ia, h, f0, fh, r, kind, x0):
     """Root in [0, h] [s] after point ia of event row r (kind 0) or of the rate of family
     r (kind 1), f0 fh < 0 the values at the ends, from x0 (NaN: the secant's root)
@@ -92,7 +91,7 @@ def _newton(pc, pts, ia, h, f0, fh, r, kind, x0):
     return x, evals
 
 
-@njit(cache=True)
+@jit
 def _check(pc, pts, ia, ib, fb, fast, h):
     """(any row uncertified, any crossed row, an uncertified row not crossed)."""
     of, nf = 1 + 2 * pc.n, pc.nf
@@ -110,7 +109,7 @@ def _check(pc, pts, ia, ib, fb, fast, h):
     return bad, crossed, other
 
 
-@njit(cache=True)
+@jit
 def _first_root(pc, pts, ia, ib, fb, h, small):
     """(row, tau [s], evaluations) of the earliest crossing among the rows ending below
     zero at ib; row -1 when some such row is not monotone (and the interval not small)."""
@@ -147,7 +146,7 @@ def _first_root(pc, pts, ia, ib, fb, h, small):
     return best_r, best, evals
 
 
-@njit(cache=True)
+@jit
 def next_point(pc, pts, h, t_stop, mb, fb):
     """From point 0: point 1 becomes the end of a certified interval of length <= h [s]
     (or t_stop), or the first event (exact_search.next_point). Returns (event row or -1,
@@ -181,7 +180,7 @@ def next_point(pc, pts, h, t_stop, mb, fb):
         first = False
 
 
-@njit(cache=True)
+@jit
 def _monotone(pts, ia, ib, k, of, nf, third, slack, h):
     """Whether family k's rate keeps one sign between points ia and ib (exact_search._monotone)."""
     da, db = pts[ia, of + nf + k], pts[ib, of + nf + k]
@@ -191,7 +190,7 @@ def _monotone(pts, ia, ib, k, of, nf, third, slack, h):
     return lower2(-da, -db, -za, -zb, third, h) >= -slack
 
 
-@njit(cache=True)
+@jit
 def _split_point(pc, pts, a, b, rows, c):
     """Make point c where [a, b] is split for the rows still open: the root of the first
     open row whose rate changes sign (its rate and those of the rows stationary there set
@@ -217,7 +216,7 @@ def _split_point(pc, pts, a, b, rows, c):
     return 1
 
 
-@njit(cache=True)
+@jit
 def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
     """Narrow rows (bool, n + 1) to those whose peak may still exceed its running maximum
     on [a, b] (exact_search.refine_peaks); returns whether any is left. fresh: mb and fb
@@ -252,7 +251,7 @@ def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
     return left
 
 
-@njit(cache=True)
+@jit
 def refine_peaks(pc, pts, maxima, mb, fb, refs, free, st_ab, st_rows, fresh):
     """Raise the running maxima (n + 1) to the peaks between points 0 and 1 (exact_search.
     refine_peaks). refs, free: reference counts and free list of the pool's slots; st_ab,

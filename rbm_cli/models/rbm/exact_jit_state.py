@@ -8,8 +8,8 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.events import REST_RATE
 from rbm_cli.physics.equations import Model
 
@@ -68,7 +68,7 @@ def new_cache(n: int) -> tuple:
     )  # fmt: skip
 
 
-@njit(cache=True)
+@jit
 def friction(mdl, acc, ag, out):
     """Raise out (n) to the friction demand |T_i / N_i| for drum accelerations acc
     [rad/s^2] and ground acceleration ag [m/s^2] (the shear ratios of physics/equations)."""
@@ -82,7 +82,7 @@ def friction(mdl, acc, ag, out):
         out[i] = max(out[i], abs(shear) / mdl.normal_forces[i])
 
 
-@njit(cache=True)
+@jit
 def _potential(mdl, i, x):
     """Law potential F_i(x) [J] (Law.potential)."""
     ax = abs(x)
@@ -98,7 +98,7 @@ def _potential(mdl, i, x):
     return cum + a * (ax - start) + 0.5 * b * (ax * ax - start * start)
 
 
-@njit(cache=True)
+@jit
 def energy1(mdl, theta, rate):
     """Energy [J] of a monolith (the energy of physics/equations, n = 1)."""
     x = mdl.argmap[0, 0] * theta

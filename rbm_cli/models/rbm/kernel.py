@@ -29,6 +29,7 @@ import time
 import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
+from rbm_cli.base.jit import plain
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.kernel_guard import arm, disarm, poll
 from rbm_cli.models.rbm.kernel_inputs import (
@@ -54,7 +55,7 @@ from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
 
-def integrate_compiled(
+def integrate(
     model: Model,
     motion: GroundMotion,
     theta0: np.ndarray,
@@ -65,8 +66,18 @@ def integrate_compiled(
     early_stop: bool = True,
     prepared: PreparedModel | None = None,
 ) -> Outcome:
-    """rbm_cli.models.rbm.python.integrate, compiled (same arguments and Outcome).
+    """Integrate one motion of a model from the initial state (theta0 [rad], rate0
+    [rad/s]) with the step kernel: compiled, or its uncompiled version (the same source,
+    rbm_cli.base.jit.plain) with ``solver.implementation: python``.
 
+    Parameters
+    ----------
+    model : Model  The column's equations (rbm_cli.physics.equations)
+    motion : GroundMotion  The ground motion
+    theta0, rate0 : array (n,)  Initial drum rotations [rad] and rates [rad/s]
+    solver : SolverConfig  Method (a Runge-Kutta pair), tolerances, budgets, implementation
+    record : bool  Keep samples every output_dt [s] (Outcome.samples)
+    early_stop : bool  Stop free motion once its outcome cannot change
     prepared : PreparedModel, optional  prepare_kernel(model), made once by a caller
         that runs one model many times (a sweep); made here when None.
     """
@@ -81,7 +92,8 @@ def integrate_compiled(
             bool(record), float(output_dt), samples)  # fmt: skip
     armed = arm()  # Ctrl-C reaches the kernel through poll (kernel_guard)
     try:
-        res = run_kernel(prepared.packed, excitation(motion), settings, task)
+        kernel = run_kernel if solver.implementation == "compiled" else plain(run_kernel)
+        res = kernel(prepared.packed, excitation(motion), settings, task)
     finally:
         disarm(armed)
     return _outcome(res, samples, n, record, solver)
@@ -128,13 +140,13 @@ def warm_up() -> None:
     col = build_column(geometry, InterfaceConfig())
     model = build_model(col)
     motion = GroundMotion("harmonic", 5.0, 6.0, 0.0, 0.1, 0.1)
-    integrate_compiled(model, motion, np.zeros(1), np.zeros(1), SolverConfig())
+    integrate(model, motion, np.zeros(1), np.zeros(1), SolverConfig())
     poll(math.inf)  # its object-mode block loads on first use (~30 ms): not in a timed run
 
 
 __all__ = [
     "PreparedModel",
-    "integrate_compiled",
+    "integrate",
     "model_arrays",
     "needs_compile",
     "prepare_kernel",

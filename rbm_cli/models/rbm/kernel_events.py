@@ -9,15 +9,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from rbm_cli.base.detmath import dot, matvec
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.brent import brent_step
 from rbm_cli.models.rbm.kernel_rk import TAB_NP
 from rbm_cli.models.rbm.kernel_vertical import add_moving, moving_rate, moving_value
 
 
-@njit(cache=True)
+@jit
 def _affine(event_rows, y, off, h0, out):
     """out = event_rows @ y[off:off + cols] (+ h0 if given): no allocation."""
     for r in range(event_rows.shape[0]):
@@ -27,7 +27,7 @@ def _affine(event_rows, y, off, h0, out):
         out[r] = d
 
 
-@njit(cache=True)
+@jit
 def _row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
     """One row of the step's interpolant, projected: the distance event_rows[row] theta +
     h0[row] (or, rate, the rate event_rows[row] theta') as a polynomial in the step's
@@ -45,7 +45,7 @@ def _row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
     return base
 
 
-@njit(cache=True)
+@jit
 def _poly_val(mc, t, t_old, h, coef, base):
     """A projected row (_row_poly) at time t: _dense_eval for one row."""
     x = (t - t_old) / h
@@ -67,7 +67,7 @@ def _poly_val(mc, t, t_old, h, coef, base):
 XTOL, RTOL, MAXITER = 1e-14, 8.881784197001252e-16, 100
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _row_val(mc, t, t_old, h, coef, base, mv):
     """A projected row at t, plus its moving part mv = (e, w, ground tuple) if e != 0
     (kernel_vertical: a kink moving with g + a_v(t))."""
@@ -77,7 +77,7 @@ def _row_val(mc, t, t_old, h, coef, base, mv):
     return v
 
 
-@njit(cache=True)
+@jit
 def _brentq(mc, xa, xb, t_old, h, coef, base, mv):
     """scipy's brentq (zeros.c) along a projected row of the step's interpolant (plus its
     moving part, _row_val)."""
@@ -99,7 +99,7 @@ def _brentq(mc, xa, xb, t_old, h, coef, base, mv):
     return xcur
 
 
-@njit(cache=True)
+@jit
 def _quad_roots(qa, qb, qc):
     """Real roots of qa s^2 + qb s + qc (as np.roots: leading zeros dropped)."""
     r = np.full(2, np.nan)
@@ -121,7 +121,7 @@ def _quad_roots(qa, qb, qc):
     return r
 
 
-@njit(cache=True)
+@jit
 def _lowest_dip(d0, d1, r0, r1, dt):
     """events._lowest_dip: (time from the start, row) of the lowest interior minimum
     below zero of the cubic Hermite interpolants, or (-1, -1)."""
@@ -145,7 +145,7 @@ def _lowest_dip(d0, d1, r0, r1, dt):
     return t_best, row
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _mv(r, gr, mv_e, mv_w):
     """The moving part of row r as _row_val takes it ((0, 1, gr) for a fixed row)."""
     if r < mv_e.size:
@@ -157,7 +157,7 @@ def _mv(r, gr, mv_e, mv_w):
 CHECK_INTERVALS = 8
 
 
-@njit(cache=True)
+@jit
 def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
     """events.within_reach, row by row: mask[r] marks the rows within reach (only
     they are searched in _first_crossing; the others cannot cross by the same
@@ -170,7 +170,7 @@ def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
     return anyrow
 
 
-@njit(cache=True)
+@jit
 def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
                     CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
@@ -237,7 +237,7 @@ def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1,
 
 
 # ---------------------------------------------------------------- laws, pieces
-@njit(cache=True)
+@jit
 def _n_below(edges, ne, x):
     k = 0
     while k < ne and edges[k] <= x:
@@ -245,7 +245,7 @@ def _n_below(edges, ne, x):
     return k
 
 
-@njit(cache=True)
+@jit
 def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
     ne = nedges[i]
     start = 0.0 if k[i] == 0 else edges[i, k[i] - 1]
@@ -258,7 +258,7 @@ def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
         lo[i], hi[i] = -end, -start
 
 
-@njit(cache=True)
+@jit
 def _system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
     """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place into
     As[:, :n] and cs: A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :],
@@ -288,7 +288,7 @@ def _system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
                         As[p, n + q] -= w * be * argmap[i, q]
 
 
-@njit(cache=True)
+@jit
 def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
     """The event rows event_rows v[off:off + n] (+ h0) of the kernel, from their two
     distinct blocks: event_rows = [gx; -gx; -gc; gc] (gx = argmap / theta_u, gc the
@@ -310,7 +310,7 @@ def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
             out[i], out[n + i], out[2 * n + i], out[3 * n + i] = a, -a, -c, c
 
 
-@njit(cache=True)
+@jit
 def _surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
     """The event distances d, rates dd and second derivatives d2 at the state y (time t [s])
     with accelerations acc; with a vertical record (mv_e not empty) the moving kinks'
@@ -323,7 +323,7 @@ def _surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
         add_moving(t, gr, mv_e, mv_w, d, dd, d2)
 
 
-@njit(cache=True)
+@jit
 def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
     """Model.energy for one state."""
     n = theta.size
@@ -344,7 +344,7 @@ def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slop
     return e
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _friction(g_new, gam, centre_map, acc, masses, normal_forces, friction):
     """Friction demand |T_i| / N_i at each interface at the step's end, kept in friction
     if larger: the shear from the drums above, their absolute accelerations g_new [m/s^2]

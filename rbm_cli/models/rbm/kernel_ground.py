@@ -19,11 +19,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from rbm_cli.base.detmath import asin as dasin
 from rbm_cli.base.detmath import exp as dexp
 from rbm_cli.base.detmath import sin as dsin
+from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.physics.ground_forms import BISECTION_STEPS, MP, RICKER, SAMPLED, SINE
 
@@ -32,7 +32,7 @@ LINE = 4
 _HALF_PI = 0.5 * math.pi
 
 
-@njit(cache=True)
+@jit
 def _ground_other(t, form, amp, om, ph, c, gamma):
     """a_g of the forms other than the sine [m/s^2]."""
     if form == RICKER:
@@ -56,7 +56,7 @@ def _ground_other(t, form, amp, om, ph, c, gamma):
     return v if amp == 1.0 else amp * v
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _ground(t, gr):
     """a_g(t) [m/s^2] of the ground tuple gr (0 on a free segment: gain 0)."""
     form, amp, om, ph, c, gamma = gr[0], gr[1], gr[2], gr[3], gr[4], gr[5]
@@ -67,7 +67,7 @@ def _ground(t, gr):
     return _ground_other(t, form, amp, om, ph, c, gamma)
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _gravity(t, gr):
     """(g + a_v(t)) / g [-] of the ground tuple gr (1 with no vertical record)."""
     if gr[6] == 0.0:
@@ -75,7 +75,7 @@ def _gravity(t, gr):
     return 1.0 + (gr[7] + gr[8] * ((t - gr[4]) / gr[5])) / G
 
 
-@njit(cache=True)
+@jit
 def _first_after(knots, x):
     """Index of the first knot > x (np.searchsorted(knots, x, side='right'))."""
     lo, hi = 0, knots.size
@@ -88,7 +88,7 @@ def _first_after(knots, x):
     return lo
 
 
-@njit(cache=True)
+@jit
 def _record_piece(t, knots, values, vertical, gain, seg_end):
     """The straight piece of a record a step from t [s] runs on, as a ground tuple, and
     the time that step ends at: the first sample past t + the smallest step (10 ulp of
@@ -110,7 +110,7 @@ def _record_piece(t, knots, values, vertical, gain, seg_end):
     return gr, bound
 
 
-@njit(cache=True)
+@jit
 def _sampled_at(t, knots, values):
     """ground_forms.sampled_value: linear between samples, 0 outside them."""
     n = knots.size
@@ -123,7 +123,7 @@ def _sampled_at(t, knots, values):
     return values[k - 1] + (values[k] - values[k - 1]) * ((t - t0) / (knots[k] - t0))
 
 
-@njit(cache=True)
+@jit
 def _ground_at(t, gr, knots, values):
     """a_g(t) [m/s^2] of the motion (gr its formula, or a record's samples, gain 1)."""
     if gr[0] != SAMPLED:
@@ -131,7 +131,7 @@ def _ground_at(t, gr, knots, values):
     return _sampled_at(t, knots, values)
 
 
-@njit(cache=True)
+@jit
 def _level_at(t, level, knots, vertical):
     """The uplift level at t [m/s^2]: level (g + a_v(t)) / g with a vertical record."""
     if vertical.size == 0:
@@ -139,7 +139,7 @@ def _level_at(t, level, knots, vertical):
     return level * (1.0 + _sampled_at(t, knots, vertical) / G)
 
 
-@njit(cache=True)
+@jit
 def sine_exceedance(t0, level, amp, om, ph, last):
     """GroundMotion.next_exceedance of a sine; -1 for none before `last`."""
     if amp <= level or t0 >= last:
@@ -159,7 +159,7 @@ def sine_exceedance(t0, level, amp, om, ph, last):
     return t
 
 
-@njit(cache=True)
+@jit
 def _solve_piece(gr, tl, tr, target):
     """ground_forms._solve_piece: bisection for a_g = target on a monotone piece."""
     s = 1.0 if target > 0.0 else -1.0
@@ -175,7 +175,7 @@ def _solve_piece(gr, tl, tr, target):
     return hi
 
 
-@njit(cache=True)
+@jit
 def _exceedance_pieces(t0, level, last, gr, knots, values, vertical):
     """ground_forms.exceedance_on_pieces; -1 for none before `last`."""
     sampled = gr[0] == SAMPLED
@@ -209,7 +209,7 @@ def _exceedance_pieces(t0, level, last, gr, knots, values, vertical):
         k += 1
 
 
-@njit(cache=True)
+@jit
 def _next_uplift(t0, level, peak, gr, knots, values, vertical, last):
     """GroundMotion.next_exceedance: the first time >= t0 with |a_g| > level [m/s^2]
     (times (g + a_v) / g with a vertical record; peak = max |a_g|); -1 for none before

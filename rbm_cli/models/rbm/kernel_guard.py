@@ -19,7 +19,9 @@ import threading
 import time
 from collections.abc import Iterator
 
-from numba import njit, objmode
+from numba import objmode
+
+from rbm_cli.base.jit import jit
 
 #: Accepted steps between two polls (a step costs ~1-100 us: a poll every few ms at most).
 POLL_STEPS = 256
@@ -34,7 +36,7 @@ def _clock() -> float:
     return -1.0 if _interrupted[0] else time.monotonic()
 
 
-@njit(cache=True)
+@jit
 def poll(deadline):
     """GO_ON, PAST_DEADLINE (time.monotonic() beyond deadline [s]) or INTERRUPTED."""
     with objmode(now="float64"):

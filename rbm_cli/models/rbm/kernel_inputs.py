@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from rbm_cli.base.detmath import matmul, matvec
+from rbm_cli.base.jit import jit
 from rbm_cli.models.events import REST_RATE
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.rbm.kernel_rk import METHOD_CODES
@@ -152,7 +152,7 @@ def _pad_laws(model: Model):
     return edges, nedges, inter, slopes, rigid
 
 
-@njit(cache=True)
+@jit
 def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
     """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es)."""
     n = argmap.shape[0]
@@ -228,7 +228,7 @@ def prepare_kernel(model: Model) -> PreparedModel:
     Returns
     -------
     PreparedModel  Its kernel arrays and the scale of atol; pass it to
-        integrate_compiled(..., prepared=) for every run of this model.
+        integrate(..., prepared=) for every run of this model.
     """
     n = model.n
     tu = float(model.column.rotation_capacity.min())

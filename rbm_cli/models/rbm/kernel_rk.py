@@ -7,9 +7,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from rbm_cli.base.detmath import pow_pos
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm import kernel_tableaux as _tb
 from rbm_cli.models.rbm.kernel_ground import _gravity, _ground
 
@@ -85,7 +85,7 @@ _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 
 
 # ---------------------------------------------------------------- small pieces
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _rhs(t, y, n, As, cs, es, gr, out):
     g = _ground(t, gr)
     if gr[6] == 0.0:
@@ -109,7 +109,7 @@ def _rhs(t, y, n, As, cs, es, gr, out):
         out[n + i] = gam * s + el + es[i] * g
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _acc_of(t, y, n, As, cs, es, gr, acc):
     """Angular accelerations theta'' at (t, y) into acc [rad/s^2]; returns a_g(t) [m/s^2]
     and (g + a_v(t)) / g [-]. (gam * x + e g is x + e g to the bit when gam = 1; the
@@ -128,7 +128,7 @@ def _acc_of(t, y, n, As, cs, es, gr, acc):
     return g, gam
 
 
-@njit(cache=True)
+@jit
 def _rms(v):
     s = 0.0
     for x in v:
@@ -136,7 +136,7 @@ def _rms(v):
     return math.sqrt(s / v.size)
 
 
-@njit(cache=True)
+@jit
 def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, work):
     """scipy.integrate._ivp.common.select_initial_step (max_step = inf)."""
     interval = abs(t_bound - t0)
@@ -160,7 +160,7 @@ def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, wor
     return min(100.0 * h0, h1, interval)
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr):
     """Stage s from the stages before it: K[s] = f(t + c_s h, y + h sum_j a_sj K_j).
     Inlined (as detmath.sin is): a call costs a reference count of every array it takes
@@ -174,7 +174,7 @@ def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr):
     _rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, gr, K[s])
 
 
-@njit(cache=True)
+@jit
 def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     """One Runge-Kutta step of size h; stages in K (row ns = f(t + h, y_new))."""
     B = TAB_B[mc]
@@ -191,7 +191,7 @@ def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     _rhs(t + h, ynew, n, As, cs, es, gr, K[ns])
 
 
-@njit(cache=True)
+@jit
 def _error_norm(mc, K, h, y, ynew, atol, rtol, scale):
     ns = TAB_NS[mc]
     E = TAB_E[mc]
@@ -223,7 +223,7 @@ def _error_norm(mc, K, h, y, ynew, atol, rtol, scale):
     return math.sqrt(s / m)
 
 
-@njit(cache=True)
+@jit
 def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
     """Coefficients F of the step's interpolant (DOP853: extra stages)."""
     m = y_old.size
@@ -253,7 +253,7 @@ def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
     return 0
 
 
-@njit(cache=True)
+@jit
 def _dense_eval(mc, t, t_old, h, y_old, F, out):
     x = (t - t_old) / h
     m = y_old.size
@@ -275,7 +275,7 @@ def _dense_eval(mc, t, t_old, h, y_old, F, out):
         out[i] = y_old[i] + v
 
 
-@njit(cache=True)
+@jit
 def _emit_rest(t_stop, samples, n_out, next_out, dt):
     while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
         samples[n_out, 0] = next_out
@@ -285,7 +285,7 @@ def _emit_rest(t_stop, samples, n_out, next_out, dt):
     return n_out, next_out
 
 
-@njit(cache=True)
+@jit
 def _emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
     while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
         samples[n_out, 0] = next_out

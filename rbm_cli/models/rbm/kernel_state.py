@@ -13,13 +13,13 @@ runs, measured).
 
 from __future__ import annotations
 
-from numba import njit
+from rbm_cli.base.jit import jit
 
 #: What an event was (switch returns it).
 PIECE, UPLIFT, IMPACT, REST = 0, 1, 2, 3
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _restitution(model, i, y, n):
     """The impact's loss of rate at interface i (e < 1), on y's rates in place."""
     argmap, arg_inv, e_rest = model.argmap, model.arg_inv, model.e_rest
@@ -35,7 +35,7 @@ def _restitution(model, i, y, n):
             y[n + j] += model.impulse_dir[j, i] * lam
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono):
     """Interface i's event at argument bound [rad]: y (state), side, k (piece),
     pending and awaiting (silent impacts) updated in place.
@@ -79,7 +79,7 @@ def switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
     return IMPACT
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _settle(awaiting, argmap, y, side):
     """events.Pieces.settle in the kernel: the silent impacts (interfaces back on their
     first piece whose argument changed sign) counted and their sides flipped; returns how

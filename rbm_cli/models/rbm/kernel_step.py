@@ -6,9 +6,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from rbm_cli.base.detmath import matvec, pow_pos
+from rbm_cli.base.jit import jit
 from rbm_cli.models.events import BIG, EVENT_EPS
 from rbm_cli.models.rbm.kernel_events import (
     CHECK_INTERVALS,
@@ -58,7 +58,7 @@ from rbm_cli.models.rbm.kernel_state import IMPACT, REST, UPLIFT, _settle, switc
 from rbm_cli.models.rbm.kernel_vertical import bound_now, moving_rows
 
 
-@njit(cache=True)
+@jit
 def run_kernel(model, motion, solver, task):
     """Run one motion of one model.
 

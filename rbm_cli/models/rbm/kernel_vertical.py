@@ -20,14 +20,13 @@ moving part is mv_e m(gam; mv_w), and the row's h0 keeps only EVENT_EPS.
 
 from __future__ import annotations
 
-from numba import njit
-
+from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.models.rbm.kernel_ground import _gravity
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _m(gam, w):
     """m(gam; w) = gam / (1 + w (gam - 1)) [-]: a kink's position over its position at
     gam = 1 (1 exactly when w = 1, a fixed kink)."""
@@ -36,7 +35,7 @@ def _m(gam, w):
     return gam / (1.0 + w * (gam - 1.0))
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def _gam_rate(gr):
     """d gam / dt [1/s] on the record's straight piece gr (kernel_ground)."""
     if gr[6] == 0.0:
@@ -44,7 +43,7 @@ def _gam_rate(gr):
     return gr[8] / (gr[5] * G)
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def moving_value(t, gr, e, w):
     """The moving part e m(gam(t); w) of an event row at t [s] (0 for a fixed row)."""
     if e == 0.0:
@@ -52,7 +51,7 @@ def moving_value(t, gr, e, w):
     return e * _m(_gravity(t, gr), w)
 
 
-@njit(cache=True, inline="always")
+@jit(inline=True)
 def moving_rate(t, gr, e, w):
     """d/dt of moving_value [1/s]."""
     if e == 0.0:
@@ -62,7 +61,7 @@ def moving_rate(t, gr, e, w):
     return e * (1.0 - w) / (den * den) * _gam_rate(gr)
 
 
-@njit(cache=True)
+@jit
 def add_moving(t, gr, mv_e, mv_w, d, dd, d2):
     """Add the moving parts of the rows (and their first and second time derivatives) at
     t [s] to the event distances d, their rates dd and second derivatives d2 (rows < 2n)."""
@@ -79,7 +78,7 @@ def add_moving(t, gr, mv_e, mv_w, d, dd, d2):
         d2[r] += -2.0 * e * w * (1.0 - w) / (den * den * den) * gp * gp
 
 
-@njit(cache=True)
+@jit
 def _end(i, k, ne, rigid, pending):
     """(edge, sign) of the start and end of interface i's piece k (kernel_events._bounds):
     edge -1 for 0 or infinity."""
@@ -91,7 +90,7 @@ def _end(i, k, ne, rigid, pending):
     return k - 1, 1.0, q_end, 1.0
 
 
-@njit(cache=True)
+@jit
 def moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv_w):
     """mv_e, mv_w of the law-bound rows of the active pieces (module docstring); h0 of a
     moving row keeps EVENT_EPS only."""
@@ -115,7 +114,7 @@ def moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv
             h0[n + i] = EVENT_EPS
 
 
-@njit(cache=True)
+@jit
 def bound_now(i, going_up, n, lo, hi, tu, t, gr, mv_e, mv_w):
     """The bound [rad] interface i's argument reached at its event at t [s]: the kink where
     the two lines meet at gam(t) for a moving one, else lo[i] or hi[i]."""

@@ -4,8 +4,7 @@ guards' verdict in those codes and how often they poll, and the Outcome of a bud
 
 from __future__ import annotations
 
-from numba import njit
-
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
 
 GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
@@ -14,7 +13,7 @@ FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
 POLL_PIECES = 64
 
 
-@njit(cache=True)
+@jit
 def guard_code(deadline):
     """kernel_guard.poll as a code: GOING, FAILED_WALL (the monotonic clock past deadline
     [s]) or INTERRUPTED (Ctrl-C)."""

@@ -193,13 +193,9 @@ class RbmRunner:
             from rbm_cli.models.rbm.exact_piece import ModalSystem
 
             return partial(integrate_exact, system=ModalSystem(self.model))
-        if implementation == "compiled":
-            from rbm_cli.models.rbm.kernel import integrate_compiled, prepare_kernel
+        from rbm_cli.models.rbm.kernel import integrate, prepare_kernel
 
-            return partial(integrate_compiled, prepared=prepare_kernel(self.model))
-        from rbm_cli.models.rbm.python import integrate
-
-        return integrate
+        return partial(integrate, prepared=prepare_kernel(self.model))
 
     def run(
         self,

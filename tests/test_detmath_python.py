@@ -1,7 +1,7 @@
-"""The Python bodies of detmath's compiled loops (their ``py_func``), which inverse and
-product run for small matrices and the Python integrator runs for pow_pos (issue 18: no
-compile or load of compiled code for them on a first use), give the compiled bits: the
-same IEEE operations in the same order, no FMA contraction and no reordering in either."""
+"""The uncompiled versions of detmath's compiled loops (rbm_cli.base.jit.plain), which
+inverse and product run for small matrices and solver.implementation: python runs for
+everything, give the compiled bits: the same IEEE operations in the same order, no FMA
+contraction and no reordering in either."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from rbm_cli.base import detmath
+from rbm_cli.base.jit import plain
 
 
 def bits(x) -> bytes:
@@ -21,9 +22,9 @@ def test_matmul_and_inverse_bodies_give_the_compiled_bits(n):
     for scale in (1.0, 1e-9, 1e9):
         a = rng.standard_normal((n, n)) * scale + np.eye(n) * rng.uniform(0.0, 2.0)
         b = rng.standard_normal((n, 3)) * rng.uniform(0.1, 10.0)
-        assert bits(detmath.matmul.py_func(a, b)) == bits(detmath.matmul(a, b))
-        assert bits(detmath.matmul.py_func(a, a)) == bits(detmath.matmul(a, a))
-        inv_py, ok_py = detmath._inverse.py_func(a)
+        assert bits(plain(detmath.matmul)(a, b)) == bits(detmath.matmul(a, b))
+        assert bits(plain(detmath.matmul)(a, a)) == bits(detmath.matmul(a, a))
+        inv_py, ok_py = plain(detmath._inverse)(a)
         inv_c, ok_c = detmath._inverse(a)
         assert ok_py == ok_c and bits(inv_py) == bits(inv_c)
 
@@ -52,6 +53,6 @@ def test_a_singular_matrix_is_refused_by_both():
 def test_pow_pos_body_gives_the_compiled_bits(y):
     rng = np.random.default_rng(11)
     xs = np.concatenate([10.0 ** rng.uniform(-15, 15, 400), [0.0, 1.0, 2.0, 0.5, 1e-300]])
-    got = [detmath.pow_pos_python(float(x), y) for x in xs]
+    got = [plain(detmath.pow_pos)(float(x), y) for x in xs]
     want = [detmath.pow_pos(float(x), y) for x in xs]
     assert bits(got) == bits(want)

@@ -12,6 +12,7 @@ reports what was run and what broke.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import time
@@ -24,7 +25,7 @@ from hypothesis import strategies as st
 
 from rbm_cli.api import run_sweep
 from rbm_cli.config.load import parse_config
-from rbm_cli.models.rbm.python import integrate
+from rbm_cli.models.rbm.kernel import integrate
 from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.models.result import STATUSES
 from rbm_cli.physics.excitation import make_ground_motion
@@ -323,9 +324,8 @@ def test_impact_energy_reproducer(formulation):
 
 def test_energy_jump_reproducer():
     """Guards against a missed first event when another row crosses later in the step
-    (energy jump 5e-4 before the fix; the limit is 1e-6). Runs the Python reference
-    integrator (rbm_cli.models.rbm.python) directly, where the step sequence of the failure
-    was found."""
+    (energy jump 5e-4 before the fix; the limit is 1e-6). Runs the step kernel's source
+    uncompiled (solver.implementation: python), as a debugger would."""
     config = parse_config(
         {
             "name": "energy_jump",
@@ -357,7 +357,7 @@ def test_energy_jump_reproducer():
         motion,
         np.zeros(6),
         np.asarray(config.excitation.initial.velocities),
-        config.solver,
+        dataclasses.replace(config.solver, implementation="python"),
         record=True,
         output_dt=0.001,
         early_stop=False,

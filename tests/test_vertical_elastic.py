@@ -26,8 +26,7 @@ import pytest
 
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.rbm.kernel import integrate_compiled
-from rbm_cli.models.rbm.python import integrate
+from rbm_cli.models.rbm.kernel import integrate
 from rbm_cli.models.rbm.runner import SHAPE_CHANGE, model_from_config
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.excitation import make_ground_motion
@@ -140,8 +139,8 @@ def _sine_vertical(amp_g, f, span, n=4001):
 @pytest.mark.parametrize("name", ["two-drum-trilinear", "monolith-bilinear"])
 def test_time_varying_vertical_compiled_equals_python(tmp_path, name):
     """A sine vertical record (0.4 g at 3 Hz, the kinks moving all the time) under a
-    half-sine: the compiled kernel takes the Python twin's steps (test_kernel's
-    tolerances: collapse time 1e-6 s, peaks 1e-4)."""
+    half-sine: the kernel compiled and uncompiled (its own source run by Python) give the
+    same figures, bit for bit."""
     drums, xi, k_n, formulation = COLUMNS[name]
     t, a = _half_sine(1.5)
     v = _sine_vertical(0.4, 3.0, SPAN)
@@ -151,10 +150,12 @@ def test_time_varying_vertical_compiled_equals_python(tmp_path, name):
                 for impl in ("compiled", "python")]  # fmt: skip
         got, ref = (_run(cfg, amp) for cfg in cfgs)
         assert got.status == ref.status
-        assert (got.n_uplifts, got.n_impacts) == (ref.n_uplifts, ref.n_impacts)
-        if ref.status == "collapsed":
-            assert abs(got.t_collapse - ref.t_collapse) < 1e-6
-        np.testing.assert_allclose(got.max_ratio, ref.max_ratio, rtol=1e-4, atol=1e-12)
+        assert (got.n_uplifts, got.n_impacts, got.n_steps) == (
+            ref.n_uplifts, ref.n_impacts, ref.n_steps)  # fmt: skip
+        assert got.t_collapse == ref.t_collapse or (
+            got.t_collapse != got.t_collapse and ref.t_collapse != ref.t_collapse
+        )
+        np.testing.assert_array_equal(got.max_ratio, ref.max_ratio)
 
 
 @pytest.mark.parametrize("impl", ["compiled", "python"])
@@ -188,9 +189,8 @@ def test_a_falling_gravity_pulls_the_elastic_end_below_a_vibrating_joint(tmp_pat
     t_u = hi_t
     assert 0.5 < t_u < 0.95  # after gam = 0.6, before the record ends
     motion = make_ground_motion(cfg.excitation, 1.0)
-    run = integrate if impl == "python" else integrate_compiled
-    out = run(model, motion, np.array([x0]), np.zeros(1), cfg.solver, record=True,
-              output_dt=1e-3)  # fmt: skip
+    out = integrate(model, motion, np.array([x0]), np.zeros(1), cfg.solver, record=True,
+                    output_dt=1e-3)  # fmt: skip
     assert out.n_uplifts >= 1
     times = np.array([s[0] for s in out.samples])
     theta = np.array([s[1][0] for s in out.samples])

@@ -352,13 +352,6 @@ def exp(x):
     return math.ldexp(y, k)
 
 
-def pow_pos_python(x: float, y: float) -> float:
-    """pow_pos run as Python (rbm_cli.base.jit.plain), for the Python
-    integrator: the same IEEE operations in the same order, so the same bits, and a first
-    run on an empty cache does not compile them (issue 18)."""
-    return plain(pow_pos)(x, y)
-
-
 @jit
 def pow_pos(x, y):
     """x^y for x >= 0 as exp(y log x), the same bits everywhere: the error of log

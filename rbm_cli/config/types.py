@@ -260,8 +260,8 @@ class SolverConfig:
     max_steps : int  Step budget of one run; beyond it the run is 'failed'
     max_events : int  Budget of events (kinks, impacts) of one run
     time_step : float  Fixed time step of the contact engine (model bullet) [s]
-    implementation : str  'compiled' (the numba kernel, rbm_cli.models.rbm.kernel) or
-        'python' (the reference loop, rbm_cli.models.rbm.python); same algorithm
+    implementation : str  'compiled' (numba) or 'python' (the same source run uncompiled,
+        rbm_cli.base.jit.plain: the same bits, 30-100x slower; for debugging)
     max_wall_time : float  Wall-clock budget of one run [s]; beyond it the run is
         'failed' (a guard against a run that would not end, not a tolerance)
     """

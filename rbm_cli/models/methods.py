@@ -5,7 +5,7 @@
   interface.stiffness rigid, xi 1, formulation relative or geometric), an excitation with a
   closed form (harmonic, free, the sine pulses, records exact per sample interval), no
   vertical record, `solver.implementation: compiled` -- else DOP853 (the step kernel, or
-  the Python loop with `implementation: python`);
+  kernel's source uncompiled with `implementation: python`);
 - `housner-linear`: `closed-form` whatever the method says (compiled, or the Python
   closed form with `implementation: python`; a vertical record: the Python one, whose gam
   is taken per piece);

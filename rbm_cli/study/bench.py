@@ -95,7 +95,7 @@ METHODS = (
     + [("compiled", "RK45", r) for r in (1e-5, 1e-6, 1e-7, 1e-8)]
     + [("python", "DOP853", SolverConfig().rtol), EXACT]
 )
-#: Cells of the sample on which the slow methods (the Python loop and the
+#: Cells of the sample on which the slow methods (the kernel uncompiled and the
 #: baseline) run: the same cells for both, and the speed-up of every method is
 #: the ratio of run times summed over these cells (paired, so the sample's mix
 #: of cheap and costly cells does not bias it).
@@ -292,7 +292,7 @@ def _run_methods(cfg: Config, cells: list, sample: list, quick: bool, jobs: int)
     and the exact method) and the baseline.
 
     Returns (method triple, rows, wall time [s], whether on the sample only) per
-    method, the baseline last; the Python loop and the baseline run the sample."""
+    method, the baseline last; the uncompiled kernel and the baseline run the sample."""
     default = _default_method(cfg)
     step = ("compiled", STEP_DEFAULT, SolverConfig().rtol)
     if quick:

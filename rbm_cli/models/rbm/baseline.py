@@ -3,7 +3,7 @@
 scipy's ``solve_ivp`` (RK45, rtol 1e-6) called once per smooth piece, with
 terminal events for the law's kinks, the impacts and collapse (one Python
 function per event surface), restarted after each event. The physics is the
-same as rbm_cli.models.rbm.python's (same pieces, same impact rule, same rest of a
+same as the step kernel's (same pieces, same impact rule, same rest of a
 rigid block), so the benchmark compares integrators, not models. Only the
 outcome is kept: status, collapse time and peak rotation ratio (from the
 solver's steps and the event states).

@@ -1,24 +1,34 @@
-"""Compiled event-driven integrator of the Rigid Beam Model (numba).
+"""The step kernel: event-driven integration of the Rigid Beam Model.
 
-The same algorithm as rbm_cli.models.rbm.python (which stays as the readable Python
-reference and serves time histories): an explicit Runge-Kutta pair (scipy's
-DOP853, RK45 or RK23 tableaux and step-size control, transcribed), stopped
-exactly at every event (kink of a law, impact, collapse) by Brent's method
-on the step's dense output. The whole run, piece changes, impacts, rest
-phases of rigid blocks and the early stop of free motion included, runs in
-one compiled call: no Python per step or per event.
+Inside one set of active law pieces the equations are smooth (linear), so the kernel runs
+an explicit Runge-Kutta pair (scipy's DOP853, RK45 or RK23 tableaux, initial step, error
+norm and step-size control, transcribed) and stops exactly at every event, found by
+Brent's method on the step's dense output:
 
-The step sequence follows scipy's (same initial step, same error norm, same
-controller; after an event both restart with the step size proposed before
-it), so for non-chaotic runs the kernel reproduces the Python path to
-round-off; the tests compare the two. Zero crossings that change nothing
-(e = 1, a law linear through zero) are counted at step ends, not stopped at,
-in both (events.Pieces.silent).
+- a law argument reaching the end of its current piece (a kink of the law): the pieces
+  change and the integration restarts there, with the step size proposed before the event;
+- a zero crossing of a law argument after an excursion beyond its elastic branch (every
+  crossing for a rigid law): an impact, the argument's rate is multiplied by the
+  restitution e and the integration restarts. With e = 1 and a law linear through zero
+  (an elastic first piece) the crossing changes nothing: it is no event, only counted at
+  the step's end (events.Pieces.silent);
+- a collapse quantity reaching c times its limit: the run stops.
 
-The modules: kernel_inputs (the kernel's four typed input records and
-prepare_kernel), kernel_step (the stepper run_kernel), kernel_rk (Runge-Kutta),
-kernel_events (event location), kernel_state (the state change at an event),
-kernel_guard (wall-clock budget and Ctrl-C); this one runs a model from Python.
+The normalised distances to these surfaces are evaluated once per step; a step that comes
+within reach of a surface is checked on its dense output in sub-intervals, and the
+earliest crossing of any surface is the event. A rigid monolithic column stays at rest,
+with no integration, until the ground demand exceeds the uplift level (found exactly from
+the excitation); a rigid block that loses its velocity at an impact returns to rest. Free
+motion stops early once its outcome cannot change (energy below every barrier).
+
+The whole run is one call of ``run_kernel`` (kernel_step), written once in the subset of
+Python that numba compiles: compiled by default, run by Python as written with
+``solver.implementation: python`` (rbm_cli.base.jit.plain; the same bits, 30-100x
+slower). The modules: kernel_inputs (the kernel's four typed input records and
+prepare_kernel), kernel_step (the stepper), kernel_rk (Runge-Kutta), kernel_events (event
+location), kernel_state (the state change at an event), kernel_ground (the excitation),
+kernel_vertical (moving kinks under a vertical record), kernel_guard (wall-clock budget and
+Ctrl-C); this one runs a model from Python.
 """
 
 from __future__ import annotations

@@ -178,7 +178,8 @@ def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
 
 
 def _early_stop_levels(model: Model) -> tuple[float, float, float]:
-    """(uplift level, rest rate, energy barrier) as rbm_cli.models.rbm.python computes them."""
+    """(uplift level [rad/s^2 of ground demand], rest rate [rad/s], energy barrier [J]) of the
+    model: the levels the early stop and the rest of a rigid block compare with."""
     tu = float(model.column.rotation_capacity.min())
     uplift = model.uplift_level
     barrier = math.nan

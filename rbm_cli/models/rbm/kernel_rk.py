@@ -1,6 +1,6 @@
-"""Runge-Kutta steps for the compiled kernel (numba): scipy's DOP853, RK45 and
-RK23 tableaux, initial step, error norm and dense output, transcribed so the
-kernel's step sequence is scipy's (rbm_cli.models.rbm.python drives scipy's steppers)."""
+"""Runge-Kutta steps for the step kernel: scipy's DOP853, RK45 and RK23 tableaux, initial
+step, error norm and dense output, transcribed so that the kernel's step sequence is the
+one scipy's steppers would take."""
 
 from __future__ import annotations
 

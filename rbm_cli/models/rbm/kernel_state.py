@@ -3,8 +3,7 @@
 At an event of interface i (a kink of its law reached, going up or down), the
 state moves exactly onto the kink and the interface's piece changes: an uplift
 from closure, one piece out or in, or an impact (closure crossed, restitution
-applied, and a rigid monolith slow enough comes to rest). As
-rbm_cli.models.rbm.python does it.
+applied, and a rigid monolith slow enough comes to rest).
 
 Both functions are inlined into the stepper (inline="always"): a call would pass the
 model record by value, some 30 arrays, at every event (+5 % on the slender block's

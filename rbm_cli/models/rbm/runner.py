@@ -1,6 +1,5 @@
-"""The Rigid Beam Model's runner: the column's equations assembled once, run by the compiled
-kernel or the readable Python loop, two implementations of the same integrator
-(`solver.implementation`); tests/test_kernel.py holds them to the same steps. With
+"""The Rigid Beam Model's runner: the column's equations assembled once, run by the step
+kernel (compiled, or its source uncompiled with `solver.implementation: python`). With
 `solver.method: exact` the linear pieces are integrated in closed form instead
 (rbm_cli.models.rbm.exact; tests/test_exact.py holds it to the step kernel). A rigid
 monolith runs in the block's closed form (rbm_cli.models.rbm.closed_form) under

@@ -3,7 +3,8 @@
 :class:`FolderLock` is an exclusive lock on a file in a folder, held by the one process
 that writes the files it guards; :func:`move_together` moves staged files onto their names
 so that a kill of the process (kill -9 included) between two moves cannot leave them half
-done. Used by `rbm fragility` (rbm_cli.report.fragility_store).
+done. :func:`signals_held` holds SIGINT, SIGTERM and SIGHUP back while files are moved. Used by
+the sweep's store (rbm_cli.study.store) and `rbm fragility` (rbm_cli.report.fragility_store).
 """
 
 from __future__ import annotations
@@ -11,7 +12,9 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import signal
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 from rbm_cli.base.files import OutputError, make_dirs
@@ -30,6 +33,22 @@ def fsync_dir(folder: str | os.PathLike) -> None:
     """Flush a folder's entries (renames, new files) to the disk, where the system allows."""
     with contextlib.suppress(OSError):
         fsync_file(folder)
+
+
+@contextlib.contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT, SIGTERM and SIGHUP held back (delivered after the block), so a Ctrl-C
+    cannot land between two renames of a publication. SIGKILL cannot be held."""
+    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+    try:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    except (AttributeError, OSError, ValueError):  # not POSIX, or not allowed here
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 class FolderBusy(OutputError):
@@ -117,7 +136,7 @@ def move_together(moves: list[tuple[Path, Path]], folder: str | os.PathLike) -> 
     process group (Ctrl-C in a terminal, kill -9) between two moves cannot leave them half
     done: it finishes them, and holds what this process held (a :class:`FolderLock`)
     until it has. The caller holds SIGINT, SIGTERM and SIGHUP back around the call
-    (rbm_cli.study.store.signals_held), so that they too wait for the end; the child
+    (:func:`signals_held`), so that they too wait for the end; the child
     inherits that. Without a fork (another platform, Python threads running, the fork
     refused) the moves are made here: a kill -9 between two of them is then not covered.
 

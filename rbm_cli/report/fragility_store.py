@@ -28,8 +28,7 @@ import tempfile
 from pathlib import Path
 
 from rbm_cli.base.files import OutputError
-from rbm_cli.base.folder import FolderLock, fsync_dir, fsync_file, move_together
-from rbm_cli.study.store import signals_held
+from rbm_cli.base.folder import FolderLock, fsync_dir, fsync_file, move_together, signals_held
 
 #: The files of a fragility set, in the order they are moved into place (the JSON last).
 FILES = ("fragility.png", "ida.png", "fragility.csv", "fragility_curve.csv", "fragility.json")

@@ -27,18 +27,18 @@ may not continue is refused, or, with ``force``, moved to ``superseded/<time>/``
 from __future__ import annotations
 
 import contextlib
-import errno
 import json
 import os
 import shutil
-import signal
 import tempfile
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.base.files import current_umask
+from rbm_cli.base.folder import FolderBusy, FolderLock, fsync_dir, fsync_file, signals_held
 from rbm_cli.study.domain import row_key
 from rbm_cli.study.journal_rows import validate_row
 
@@ -49,10 +49,6 @@ FINALS = ("domain.png", "boundary.csv", "domain.csv", "meta.json")  # publicatio
 STAGING_PREFIX = ".publish."
 SUPERSEDED = "superseded"
 JOURNAL_FORMAT = 1
-
-
-class FolderBusy(RbmError):
-    """Another sweep holds the folder's lock."""
 
 
 @dataclass
@@ -68,45 +64,6 @@ class JournalRead:
     records: list | None = None  # the header's record files [key, file, SHA-256] (None: none)
 
 
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def _fsync_dir(folder: Path) -> None:
-    with contextlib.suppress(OSError):
-        fd = os.open(folder, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-
-
-def _fsync_file(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-@contextlib.contextmanager
-def signals_held() -> Iterator[None]:
-    """SIGINT, SIGTERM and SIGHUP held back (delivered after the block), so a Ctrl-C
-    cannot land between two renames of a publication. SIGKILL cannot be held."""
-    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
-    try:
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    except (AttributeError, OSError, ValueError):  # not POSIX, or not allowed here
-        yield
-        return
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
-
-
 class SweepStore:
     """The folder of one sweep, locked for as long as the store is open (a context
     manager). See the module's docstring for the layout."""
@@ -115,7 +72,7 @@ class SweepStore:
         self.folder = Path(folder)
         self.journal = self.folder / JOURNAL
         self.state = self.folder / STATE
-        self._lock_fd: int | None = None
+        self._lock: FolderLock | None = None
         self._fh = None
 
     # ---------------------------------------------------------------- lock
@@ -126,62 +83,15 @@ class SweepStore:
             raise RbmError(
                 f"cannot write to output folder {self.folder}: {exc.strerror or exc}"
             ) from None
-        for _ in range(100):  # the lock file may be removed by its holder as it ends
-            fd = self._lock_once()
-            if fd is not None:
-                break
-        else:  # pragma: no cover - a hundred holders in a row
-            raise FolderBusy(f"{self.folder} is being written by another sweep")
-        self._lock_fd = fd
-        with contextlib.suppress(OSError):
-            os.ftruncate(fd, 0)
-            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        self._lock = FolderLock(self.folder, LOCK, "sweep").__enter__()
         self._remove_stale_staging()
         return self
 
-    def _lock_once(self) -> int | None:
-        """The locked lock file's descriptor; None if the file was replaced meanwhile."""
-        import fcntl
-
-        path = self.folder / LOCK
-        try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError as exc:
-            raise RbmError(
-                f"cannot write to output folder {self.folder}: {exc.strerror or exc}"
-            ) from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as exc:
-            os.close(fd)
-            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                raise FolderBusy(
-                    f"{self.folder} is being written by another sweep"
-                    f"{self._holder()}: wait for it to end, or use another -o folder"
-                ) from None
-            raise RbmError(f"cannot lock {path}: {exc.strerror or exc}") from None
-        try:
-            same = os.stat(path).st_ino == os.fstat(fd).st_ino
-        except FileNotFoundError:
-            same = False
-        if not same:  # its holder removed it after we opened it: lock the new one
-            os.close(fd)
-            return None
-        return fd
-
-    def _holder(self) -> str:
-        with contextlib.suppress(OSError, ValueError):
-            pid = int((self.folder / LOCK).read_text().split()[0])
-            return f" (pid {pid})"
-        return ""
-
     def __exit__(self, *exc) -> None:
         self.close_journal()
-        if self._lock_fd is not None:
-            with contextlib.suppress(OSError):
-                (self.folder / LOCK).unlink()  # still held: a waiter re-checks the inode
-            os.close(self._lock_fd)  # releases the flock
-            self._lock_fd = None
+        if self._lock is not None:
+            self._lock.__exit__(*exc)
+            self._lock = None
 
     def _remove_stale_staging(self) -> None:
         """Staging folders of publications that did not finish, and temporary copies of the
@@ -284,7 +194,7 @@ class SweepStore:
         for name in names:
             if (self.folder / name).exists():
                 os.replace(self.folder / name, target / name)
-        _fsync_dir(self.folder)
+        fsync_dir(self.folder)
         return target
 
     def start_journal(
@@ -335,7 +245,7 @@ class SweepStore:
     def _write_small(self, path: Path, text: str) -> None:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.folder)
         try:
-            os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0o600 files
+            os.fchmod(fd, 0o666 & ~current_umask())  # mkstemp makes 0o600 files
             with os.fdopen(fd, "w", encoding="utf-8") as fh:
                 fh.write(text)
                 fh.flush()
@@ -345,7 +255,7 @@ class SweepStore:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
             raise
-        _fsync_dir(self.folder)
+        fsync_dir(self.folder)
 
     def open_journal(self) -> None:
         """Open the journal for appending; a line cut by a kill gets its newline first,
@@ -382,15 +292,15 @@ class SweepStore:
         try:
             for name, write in writers:
                 write(staging / name)
-                _fsync_file(staging / name)
-            _fsync_dir(staging)
+                fsync_file(staging / name)
+            fsync_dir(staging)
             with signals_held():
                 for name, _ in writers:
                     os.replace(staging / name, self.folder / name)
-                _fsync_dir(self.folder)
+                fsync_dir(self.folder)
                 self.journal.unlink(missing_ok=True)
                 self.state.unlink(missing_ok=True)
-                _fsync_dir(self.folder)
+                fsync_dir(self.folder)
         finally:
             shutil.rmtree(staging, ignore_errors=True)
 

@@ -17,6 +17,7 @@ import math
 import numpy as np
 import pytest
 
+from rbm_cli.base.errors import RbmError
 from rbm_cli.config import parse_config
 from rbm_cli.config.types import MODELS
 from rbm_cli.models.contract import Runner
@@ -26,26 +27,51 @@ from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 
 
-def block(model: str) -> dict:
+def _block_dict(model: str) -> dict:
     interface = {"stiffness": "rigid", "restitution": 0.9}
     solver = {"time_step": 2e-4} if model == "bullet" else {}
-    return parse_config(
-        {
-            "name": f"contract_{model}",
-            "model": model,
-            "column": {"height": 4.0, "base_width": 1.0, "density": 2700},
-            "interface": interface,
-            "excitation": {"type": "half-sine", "duration": 3.0},
-            "solver": solver,
-        }
-    )
+    return {
+        "name": f"contract_{model}",
+        "model": model,
+        "column": {"height": 4.0, "base_width": 1.0, "density": 2700},
+        "interface": interface,
+        "excitation": {"type": "half-sine", "duration": 3.0},
+        "solver": solver,
+    }
 
 
-def test_the_registry_is_the_config_table():
-    """The config validates `model:` against the same table the registry resolves."""
-    assert model_names() == tuple(MODELS)
+def block(model: str):
+    return parse_config(_block_dict(model))
+
+
+def test_the_config_takes_every_registered_model_and_refuses_others():
+    """A registry line is all a model needs to be accepted by the config, and a name
+    without one is refused in one line that lists the registered names."""
     for name in model_names():
-        assert hasattr(runner_class(name), "run"), name
+        assert block(name).model == name
+        assert issubclass(runner_class(name), object) and callable(runner_class(name).run)
+    with pytest.raises(RbmError) as err:
+        parse_config({**_block_dict("rbm"), "model": "not-a-model"})
+    message = str(err.value)
+    assert "\n" not in message and "not-a-model" in message
+    for name in model_names():
+        assert name in message
+
+
+@pytest.mark.parametrize("name", model_names())
+def test_a_registry_line_says_whether_the_model_takes_drums(name):
+    """`multi_drum` in a model's registry line decides what the config accepts: a model
+    for monolithic blocks refuses two drums in one line naming itself; a multi-drum model
+    builds a runner with one interface per drum."""
+    cfg = _block_dict(name)
+    cfg["column"]["drums"] = 2
+    cfg["interface"] = {"stiffness": {"rotational": 1e9}, "restitution": 0.9}
+    if MODELS[name].multi_drum:
+        runner = make_runner(parse_config(cfg))
+        assert runner.n_interfaces == 2
+    else:
+        with pytest.raises(RbmError, match=f"model '{name}' needs a monolithic column"):
+            parse_config(cfg)
 
 
 @pytest.mark.parametrize("name", model_names())

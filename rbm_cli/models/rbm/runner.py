@@ -9,129 +9,22 @@ monolith runs in the block's closed form (rbm_cli.models.rbm.closed_form) under
 from __future__ import annotations
 
 import dataclasses
-import math
 from functools import partial
 
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import CLOSED_FORM_KINDS, STEP_DEFAULT, Config, G, SolverConfig
+from rbm_cli.config.types import CLOSED_FORM_KINDS, STEP_DEFAULT, Config, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.methods import resolve_method
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.result import history_from_samples
-from rbm_cli.physics.column import Column, build_column
-from rbm_cli.physics.equations import Model, build_model
+from rbm_cli.physics.assembly import SHAPE_CHANGE, model_from_config, shape_change
+from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.restitution import column_restitution, resolve
 
 #: What a numerical failure of the integrator raises; the run ends `failed`, with the reason.
 NUMERICAL_FAILURES = (FloatingPointError, np.linalg.LinAlgError, ValueError, ZeroDivisionError)
-
-
-#: Why a run stops where g + a_v(t) changes the order of a law's pieces (shape_change).
-SHAPE_CHANGE = (
-    "g + a_v(t) changes the order of a joint law's pieces (the elastic end xi gam M_u / K_M"
-    " passes the cap's end theta_u (1 - xi)), which this version does not integrate"
-    " (excitation.vertical)"
-)
-
-
-def shape_change(model: Model, motion: GroundMotion) -> float | None:
-    """First time [s] gam = (g + a_v(t)) / g leaves Model.shape_range() (the pieces of
-    every law keep their order inside it), or None. a_v is linear between the knots."""
-    if motion.vertical is None:
-        return None
-    lo, hi = model.shape_range()
-    if lo <= 0.0 and hi == math.inf:
-        return None
-    gam = 1.0 + np.asarray(motion.vertical) / G
-    bad = (gam < lo) | (gam > hi)
-    if not bad.any():
-        return None
-    k = int(np.argmax(bad))
-    knots = motion.knots
-    if k == 0 or knots[k] == knots[k - 1]:
-        return float(knots[k])
-    limit = lo if gam[k] < lo else hi
-    frac = (limit - gam[k - 1]) / (gam[k] - gam[k - 1])
-    return float(knots[k - 1] + (knots[k] - knots[k - 1]) * frac)
-
-
-def model_from_config(config: Config, column: Column | None = None) -> Model:
-    """Assemble the model of a config (column may be overridden, e.g. in tests).
-
-    Raises RbmError if a derived quantity (mass, inertia, capacity, stiffness, the
-    mass matrix or its inverse, a law's pieces, p) is not finite: see check_derived."""
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
-        if column is None:
-            column = build_column(config.column, config.interface)
-        e = resolve(config.interface.restitution, lambda: column_restitution(column))
-        try:
-            model = build_model(
-                column,
-                xi=config.interface.xi,
-                restitution=float(e),
-                formulation=config.interface.formulation,
-                collapse_ratio=config.collapse.ratio,
-            )
-        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            raise RbmError(
-                f"the column's model cannot be assembled ({type(exc).__name__}: {exc}): its"
-                " inputs are outside the range where the arithmetic is sound"
-            ) from None
-        check_derived(model)
-    return model
-
-
-def check_derived(model: Model) -> None:
-    """Every derived quantity of a model finite (and positive where it must be), before a
-    run starts: a density of 1e307 once made masses overflow and a collapsing column
-    report 'survived' (issue 14). Raises RbmError naming the first bad quantity."""
-    col = model.column
-    positive = {
-        "drum masses": col.masses,
-        "drum inertias": col.inertias,
-        "normal forces N_i": col.normal_forces,
-        "moment capacities M_u,i": col.moment_capacity,
-        "rotation capacities theta_u,i": col.rotation_capacity,
-        "lever arms": col.lever_arms,
-    }
-    finite = {
-        "mass matrix": model.mass,
-        "inverse mass matrix": model.mass_inv,
-        "gravity matrix": model.gravity,
-        "ground load": model.ground_load,
-        "collapse limits": model.collapse_limit,
-    }
-    for i, law in enumerate(model.laws):
-        finite[f"law of interface {i + 1}"] = np.concatenate(
-            [law.edges, law.intercepts, law.slopes]
-        )
-    stiff = col.stiffness
-    bad_stiffness = not np.all(np.isinf(stiff) | (np.isfinite(stiff) & (stiff > 0)))
-    for name, values in positive.items():
-        v = np.asarray(values, dtype=float)
-        if not (np.all(np.isfinite(v)) and np.all(v > 0)):
-            _derived_error(name, v)
-    for name, values in finite.items():
-        v = np.asarray(values, dtype=float)
-        if not np.all(np.isfinite(v)):
-            _derived_error(name, v)
-    if bad_stiffness:
-        _derived_error("joint stiffnesses K_M,i", stiff)
-    p = model.rocking_p
-    if not (math.isfinite(p) and p > 0):
-        _derived_error("rocking parameter p", np.array([p]))
-
-
-def _derived_error(name: str, values: np.ndarray) -> None:
-    shown = ", ".join(f"{x:.4g}" for x in values.ravel()[:3])
-    raise RbmError(
-        f"the column's {name} are not finite and positive ({shown}...): the inputs are"
-        " outside the range where the arithmetic is sound (check column sizes, density"
-        " and interface.stiffness)"
-    )
 
 
 class RbmRunner:

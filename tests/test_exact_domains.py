@@ -13,7 +13,7 @@ Sub-grids of the stored studies, the 8-drum CI band and a 2-drum grid are re-mad
   outcome and events, and peak rotation ratio, top displacement and collapse time within
   1e-8 of rtol 1e-12. Event counts are not compared on runs stopped early after a
   half-sine pulse: where the free motion stops is decided at step ends (rbm_cli.models.rbm.
-  exact._passed_peak), so the impacts counted before it are not a property of the run.
+  exact.run._passed_peak), so the impacts counted before it are not a property of the run.
 """
 
 from __future__ import annotations

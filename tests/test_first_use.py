@@ -205,7 +205,7 @@ def test_a_first_exact_run_compiles_the_exact_integrator(tmp_path, monkeypatch):
     """`solver.method: exact` runs the compiled exact integrator, not the step kernel: its
     first use compiles that (and says so), where it once compiled the step kernel, which
     the run does not use."""
-    import rbm_cli.models.rbm.exact_jit as exact_jit
+    import rbm_cli.models.rbm.exact.integrate as exact_integrate
     import rbm_cli.models.rbm.kernel as kernel
 
     def no_compile():
@@ -213,7 +213,7 @@ def test_a_first_exact_run_compiles_the_exact_integrator(tmp_path, monkeypatch):
 
     monkeypatch.setattr(kernel, "needs_compile", lambda: True)
     monkeypatch.setattr(kernel, "warm_up", no_compile)
-    monkeypatch.setattr(exact_jit, "needs_compile", lambda: True, raising=False)
+    monkeypatch.setattr(exact_integrate, "needs_compile", lambda: True, raising=False)
     text = (CONFIGS / "harmonic_monolithic.yaml").read_text()
     path = tmp_path / "exact.yaml"
     path.write_text(text + "\nsolver: {method: exact}\n")

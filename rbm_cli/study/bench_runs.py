@@ -32,7 +32,7 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
 
     method = resolve_method(cfg)
     if method == "exact":
-        from rbm_cli.models.rbm.exact_jit import warm_up
+        from rbm_cli.models.rbm.exact.integrate import warm_up
     elif method == "closed-form":
         from rbm_cli.models.rbm.closed_form import warm_up
     else:

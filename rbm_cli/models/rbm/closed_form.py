@@ -29,7 +29,7 @@ from rbm_cli.models.events import EVENT_EPS, REST_RATE
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm import run_codes as cr
 from rbm_cli.models.rbm.closed_form_jit_run import run_block
-from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, HARMONIC
+from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC
 from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings
 from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.physics.equations import Model

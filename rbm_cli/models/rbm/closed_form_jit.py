@@ -34,7 +34,7 @@ import math
 
 from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.brent import brent_step
-from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, LINEAR, f_phase
+from rbm_cli.models.rbm.exact.modal import HARMONIC, LINEAR, f_phase
 
 #: A piece: start time t0 [s], side s, C [rad], omega [rad/s], phi0 [rad], q0 [rad],
 #: q1 [rad/s], c1, c2 [rad], alpha [rad], p [rad/s]; the ground acceleration on it,

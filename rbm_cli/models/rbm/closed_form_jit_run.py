@@ -38,7 +38,7 @@ from rbm_cli.models.rbm.closed_form_jit import (
     scan_piece,
     start_piece,
 )
-from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel, linear_exceedance
+from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.kernel_ground import sine_exceedance
 from rbm_cli.models.rbm.run_codes import (
     AT_REST_END,

@@ -38,7 +38,7 @@ POLL_S = 0.1
 TARGETS = {
     "kernel": ("rbm_cli.models.rbm.kernel", "run_kernel"),
     "closed-form": ("rbm_cli.models.rbm.closed_form", "run_block"),
-    "exact": ("rbm_cli.models.rbm.exact_jit", "run_exact"),
+    "exact": ("rbm_cli.models.rbm.exact.integrate", "run_exact"),
 }
 #: What each is called in a note.
 NAMES = {

@@ -1,8 +1,8 @@
 """A ground motion's forcing segments as the arrays the compiled closed forms read: the
-exact integrator (exact_jit) and the rigid block's closed form (closed_form).
+exact integrator (rbm_cli.models.rbm.exact) and the rigid block's closed form (closed_form).
 
 seg_t (segments, 2): start and end [s] of each smooth segment; seg_fc (segments,
-FORCING_SIZE): its forcing (exact_jit_modal: zero, harmonic or linear).
+FORCING_SIZE): its forcing (exact.modal: zero, harmonic or linear).
 """
 
 from __future__ import annotations
@@ -11,14 +11,14 @@ import time
 
 import numpy as np
 
-from rbm_cli.models.rbm.exact_jit_modal import FORCING_SIZE, LINEAR, ZERO, forcing_array
-from rbm_cli.models.rbm.exact_motion import check_exact, resolve_segments
+from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, LINEAR, ZERO, forcing_array
+from rbm_cli.models.rbm.exact.motion import check_exact, resolve_segments
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
 
 def segment_arrays(segs: list) -> tuple[np.ndarray, np.ndarray]:
-    """(seg_t, seg_fc) of a list of (start [s], end [s], exact_modal.Forcing)."""
+    """(seg_t, seg_fc) of a list of (start [s], end [s], exact.motion.Forcing)."""
     seg_t = np.array([[s, e] for s, e, _ in segs], dtype=float).reshape(-1, 2)
     seg_fc = np.array([forcing_array(f) for _, _, f in segs]).reshape(-1, FORCING_SIZE)
     return seg_t, seg_fc
@@ -26,7 +26,7 @@ def segment_arrays(segs: list) -> tuple[np.ndarray, np.ndarray]:
 
 def record_arrays(motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:
     """The segments of a record motion as (seg_t, seg_fc) arrays, as
-    segment_arrays(exact_motion.record_segments(motion)) makes them, without a Python object
+    segment_arrays(exact.motion.record_segments(motion)) makes them, without a Python object
     per sample (3,000 samples: 0.3 ms instead of 21 ms a run)."""
     knots = np.asarray(motion.knots, dtype=float)
     values = np.asarray(motion.values, dtype=float)
@@ -55,7 +55,7 @@ def motion_arrays(
     model: Model, motion: GroundMotion, segments: list | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """(seg_t, seg_fc) of a run: a record's (record_arrays), the motion's other segments
-    (exact_motion.resolve_segments, which refuses what has no closed form in one line), or
+    (exact.motion.resolve_segments, which refuses what has no closed form in one line), or
     segments given by the caller."""
     if segments is None and motion.kind == "record":
         check_exact(model, motion.kind, motion.has_vertical)

@@ -47,7 +47,7 @@ class RbmRunner:
         self._integrators: dict = {}  # (method, implementation) -> integrator, on first use
         excitation = config.excitation
         if config.solver.method == "exact":
-            from rbm_cli.models.rbm.exact_motion import check_exact
+            from rbm_cli.models.rbm.exact.motion import check_exact
 
             check_exact(self.model, excitation.type, excitation.vertical is not None)
         if config.solver.method == "closed-form":
@@ -76,15 +76,10 @@ class RbmRunner:
                     " implementation compiled, or model housner-linear for the Python one)"
                 )
             return partial(integrate_closed_form, block=rbm_block(self.model))
-        if method == "exact" and implementation == "compiled":
-            from rbm_cli.models.rbm.exact_jit import integrate_exact_compiled, prepare_exact
-
-            return partial(integrate_exact_compiled, prepared=prepare_exact(self.model))
         if method == "exact":
-            from rbm_cli.models.rbm.exact import integrate_exact
-            from rbm_cli.models.rbm.exact_piece import ModalSystem
+            from rbm_cli.models.rbm.exact.integrate import integrate_exact, prepare_exact
 
-            return partial(integrate_exact, system=ModalSystem(self.model))
+            return partial(integrate_exact, prepared=prepare_exact(self.model))
         from rbm_cli.models.rbm.kernel import integrate, prepare_kernel
 
         return partial(integrate, prepared=prepare_kernel(self.model))

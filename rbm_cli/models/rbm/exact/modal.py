@@ -1,4 +1,36 @@
-"""The closed forms of rbm_cli.models.rbm.exact_modal, compiled (numba), one mode at a time.
+"""Closed-form motion of one modal coordinate of a linear piece (numba), one mode at a time.
+
+Inside one set of active law pieces the column's equations are linear with constant
+coefficients, M theta'' + K theta = -F0 - r a_g(t). With the M-orthonormal modes of the
+pencil (K, M) (rbm_cli.models.rbm.exact.piece), each modal coordinate obeys
+
+    q'' + lam q = f + g a_g(t)                                             (1)
+
+lam [1/s^2] of either sign (rising law pieces give lam > 0, oscillatory; descending ones
+lam < 0, exponential; a flat piece lam = 0), f and g constants. Its solution from
+(q0, v0) at tau = 0 is
+
+    q(tau) = q0 C(tau) + v0 S(tau) + f S2(tau) + g Y(tau)
+
+with the fundamental functions, continuous in lam through lam = 0,
+
+    C  = cos(w tau)  | cosh(k tau)          (w = sqrt(lam), k = sqrt(-lam))
+    S  = int_0^tau C = sin(w tau) / w | sinh(k tau) / k
+    S2 = int_0^tau S = (1 - C) / lam      (tau^2 / 2 at lam = 0)
+    S3 = int_0^tau S2 = (tau - S) / lam   (tau^3 / 6 at lam = 0)
+
+(power series for |lam| tau^2 < 1, so no cancellation near lam = 0; beyond it the
+differences lose at most an absolute eps / |lam|), and Y the response
+from rest to the ground acceleration:
+
+- harmonic, a_g = A sin(Om tau + phi): Y = A [sin(Om tau + phi) - sin(phi) C
+  - Om cos(phi) S] / (lam - Om^2), except near resonance (lam > 0, |w - Om| <
+  RESONANCE_BAND Om), where the same function is written
+  Y = A [cos(phi) S - tau cos(sig tau / 2 + phi) sinc(del tau / 2)] / (w + Om),
+  sig = w + Om, del = w - Om: exact at resonance (w = Om gives the tau cos term) and
+  without cancellation near it;
+- piecewise linear, a_g = a0 + a1 tau (a sampled record, exact on each sample interval
+  as in Nigam and Jennings' response spectra): Y = a0 S2 + a1 S3.
 
 A forcing is a float array fc of FORCING_SIZE entries: [kind, amplitude [m/s^2],
 omega [rad/s], phase [rad], t0 [s], a0 [m/s^2], a1 [m/s^3]], kind ZERO, HARMONIC
@@ -12,14 +44,20 @@ import math
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.exact_modal import RESONANCE_BAND, SERIES_TERMS
+
+#: Terms of the power series of C, S, S2, S3 tabulated (used for |lam| tau^2 < 1: the
+#: last term is below 1e-26 of the first; _terms takes as many as a given |z| needs).
+SERIES_TERMS = 14
+#: The harmonic response uses its resonance-stable form for modes with
+#: |w - omega| < RESONANCE_BAND omega, the plain particular-solution form elsewhere.
+RESONANCE_BAND = 0.5
 
 ZERO, HARMONIC, LINEAR = 0, 1, 2
 FORCING_SIZE = 7
 
 
 def forcing_array(forcing) -> np.ndarray:
-    """The fc array of an exact_modal.Forcing."""
+    """The fc array of a Forcing (rbm_cli.models.rbm.exact.motion)."""
     kind = {"zero": ZERO, "harmonic": HARMONIC, "linear": LINEAR}[forcing.kind]
     return np.array(
         [kind, forcing.amplitude, forcing.omega, forcing.phase, forcing.t0, forcing.a0,
@@ -99,7 +137,7 @@ def _series(z, first, terms):
 
 @jit
 def basis1(lam, tau):
-    """(C, S, S2, S3) of one mode at tau [s] (exact_modal.basis)."""
+    """(C, S, S2, S3) of one mode at tau [s] (equation (1) of the module docstring)."""
     z = lam * tau * tau
     if abs(z) < 1.0:
         m = _terms(abs(z))
@@ -124,8 +162,8 @@ def near_resonance(lam, om):
 
 @jit
 def harmonic_near(lam, tau, om, phase, c, s):
-    """(Y, Y') of q'' + lam q = sin(om tau + phase) from rest, resonance-stable form
-    (exact_modal.harmonic_response)."""
+    """(Y, Y') of q'' + lam q = sin(om tau + phase) from rest, resonance-stable form (module
+    docstring), given C = c and S = s of the same tau."""
     w = math.sqrt(lam)
     sig, dlt = w + om, w - om
     arg = 0.5 * sig * tau + phase
@@ -140,7 +178,9 @@ def harmonic_near(lam, tau, om, phase, c, s):
 
 @jit
 def advance(lam, q, v, f, g, fc, t, tau, qn, vn):
-    """(q, v) at t + tau [s] from (q, v) at t, into (qn, vn) (exact_modal.advance)."""
+    """Modal coordinates and rates (q, v) at t + tau [s] from (q, v) at t, exactly, into
+    (qn, vn) (equation (1) of the module docstring, the forcing fc read from absolute time
+    t; lam [1/s^2], f and g per mode)."""
     kind = int(fc[0])
     harmonic = kind == HARMONIC and fc[1] != 0.0
     om = fc[2]

@@ -1,11 +1,11 @@
-"""The run loop of the compiled exact integrator (numba): rbm_cli.models.rbm.exact's
-algorithm, statement for statement, in one compiled call per run.
+"""The run loop of the exact integrator (numba): one call per run, from piece to piece
+(rbm_cli.models.rbm.exact, the package docstring, says what it does).
 
 Mutable scalars live in small arrays: st = [t, h, next_out, t_collapse, at_rest, n_out]
 (floats) and cnt = [n_uplifts, n_impacts, n_steps, n_rhs, n_events, collapse interface,
 the part of n_rhs spent on peaks, the current segment] (ints). A motion is
 mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
-(start, end) with their forcings (exact_jit_modal); settings are
+(start, end) with their forcings (exact.modal); settings are
 se = [max_steps, max_events, deadline, early_stop, record, output_dt].
 """
 
@@ -17,10 +17,10 @@ from collections import namedtuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.exact_bounds import FIRST_STEP
-from rbm_cli.models.rbm.exact_jit_modal import LINEAR, ZERO, f_accel, linear_exceedance
-from rbm_cli.models.rbm.exact_jit_peaks import NOTES, new_notes, note_interval, settle_peaks
-from rbm_cli.models.rbm.exact_jit_piece import (
+from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
+from rbm_cli.models.rbm.exact.model import energy1, friction
+from rbm_cli.models.rbm.exact.peaks import NOTES, new_notes, note_interval, settle_peaks
+from rbm_cli.models.rbm.exact.piece import (
     cross,
     eval_point,
     locate,
@@ -29,8 +29,7 @@ from rbm_cli.models.rbm.exact_jit_piece import (
     row_at,
     set_point,
 )
-from rbm_cli.models.rbm.exact_jit_search import SCRATCH, next_point
-from rbm_cli.models.rbm.exact_jit_state import energy1, friction
+from rbm_cli.models.rbm.exact.search import SCRATCH, next_point
 from rbm_cli.models.rbm.kernel_ground import sine_exceedance
 from rbm_cli.models.rbm.run_codes import (
     AT_REST_END,
@@ -47,8 +46,11 @@ from rbm_cli.models.rbm.run_codes import (
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
 
+#: First interval tried at the start of a run and of a segment [s].
+FIRST_STEP = 1e-3
+
 #: Work arrays of a run: the point pool, mode and family bounds, the peak refinement's
-#: reference counts, free list and stack, and the noted intervals (exact_jit_peaks).
+#: reference counts, free list and stack, and the noted intervals (exact.peaks).
 Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes")
 #: The moving state: rotations, rates, law pieces (side, k, pending, awaiting), maxima of
 #: the tracked quantities, friction demand.
@@ -93,7 +95,8 @@ def _accel_and_friction(mdl, pc, pts, i, fric):
 
 @jit
 def _passed_peak(mdl, pc, pts):
-    """Early stop of free motion between points 0 and 1 (exact._passed_peak)."""
+    """Early stop of free motion between points 0 and 1: a monolith past a peak of its collapse
+    ratio with less energy than the collapse barrier."""
     if math.isnan(mdl.barrier):
         return False
     k = 1 + 2 * pc.n + pc.n  # collapse ratio of interface 1
@@ -119,7 +122,7 @@ def _budget(s, se):
 
 @jit
 def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
-    """Advance through the piece to its first event or seg_end [s] (exact._march).
+    """Advance through the piece to its first event or seg_end [s].
     Returns the event row, -1 at seg_end, or -(a terminal code)."""
     pts = wk.pts
     best, row = math.inf, -1
@@ -158,7 +161,7 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
 
 @jit
 def _handle(mdl, pc, row, s, se):
-    """Apply the event of a row at the state (exact._handle). Returns a code."""
+    """Apply the event of a row at the state. Returns a code."""
     n = s.theta.size
     if row >= 4 * n:
         i = pc.silent[row - 4 * n]
@@ -197,7 +200,7 @@ def _handle(mdl, pc, row, s, se):
 
 @jit
 def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
-    """A rigid monolith at rest (exact._leave_rest): 0 no ground motion left (rests to
+    """A rigid monolith at rest: 0 no ground motion left (rests to
     the end), 1 the segment ends first, 2 it lifts (a harmonic's exceedance from its
     formula, a linear piece's from its line)."""
     t = s.st[T]
@@ -231,7 +234,7 @@ def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
 
 @jit
 def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
-    """Run up to seg_end [s] under the forcing fc (exact._segment). Returns a code."""
+    """Run up to seg_end [s] under the forcing fc. Returns a code."""
     while s.st[T] < seg_end:
         if s.st[AT_REST] != 0.0:
             kind = _leave_rest(mdl, s, mo, seg_end, fc, samples, se[5])
@@ -253,7 +256,7 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
 
 @jit
 def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, stack):
-    """One run (exact.integrate_exact). Returns (code, st, cnt, maxima, friction)."""
+    """One run (exact.integrate.integrate_exact). Returns (code, st, cnt, maxima, friction)."""
     n = theta0.size
     side = np.ones(n, dtype=np.int64)
     k = np.zeros(n, dtype=np.int64)

@@ -1,9 +1,32 @@
-"""rbm_cli.models.rbm.exact_search compiled (numba): the next certified point or the first
-event of a piece, roots by safeguarded Newton, and the refinement of peaks.
+"""Where the exact integrator samples a piece, and how it finds events and peaks that no
+sampling can miss (numba).
 
-Points live in a pool array (exact_jit_piece): slots 0-2 belong to the run loop (the
-current point, the next one, a scratch point); the peak refinement takes its points from
-the slots above, with reference counts.
+An interval [a, b] of a piece is *certified* for an event row when a lower bound of the
+row's distance over the whole interval is positive (rbm_cli.models.rbm.exact.bounds: a
+slow part bounded by curvature, fast oscillations by their envelope):
+
+    lower = max(min(s_a, s_b) - C h^2 / 8,                 (linear interpolation)
+                min(s_a, s_a + s'_a h - C h^2 / 2),        (Taylor from a)
+                min(s_b, s_b - s'_b h - C h^2 / 2)) - E    (Taylor from b)
+
+with s the slow part, C the bound of its second derivative and E the envelope of the fast
+modes (the same with every mode in C and E = 0 is also tried). No crossing can hide in a
+certified interval. The integrator advances by certified intervals, doubling the interval
+after a success and halving it after a failure; an interval where some rows end below zero
+and every other row is certified holds the first event, provided each such row's distance
+is monotone there (its rate cannot reach zero: d'_a + C_full h < 0 or d'_b + C_full h < 0,
+so the root is unique), and a safeguarded Newton method finds it. Below MIN_STEP the
+interval is taken as it is (a graze deeper than C MIN_STEP^2 cannot hide there).
+
+Peaks of the tracked quantities (collapse ratios, top displacement) use the same bounds
+from above: an interval whose upper bound of |z| does not exceed the running maximum is
+done, and so is one where z' keeps its sign (a lower bound of +-z' from the ends' z', z''
+and a bound of |z'''|): |z| peaks at an end. Otherwise the interval is split at the root
+of z' (safeguarded Newton) when z' changes sign, else in halves.
+
+Points live in a pool array (rbm_cli.models.rbm.exact.piece): slots 0-2 belong to the run
+loop (the current point, the next one, a scratch point); the peak refinement takes its
+points from the slots above, with reference counts.
 """
 
 from __future__ import annotations
@@ -11,21 +34,24 @@ from __future__ import annotations
 import math
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.exact_bounds import (
-    MIN_STEP,
-    PEAK_RTOL,
-    ROOT_XTOL,
-    STATIONARY_GAP,
-    hermite_root,
-)
-from rbm_cli.models.rbm.exact_jit_bounds import (
+from rbm_cli.models.rbm.exact.bounds import (
     family_bounds,
     lower2,
     mode_bounds,
     row_lower,
     track_upper,
 )
-from rbm_cli.models.rbm.exact_jit_piece import eval_family, eval_point
+from rbm_cli.models.rbm.exact.piece import eval_family, eval_point
+
+#: Shortest interval the search splits down to, relative to max(1, t) [s].
+MIN_STEP = 1e-13
+#: Absolute tolerance of the root finding on event times and peak times [s].
+ROOT_XTOL = 1e-15
+#: Relative tolerance of the peaks (running maxima of |z|).
+PEAK_RTOL = 1e-12
+#: A root of z' closer than this fraction of its interval to an end is taken as that end;
+#: a rate below this fraction of the interval's end rates is a stationary point.
+STATIONARY_GAP = 1e-9
 
 #: Slots of the point pool owned by the run loop.
 RESERVED = 3
@@ -55,14 +81,33 @@ def _value(pc, pts, ia, x, r, kind):
     return dv, ff
 
 
-_hermite_root = jit(hermite_root)
+@jit
+def hermite_root(f0, d0, fh, dh, h):
+    """Start for the root finding in [0, h] [s] of a function with values f0, fh (f0 fh < 0)
+    and rates d0, dh at the ends: the root of their cubic Hermite interpolant (Newton on the
+    cubic from the secant's root, kept inside the interval)."""
+    m0, m1 = d0 * h, dh * h
+    s = f0 / (f0 - fh)
+    for _ in range(6):
+        s2 = s * s
+        p = (2 * s2 * s - 3 * s2 + 1) * f0 + (s2 * s - 2 * s2 + s) * m0
+        p += (-2 * s2 * s + 3 * s2) * fh + (s2 * s - s2) * m1
+        dp = (6 * s2 - 6 * s) * f0 + (3 * s2 - 4 * s + 1) * m0
+        dp += (-6 * s2 + 6 * s) * fh + (3 * s2 - 2 * s) * m1
+        if dp == 0.0:
+            break
+        s_new = s - p / dp
+        if not 0.0 < s_new < 1.0:
+            break
+        s = s_new
+    return s * h
 
 
 @jit
 def _newton(pc, pts, ia, h, f0, fh, r, kind, x0):
     """Root in [0, h] [s] after point ia of event row r (kind 0) or of the rate of family
     r (kind 1), f0 fh < 0 the values at the ends, from x0 (NaN: the secant's root)
-    (exact_search._safe_newton). Returns (root, evaluations)."""
+    (safeguarded Newton). Returns (root, evaluations)."""
     if f0 < 0.0:
         lo, hi = 0.0, h
     else:
@@ -121,8 +166,7 @@ def _first_root(pc, pts, ia, ib, fb, h, small):
             mono = s * pts[ia, of + nf + k] + cfull < 0.0 or s * pts[ib, of + nf + k] + cfull < 0.0
             if not (small or mono):
                 return -1, 0.0, 0
-    # the earliest root (exact_search._earliest): a row still positive at the earliest
-    # root so far crosses later
+    # the earliest root: a row still positive at the earliest root so far crosses later
     best, best_r, evals = h, -1, 0
     for r in range(pc.sgn.size):
         k, s = pc.fam[r], pc.sgn[r]
@@ -139,7 +183,7 @@ def _first_root(pc, pts, ia, ib, fb, h, small):
             best_r = r
             continue
         f0, d0 = s * pts[ia, of + k] + pc.off[r], s * pts[ia, of + nf + k]
-        start = _hermite_root(f0, d0, f_best, d_best, best)
+        start = hermite_root(f0, d0, f_best, d_best, best)
         best, ne = _newton(pc, pts, ia, best, f0, f_best, r, 0, start)
         best_r = r
         evals += ne
@@ -149,7 +193,7 @@ def _first_root(pc, pts, ia, ib, fb, h, small):
 @jit
 def next_point(pc, pts, h, t_stop, mb, fb):
     """From point 0: point 1 becomes the end of a certified interval of length <= h [s]
-    (or t_stop), or the first event (exact_search.next_point). Returns (event row or -1,
+    (or t_stop), or the first event (module docstring). Returns (event row or -1,
     interval to try next [s], evaluations, whether mb and fb hold the bounds of [0, 1])."""
     ta = pts[0, 0]
     h_min = MIN_STEP * max(1.0, abs(ta))
@@ -182,7 +226,7 @@ def next_point(pc, pts, h, t_stop, mb, fb):
 
 @jit
 def _monotone(pts, ia, ib, k, of, nf, third, slack, h):
-    """Whether family k's rate keeps one sign between points ia and ib (exact_search._monotone)."""
+    """Whether family k's rate keeps one sign between points ia and ib."""
     da, db = pts[ia, of + nf + k], pts[ib, of + nf + k]
     za, zb = pts[ia, of + 2 * nf + k], pts[ib, of + 2 * nf + k]
     if lower2(da, db, za, zb, third, h) >= -slack:
@@ -219,7 +263,7 @@ def _split_point(pc, pts, a, b, rows, c):
 @jit
 def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
     """Narrow rows (bool, n + 1) to those whose peak may still exceed its running maximum
-    on [a, b] (exact_search.refine_peaks); returns whether any is left. fresh: mb and fb
+    on [a, b] (module docstring); returns whether any is left. fresh: mb and fb
     hold the bounds of [a, b] already."""
     n, of, nf = pc.n, 1 + 2 * pc.n, pc.nf
     for i in range(n + 1):
@@ -253,8 +297,8 @@ def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
 
 @jit
 def refine_peaks(pc, pts, maxima, mb, fb, refs, free, st_ab, st_rows, fresh):
-    """Raise the running maxima (n + 1) to the peaks between points 0 and 1 (exact_search.
-    refine_peaks). refs, free: reference counts and free list of the pool's slots; st_ab,
+    """Raise the running maxima (n + 1) to the peaks between points 0 and 1 (module
+    docstring). refs, free: reference counts and free list of the pool's slots; st_ab,
     st_rows: the stack; fresh: mb and fb hold the bounds of [0, 1]. Returns the
     evaluations."""
     n, of = pc.n, 1 + 2 * pc.n

@@ -1,11 +1,33 @@
-"""The mode bounds of rbm_cli.models.rbm.exact_bounds, compiled (numba), and their use on
-rows: lower bounds of event distances, upper bounds of |tracked quantities|.
+"""Bounds of the modes of a piece over an interval (numba), and their use on rows: lower
+bounds of event distances, upper bounds of |tracked quantities|. They make the exact
+integrator's sampling certain (rbm_cli.models.rbm.exact.search).
 
-Mode bounds of an interval go into an (MB_ROWS, n) array: CURV, FULL, THIRD, FAST (1.0 for
-the modes treated by their envelope), ENV, OSC_A, OSC_B, RATE_A, RATE_B (exact_bounds.
-ModeBounds). Row bounds work on *families*: every event or peak row is sign * F[fam] + off,
-F = Gf q the family values (law arguments over theta_u, collapse ratios, top displacement),
-so a family's bound serves every row built on it.
+For each mode q'' + lam q = f + g a_g(t) on [a, a + h], from its state (q_a, v_a) there:
+
+- a majorant of the linear ODE: with k^2 = |lam| and F = max |f + g a_g|,
+  |q| <= |q_a| C + |v_a| S + F S2 and |q'| <= |q_a| k^2 S + |v_a| C + F S (hyperbolic C,
+  S, S2 of k at h), so |q''| <= |lam| max|q| + F and |q'''| <= |lam| max|q'| + max|g a_g'|;
+- for lam > 0, the energy E = v^2 + lam q^2 grows at most as sqrt(E) <= sqrt(E_a) + h F,
+  which bounds |q'| and |q| for any h (the smaller of the two bounds is kept; the
+  hyperbolic one only while lam h^2 < HYPERBOLIC_LIMIT, beyond which it is the larger);
+- for an oscillatory mode away from resonance (lam > 0, and for a harmonic forcing
+  lam >= 4 omega^2: "eligible"), the free oscillation o = q - p, p the particular solution,
+  has the constant amplitude R = sqrt(o^2 + o'^2 / lam) over the whole piece, so
+  |q''| <= lam R + |p''| and |q'''| <= lam^1.5 R + |p'''|; and where lam h^2 >
+  ENVELOPE_RATIO ("fast") the row's oscillation in that mode is better bounded by its
+  envelope |G_j| R than by its curvature: the row's slow part (the row minus the fast
+  oscillations, known at both ends) is bounded by curvature, the fast part by
+  sum_j |G_j| R_j.
+
+Every bound is inflated by SAFETY against rounding.
+
+Mode bounds of an interval go into an (MB_ROWS, n) array: CURV (|q''| of the modes treated
+by curvature, |p''| of the fast ones), FULL (|q''| of every mode, all by curvature), THIRD
+(|q'''|), FAST (1.0 for the modes treated by their envelope), ENV (their envelope R), OSC_A,
+OSC_B, RATE_A, RATE_B (their free oscillation o and o' at both ends). Row bounds work on
+*families*: every event or peak row is sign * F[fam] + off, F = Gf q the family values (law
+arguments over theta_u, collapse ratios, top displacement), so a family's bound serves every
+row built on it.
 """
 
 from __future__ import annotations
@@ -15,8 +37,15 @@ import math
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.exact_bounds import ENVELOPE_RATIO, HYPERBOLIC_LIMIT, SAFETY
-from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, LINEAR, basis1, f_accel, f_peak, f_phase
+from rbm_cli.models.rbm.exact.modal import HARMONIC, LINEAR, basis1, f_accel, f_peak, f_phase
+
+#: Bounds are inflated by this relative margin against rounding.
+SAFETY = 1.0 + 1e-9
+#: A mode is treated by its envelope on an interval when lam h^2 exceeds this.
+ENVELOPE_RATIO = 8.0
+#: For lam > 0 the hyperbolic majorant is used only while lam h^2 is below this (beyond,
+#: the energy bound is the smaller).
+HYPERBOLIC_LIMIT = 4.0
 
 CURV, FULL, THIRD, FAST, ENV, OSC_A, OSC_B, RATE_A, RATE_B = range(9)
 MB_ROWS = 9
@@ -24,7 +53,7 @@ MB_ROWS = 9
 
 @jit
 def _particular(lam, f, g, fc, ag_a, ag_b, sin_a, cos_a, sin_b, cos_b):
-    """(p, p') of an eligible mode at both ends of an interval (exact_bounds.particular),
+    """(p, p') of an eligible mode at both ends of an interval (module docstring),
     from the forcing's sines at both ends (harmonic) or its values ag_a, ag_b (linear)."""
     kind = int(fc[0])
     p_a = p_b = f / lam
@@ -66,7 +95,7 @@ def _mode(lam, q, v, big, dbig, h):
 
 @jit
 def mode_bounds(lam, f, g, elig, w, fc, t, q, v, h, qb, vb, mb):
-    """Fill mb (MB_ROWS, n) with the modes' bounds on [t, t + h] (exact_bounds.mode_bounds)
+    """Fill mb (MB_ROWS, n) with the modes' bounds on [t, t + h] (module docstring)
     from (q, v) at t and (qb, vb) at t + h. Returns whether some mode is fast."""
     kind = int(fc[0])
     peak = f_peak(fc, t, h)
@@ -138,7 +167,7 @@ def family_bounds(gf, absgf, mb, any_fast, fb):
 @jit
 def lower2(va, vb, ra, rb, curv, h):
     """Lower bound over [0, h] of a function with end values va, vb, end rates ra, rb and
-    |second derivative| <= curv (exact_search._lower)."""
+    |second derivative| <= curv (rbm_cli.models.rbm.exact.search)."""
     interp = min(va, vb) - curv * (h * h / 8.0)
     left = min(va, va + ra * h - curv * (h * h / 2.0))
     right = min(vb, vb - rb * h - curv * (h * h / 2.0))
@@ -147,7 +176,7 @@ def lower2(va, vb, ra, rb, curv, h):
 
 @jit
 def upper_abs2(va, vb, ra, rb, curv, h):
-    """Upper bound of |value| over [0, h] (exact_search._upper_abs)."""
+    """Upper bound of |value| over [0, h] (rbm_cli.models.rbm.exact.search)."""
     interp = max(abs(va), abs(vb)) + curv * (h * h / 8.0)
     left = max(abs(va), abs(va + ra * h)) + curv * (h * h / 2.0)
     right = max(abs(vb), abs(vb - rb * h)) + curv * (h * h / 2.0)

@@ -1,6 +1,6 @@
-"""What the compiled exact integrator's run loop needs besides pieces and search (numba):
-the model's arrays, the friction demand, the energy of a monolith, the rest of a rigid
-block and recorded samples."""
+"""The model as the exact integrator reads it: its arrays (made once per column), the
+empty cache of modes, and what the run loop computes from them (numba): the friction
+demand and the energy of a monolith."""
 
 from __future__ import annotations
 
@@ -56,7 +56,7 @@ def exact_model(model: Model) -> ExactModel:
 
 
 def new_cache(n: int) -> tuple:
-    """An empty cache of modes for n interfaces (exact_jit_piece.modes): a power-of-two
+    """An empty cache of modes for n interfaces (exact.piece.modes): a power-of-two
     table of at most 2^22 / n^2 sets of pieces (64 MB of modes at most)."""
     cap = 64
     while cap * 2 <= min(8192, (1 << 22) // (n * n)):

@@ -1,8 +1,8 @@
 """Peaks of the compiled exact integrator, refined at the end of the run (numba).
 
-The Python loop refines the peaks of every interval whose upper bound of |z| exceeds the
-running maximum as it goes (exact_search.refine_peaks). Most of that work is for maxima
-that a later peak exceeds anyway. Here such an interval is only noted (its start point,
+Refining the peaks of every interval whose upper bound of |z| exceeds the running maximum
+as the run goes (rbm_cli.models.rbm.exact.search.refine_peaks) would spend most of its work
+on maxima that a later peak exceeds anyway. Such an interval is only noted (its start point,
 length, law pieces, segment and upper bounds); at the end of the run the notes are taken
 in decreasing order of their excess over the maxima and refined by the same procedure
 while some row may still exceed its maximum. The maxima are the same (the refinement is
@@ -17,9 +17,9 @@ from collections import namedtuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.exact_jit_bounds import track_upper
-from rbm_cli.models.rbm.exact_jit_piece import eval_point, make_piece, set_point
-from rbm_cli.models.rbm.exact_jit_search import bounds_of, refine_peaks
+from rbm_cli.models.rbm.exact.bounds import track_upper
+from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, set_point
+from rbm_cli.models.rbm.exact.search import bounds_of, refine_peaks
 
 #: Notes kept at most.
 NOTES = 2048

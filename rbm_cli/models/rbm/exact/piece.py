@@ -1,12 +1,21 @@
-"""The pieces of the compiled exact integrator (numba): the law pieces each interface is on
-(rbm_cli.models.events.Pieces), the modes of a set of pieces (cached across runs, as
-exact_piece.ModalSystem), a linear piece's rows, and its points.
+"""One linear piece of the exact integrator (numba): the law pieces each interface is on
+(rbm_cli.models.events.Pieces), the modes of a set of pieces, a linear piece's rows, and
+its points.
 
-A point of a piece is a row of a pool array: [t, q (n), v (n), F (nf), F' (nf), F'' (nf)],
-F = Gf q the family values (nf = 2n + 1: law arguments over theta_u, collapse ratios,
-top displacement). An event row r is sgn[r] * F[fam[r]] + off[r] (exact_search rows, in
-the same order: lower law bounds, upper law bounds, collapse on either side, then the
-silent zero crossings of the interfaces awaiting one).
+The modes solve the symmetric pencil K phi = lam M phi (through the Cholesky factor of M:
+M symmetric positive definite in the `relative` and `geometric` formulations, K symmetric,
+possibly indefinite or singular), M-orthonormal: Phi^T M Phi = I, so q = Phi^T M theta.
+They depend only on the slopes of the active pieces, so they are cached by the pieces'
+indices across the runs of one column (modes); the intercepts (which side) only move the
+constant load f.
+
+Every event surface and every tracked peak quantity is linear in theta, so in modal
+coordinates a row is d(t) = G q(t) + h0 (event distances, >= 0 inside the piece) or
+z(t) = T q(t) (peaks). A point of a piece is a row of a pool array: [t, q (n), v (n),
+F (nf), F' (nf), F'' (nf)], F = Gf q the family values (nf = 2n + 1: law arguments over
+theta_u, collapse ratios, top displacement). An event row r is sgn[r] * F[fam[r]] + off[r],
+in the order: lower law bounds, upper law bounds, collapse on either side, then the silent
+zero crossings of the interfaces awaiting one.
 """
 
 from __future__ import annotations
@@ -17,10 +26,10 @@ import numpy as np
 
 from rbm_cli.base.jit import jit
 from rbm_cli.models.events import BIG, EVENT_EPS
-from rbm_cli.models.rbm.exact_jit_modal import HARMONIC, advance, f_accel
+from rbm_cli.models.rbm.exact.modal import HARMONIC, advance, f_accel
 
 #: A linear piece: modes (lam, phi, tom = Phi^T M), modal loads f, g, the eligible modes
-#: and their frequencies w (exact_bounds), family rows gf = Gf Phi and |gf|, event rows
+#: and their frequencies w (exact.bounds), family rows gf = Gf Phi and |gf|, event rows
 #: (sgn, off, fam), the interfaces awaiting a silent crossing, the forcing fc.
 #: The pool slot root finding works in.
 SCRATCH_SLOT = 2

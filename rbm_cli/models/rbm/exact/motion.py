@@ -1,5 +1,5 @@
 """What the exact integrator takes of a ground motion: smooth segments, each with one
-closed-form forcing (rbm_cli.models.rbm.exact_modal.Forcing), and what it refuses.
+closed-form forcing (Forcing), and what it refuses.
 
 A sampled record (times t_k, accelerations a_k) is exact per sample interval as a
 piecewise-linear forcing, as Nigam and Jennings integrate response spectra:
@@ -16,10 +16,11 @@ and the absolute formulation (not symmetric).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.models.rbm.exact_modal import Forcing
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -32,6 +33,26 @@ _NOT_EXACT = {
     "ricker": "a Gaussian times a polynomial has no closed-form modal response",
     "mavroeidis-papageorgiou": "its sum of three sines is not integrated exactly yet",
 }
+
+
+@dataclass(frozen=True)
+class Forcing:
+    """The ground acceleration on a segment of the motion, from absolute time t [s]
+    (rbm_cli.models.rbm.exact.modal.forcing_array makes its array).
+
+    kind : str  'harmonic' (a_g = amplitude sin(omega t + phase)), 'linear'
+        (a_g = a0 + a1 (t - t0), t0 the segment's start) or 'zero'
+    amplitude [m/s^2], omega [rad/s], phase [rad]: the harmonic's
+    t0 [s], a0 [m/s^2], a1 [m/s^3]: the linear piece's
+    """
+
+    kind: str
+    amplitude: float = 0.0
+    omega: float = 0.0
+    phase: float = 0.0
+    t0: float = 0.0
+    a0: float = 0.0
+    a1: float = 0.0
 
 
 def check_exact(model: Model, kind: str, vertical: bool = False) -> None:

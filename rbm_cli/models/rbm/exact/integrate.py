@@ -1,9 +1,9 @@
-"""The compiled exact integrator (`solver.method: exact`, `solver.implementation:
-compiled`): rbm_cli.models.rbm.exact's algorithm in one numba call per run
-(exact_jit_run), run from Python here.
+"""The exact integrator from Python: the model's arrays and cache of modes (prepare_exact),
+one run (integrate_exact: the compiled run loop, rbm_cli.models.rbm.exact.run, or its
+uncompiled version with ``solver.implementation: python``), and its first compile.
 
 The modes of every set of law pieces met are cached across the runs of one column
-(PreparedExact.cache), as the Python loop's ModalSystem does.
+(PreparedExact.cache).
 """
 
 from __future__ import annotations
@@ -14,10 +14,11 @@ from typing import NamedTuple
 import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
+from rbm_cli.base.jit import plain
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
-from rbm_cli.models.rbm.exact_jit_run import run_exact
-from rbm_cli.models.rbm.exact_jit_state import ExactModel, exact_model, new_cache
-from rbm_cli.models.rbm.exact_motion import check_exact
+from rbm_cli.models.rbm.exact.model import ExactModel, exact_model, new_cache
+from rbm_cli.models.rbm.exact.motion import check_exact
+from rbm_cli.models.rbm.exact.run import run_exact
 from rbm_cli.models.rbm.forcing_arrays import motion_arrays, run_settings
 from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.models.rbm.run_codes import (
@@ -42,6 +43,8 @@ class PreparedExact(NamedTuple):
 
 
 def prepare_exact(model: Model) -> PreparedExact:
+    """The arrays and an empty cache of modes of a model the exact method takes
+    (RbmError in one line otherwise)."""
     check_exact(model, "free")
     return PreparedExact(exact_model(model), new_cache(model.n))
 
@@ -65,7 +68,7 @@ def _outcome(code, st, cnt, maxima, fric, solver, n: int) -> Outcome:
     return out
 
 
-def integrate_exact_compiled(
+def integrate_exact(
     model: Model,
     motion: GroundMotion,
     theta0: np.ndarray,
@@ -77,11 +80,24 @@ def integrate_exact_compiled(
     prepared: PreparedExact | None = None,
     segments: list | None = None,
 ) -> Outcome:
-    """rbm_cli.models.rbm.exact.integrate_exact, compiled (same arguments and Outcome).
+    """Integrate one motion of a model from the initial state (theta0 [rad], rate0
+    [rad/s]) exactly, piece by piece (rbm_cli.models.rbm.exact): compiled, or its
+    uncompiled version (the same source, rbm_cli.base.jit.plain) with
+    ``solver.implementation: python``.
 
+    Parameters
+    ----------
+    model : Model  The column's equations (rbm_cli.physics.equations)
+    motion : GroundMotion  The ground motion (its kind, end and pulse end with segments)
+    theta0, rate0 : array (n,)  Initial drum rotations [rad] and rates [rad/s]
+    solver : SolverConfig  Budgets (max_steps: certified intervals, max_events,
+        max_wall_time) and implementation
+    record : bool  Keep samples every output_dt [s] (Outcome.samples)
+    early_stop : bool  Stop free motion once its outcome cannot change
     prepared : PreparedExact, optional  prepare_exact(model), made once by a caller that
         runs one model many times (a sweep); made here when None.
-    segments : list, optional  The forcing instead of the motion's (exact.integrate_exact)
+    segments : list, optional  (start [s], end [s], Forcing) to integrate instead of the
+        motion's segments (rbm_cli.models.rbm.exact.motion.sampled_segments)
     """
     seg_t, seg_fc = motion_arrays(model, motion, segments)
     if prepared is None:
@@ -91,7 +107,8 @@ def integrate_exact_compiled(
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     armed = arm()  # Ctrl-C reaches the run through poll (kernel_guard)
     try:
-        code, st, cnt, maxima, fric = run_exact(
+        run = run_exact if solver.implementation == "compiled" else plain(run_exact)
+        code, st, cnt, maxima, fric = run(
             prepared.arrays, prepared.cache, seg_t, seg_fc, mo, se,
             np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), samples, POOL, STACK,
         )  # fmt: skip
@@ -114,7 +131,7 @@ def warm_up() -> None:
     rigid monolith and an elastic 2-drum column (their model arrays type differently),
     under a harmonic and a linear forcing."""
     from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig, StiffnessConfig
-    from rbm_cli.models.rbm.exact_motion import sampled_segments
+    from rbm_cli.models.rbm.exact.motion import sampled_segments
     from rbm_cli.physics.column import build_column
     from rbm_cli.physics.equations import build_model
 
@@ -125,7 +142,7 @@ def warm_up() -> None:
         geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=drums)
         model = build_model(build_column(geometry, interface))
         zeros = np.zeros(model.n)
-        integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig())
+        integrate_exact(model, motion, zeros, zeros, SolverConfig())
         if model.uplift_level is None:  # a rigid monolith is refused a given linear forcing
-            integrate_exact_compiled(model, motion, zeros, zeros, SolverConfig(),
+            integrate_exact(model, motion, zeros, zeros, SolverConfig(),
                                      segments=segments)  # fmt: skip

@@ -36,7 +36,7 @@ from rbm_cli.models.rbm.exact_modal import Forcing, advance
 from rbm_cli.models.rbm.exact_motion import sampled_segments
 from rbm_cli.models.rbm.exact_piece import LinearPiece, ModalSystem
 from rbm_cli.models.rbm.exact_search import Evaluator, row_lower, track_upper
-from rbm_cli.models.rbm.kernel import integrate
+from rbm_cli.models.rbm.step import integrate
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.closed_forms import (
     free_rocking_period,

@@ -192,7 +192,7 @@ class RbmRunner:
             from rbm_cli.models.rbm.exact_piece import ModalSystem
 
             return partial(integrate_exact, system=ModalSystem(self.model))
-        from rbm_cli.models.rbm.kernel import integrate, prepare_kernel
+        from rbm_cli.models.rbm.step import integrate, prepare_kernel
 
         return partial(integrate, prepared=prepare_kernel(self.model))
 

@@ -211,7 +211,7 @@ def test_run_says_when_it_compiles_the_kernel(tmp_path, monkeypatch, cold):
     """A first run compiles the kernel (15-20 s of silence otherwise): one note on
     stderr then, none when numba's cache is there. A rigid monolith runs the block's
     closed form by default (seconds to compile, no kernel): no note either way."""
-    import rbm_cli.models.rbm.kernel as kernel
+    import rbm_cli.models.rbm.step as kernel
 
     monkeypatch.setattr(kernel, "needs_compile", lambda: cold)
     res = invoke("run", CONFIGS / "harmonic_monolithic.yaml", "-a", 0.5, "-f", 1, "-o", tmp_path)
@@ -227,12 +227,12 @@ def test_needs_compile_sees_the_cache(tmp_path):
     this process (the on-disk cache exists), True in a process whose cache folder is empty.
     Guards against a check that cannot fail: it once answered False on any error, and it
     answers None when numba's cache internals are no longer the ones it reads."""
-    from rbm_cli.models.rbm.kernel import needs_compile, warm_up
+    from rbm_cli.models.rbm.step import needs_compile, warm_up
 
     warm_up()
     assert needs_compile() is False
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"))
-    code = "from rbm_cli.models.rbm.kernel import needs_compile; print(needs_compile())"
+    code = "from rbm_cli.models.rbm.step import needs_compile; print(needs_compile())"
     res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                          timeout=300)  # fmt: skip
     assert res.returncode == 0, res.stderr[-2000:]

@@ -40,7 +40,7 @@ from rbm_cli.models.rbm.exact.model import exact_model, new_cache
 from rbm_cli.models.rbm.exact.motion import Forcing, sampled_segments
 from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, point_size, set_point
 from rbm_cli.models.rbm.exact.search import bounds_of
-from rbm_cli.models.rbm.kernel import integrate
+from rbm_cli.models.rbm.step import integrate
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.closed_forms import (
     free_rocking_period,

@@ -237,7 +237,7 @@ def _assert_clean(tally: Tally) -> None:
 
 @pytest.fixture(scope="module")
 def compiled():
-    from rbm_cli.models.rbm.kernel import warm_up
+    from rbm_cli.models.rbm.step import warm_up
 
     warm_up()
 

@@ -184,7 +184,7 @@ def test_a_sweep_says_what_it_compiles_before_it_waits_and_after(tmp_path, monke
 def test_a_run_in_python_compiles_nothing(tmp_path, monkeypatch):
     """`solver.implementation: python` is what the user asked for: no compile, no note,
     the Python integrator's answer."""
-    import rbm_cli.models.rbm.kernel as kernel
+    import rbm_cli.models.rbm.step as kernel
 
     def no_compile():
         raise AssertionError("the kernel was compiled for a run in Python")
@@ -206,7 +206,7 @@ def test_a_first_exact_run_compiles_the_exact_integrator(tmp_path, monkeypatch):
     first use compiles that (and says so), where it once compiled the step kernel, which
     the run does not use."""
     import rbm_cli.models.rbm.exact.integrate as exact_integrate
-    import rbm_cli.models.rbm.kernel as kernel
+    import rbm_cli.models.rbm.step as kernel
 
     def no_compile():
         raise AssertionError("the step kernel was compiled for an exact run")

@@ -217,13 +217,13 @@ def _worker_modules(cfg, workers: list[int]) -> set[str]:
 def test_a_worker_does_not_import_plotting(workers):
     modules = _worker_modules(rigid(), workers)
     assert "rbm_cli.models.rbm.closed_form" in modules  # the compiled path ran there
-    assert "rbm_cli.models.rbm.kernel" not in modules  # a rigid block's: not the kernel
+    assert "rbm_cli.models.rbm.step" not in modules  # a rigid block's: not the kernel
     assert not {m for m in modules if m.split(".")[0] == "matplotlib"}
     assert "rbm_cli.report.domain_figure" not in modules
 
 
 def test_a_worker_imports_no_scipy_solver(workers):
-    """The compiled path's tableaux are written out (models/rbm/kernel_tableaux.py) and
+    """The compiled path's tableaux are written out (models/rbm/step/tableaux.py) and
     Brent's method is imported where the Python paths call it: a worker never imports
     scipy.integrate or scipy.optimize (numba itself imports scipy.linalg for its BLAS)."""
     modules = _worker_modules(rigid(), workers)
@@ -300,7 +300,7 @@ def test_ctrl_c_on_a_pool_keeps_the_cells_and_leaves_no_process(tmp_path, rows):
     Ctrl-C to the whole group (a terminal's), as soon as the workers exist (still
     importing: they must not print tracebacks) or once `rows` cells are done, ends the
     sweep in one line, exit 130, and no process of the group outlives it."""
-    from rbm_cli.models.rbm.kernel import warm_up
+    from rbm_cli.models.rbm.step import warm_up
 
     warm_up()  # the subprocess loads the kernel, it does not compile it
     path = tmp_path / "costly.yaml"

@@ -1,4 +1,4 @@
-"""The step kernel (rbm_cli.models.rbm.kernel) against closed forms and physical checks.
+"""The step kernel (rbm_cli.models.rbm.step) against closed forms and physical checks.
 
 Compiled and uncompiled (its own source run by Python) it gives the same bits:
 tests/test_jit.py.
@@ -14,8 +14,8 @@ import pytest
 
 from rbm_cli.config.load import load_config
 from rbm_cli.models.housner_linear import housner_linear_run
-from rbm_cli.models.rbm.kernel import integrate
 from rbm_cli.models.rbm.runner import RbmRunner
+from rbm_cli.models.rbm.step import integrate
 from rbm_cli.physics.closed_forms import linear_rocking_parameters
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.study.simulate import model_from_config, simulate

@@ -2,7 +2,7 @@
 answers as every later use (first use and a correct cache).
 
 numba checks a cached function only against its own file: a change to a callee in another
-module (kernel_rk.py, detmath.py) once left the cached run_kernel in use, and
+module (step/rk.py, detmath.py) once left the cached run_kernel in use, and
 needs_compile() said nothing needed compiling. Here a copy of the package is run in
 subprocesses (the copy first on PYTHONPATH, numba's cache in a fresh folder):
 
@@ -54,7 +54,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "rbm_cli"
 DRIVER = """
 import json, sys
 import rbm_cli
-from rbm_cli.models.rbm.kernel import needs_compile
+from rbm_cli.models.rbm.step import needs_compile
 before = needs_compile()
 from rbm_cli.api import run
 cfg = {"name": "block", "column": {"height": 2.0, "base_width": 0.5},
@@ -103,8 +103,8 @@ def _rbm(*args: str) -> list[str]:
 def _edit_safety(path: Path, new: str) -> None:
     """The step-size controller's safety factor (0.9, scipy's) of the Runge-Kutta module."""
     text = path.read_text()
-    edited, n = re.subn(r"^(_SAFETY\b[^=\n]*=\s*)0\.9\b", rf"\g<1>{new}", text, flags=re.M)
-    assert n == 1, f"no '_SAFETY ... = 0.9' in {path}"
+    edited, n = re.subn(r"^(SAFETY\b[^=\n]*=\s*)0\.9\b", rf"\g<1>{new}", text, flags=re.M)
+    assert n == 1, f"no 'SAFETY ... = 0.9' in {path}"
     path.write_text(edited)
 
 
@@ -158,9 +158,9 @@ def test_first_use_then_a_change_to_a_compiled_callee_invalidates_the_cache(tmp_
     indexes = sorted(p.name for p in cache.rglob("*.nbi"))
 
     # same length, same size on disk: only the contents differ
-    _edit_safety(copy / "rbm_cli" / "models" / "rbm" / "kernel_rk.py", "0.8")
+    _edit_safety(copy / "rbm_cli" / "models" / "rbm" / "step" / "rk.py", "0.8")
     edited = _run(copy, cache, tmp_path)
-    assert edited["before"] is True, "needs_compile() missed a change to kernel_rk.py"
+    assert edited["before"] is True, "needs_compile() missed a change to step/rk.py"
     assert edited["n_steps"] != first["n_steps"], "the stale cached kernel ran"
     assert edited["after"] is False
     assert sorted(p.name for p in cache.rglob("*.nbi")) == indexes  # rewritten, not added
@@ -211,11 +211,11 @@ def test_the_digest_moves_with_the_compiled_sources_only(tmp_path):
 
     cli = root / "cli" / "main.py"
     assert not changed(cli, cli.read_text() + "\n# a comment\n")
-    rk = root / "models" / "rbm" / "kernel_rk.py"
-    assert changed(rk, rk.read_text().replace("_SAFETY, _MIN_FACTOR", "_SAFETY,  _MIN_FACTOR"))
+    rk = root / "models" / "rbm" / "step" / "rk.py"
+    assert changed(rk, rk.read_text().replace("SAFETY, MIN_FACTOR", "SAFETY,  MIN_FACTOR"))
     events = root / "models" / "events.py"
     assert changed(events, events.read_text() + "\n# EVENT_EPS is read by run_kernel\n")
-    new = root / "models" / "rbm" / "kernel_new.py"  # a new kernel module, named nowhere
+    new = root / "models" / "rbm" / "step" / "new.py"  # a new kernel module, named nowhere
     assert changed(new, "from numba import njit\n\n\n@njit(cache=True)\ndef f(x):\n    return x\n")
     assert new in compile_cache.compiled_sources(root)
     compile_cache.source_digest.cache_clear()

@@ -1,4 +1,4 @@
-"""The kernel's Runge-Kutta tableaux (written out in models/rbm/kernel_tableaux.py so the
+"""The kernel's Runge-Kutta tableaux (written out in models/rbm/step/tableaux.py so the
 compiled path does not import scipy.integrate, issue 18) are scipy's, bit for bit: the
 kernel's step sequence is scipy's only if every coefficient is."""
 
@@ -9,8 +9,8 @@ import pytest
 from scipy.integrate._ivp import dop853_coefficients as dop
 from scipy.integrate._ivp.rk import RK23, RK45
 
-from rbm_cli.models.rbm import kernel_rk
-from rbm_cli.models.rbm import kernel_tableaux as tb
+from rbm_cli.models.rbm.step import rk
+from rbm_cli.models.rbm.step import tableaux as tb
 
 
 def padded(rows, shape) -> np.ndarray:
@@ -51,25 +51,25 @@ def test_the_kernels_padded_tables_hold_scipys():
     """The kernel's tables (one padded shape for the three methods) hold scipy's arrays
     in their corners and zeros elsewhere."""
     m = {"RK23": 0, "RK45": 1, "DOP853": 2}
-    assert kernel_rk.METHOD_CODES == m
+    assert rk.METHOD_CODES == m
     d = m["DOP853"]
     n = dop.N_STAGES_EXTENDED
-    assert same_bits(kernel_rk.TAB_A[d], dop.A) and same_bits(kernel_rk.TAB_C[d], dop.C)
-    assert same_bits(kernel_rk.TAB_B[d], padded(dop.B, n))
-    assert same_bits(kernel_rk.TAB_E[d], padded(dop.E5, n))
-    assert same_bits(kernel_rk.TAB_E3[d], padded(dop.E3, n))
-    assert same_bits(kernel_rk.TAB_P[d][:, :4], dop.D.T) and not kernel_rk.TAB_P[d][:, 4:].any()
-    assert (kernel_rk.TAB_NS[d], kernel_rk.TAB_EST[d]) == (dop.N_STAGES, 7)
+    assert same_bits(rk.TAB_A[d], dop.A) and same_bits(rk.TAB_C[d], dop.C)
+    assert same_bits(rk.TAB_B[d], padded(dop.B, n))
+    assert same_bits(rk.TAB_E[d], padded(dop.E5, n))
+    assert same_bits(rk.TAB_E3[d], padded(dop.E3, n))
+    assert same_bits(rk.TAB_P[d][:, :4], dop.D.T) and not rk.TAB_P[d][:, 4:].any()
+    assert (rk.TAB_NS[d], rk.TAB_EST[d]) == (dop.N_STAGES, 7)
     for cls in (RK23, RK45):
         k = m[cls.__name__]
         a = np.zeros((n, n))
         a[: cls.A.shape[0], : cls.A.shape[1]] = cls.A
         p = np.zeros((n, 8))
         p[: cls.P.shape[0], : cls.P.shape[1]] = cls.P
-        assert same_bits(kernel_rk.TAB_A[k], a) and same_bits(kernel_rk.TAB_P[k], p)
-        assert same_bits(kernel_rk.TAB_C[k], padded(cls.C, n))
-        assert same_bits(kernel_rk.TAB_B[k], padded(cls.B, n))
-        assert same_bits(kernel_rk.TAB_E[k], padded(cls.E, n))
-        assert not kernel_rk.TAB_E3[k].any()
-        assert kernel_rk.TAB_NS[k] == cls.n_stages
-        assert kernel_rk.TAB_EST[k] == cls.error_estimator_order
+        assert same_bits(rk.TAB_A[k], a) and same_bits(rk.TAB_P[k], p)
+        assert same_bits(rk.TAB_C[k], padded(cls.C, n))
+        assert same_bits(rk.TAB_B[k], padded(cls.B, n))
+        assert same_bits(rk.TAB_E[k], padded(cls.E, n))
+        assert not rk.TAB_E3[k].any()
+        assert rk.TAB_NS[k] == cls.n_stages
+        assert rk.TAB_EST[k] == cls.error_estimator_order

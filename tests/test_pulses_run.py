@@ -22,7 +22,7 @@ from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
 from rbm_cli.models.housner_linear import housner_linear_run
-from rbm_cli.models.rbm.kernel_ground import _next_uplift
+from rbm_cli.models.rbm.kernel_ground import next_uplift
 from rbm_cli.models.rbm.runner import model_from_config
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.excitation import make_ground_motion
@@ -179,7 +179,7 @@ def test_uplift_time_against_a_scan(kind, extra, level_g):
           motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip
     knots = np.zeros(0) if motion.knots is None else np.array(motion.knots)
     none = np.zeros(0)
-    t_k = _next_uplift(0.0, level, motion.amplitude, gr, knots, none, none, motion.pulse_end)
+    t_k = next_uplift(0.0, level, motion.amplitude, gr, knots, none, none, motion.pulse_end)
     assert t_py is not None and t_k == pytest.approx(t_py, abs=1e-12)
     ts = np.linspace(0.0, motion.pulse_end, 1_000_001)
     first = ts[np.argmax(np.abs(motion.accel(ts)) > level)]

@@ -22,7 +22,7 @@ from rbm_cli.cli.main import cli
 from rbm_cli.config.excitation import resolve_record_path, with_record
 from rbm_cli.config.load import load_config, parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.rbm.kernel_ground import _next_uplift
+from rbm_cli.models.rbm.kernel_ground import next_uplift
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.physics.records import Record, write_at2, write_csv
@@ -170,7 +170,7 @@ def test_uplift_time_on_a_straight_piece(tmp_path, level_g):
     assert motion.next_exceedance(t_fall + 1e-9, level) is None
     gr = (motion.form, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     knots, values, none = np.array(motion.knots), np.array(motion.values), np.zeros(0)
-    t_kernel = _next_uplift(0.0, level, motion.amplitude, gr, knots, values, none, motion.pulse_end)
+    t_kernel = next_uplift(0.0, level, motion.amplitude, gr, knots, values, none, motion.pulse_end)
     assert t_kernel == pytest.approx(level_g / 2.0, abs=1e-12)
     assert motion.uplift_side(level_g / 2.0) == -1  # a_g > 0: it lifts on the -theta side
 

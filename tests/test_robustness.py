@@ -324,7 +324,7 @@ import numpy as np
 from rbm_cli.physics.column import build_column
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
 from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.models.rbm.kernel import integrate
+from rbm_cli.models.rbm.step import integrate
 from rbm_cli.physics.equations import build_model
 with np.errstate(all="ignore"):
     geometry = ColumnConfig(height=4.0, base_width=1.0, top_width=1.0, depth=1.0,
@@ -357,7 +357,7 @@ def test_case07_density_1e308_is_refused_in_one_line(tmp_path):
 @pytest.fixture(scope="module")
 def compiled():
     """The kernel compiled (or loaded) once, so a subprocess only loads it."""
-    from rbm_cli.models.rbm.kernel import warm_up
+    from rbm_cli.models.rbm.step import warm_up
 
     warm_up()
 

@@ -237,7 +237,7 @@ def test_no_child_outlives_its_run(tmp_path, how):
     """A run of minutes, its child forked: kill -9 of the run (its child sees the pipe
     close and exits), or Ctrl-C to the whole group (the child ignores it, the run kills
     it): the child is gone, and no run folder was written."""
-    from rbm_cli.models.rbm.kernel import warm_up
+    from rbm_cli.models.rbm.step import warm_up
 
     warm_up()  # the subprocess loads the kernel, it does not compile it
     path = tmp_path / "long.yaml"

@@ -17,7 +17,7 @@ import pytest
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.rbm.kernel_ground import _next_uplift
+from rbm_cli.models.rbm.kernel_ground import next_uplift
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.excitation import make_ground_motion, merge_records
 from rbm_cli.physics.records import write_csv
@@ -109,7 +109,7 @@ def test_uplift_level_follows_the_vertical(tmp_path):
     assert motion.next_exceedance(0.0, level) == pytest.approx(expected, abs=1e-12)
     gr = (motion.form, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     arrays = (np.array(motion.knots), np.array(motion.values), np.array(motion.vertical))
-    t_k = _next_uplift(0.0, level, motion.amplitude, gr, *arrays, motion.pulse_end)
+    t_k = next_uplift(0.0, level, motion.amplitude, gr, *arrays, motion.pulse_end)
     assert t_k == pytest.approx(expected, abs=1e-12)
 
 

@@ -225,7 +225,7 @@ def run_bench(
     The figure (bench.png) is drawn by the caller from the returned table
     (:func:`rbm_cli.report.bench_figures.work_precision_figure`)."""
     from rbm_cli.base.files import write_text_atomic
-    from rbm_cli.models.rbm.kernel import warm_up
+    from rbm_cli.models.rbm.step import warm_up
 
     ref_dir = Path(reference_dir) if reference_dir else REFERENCE_DIR
     out_dir = Path(output)

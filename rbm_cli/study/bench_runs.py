@@ -36,7 +36,7 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
     elif method == "closed-form":
         from rbm_cli.models.rbm.closed_form import warm_up
     else:
-        from rbm_cli.models.rbm.kernel import warm_up
+        from rbm_cli.models.rbm.step import warm_up
     warm_up()  # load the method's compiled code in this worker before timing runs
     runner = make_runner(cfg)
     rows = []

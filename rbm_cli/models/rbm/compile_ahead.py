@@ -36,7 +36,7 @@ POLL_S = 0.1
 #: What can be compiled (rbm_cli.models.methods.compiled_code): the module of its
 #: needs_compile and warm_up, and its compiled function whose cache folder holds the lock.
 TARGETS = {
-    "kernel": ("rbm_cli.models.rbm.kernel", "run_kernel"),
+    "kernel": ("rbm_cli.models.rbm.step", "run_kernel"),
     "closed-form": ("rbm_cli.models.rbm.closed_form", "run_block"),
     "exact": ("rbm_cli.models.rbm.exact.integrate", "run_exact"),
 }

@@ -9,7 +9,7 @@ arrays: an array passed down to them costs reference counts at every call (a tup
 holding a record's samples made harmonic runs 5-10 % slower). A record reaches them one
 straight piece at a time: its steps end at every sample (the kinks of a_g), so inside a
 step a_g is the line through two samples, ``(LINE, gain, a_{k+1} - a_k, a_k, t_k,
-t_{k+1} - t_k)``, evaluated as ground_forms.sampled_value does (:func:`_record_piece`
+t_{k+1} - t_k)``, evaluated as ground_forms.sampled_value does (:func:`record_piece`
 picks it). A cosine is sin(y + pi/2) here and in the Python forms alike (detmath has
 no cosine).
 """
@@ -57,7 +57,7 @@ def _ground_other(t, form, amp, om, ph, c, gamma):
 
 
 @jit(inline=True)
-def _ground(t, gr):
+def ground(t, gr):
     """a_g(t) [m/s^2] of the ground tuple gr (0 on a free segment: gain 0)."""
     form, amp, om, ph, c, gamma = gr[0], gr[1], gr[2], gr[3], gr[4], gr[5]
     if amp == 0.0:
@@ -68,7 +68,7 @@ def _ground(t, gr):
 
 
 @jit(inline=True)
-def _gravity(t, gr):
+def gravity_factor(t, gr):
     """(g + a_v(t)) / g [-] of the ground tuple gr (1 with no vertical record)."""
     if gr[6] == 0.0:
         return 1.0
@@ -89,12 +89,12 @@ def _first_after(knots, x):
 
 
 @jit
-def _record_piece(t, knots, values, vertical, gain, seg_end):
+def record_piece(t, knots, values, vertical, gain, seg_end):
     """The straight piece of a record a step from t [s] runs on, as a ground tuple, and
     the time that step ends at: the first sample past t + the smallest step (10 ulp of
     t, as python.Stepper takes it), or seg_end if sooner. Before the first sample and
     after the last the ground rests (gain 0). vertical: a_v at the knots (or empty; if not,
-    the tuple says so even where a_v = 0, since the laws are then split, _rhs)."""
+    the tuple says so even where a_v = 0, since the laws are then split, rhs)."""
     min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
     j = _first_after(knots, t + min_step)
     n = knots.size
@@ -105,7 +105,7 @@ def _record_piece(t, knots, values, vertical, gain, seg_end):
             vf, va, vd = 1.0, vertical[j - 1], vertical[j] - vertical[j - 1]
         gr = (LINE, gain, values[j] - values[j - 1], values[j - 1], knots[j - 1],
               knots[j] - knots[j - 1], vf, va, vd)  # fmt: skip
-    else:  # with a vertical record, a_v = 0 still read as one (its split laws: kernel_vertical)
+    else:  # with a vertical record, a_v = 0 still read as one (its split laws: step.vertical)
         gr = (LINE, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0 if vertical.size > 0 else 0.0, 0.0, 0.0)
     return gr, bound
 
@@ -124,10 +124,10 @@ def _sampled_at(t, knots, values):
 
 
 @jit
-def _ground_at(t, gr, knots, values):
+def ground_at(t, gr, knots, values):
     """a_g(t) [m/s^2] of the motion (gr its formula, or a record's samples, gain 1)."""
     if gr[0] != SAMPLED:
-        return _ground(t, gr)
+        return ground(t, gr)
     return _sampled_at(t, knots, values)
 
 
@@ -168,7 +168,7 @@ def _solve_piece(gr, tl, tr, target):
         mid = 0.5 * (lo + hi)
         if mid <= lo or mid >= hi:
             break
-        if s * (_ground(mid, gr) - target) > 0.0:
+        if s * (ground(mid, gr) - target) > 0.0:
             hi = mid
         else:
             lo = mid
@@ -179,13 +179,13 @@ def _solve_piece(gr, tl, tr, target):
 def _exceedance_pieces(t0, level, last, gr, knots, values, vertical):
     """ground_forms.exceedance_on_pieces; -1 for none before `last`."""
     sampled = gr[0] == SAMPLED
-    if abs(_ground_at(t0, gr, knots, values)) > _level_at(t0, level, knots, vertical):
+    if abs(ground_at(t0, gr, knots, values)) > _level_at(t0, level, knots, vertical):
         return t0
     k = _first_after(knots, t0)
     tl = t0
     while True:
         tr = min(knots[k] if k < knots.size else last, last)
-        ar = _ground_at(tr, gr, knots, values)
+        ar = ground_at(tr, gr, knots, values)
         if abs(ar) > _level_at(tr, level, knots, vertical):
             target = level if ar > 0.0 else -level
             if not sampled:
@@ -210,7 +210,7 @@ def _exceedance_pieces(t0, level, last, gr, knots, values, vertical):
 
 
 @jit
-def _next_uplift(t0, level, peak, gr, knots, values, vertical, last):
+def next_uplift(t0, level, peak, gr, knots, values, vertical, last):
     """GroundMotion.next_exceedance: the first time >= t0 with |a_g| > level [m/s^2]
     (times (g + a_v) / g with a vertical record; peak = max |a_g|); -1 for none before
     `last`."""

@@ -1,6 +1,8 @@
-"""How a compiled closed-form run ends (the exact integrator's loop, exact_jit_run, and the
-rigid block's, closed_form_jit_run): the codes their loops return (GOING: not ended), the
-guards' verdict in those codes and how often they poll, and the Outcome of a budget's code."""
+"""How a compiled run ends, for every integrator (the step kernel, step.stepper; the exact
+integrator's loop, exact.run; the rigid block's closed form, closed_form_jit_run): the
+codes their loops return (GOING: not ended), the guards' verdict in those codes and how
+often the closed-form loops poll, and the Outcome of a budget's code. The codes never
+leave the process."""
 
 from __future__ import annotations
 
@@ -9,6 +11,9 @@ from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
 
 GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
 FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
+#: The step kernel's own failures: a step below the spacing of the numbers at t, and a
+#: state that became NaN or infinite.
+FAILED_STEP, FAILED_NONFINITE = 9, 10
 #: Loop turns (pieces, certified intervals) between two polls of the wall clock and Ctrl-C.
 POLL_PIECES = 64
 
@@ -23,23 +28,18 @@ def guard_code(deadline):
     return FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
 
 
-#: The budgets' codes, in end_by_budget's order.
-BUDGETS = (FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED)
-
-
-def end_by_budget(out, code: int, solver, budgets: tuple = BUDGETS) -> bool:
-    """End the Outcome ``out`` as its budget code says (steps, events, wall clock; Ctrl-C
-    raises KeyboardInterrupt) at out.t_end; False for a code that is not a budget's.
-    budgets: those four codes in a loop's own numbering (the step kernel's differs)."""
+def end_by_budget(out, code: int, solver) -> bool:
+    """End the Outcome ``out`` as its budget code says (FAILED_STEPS, FAILED_EVENTS,
+    FAILED_WALL; INTERRUPTED raises KeyboardInterrupt) at out.t_end; False for a code that
+    is not a budget's."""
     t = out.t_end
-    steps, events, wall, interrupted = budgets
-    if code == steps:
+    if code == FAILED_STEPS:
         out.out_of_steps(solver, t)
-    elif code == events:
+    elif code == FAILED_EVENTS:
         out.out_of_events(solver, t)
-    elif code == wall:
+    elif code == FAILED_WALL:
         out.out_of_time(solver, t)
-    elif code == interrupted:  # pragma: no cover - disarm() raises first
+    elif code == INTERRUPTED:  # pragma: no cover - disarm() raises first
         raise KeyboardInterrupt
     else:
         return False

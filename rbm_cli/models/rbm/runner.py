@@ -80,7 +80,7 @@ class RbmRunner:
             from rbm_cli.models.rbm.exact.integrate import integrate_exact, prepare_exact
 
             return partial(integrate_exact, prepared=prepare_exact(self.model))
-        from rbm_cli.models.rbm.kernel import integrate, prepare_kernel
+        from rbm_cli.models.rbm.step import integrate, prepare_kernel
 
         return partial(integrate, prepared=prepare_kernel(self.model))
 

@@ -3,7 +3,7 @@
 Inside one set of active law pieces the column's equations are linear with constant
 coefficients; the integrator decomposes them once per set of pieces (cached) and moves
 every mode in closed form (modal, piece): no time step and no truncation error, only
-rounding. The events are those of the Runge-Kutta integrator (rbm_cli.models.rbm.kernel,
+rounding. The events are those of the Runge-Kutta integrator (rbm_cli.models.rbm.step,
 same surfaces, same EVENT_EPS, same actions):
 
 - a law argument reaching the end of its piece (uplift, kink, impact with restitution;

@@ -8,17 +8,17 @@ import math
 
 import numpy as np
 
+import rbm_cli.models.rbm.step.tableaux as _tb
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm import kernel_tableaux as _tb
-from rbm_cli.models.rbm.kernel_ground import _gravity, _ground
+from rbm_cli.models.rbm.kernel_ground import gravity_factor, ground
 
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
 
-# ---- Butcher tableaux (scipy's, written out in kernel_tableaux), padded to one shape:
+# ---- Butcher tableaux (scipy's, written out in step.tableaux), padded to one shape:
 # (A, B, C, E, P, n_stages, est_order)
-_NS_MAX = _tb.DOP853_N_STAGES_EXTENDED
+NS_MAX = _tb.DOP853_N_STAGES_EXTENDED
 
 
 def _fill(out: np.ndarray, rows) -> np.ndarray:
@@ -32,12 +32,12 @@ def _fill(out: np.ndarray, rows) -> np.ndarray:
 
 
 def _tableau(method: str):
-    A = np.zeros((_NS_MAX, _NS_MAX))
-    C = np.zeros(_NS_MAX)
-    B = np.zeros(_NS_MAX)
-    E = np.zeros(_NS_MAX)
-    E3 = np.zeros(_NS_MAX)
-    P = np.zeros((_NS_MAX, 8))
+    A = np.zeros((NS_MAX, NS_MAX))
+    C = np.zeros(NS_MAX)
+    B = np.zeros(NS_MAX)
+    E = np.zeros(NS_MAX)
+    E3 = np.zeros(NS_MAX)
+    P = np.zeros((NS_MAX, 8))
     if method == "DOP853":
         _fill(A, _tb.DOP853_A)
         _fill(C, _tb.DOP853_C)
@@ -45,7 +45,7 @@ def _tableau(method: str):
         _fill(E, _tb.DOP853_E5)
         _fill(E3, _tb.DOP853_E3)
         # dense output: D (4 x 16) stored transposed in P[:, :4]
-        D = _fill(np.zeros((4, _NS_MAX)), _tb.DOP853_D)
+        D = _fill(np.zeros((4, NS_MAX)), _tb.DOP853_D)
         P[:, :4] = D.T
         return A, B, C, E, E3, P, _tb.DOP853_N_STAGES, 7
     name = "RK45" if method == "RK45" else "RK23"
@@ -77,17 +77,14 @@ TAB_NS = np.array([t[6] for t in _TAB], dtype=np.int64)
 TAB_EST = np.array([t[7] for t in _TAB], dtype=np.int64)
 TAB_NP = np.array([3, 4, 7], dtype=np.int64)  # interpolant order of RK23 / RK45 / DOP853
 
-# status codes of the kernel
-SURVIVED, STOPPED_EARLY, COLLAPSED, FAILED_STEP, FAILED_STEPS, FAILED_EVENTS = range(6)
-# a run past its wall-clock budget, stopped by Ctrl-C, or whose state became NaN or inf
-FAILED_WALL, INTERRUPTED, FAILED_NONFINITE = 6, 7, 8
-_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+#: Step-size control (scipy's): the safety factor and the least and greatest change of h.
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
 
 # ---------------------------------------------------------------- small pieces
 @jit(inline=True)
-def _rhs(t, y, n, As, cs, es, gr, out):
-    g = _ground(t, gr)
+def rhs(t, y, n, As, cs, es, gr, out):
+    g = ground(t, gr)
     if gr[6] == 0.0:
         for i in range(n):
             out[i] = y[n + i]
@@ -97,8 +94,8 @@ def _rhs(t, y, n, As, cs, es, gr, out):
             out[n + i] = s
         return
     # a vertical record: every weight (the law's weight part and gravity, As[:, :n] and cs)
-    # times (g + a_v) / g; the joints' stiffness (As[:, n:], kernel_events._system) not
-    gam = _gravity(t, gr)
+    # times (g + a_v) / g; the joints' stiffness (As[:, n:], step.events.system) not
+    gam = gravity_factor(t, gr)
     for i in range(n):
         out[i] = y[n + i]
         s = cs[i]
@@ -110,12 +107,12 @@ def _rhs(t, y, n, As, cs, es, gr, out):
 
 
 @jit(inline=True)
-def _acc_of(t, y, n, As, cs, es, gr, acc):
+def acc_of(t, y, n, As, cs, es, gr, acc):
     """Angular accelerations theta'' at (t, y) into acc [rad/s^2]; returns a_g(t) [m/s^2]
     and (g + a_v(t)) / g [-]. (gam * x + e g is x + e g to the bit when gam = 1; the
-    elastic part As[:, n:] is read with a vertical record only, as _rhs reads it.)"""
-    g = _ground(t, gr)
-    gam = _gravity(t, gr)
+    elastic part As[:, n:] is read with a vertical record only, as rhs reads it.)"""
+    g = ground(t, gr)
+    gam = gravity_factor(t, gr)
     vert = gr[6] != 0.0
     for i in range(n):
         d = cs[i]
@@ -137,7 +134,7 @@ def _rms(v):
 
 
 @jit
-def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, work):
+def initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, work):
     """scipy.integrate._ivp.common.select_initial_step (max_step = inf)."""
     interval = abs(t_bound - t0)
     if interval == 0.0:
@@ -151,7 +148,7 @@ def _initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, wor
     y1 = np.empty(m)
     for i in range(m):
         y1[i] = y0[i] + h0 * f0[i]
-    _rhs(t0 + h0, y1, n, As, cs, es, gr, work)
+    rhs(t0 + h0, y1, n, As, cs, es, gr, work)
     d2 = _rms((work - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -171,11 +168,11 @@ def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr):
         for j in range(s):
             acc += A[s, j] * K[j, i]
         tmp[i] = y[i] + h * acc
-    _rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, gr, K[s])
+    rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, gr, K[s])
 
 
 @jit
-def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
+def rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     """One Runge-Kutta step of size h; stages in K (row ns = f(t + h, y_new))."""
     B = TAB_B[mc]
     ns = TAB_NS[mc]
@@ -188,11 +185,11 @@ def _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
         for j in range(ns):
             acc += B[j] * K[j, i]
         ynew[i] = y[i] + h * acc
-    _rhs(t + h, ynew, n, As, cs, es, gr, K[ns])
+    rhs(t + h, ynew, n, As, cs, es, gr, K[ns])
 
 
 @jit
-def _error_norm(mc, K, h, y, ynew, atol, rtol, scale):
+def error_norm(mc, K, h, y, ynew, atol, rtol, scale):
     ns = TAB_NS[mc]
     E = TAB_E[mc]
     m = scale.size
@@ -224,13 +221,13 @@ def _error_norm(mc, K, h, y, ynew, atol, rtol, scale):
 
 
 @jit
-def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
+def dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
     """Coefficients F of the step's interpolant (DOP853: extra stages)."""
     m = y_old.size
     ns = TAB_NS[mc]
     P = TAB_P[mc]
     if mc == 2:
-        for s in range(ns + 1, _NS_MAX):
+        for s in range(ns + 1, NS_MAX):
             _stage(mc, s, t_old, y_old, h, K, tmp, n, As, cs, es, gr)
         for i in range(m):
             dy = y_new[i] - y_old[i]
@@ -239,10 +236,10 @@ def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
             F[2, i] = 2.0 * dy - h * (K[ns, i] + K[0, i])
             for r in range(4):
                 acc = 0.0
-                for j in range(_NS_MAX):
+                for j in range(NS_MAX):
                     acc += P[j, r] * K[j, i]
                 F[3 + r, i] = h * acc
-        return _NS_MAX - ns - 1
+        return NS_MAX - ns - 1
     order = TAB_NP[mc]
     for i in range(m):
         for r in range(order):
@@ -254,7 +251,7 @@ def _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
 
 
 @jit
-def _dense_eval(mc, t, t_old, h, y_old, F, out):
+def dense_eval(mc, t, t_old, h, y_old, F, out):
     x = (t - t_old) / h
     m = y_old.size
     if mc == 2:
@@ -276,7 +273,7 @@ def _dense_eval(mc, t, t_old, h, y_old, F, out):
 
 
 @jit
-def _emit_rest(t_stop, samples, n_out, next_out, dt):
+def emit_rest(t_stop, samples, n_out, next_out, dt):
     while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
         samples[n_out, 0] = next_out
         samples[n_out, 1:] = 0.0
@@ -286,10 +283,10 @@ def _emit_rest(t_stop, samples, n_out, next_out, dt):
 
 
 @jit
-def _emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
+def emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
     while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
         samples[n_out, 0] = next_out
-        _dense_eval(mc, next_out, t_old, h, y_old, F, samples[n_out, 1:])
+        dense_eval(mc, next_out, t_old, h, y_old, F, samples[n_out, 1:])
         n_out += 1
         next_out += dt
     return n_out, next_out

@@ -79,7 +79,7 @@ def switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
 
 
 @jit(inline=True)
-def _settle(awaiting, argmap, y, side):
+def settle(awaiting, argmap, y, side):
     """events.Pieces.settle in the kernel: the silent impacts (interfaces back on their
     first piece whose argument changed sign) counted and their sides flipped; returns how
     many."""

@@ -1,5 +1,5 @@
 """The compiled stepper of the Rigid Beam Model (numba): one call runs a whole motion
-(the algorithm: rbm_cli.models.rbm.kernel), from four typed records (kernel_inputs)."""
+(the algorithm: rbm_cli.models.rbm.step), from four typed records (step.inputs)."""
 
 from __future__ import annotations
 
@@ -10,52 +10,54 @@ import numpy as np
 from rbm_cli.base.detmath import matvec, pow_pos
 from rbm_cli.base.jit import jit
 from rbm_cli.models.events import BIG, EVENT_EPS
-from rbm_cli.models.rbm.kernel_events import (
-    CHECK_INTERVALS,
-    _affine,
-    _bounds,
-    _brentq,
-    _energy1,
-    _first_crossing,
-    _friction,
-    _n_below,
-    _poly_val,
-    _row_poly,
-    _surfaces,
-    _system,
-    _within_reach,
-)
-from rbm_cli.models.rbm.kernel_ground import _ground_at, _next_uplift, _record_piece
-from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, POLL_STEPS, poll
-from rbm_cli.models.rbm.kernel_inputs import Excitation, ModelArrays, RunTask, SolverSettings
-from rbm_cli.models.rbm.kernel_rk import (
-    _MAX_FACTOR,
-    _MIN_FACTOR,
-    _NS_MAX,
-    _SAFETY,
+from rbm_cli.models.rbm.kernel_ground import ground_at, next_uplift, record_piece
+from rbm_cli.models.rbm.kernel_guard import POLL_STEPS
+from rbm_cli.models.rbm.run_codes import (
     COLLAPSED,
     FAILED_EVENTS,
     FAILED_NONFINITE,
     FAILED_STEP,
     FAILED_STEPS,
-    FAILED_WALL,
-    INTERRUPTED,
+    GOING,
     STOPPED_EARLY,
     SURVIVED,
+    guard_code,
+)
+from rbm_cli.models.rbm.step.events import (
+    CHECK_INTERVALS,
+    affine,
+    brentq,
+    energy1,
+    first_crossing,
+    friction_demand,
+    n_below,
+    piece_bounds,
+    poly_val,
+    row_poly,
+    surfaces,
+    system,
+    within_reach,
+)
+from rbm_cli.models.rbm.step.inputs import Excitation, ModelArrays, RunTask, SolverSettings
+from rbm_cli.models.rbm.step.rk import (
+    MAX_FACTOR,
+    MIN_FACTOR,
+    NS_MAX,
+    SAFETY,
     TAB_EST,
     TAB_NS,
-    _acc_of,
-    _dense_eval,
-    _dense_prepare,
-    _emit,
-    _emit_rest,
-    _error_norm,
-    _initial_step,
-    _rhs,
-    _rk_attempt,
+    acc_of,
+    dense_eval,
+    dense_prepare,
+    emit,
+    emit_rest,
+    error_norm,
+    initial_step,
+    rhs,
+    rk_attempt,
 )
-from rbm_cli.models.rbm.kernel_state import IMPACT, REST, UPLIFT, _settle, switch
-from rbm_cli.models.rbm.kernel_vertical import bound_now, moving_rows
+from rbm_cli.models.rbm.step.state import IMPACT, REST, UPLIFT, settle, switch
+from rbm_cli.models.rbm.step.vertical import bound_now, moving_rows
 
 
 @jit
@@ -68,14 +70,14 @@ def run_kernel(model, motion, solver, task):
 
     Parameters
     ----------
-    model : tuple  A kernel_inputs.ModelArrays (kernel_inputs.prepare_kernel).
-    motion : tuple  A kernel_inputs.Excitation: the ground motion.
-    solver : tuple  A kernel_inputs.SolverSettings: method, tolerances, budgets, deadline.
-    task : tuple  A kernel_inputs.RunTask: initial state, early stop, samples (in place).
+    model : tuple  A step.inputs.ModelArrays (step.inputs.prepare_kernel).
+    motion : tuple  A step.inputs.Excitation: the ground motion.
+    solver : tuple  A step.inputs.SolverSettings: method, tolerances, budgets, deadline.
+    task : tuple  A step.inputs.RunTask: initial state, early stop, samples (in place).
 
     Returns
     -------
-    tuple  (status code (kernel_rk), t_end [s], t_collapse [s], collapsed interface,
+    tuple  (status code (run_codes), t_end [s], t_collapse [s], collapsed interface,
         max_ratio (n,), max_top, friction (n,), n_uplifts, n_impacts, n_steps, n_rhs,
         n_events, n_samples).
     """
@@ -91,7 +93,7 @@ def run_kernel(model, motion, solver, task):
     knots, values, vertical, clipped = motion.knots, motion.values, motion.vertical, motion.clipped
     bounds, forced = motion.bounds, motion.forced
     # the ground (kernel_ground): of the motion, and nothing (a free segment); a record
-    # one straight piece a step (_record_piece)
+    # one straight piece a step (record_piece)
     gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
                motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip
     gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center, motion.gamma,
@@ -123,11 +125,11 @@ def run_kernel(model, motion, solver, task):
     event_rows, gx, gc, same = model.event_rows, model.gx, model.gc, model.same
     md, mg, track, es = model.md, model.mg, model.track, model.es
     peaks = np.zeros(nt)
-    As, cs = np.empty((n, 2 * n)), np.empty(n)  # As[:, n:]: the joints' (kernel_events._system)
-    vert = vertical.size > 0  # a vertical record: kinks that move with it (kernel_vertical)
+    As, cs = np.empty((n, 2 * n)), np.empty(n)  # As[:, n:]: the joints' (step.events.system)
+    vert = vertical.size > 0  # a vertical record: kinks that move with it (step.vertical)
     mv_e, mv_w = np.zeros(2 * n if vert else 0), np.ones(2 * n if vert else 0)
     h0 = np.empty(4 * n)
-    K = np.empty((_NS_MAX, m))
+    K = np.empty((NS_MAX, m))
     F = np.empty((8, m))
     f = np.empty(m)
     ynew = np.empty(m)
@@ -169,7 +171,7 @@ def run_kernel(model, motion, solver, task):
     for i in range(n):
         s = 1 if x0[i] > 0 else (-1 if x0[i] < 0 else (1 if r0[i] >= 0 else -1))
         side[i] = s
-        k[i] = _n_below(edges[i], nedges[i], abs(x0[i]))
+        k[i] = n_below(edges[i], nedges[i], abs(x0[i]))
         pending[i] = k[i] > 0 and not rigid[i]
 
     for seg in range(bounds.size - 1):
@@ -185,31 +187,31 @@ def run_kernel(model, motion, solver, task):
             if at_rest:
                 if free_seg:
                     if record:
-                        n_out, next_out = _emit_rest(t_end, samples, n_out, next_out, output_dt)
+                        n_out, next_out = emit_rest(t_end, samples, n_out, next_out, output_dt)
                     return (status, t_end, t_col, c_if, max_ratio, max_top, friction,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 last = min(pulse_end, t_end)
-                t_up = _next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical,
+                t_up = next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical,
                                     last)  # fmt: skip
                 if t_up < 0.0 or t_up >= seg_end:
                     if record:
-                        n_out, next_out = _emit_rest(seg_end, samples, n_out, next_out, output_dt)
+                        n_out, next_out = emit_rest(seg_end, samples, n_out, next_out, output_dt)
                     t = seg_end
                     break
                 if record:
-                    n_out, next_out = _emit_rest(t_up - 1e-15, samples, n_out, next_out, output_dt)
+                    n_out, next_out = emit_rest(t_up - 1e-15, samples, n_out, next_out, output_dt)
                 t = t_up
                 for i in range(m):
                     y[i] = 0.0
-                side[0] = -1 if _ground_at(t, gr_full, knots, values) > 0.0 else 1
+                side[0] = -1 if ground_at(t, gr_full, knots, values) > 0.0 else 1
                 k[0] = 0
                 at_rest = False
                 n_upl += 1
                 h_carry = -1.0
 
-            _system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs)
+            system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs)
             for i in range(n):
-                _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi)
+                piece_bounds(i, side, k, pending, rigid, edges, nedges, lo, hi)
                 h0[i] = min(-lo[i] / tu[i], BIG) + EVENT_EPS
                 h0[n + i] = min(hi[i] / tu[i], BIG) + EVENT_EPS
                 h0[2 * n + i] = c_ratio + EVENT_EPS
@@ -220,19 +222,19 @@ def run_kernel(model, motion, solver, task):
             # a new stepper from (t, y)
             t_bound = seg_end
             if clipped:
-                gr, t_bound = _record_piece(t, knots, values, vertical, seg_gain, seg_end)
-            _rhs(t, y, n, As, cs, es, gr, f)
+                gr, t_bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
+            rhs(t, y, n, As, cs, es, gr, f)
             if h_carry > 0.0:
                 h_abs = min(h_carry, seg_end - t)
                 n_rhs += 1
             else:
-                h_abs = _initial_step(t, y, f, t_bound, est_order, rtol, atol, n, As, cs, es,
+                h_abs = initial_step(t, y, f, t_bound, est_order, rtol, atol, n, As, cs, es,
                                       gr, work)  # fmt: skip
                 n_rhs += 2
-            _affine(track, y, 0, no_offset, z_old)
-            _affine(track, y, n, no_offset, dz_old)
-            _acc_of(t, y, n, As, cs, es, gr, acc)
-            _surfaces(gx, gc, same, y, acc, h0, d_old, dd_old, d2_old, t, gr, mv_e, mv_w)
+            affine(track, y, 0, no_offset, z_old)
+            affine(track, y, n, no_offset, dz_old)
+            acc_of(t, y, n, As, cs, es, gr, acc)
+            surfaces(gx, gc, same, y, acc, h0, d_old, dd_old, d2_old, t, gr, mv_e, mv_w)
             event = False
             running = True
             while running:
@@ -242,7 +244,7 @@ def run_kernel(model, motion, solver, task):
                     h_abs = min_step
                 bound = seg_end  # a record's steps end at its samples (python.Stepper's)
                 if clipped:
-                    gr, bound = _record_piece(t, knots, values, vertical, seg_gain, seg_end)
+                    gr, bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
                 rejected = False
                 while True:
                     if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
@@ -254,31 +256,30 @@ def run_kernel(model, motion, solver, task):
                         t_new = bound
                     h = t_new - t
                     h_abs = abs(h)
-                    _rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr)
+                    rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr)
                     n_rhs += stage_rhs
-                    err = _error_norm(mc, K, h, y, ynew, atol, rtol, scale)
+                    err = error_norm(mc, K, h, y, ynew, atol, rtol, scale)
                     if not (err == err and abs(err) < math.inf):  # NaN or inf state
                         return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top, friction,
                                 n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                     if err < 1.0:
                         if err == 0.0:
-                            factor = _MAX_FACTOR
+                            factor = MAX_FACTOR
                         else:
-                            factor = min(_MAX_FACTOR, _SAFETY * pow_pos(err, err_exp))
+                            factor = min(MAX_FACTOR, SAFETY * pow_pos(err, err_exp))
                         if rejected:
                             factor = min(1.0, factor)
                         h_abs *= factor
                         break
-                    h_abs *= max(_MIN_FACTOR, _SAFETY * pow_pos(err, err_exp))
+                    h_abs *= max(MIN_FACTOR, SAFETY * pow_pos(err, err_exp))
                     rejected = True
                 n_steps += 1
                 if n_steps > max_steps:
                     return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 if n_steps % POLL_STEPS == 0:  # the wall-clock budget and Ctrl-C
-                    guard = poll(deadline)
-                    if guard != GO_ON:
-                        code = FAILED_WALL if guard == PAST_DEADLINE else INTERRUPTED
+                    code = guard_code(deadline)
+                    if code != GOING:
                         return (code, t, t_col, c_if, max_ratio, max_top, friction,
                                 n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 if t_new - seg_end >= 0:
@@ -287,38 +288,38 @@ def run_kernel(model, motion, solver, task):
                 y_old = y
                 y_new[:] = ynew
                 dense_ready = False
-                g_new, gam_new = _acc_of(t_new, y_new, n, As, cs, es, gr, acc)
-                _surfaces(gx, gc, same, y_new, acc, h0, d_new, dd_new, d2_new, t_new, gr, mv_e,
+                g_new, gam_new = acc_of(t_new, y_new, n, As, cs, es, gr, acc)
+                surfaces(gx, gc, same, y_new, acc, h0, d_new, dd_new, d2_new, t_new, gr, mv_e,
                           mv_w)  # fmt: skip
                 event_row = -1
                 t_e = t_new
-                if _within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
-                    n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
+                if within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
+                    n_rhs += dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
                                             cs, es, gr)  # fmt: skip
                     dense_ready = True
-                    t_e, event_row = _first_crossing(mc, t_old, t_new, y_old, F, event_rows, h0,
+                    t_e, event_row = first_crossing(mc, t_old, t_new, y_old, F, event_rows, h0,
                                                      n, Dq, Rq, dc0, dc1, rc0, rc1, near, CP,
                                                      BP, CR, BR, gr, mv_e, mv_w)  # fmt: skip
                 if event_row >= 0:
-                    _dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
+                    dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e
                     event = True
-                    g_new, gam_new = _acc_of(t_new, y_new, n, As, cs, es, gr, acc)
+                    g_new, gam_new = acc_of(t_new, y_new, n, As, cs, es, gr, acc)
                     if record:
-                        n_out, next_out = _emit(mc, t_e, t_old, h, y_old, F, samples, n_out,
+                        n_out, next_out = emit(mc, t_e, t_old, h, y_old, F, samples, n_out,
                                                 next_out, output_dt)  # fmt: skip
                 elif record:
                     if not dense_ready:
-                        n_rhs += _dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
+                        n_rhs += dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
                                                 cs, es, gr)  # fmt: skip
                         dense_ready = True
-                    n_out, next_out = _emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
+                    n_out, next_out = emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
                                             next_out, output_dt)  # fmt: skip
                 if any_silent:
-                    n_imp += _settle(awaiting, argmap, y_new, side)
+                    n_imp += settle(awaiting, argmap, y_new, side)
                 # peaks and friction demand over [t_old, t_new]
-                _affine(track, y_new, 0, no_offset, z_new)
-                _affine(track, y_new, n, no_offset, dz_new)
+                affine(track, y_new, 0, no_offset, z_new)
+                affine(track, y_new, n, no_offset, dz_new)
                 # peaks inside the step: at the root of the rate, on the dense output
                 for r in range(nt):
                     v = max(abs(z_old[r]), abs(z_new[r]))
@@ -329,13 +330,13 @@ def run_kernel(model, motion, solver, task):
                     reach = v + 0.5 * (t_new - t_old) * (abs(dz_old[r]) + abs(dz_new[r]))
                     if dz_old[r] * dz_new[r] < 0.0 and reach > peaks[r]:
                         if not dense_ready:
-                            n_rhs += _dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
+                            n_rhs += dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
                                                     As, cs, es, gr)  # fmt: skip
                             dense_ready = True
-                        base = _row_poly(mc, F, y_old, track, r, zero_t, n, True, coef)
-                        t_pk = _brentq(mc, t_old, t_new, t_old, h, coef, base, (0.0, 1.0, gr))
-                        base = _row_poly(mc, F, y_old, track, r, zero_t, n, False, coef)
-                        v = max(v, abs(_poly_val(mc, t_pk, t_old, h, coef, base)))
+                        base = row_poly(mc, F, y_old, track, r, zero_t, n, True, coef)
+                        t_pk = brentq(mc, t_old, t_new, t_old, h, coef, base, (0.0, 1.0, gr))
+                        base = row_poly(mc, F, y_old, track, r, zero_t, n, False, coef)
+                        v = max(v, abs(poly_val(mc, t_pk, t_old, h, coef, base)))
                     if v > peaks[r]:
                         peaks[r] = v
                 for i in range(n):
@@ -343,7 +344,7 @@ def run_kernel(model, motion, solver, task):
                         max_ratio[i] = peaks[i]
                 if peaks[n] > max_top:
                     max_top = peaks[n]
-                _friction(g_new, gam_new, centre_map, acc, masses, normal_forces, friction)
+                friction_demand(g_new, gam_new, centre_map, acc, masses, normal_forces, friction)
                 z_prev, z_old, z_new = z_old, z_new, z_prev
                 dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
                 d_old, d_new = d_new, d_old
@@ -355,7 +356,7 @@ def run_kernel(model, motion, solver, task):
                 if event:
                     break
                 if can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]:
-                    en = _energy1(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
+                    en = energy1(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
                                   intercepts, slopes)  # fmt: skip
                     if en < barrier * (1.0 - 1e-9):
                         return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction,

@@ -1,8 +1,8 @@
 """Event search and law bookkeeping for the compiled kernel (numba): the
 transcriptions of rbm_cli.models.events (earliest crossing on the dense output,
 cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces); the moving kinks of
-a vertical record are kernel_vertical's (the exact uplift time of a rigid block at rest is
-in kernel_ground, time-history sampling in kernel_rk)."""
+a vertical record are step.vertical's (the exact uplift time of a rigid block at rest is
+in kernel_ground, time-history sampling in step.rk)."""
 
 from __future__ import annotations
 
@@ -13,12 +13,12 @@ import numpy as np
 from rbm_cli.base.detmath import dot, matvec
 from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.brent import brent_step
-from rbm_cli.models.rbm.kernel_rk import TAB_NP
-from rbm_cli.models.rbm.kernel_vertical import add_moving, moving_rate, moving_value
+from rbm_cli.models.rbm.step.rk import TAB_NP
+from rbm_cli.models.rbm.step.vertical import add_moving, moving_rate, moving_value
 
 
 @jit
-def _affine(event_rows, y, off, h0, out):
+def affine(event_rows, y, off, h0, out):
     """out = event_rows @ y[off:off + cols] (+ h0 if given): no allocation."""
     for r in range(event_rows.shape[0]):
         d = 0.0 if h0.size == 0 else h0[r]
@@ -28,11 +28,11 @@ def _affine(event_rows, y, off, h0, out):
 
 
 @jit
-def _row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
+def row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
     """One row of the step's interpolant, projected: the distance event_rows[row] theta +
     h0[row] (or, rate, the rate event_rows[row] theta') as a polynomial in the step's
-    fraction, with _dense_eval's form. Fills coef, returns the constant term;
-    _poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
+    fraction, with dense_eval's form. Fills coef, returns the constant term;
+    poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
     off = n if rate else 0
     for q in range(TAB_NP[mc]):
         v = 0.0
@@ -46,12 +46,12 @@ def _row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
 
 
 @jit
-def _poly_val(mc, t, t_old, h, coef, base):
-    """A projected row (_row_poly) at time t: _dense_eval for one row."""
+def poly_val(mc, t, t_old, h, coef, base):
+    """A projected row (row_poly) at time t: dense_eval for one row."""
     x = (t - t_old) / h
     v = 0.0
     nq = TAB_NP[mc]
-    if mc == 2:  # DOP853's nested form (_dense_eval)
+    if mc == 2:  # DOP853's nested form (dense_eval)
         for q in range(nq):
             v += coef[nq - 1 - q]
             v *= x if q % 2 == 0 else 1.0 - x
@@ -70,15 +70,15 @@ XTOL, RTOL, MAXITER = 1e-14, 8.881784197001252e-16, 100
 @jit(inline=True)
 def _row_val(mc, t, t_old, h, coef, base, mv):
     """A projected row at t, plus its moving part mv = (e, w, ground tuple) if e != 0
-    (kernel_vertical: a kink moving with g + a_v(t))."""
-    v = _poly_val(mc, t, t_old, h, coef, base)
+    (step.vertical: a kink moving with g + a_v(t))."""
+    v = poly_val(mc, t, t_old, h, coef, base)
     if mv[0] != 0.0:
         v += moving_value(t, mv[2], mv[0], mv[1])
     return v
 
 
 @jit
-def _brentq(mc, xa, xb, t_old, h, coef, base, mv):
+def brentq(mc, xa, xb, t_old, h, coef, base, mv):
     """scipy's brentq (zeros.c) along a projected row of the step's interpolant (plus its
     moving part, _row_val)."""
     xpre, xcur = xa, xb
@@ -158,9 +158,9 @@ CHECK_INTERVALS = 8
 
 
 @jit
-def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
+def within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
     """events.within_reach, row by row: mask[r] marks the rows within reach (only
-    they are searched in _first_crossing; the others cannot cross by the same
+    they are searched in first_crossing; the others cannot cross by the same
     criterion that lets a step with no row within reach go unchecked)."""
     anyrow = False
     for r in range(d0.size):
@@ -171,28 +171,28 @@ def _within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
 
 
 @jit
-def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
+def first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
                     CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
     (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
     The masked rows' interpolants are projected once (CP, BP: distances; CR, BR:
     rates) and evaluated as scalars; rows r < mv_e.size with mv_e[r] != 0 add their
-    moving part (kernel_vertical) on the step's ground piece gr."""
+    moving part (step.vertical) on the step's ground piece gr."""
     nseg = CHECK_INTERVALS
     h = t1 - t0
     nrow = event_rows.shape[0]
     for r in range(nrow):
         if mask[r]:
-            BP[r] = _row_poly(mc, F, y_old, event_rows, r, h0, n, False, CP[r])
-            BR[r] = _row_poly(mc, F, y_old, event_rows, r, h0, n, True, CR[r])
+            BP[r] = row_poly(mc, F, y_old, event_rows, r, h0, n, False, CP[r])
+            BR[r] = row_poly(mc, F, y_old, event_rows, r, h0, n, True, CR[r])
     for q in range(nseg + 1):
         tq = t0 + h * q / nseg if q < nseg else t1
         for r in range(nrow):
             if not mask[r]:
                 D[r, q], R[r, q] = np.inf, 0.0  # inert: never below zero, never turning
                 continue
-            D[r, q] = _poly_val(mc, tq, t0, h, CP[r], BP[r])
-            R[r, q] = _poly_val(mc, tq, t0, h, CR[r], BR[r])
+            D[r, q] = poly_val(mc, tq, t0, h, CP[r], BP[r])
+            R[r, q] = poly_val(mc, tq, t0, h, CR[r], BR[r])
             if r < mv_e.size and mv_e[r] != 0.0:
                 D[r, q] += moving_value(tq, gr, mv_e[r], mv_w[r])
                 R[r, q] += moving_rate(tq, gr, mv_e[r], mv_w[r])
@@ -221,14 +221,14 @@ def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1,
             rcol0[r], rcol1[r] = R[r, q], R[r, q + 1]
         for r in range(nrow):
             if D[r, q + 1] < 0.0:
-                tr = _brentq(mc, a, b, t0, h, CP[r], BP[r], _mv(r, gr, mv_e, mv_w))
+                tr = brentq(mc, a, b, t0, h, CP[r], BP[r], _mv(r, gr, mv_e, mv_w))
                 if tr < t_first:
                     t_first, r_first = tr, r
         s_dip, r_dip = _lowest_dip(dcol0, dcol1, rcol0, rcol1, b - a)
         if r_dip >= 0:
             mv = _mv(r_dip, gr, mv_e, mv_w)
             if _row_val(mc, a + s_dip, t0, h, CP[r_dip], BP[r_dip], mv) < 0.0:
-                tr = _brentq(mc, a, a + s_dip, t0, h, CP[r_dip], BP[r_dip], mv)
+                tr = brentq(mc, a, a + s_dip, t0, h, CP[r_dip], BP[r_dip], mv)
                 if tr < t_first:
                     t_first, r_first = tr, r_dip
         if r_first >= 0:
@@ -238,7 +238,7 @@ def _first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1,
 
 # ---------------------------------------------------------------- laws, pieces
 @jit
-def _n_below(edges, ne, x):
+def n_below(edges, ne, x):
     k = 0
     while k < ne and edges[k] <= x:
         k += 1
@@ -246,7 +246,7 @@ def _n_below(edges, ne, x):
 
 
 @jit
-def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
+def piece_bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
     ne = nedges[i]
     start = 0.0 if k[i] == 0 else edges[i, k[i] - 1]
     end = edges[i, k[i]] if k[i] < ne else np.inf
@@ -259,7 +259,7 @@ def _bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
 
 
 @jit
-def _system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
+def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
     """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place into
     As[:, :n] and cs: A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :],
     c = -(M^-1 D^T) a, with md = M^-1 D^T and mg = M^-1 K_g assembled once
@@ -311,10 +311,10 @@ def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
 
 
 @jit
-def _surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
+def surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
     """The event distances d, rates dd and second derivatives d2 at the state y (time t [s])
     with accelerations acc; with a vertical record (mv_e not empty) the moving kinks'
-    parts added (kernel_vertical)."""
+    parts added (step.vertical)."""
     n = gx.shape[0]
     _event_rows(gx, gc, same, y, 0, h0, True, d)
     _event_rows(gx, gc, same, y, n, h0, False, dd)
@@ -324,7 +324,7 @@ def _surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
 
 
 @jit
-def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
+def energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
     """Model.energy for one state."""
     n = theta.size
     e = 0.5 * dot(rate, matvec(mass, rate, np.empty(n))) - 0.5 * dot(
@@ -335,7 +335,7 @@ def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slop
         ax = abs(x[i])
         ne = nedges[i]
         cum, x0 = 0.0, 0.0
-        kk = _n_below(edges[i], ne, ax)
+        kk = n_below(edges[i], ne, ax)
         for q in range(kk):
             x1 = edges[i, q]
             cum += intercepts[i, q] * (x1 - x0) + 0.5 * slopes[i, q] * (x1 * x1 - x0 * x0)
@@ -345,7 +345,7 @@ def _energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slop
 
 
 @jit(inline=True)
-def _friction(g_new, gam, centre_map, acc, masses, normal_forces, friction):
+def friction_demand(g_new, gam, centre_map, acc, masses, normal_forces, friction):
     """Friction demand |T_i| / N_i at each interface at the step's end, kept in friction
     if larger: the shear from the drums above, their absolute accelerations g_new [m/s^2]
     (the ground) + centre_map @ acc (theta'' [rad/s^2]); N_i times gam = (g + a_v) / g."""

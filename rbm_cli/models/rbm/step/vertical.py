@@ -13,7 +13,7 @@ record's steps end at its samples), so the row is the dense output's polynomial 
 E m(gam(t)) / theta_u, evaluated exactly.
 
 The event rows' bookkeeping: mv_e[r] (0 for a fixed row) and mv_w[r] describe the moving
-part of rows r < 2n (the law bounds, kernel_events._bounds): row i (lower bound) is
+part of rows r < 2n (the law bounds, step.events.piece_bounds): row i (lower bound) is
 x_i / theta_u - lo_i / theta_u, row n + i (upper) is hi_i / theta_u - x_i / theta_u; the
 moving part is mv_e m(gam; mv_w), and the row's h0 keeps only EVENT_EPS.
 """
@@ -23,7 +23,7 @@ from __future__ import annotations
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.models.events import EVENT_EPS
-from rbm_cli.models.rbm.kernel_ground import _gravity
+from rbm_cli.models.rbm.kernel_ground import gravity_factor
 
 
 @jit(inline=True)
@@ -48,7 +48,7 @@ def moving_value(t, gr, e, w):
     """The moving part e m(gam(t); w) of an event row at t [s] (0 for a fixed row)."""
     if e == 0.0:
         return 0.0
-    return e * _m(_gravity(t, gr), w)
+    return e * _m(gravity_factor(t, gr), w)
 
 
 @jit(inline=True)
@@ -56,7 +56,7 @@ def moving_rate(t, gr, e, w):
     """d/dt of moving_value [1/s]."""
     if e == 0.0:
         return 0.0
-    gam = _gravity(t, gr)
+    gam = gravity_factor(t, gr)
     den = 1.0 + w * (gam - 1.0)
     return e * (1.0 - w) / (den * den) * _gam_rate(gr)
 
@@ -71,7 +71,7 @@ def add_moving(t, gr, mv_e, mv_w, d, dd, d2):
         if e == 0.0:
             continue
         w = mv_w[r]
-        gam = _gravity(t, gr)
+        gam = gravity_factor(t, gr)
         den = 1.0 + w * (gam - 1.0)
         d[r] += e * _m(gam, w)
         dd[r] += e * (1.0 - w) / (den * den) * gp
@@ -80,7 +80,7 @@ def add_moving(t, gr, mv_e, mv_w, d, dd, d2):
 
 @jit
 def _end(i, k, ne, rigid, pending):
-    """(edge, sign) of the start and end of interface i's piece k (kernel_events._bounds):
+    """(edge, sign) of the start and end of interface i's piece k (step.events.piece_bounds):
     edge -1 for 0 or infinity."""
     q_end = k if k < ne else -1
     if k == 0 and not (rigid or pending):

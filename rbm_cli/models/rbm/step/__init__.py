@@ -21,13 +21,13 @@ with no integration, until the ground demand exceeds the uplift level (found exa
 the excitation); a rigid block that loses its velocity at an impact returns to rest. Free
 motion stops early once its outcome cannot change (energy below every barrier).
 
-The whole run is one call of ``run_kernel`` (kernel_step), written once in the subset of
+The whole run is one call of ``run_kernel`` (step.stepper), written once in the subset of
 Python that numba compiles: compiled by default, run by Python as written with
 ``solver.implementation: python`` (rbm_cli.base.jit.plain; the same bits, 30-100x
-slower). The modules: kernel_inputs (the kernel's four typed input records and
-prepare_kernel), kernel_step (the stepper), kernel_rk (Runge-Kutta), kernel_events (event
-location), kernel_state (the state change at an event), kernel_ground (the excitation),
-kernel_vertical (moving kinks under a vertical record), kernel_guard (wall-clock budget and
+slower). The modules: step.inputs (the kernel's four typed input records and
+prepare_kernel), step.stepper (the stepper), step.rk (Runge-Kutta), step.events (event
+location), step.state (the state change at an event), kernel_ground (the excitation),
+step.vertical (moving kinks under a vertical record), kernel_guard (wall-clock budget and
 Ctrl-C); this one runs a model from Python.
 """
 
@@ -42,25 +42,21 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.kernel_guard import arm, disarm, poll
-from rbm_cli.models.rbm.kernel_inputs import (
+from rbm_cli.models.rbm.run_codes import (
+    COLLAPSED,
+    FAILED_NONFINITE,
+    FAILED_STEP,
+    STOPPED_EARLY,
+    end_by_budget,
+)
+from rbm_cli.models.rbm.step.inputs import (
     PreparedModel,
     excitation,
     model_arrays,
     prepare_kernel,
     solver_settings,
 )
-from rbm_cli.models.rbm.kernel_rk import (
-    COLLAPSED,
-    FAILED_EVENTS,
-    FAILED_NONFINITE,
-    FAILED_STEP,
-    FAILED_STEPS,
-    FAILED_WALL,
-    INTERRUPTED,
-    STOPPED_EARLY,
-)
-from rbm_cli.models.rbm.kernel_step import run_kernel
-from rbm_cli.models.rbm.run_codes import end_by_budget
+from rbm_cli.models.rbm.step.stepper import run_kernel
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -97,7 +93,7 @@ def integrate(
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)
-    # a RunTask, as a plain tuple (kernel_inputs)
+    # a RunTask, as a plain tuple (step.inputs)
     task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), bool(early_stop),
             bool(record), float(output_dt), samples)  # fmt: skip
     armed = arm()  # Ctrl-C reaches the kernel through poll (kernel_guard)
@@ -130,7 +126,7 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
     elif code == FAILED_NONFINITE:
         out.stop("failed", "the state became NaN or infinite (non-finite arithmetic)", t_end)
     else:
-        end_by_budget(out, code, solver, (FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED))
+        end_by_budget(out, code, solver)
     return out
 
 

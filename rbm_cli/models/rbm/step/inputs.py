@@ -1,7 +1,7 @@
 """The inputs of the compiled kernel, as four typed records (named tuples).
 
 numba reads the fields of a tuple of arrays and scalars at no cost, so the stepper
-(kernel_step.run_kernel) takes four records instead of some 45 positional arguments
+(step.stepper.run_kernel) takes four records instead of some 45 positional arguments
 (passed as plain tuples in the order of their fields, named again inside the kernel:
 a named tuple costs more to pass, see run_kernel):
 
@@ -24,7 +24,7 @@ from rbm_cli.base.detmath import matmul, matvec
 from rbm_cli.base.jit import jit
 from rbm_cli.models.events import REST_RATE
 from rbm_cli.models.methods import step_method
-from rbm_cli.models.rbm.kernel_rk import METHOD_CODES
+from rbm_cli.models.rbm.step.rk import METHOD_CODES
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 

@@ -34,7 +34,7 @@ import pandas as pd  # noqa: E402
 from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import ExcitationConfig, GridConfig, InitialConfig  # noqa: E402
-from rbm_cli.models.housner_linear import housner_linear_run  # noqa: E402
+from rbm_cli.models.block.closed_form import linear_run  # noqa: E402
 from rbm_cli.physics.block import block_geometry  # noqa: E402
 from rbm_cli.physics.closed_forms import (  # noqa: E402
     free_rocking_period,
@@ -141,7 +141,7 @@ def section1(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         f"e {e:g}). Mapping of SPEC section 2: alpha = B/H = {alpha:.6g} rad, "
         f"p = sqrt(m g (H/2) / (I_G + m H^2/4)) = {p:.6g} rad/s "
         "(`closed_forms.linear_rocking_parameters`). The closed form is "
-        "`housner_linear.housner_linear_run` with these alpha and p (cosh/sinh pieces, "
+        "`block.closed_form.linear_run` with these alpha and p (cosh/sinh pieces, "
         "events by root finding, no numerical integration)."
     )
     rep()
@@ -159,9 +159,7 @@ def history_case(cfg, a, f, alpha, p, e, dt, axes) -> list:
     res = simulate(cfg, a, f, record=True, output_dt=dt)
     h = res.history
     motion = make_ground_motion(cfg.excitation, a, f)
-    lin = housner_linear_run(
-        alpha, p, motion, restitution=e, record=True, output_dt=dt, early_stop=False
-    )
+    lin = linear_run(alpha, p, motion, restitution=e, record=True, output_dt=dt, early_stop=False)
     tl = np.array([s[0] for s in lin.samples])
     thl = np.array([s[1][0] for s in lin.samples])
     n = min(len(h.t), len(tl))
@@ -181,9 +179,7 @@ def history_case(cfg, a, f, alpha, p, e, dt, axes) -> list:
         f"{err.max():.2e}",
     ]
     ax, ax_err = axes
-    ax.plot(
-        tl, thl / alpha, color="C1", lw=2.5, alpha=0.6, label="closed form (housner_linear_run)"
-    )
+    ax.plot(tl, thl / alpha, color="C1", lw=2.5, alpha=0.6, label="closed form (linear_run)")
     ax.plot(h.t, h.rotations[:, 0] / alpha, color="C0", lw=1.0, label="RBM n = 1 (simulate)")
     ax.axhline(1, color="0.5", ls=":", lw=0.8)
     ax.axhline(-1, color="0.5", ls=":", lw=0.8)
@@ -539,7 +535,7 @@ def free_rocking_case(cfg, alpha: float, p: float, r: float, dt: float, ax) -> l
     h = res.history
     t_rbm = period_from_crossings(zero_crossings(h.t, h.rotations[:, 0], h.rates[:, 0]))
     ev: list = []
-    housner_linear_run(
+    linear_run(
         alpha,
         p,
         make_ground_motion(exc, 0.0, 0.0),
@@ -572,7 +568,7 @@ def section4(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         f"`simulate(record=True, output_dt={dt:g})`, zero crossings located on the cubic "
         "Hermite interpolant of the recorded (theta, theta') and refined by brentq; period = 2 x "
         "the mean spacing of the crossings over about 4 periods. Closed form: "
-        "`housner_linear_run(events=[])`, period = 2 x the mean spacing of the impacts. "
+        "`linear_run(events=[])`, period = 2 x the mean spacing of the impacts. "
         "Reference: T = (4/p) arccosh(1 / (1 - theta0/alpha))."
     )
     rep()

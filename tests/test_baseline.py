@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rbm_cli.config.load import load_config
-from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.baseline import baseline_run
 from rbm_cli.physics.closed_forms import linear_rocking_parameters
@@ -25,7 +25,7 @@ def test_baseline_agrees_with_the_closed_form(amplitude, frequency):
     model = model_from_config(cfg)
     motion = make_ground_motion(cfg.excitation, amplitude, frequency)
     alpha, p = linear_rocking_parameters(model.column)
-    exact = housner_linear_run(alpha, p, motion, restitution=model.restitution)
+    exact = linear_run(alpha, p, motion, restitution=model.restitution)
     out = baseline_run(model, motion)
     assert isinstance(out, Outcome)
     assert out.status == exact.status

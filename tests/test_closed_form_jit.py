@@ -1,6 +1,6 @@
-"""The rigid block's compiled closed form (rbm_cli.models.rbm.closed_form): the RBM's
-`solver.method: closed-form` on a rigid monolith (what `auto`, the default, runs there) and
-the compiled `housner-linear`.
+"""The rigid block's closed form (rbm_cli.models.block): the RBM's `solver.method:
+closed-form` on a rigid monolith (what `auto`, the default, runs there) and
+`housner-linear`, compiled and uncompiled.
 
 Expected values from other sources:
 
@@ -9,8 +9,11 @@ Expected values from other sources:
   agree (same outcome and events, peaks and collapse times within 1e-9), the same outcome
   and events, peaks and collapse times within 1e-8 of rtol 1e-12 (the two locate an impact
   differently: the kernel EVENT_EPS theta_u past zero, then projected back);
-- housner_linear_run, the Python closed form (scipy's brentq on numpy), with the RBM's
-  mapping (physics.closed_forms.linear_rocking_parameters) and for housner-linear itself;
+- the RBM's mapping (physics.closed_forms.linear_rocking_parameters): the rigid monolith's
+  block (closed_form.rbm_block, from the model's linear system) runs as Spanos and Koh's
+  block of those (alpha, p) (closed_form.linear_block);
+- the same source run uncompiled (rbm_cli.base.jit.plain): the same bits, on a rigid RBM,
+  a housner-linear block and a vertical record;
 - free rocking: the energy theta'^2/2 + p^2 (alpha |theta| - theta^2/2) is conserved
   between impacts, and the impacts come at the period of
   physics.closed_forms.free_rocking_period;
@@ -32,7 +35,7 @@ import pytest
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config, parse_config
-from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.closed_forms import free_rocking_period, linear_rocking_parameters
 from rbm_cli.physics.excitation import make_ground_motion
@@ -119,27 +122,29 @@ def _facts(run):
     return run.status, run.n_uplifts, run.n_impacts, float(run.max_ratio[0]), run.t_collapse
 
 
-def test_the_python_closed_form_agrees():
-    """The RBM's closed form against housner_linear_run with the SPEC's mapping, and
-    housner-linear compiled against python: same outcome and events, peaks and collapse
-    times within 1e-9 where a 1e-10 change of the amplitude moves the peak by < 1e-9 (the
-    RBM places an impact EVENT_EPS theta_u past zero, housner-linear at zero)."""
+def test_the_rbm_block_is_the_linear_block_of_its_mapping():
+    """The RBM's closed form against Spanos and Koh's block with the SPEC's mapping (alpha,
+    p), and housner-linear compiled against python (its source uncompiled): same outcome
+    and events, peaks and collapse times within 1e-9 where a 1e-10 change of the amplitude
+    moves the peak by < 1e-9 (the RBM places an impact EVENT_EPS theta_u past zero,
+    housner-linear at zero); compiled and python give the same figures."""
     cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
     runner = make_runner(cfg)
     alpha, p = linear_rocking_parameters(runner.model.column)
     lin = load_config(CONFIGS / "spanos_koh_slender_linear.yaml")
-    lin_c, lin_p = make_runner(lin), make_runner(_with(lin, implementation="python"))
+    lin_py = _with(lin, implementation="python")
+    lin_c, lin_p = make_runner(lin), make_runner(lin_py)
     compared = 0
     for f in cfg.grid.frequencies_hz[::5]:
         for a in cfg.grid.amplitudes_g[::5]:
             motion = make_ground_motion(cfg.excitation, a, f)
-            ref = housner_linear_run(alpha, p, motion)
-            nudged = housner_linear_run(
-                alpha, p, make_ground_motion(cfg.excitation, a * (1 + 1e-10), f)
-            )
+            ref = linear_run(alpha, p, motion)
+            nudged = linear_run(alpha, p, make_ground_motion(cfg.excitation, a * (1 + 1e-10), f))
             steady = abs(nudged.max_ratio[0] - ref.max_ratio[0]) <= 1e-9 * ref.max_ratio[0]
-            compiled, python = simulate(lin, a, f, runner=lin_c), simulate(lin, a, f, runner=lin_p)
+            compiled = simulate(lin, a, f, runner=lin_c)
+            python = simulate(lin_py, a, f, runner=lin_p)
             assert compiled.method == python.method == "closed-form"
+            assert repr(_facts(compiled)) == repr(_facts(python)), (a, f)  # NaN as NaN
             for out, want in ((simulate(cfg, a, f, runner=runner), ref), (compiled, python)):
                 got, expected = _facts(out), _facts(want)
                 assert got[:3] == expected[:3], (a, f)
@@ -155,8 +160,8 @@ def test_free_rocking_conserves_energy_at_the_closed_form_period():
     - theta^2/2) at every sample equals its initial value to round-off for housner-linear's
     impacts (at theta = 0); the RBM's (where s theta = -eps, then projected onto 0) each
     add p^2 alpha eps, no more; the impacts come at T/4, 3T/4, ... of free_rocking_period."""
+    from rbm_cli.models.block.closed_form import linear_block, rbm_block, run_closed_form
     from rbm_cli.models.events import EVENT_EPS
-    from rbm_cli.models.rbm.closed_form import linear_block, rbm_block, run_closed_form
 
     cfg = parse_config({"name": "free", "column": COLUMN, "interface": {"restitution": 1.0},
                         "excitation": {"type": "free", "duration": 8.0,
@@ -182,7 +187,7 @@ def test_free_rocking_conserves_energy_at_the_closed_form_period():
 
 def _dense(pc, ts):
     """s theta at t0 + ts, written out from the piece's coefficients (numpy)."""
-    from rbm_cli.models.rbm import closed_form_jit as cj
+    from rbm_cli.models.block import piece as cj
 
     theta = (pc[cj.SIDE] * pc[cj.ALPHA] + pc[cj.AMP] * np.sin(pc[cj.OM] * ts + pc[cj.PHI])
              + pc[cj.Q0] + pc[cj.Q1] * ts + pc[cj.C1] * np.exp(pc[cj.P] * ts)
@@ -191,8 +196,8 @@ def _dense(pc, ts):
 
 
 def _random_piece(rng, pc):
-    from rbm_cli.models.rbm.closed_form import linear_block
-    from rbm_cli.models.rbm.closed_form_jit import start_piece
+    from rbm_cli.models.block.closed_form import linear_block
+    from rbm_cli.models.block.piece import start_piece
 
     alpha, p = rng.uniform(0.05, 0.3), rng.uniform(0.5, 5.0)
     blk = linear_block(alpha, p).params
@@ -204,7 +209,7 @@ def _random_piece(rng, pc):
         fc[0], fc[5], fc[6] = 2, rng.uniform(-2, 2) * 9.81 * alpha, rng.uniform(-50, 50)
     side = rng.choice([-1.0, 1.0])
     theta, rate = side * alpha * rng.uniform(0.0, 0.99), side * alpha * p * rng.uniform(-0.5, 0.5)
-    start_piece(blk, rng.uniform(0.0, 3.0), theta, rate, side, fc, pc)
+    start_piece(blk, rng.uniform(0.0, 3.0), theta, rate, side, fc, 1.0, pc)
     return blk
 
 
@@ -212,7 +217,7 @@ def test_the_scan_misses_no_crossing_of_random_pieces():
     """Random pieces (harmonic, linear, free) against 100,001 samples: the scan's first
     event (impact where s theta + eps <= 0, collapse where s theta >= limit) is the first
     sample crossing, to the sample spacing; the peak before it is not below the samples'."""
-    from rbm_cli.models.rbm.closed_form_jit import (
+    from rbm_cli.models.block.piece import (
         B_EPS,
         B_LIMIT,
         COLLAPSE,
@@ -249,8 +254,8 @@ def test_the_scan_misses_no_crossing_of_random_pieces():
 def test_a_grazing_peak_is_seen(delta):
     """Free motion from theta = 0 at the rate that peaks at alpha (1 - delta): delta > 0
     turns back (impact), delta < 0 collapses; one interval of the scan spans the peak."""
-    from rbm_cli.models.rbm.closed_form import linear_block
-    from rbm_cli.models.rbm.closed_form_jit import (
+    from rbm_cli.models.block.closed_form import linear_block
+    from rbm_cli.models.block.piece import (
         COLLAPSE,
         IMPACT,
         PIECE_SIZE,
@@ -263,7 +268,7 @@ def test_a_grazing_peak_is_seen(delta):
     pc, acc = np.zeros(PIECE_SIZE), np.zeros(4)
     peak = alpha * (1.0 - delta)
     rate = math.sqrt(2.0 * p * p * (alpha * peak - 0.5 * peak * peak))  # energy at the peak
-    start_piece(blk, 0.0, 0.0, rate, 1.0, np.zeros(7), pc)
+    start_piece(blk, 0.0, 0.0, rate, 1.0, np.zeros(7), 1.0, pc)
     got, tau = scan_piece(pc, blk, 20.0, acc)
     assert got == (IMPACT if delta > 0 else COLLAPSE)
     if delta > 0:
@@ -313,7 +318,7 @@ def test_a_vertical_record_falls_back_to_the_integrator(tmp_path):
     with pytest.raises(RbmError, match="vertical"):
         make_runner(_with(cfg, method="closed-form"))
     lin = dataclasses.replace(cfg, model="housner-linear")
-    assert simulate(lin, 1.0, None).status in ("survived", "collapsed")  # the Python one
+    assert simulate(lin, 1.0, None).status in ("survived", "collapsed")  # its closed form
 
 
 def test_a_history_is_recorded():
@@ -324,6 +329,62 @@ def test_a_history_is_recorded():
     ref = simulate(_with(cfg, method="DOP853", rtol=1e-12), 0.6, 1.5, record=True, output_dt=0.01)
     assert out.history.t.size == ref.history.t.size > 100
     assert np.abs(out.history.rotations - ref.history.rotations).max() < 1e-8 * 0.25
+
+
+def _figures(out):
+    """Every figure of an Outcome, samples included, as text (repr: a float's shortest exact
+    digits; NaN equals NaN)."""
+    samples = [(t, float(th[0]), float(r[0])) for t, th, r in out.samples]
+    return repr((out.status, out.message, out.t_end, out.t_collapse, out.max_top,
+                 out.max_ratio.tolist(), out.friction.tolist(), out.n_uplifts, out.n_impacts,
+                 out.n_events, out.n_steps, out.n_rhs, samples))  # fmt: skip
+
+
+def test_compiled_and_uncompiled_give_the_same_bits(tmp_path):
+    """The closed form compiled and its source run uncompiled (implementation python,
+    rbm_cli.base.jit.plain): the same figures, every history sample included, for a rigid
+    RBM monolith (explicit closed-form, harmonic and record), a housner-linear block and a
+    housner-linear block under a vertical record (gam per piece); the event log too."""
+    from rbm_cli.config.types import G
+    from rbm_cli.models.block.closed_form import linear_run
+    from rbm_cli.physics.records import write_csv
+
+    t = np.linspace(0.0, 4.0, 401)  # a_g = A g sin(2 pi t), a_v = 0.4 A g sin(6 pi t + 0.3)
+    h = write_csv(tmp_path / "h.csv", (t, G * np.sin(2 * np.pi * t)), units="g")
+    v = write_csv(tmp_path / "v.csv", (t, 0.4 * G * np.sin(6 * np.pi * t + 0.3)), units="g")
+    vertical = {"type": "record", "file": str(h), "vertical": str(v), "scale": "factor",
+                "free_time": 2.0}  # fmt: skip
+    rigid = load_config(CONFIGS / "spanos_koh_slender.yaml")
+    record = parse_config({"name": "r", "column": COLUMN, "excitation": {
+        "type": "record", "file": str(RECORD), "units": "g", "free_time": 2.0}})  # fmt: skip
+    cases = [
+        (_with(rigid, method="closed-form"), [(0.3, 3.0), (0.6, 1.5), (1.2, 1.0)]),
+        (_with(record, method="closed-form"), [(0.5, None), (0.9, None)]),
+        (dataclasses.replace(rigid, model="housner-linear"), [(0.3, 3.0), (0.6, 1.5)]),
+        (parse_config({"name": "v", "model": "housner-linear", "column": COLUMN,
+                       "excitation": vertical}), [(0.2, None), (0.25, None), (0.4, None)]),
+    ]  # fmt: skip
+    statuses = set()
+    for cfg, cells in cases:
+        python_cfg = _with(cfg, implementation="python")
+        compiled, python = make_runner(cfg), make_runner(python_cfg)
+        for a, f in cells:
+            motion = make_ground_motion(cfg.excitation, a, f)
+            got = compiled.run(motion, cfg.solver, record=True, output_dt=0.01)
+            want = python.run(motion, python_cfg.solver, record=True, output_dt=0.01)
+            assert got.method == want.method == "closed-form"
+            assert _figures(got) == _figures(want), (cfg.name, a, f)
+            statuses.add((cfg.name, got.status))
+    assert {status for name, status in statuses if name == "v"} == {"survived", "collapsed"}
+    assert {status for _, status in statuses} == {"survived", "collapsed"}
+    motion = make_ground_motion(cfg.excitation, 0.25, None)
+    logs = []
+    for implementation in ("compiled", "python"):
+        events: list = []
+        solver = dataclasses.replace(cfg.solver, implementation=implementation)
+        linear_run(0.19, 1.5, motion, 0.9, solver=solver, events=events)
+        logs.append(events)
+    assert logs[0] == logs[1] and {k for _, k in logs[0]} >= {"uplift", "impact"}
 
 
 # ------------------------------------------------------------------ guards of a compiled run

@@ -15,7 +15,7 @@ from rbm_cli.api import run_sweep
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import GridConfig
-from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.physics.closed_forms import linear_rocking_parameters
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.study.domain import read_domain
@@ -55,7 +55,7 @@ def closed_form_fraction(cfg, a, f, k):
     for m in members(k):
         exc = dataclasses.replace(cfg.excitation, phase=cfg.excitation.phase + m.phase_rad)
         motion = make_ground_motion(exc, a * (1 + m.amplitude_relative), f)
-        out = housner_linear_run(alpha, p, motion, restitution=model.restitution)
+        out = linear_run(alpha, p, motion, restitution=model.restitution)
         flags.append(out.status == "collapsed")
     return float(np.mean(flags))
 

@@ -31,8 +31,8 @@ from scipy.integrate import solve_ivp
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.events import EVENT_EPS
-from rbm_cli.models.housner_linear import housner_linear_run
 from rbm_cli.models.rbm.exact.bounds import FULL, THIRD, empty_bounds, row_lower, track_upper
 from rbm_cli.models.rbm.exact.integrate import integrate_exact
 from rbm_cli.models.rbm.exact.modal import advance, forcing_array
@@ -255,8 +255,8 @@ def test_rigid_monolith_equals_housner_linear():
         tu = runner.model.column.rotation_capacity[0]
         for f in cfg.grid.frequencies_hz[::stride]:
             for a in cfg.grid.amplitudes_g[::stride]:
-                ref = housner_linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f), 1.0)
-                nudged = housner_linear_run(
+                ref = linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f), 1.0)
+                nudged = linear_run(
                     alpha, p, make_ground_motion(cfg.excitation, a * (1 + 1e-10), f), 1.0
                 )
                 out = simulate(cfg, a, f, runner=runner)

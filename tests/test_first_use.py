@@ -161,7 +161,7 @@ def test_a_sweep_says_what_it_compiles_before_it_waits_and_after(tmp_path, monke
     "compiling the rigid block's closed form" on stderr before the compile, and its last
     line names the compile. (The cache is there: the compile is made to look needed and
     to take a second.)"""
-    import rbm_cli.models.rbm.closed_form as closed_form
+    import rbm_cli.models.block.closed_form as closed_form
 
     real = closed_form.warm_up
 

@@ -216,7 +216,7 @@ def _worker_modules(cfg, workers: list[int]) -> set[str]:
 
 def test_a_worker_does_not_import_plotting(workers):
     modules = _worker_modules(rigid(), workers)
-    assert "rbm_cli.models.rbm.closed_form" in modules  # the compiled path ran there
+    assert "rbm_cli.models.block.closed_form" in modules  # the compiled path ran there
     assert "rbm_cli.models.rbm.step" not in modules  # a rigid block's: not the kernel
     assert not {m for m in modules if m.split(".")[0] == "matplotlib"}
     assert "rbm_cli.report.domain_figure" not in modules

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from rbm_cli.config.load import load_config
-from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.models.rbm.step import integrate
 from rbm_cli.physics.closed_forms import linear_rocking_parameters
@@ -34,7 +34,7 @@ def test_kernel_peak_matches_the_closed_form(amplitude, frequency):
     model = model_from_config(cfg)
     alpha, p = linear_rocking_parameters(model.column)
     motion = make_ground_motion(cfg.excitation, amplitude, frequency)
-    exact = housner_linear_run(alpha, p, motion, restitution=model.restitution)
+    exact = linear_run(alpha, p, motion, restitution=model.restitution)
     res = simulate(cfg, amplitude, frequency, runner=RbmRunner(cfg, model=model))
     assert res.status == exact.status
     if res.status == "collapsed":

@@ -21,7 +21,7 @@ import pytest
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.rbm.kernel_ground import next_uplift
 from rbm_cli.models.rbm.runner import model_from_config
 from rbm_cli.models.registry import make_runner
@@ -156,7 +156,7 @@ def test_rigid_rbm_equals_housner_linear_under_sampled_pulse(kind, extra):
         for a in (0.25, 0.4, 0.6, 0.9, 1.5, 3.0):
             motion = make_ground_motion(cfg.excitation, a, f)
             rbm = runner.run(motion, cfg.solver)
-            lin = housner_linear_run(alpha, p, motion)
+            lin = linear_run(alpha, p, motion)
             assert rbm.status == lin.status, (a, f)
             statuses.add(rbm.status)
             if rbm.status == "collapsed":

@@ -18,7 +18,7 @@ import pandas as pd
 import pytest
 
 from rbm_cli.config.load import load_config
-from rbm_cli.models.housner_linear import housner_linear_run
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.physics.closed_forms import linear_rocking_parameters
 from rbm_cli.physics.column import build_column
 from rbm_cli.physics.excitation import make_ground_motion
@@ -34,7 +34,7 @@ def linear_domain(cfg) -> pd.DataFrame:
     for f in cfg.grid.frequencies_hz:
         for a in cfg.grid.amplitudes_g:
             motion = make_ground_motion(cfg.excitation, a, f)
-            out = housner_linear_run(alpha, p, motion, restitution=1.0)
+            out = linear_run(alpha, p, motion, restitution=1.0)
             rows.append(
                 {"amplitude_g": a, "frequency_hz": f, "collapsed": int(out.status == "collapsed")}
             )
@@ -81,7 +81,7 @@ def both_models(cfg, a: float, f: float):
     model = model_from_config(cfg)
     alpha, p = linear_rocking_parameters(model.column)
     motion = make_ground_motion(cfg.excitation, a, f)
-    lin = housner_linear_run(
+    lin = linear_run(
         alpha, p, motion, restitution=model.restitution, collapse_ratio=cfg.collapse.ratio
     )
     return simulate(cfg, a, f), lin
@@ -129,15 +129,15 @@ def test_a_restart_at_theta_zero_is_not_taken_for_an_impact():
     housner-linear, with the mapped (alpha, p), started each piece after an impact at
     theta = 0, where s theta's round-off has either sign; when it was positive, the root
     of s theta next to the start was taken for the next impact (three within 3e-14 s, then
-    a million, and the run 'failed' on its piece budget). Now both closed forms (Python,
-    compiled) collapse after the RBM's 174 impacts, at the same time as each other; and
-    the compiled one, given the RBM's convention for where an impact is placed (s theta =
-    -eps, then theta = 0, instead of s theta = 0), at the RBM step integrator's time. The
-    two conventions' collapse times differ by ~1e-4 s after 174 impacts."""
+    a million, and the run 'failed' on its piece budget). Now the closed form (compiled, and
+    uncompiled with the same bits) collapses after the RBM's 174 impacts; given the RBM's
+    convention for where an impact is placed (s theta = -eps, then theta = 0, instead of
+    s theta = 0), at the RBM step integrator's time. The two conventions' collapse times
+    differ by ~1e-4 s after 174 impacts."""
     from rbm_cli.config.load import parse_config
     from rbm_cli.config.types import SolverConfig
-    from rbm_cli.models.rbm.closed_form import linear_block, run_closed_form
-    from rbm_cli.models.rbm.closed_form_jit import B_AT_ZERO
+    from rbm_cli.models.block.closed_form import linear_block, run_closed_form
+    from rbm_cli.models.block.piece import B_AT_ZERO
 
     cfg = parse_config({
         "name": "restart",
@@ -150,7 +150,7 @@ def test_a_restart_at_theta_zero_is_not_taken_for_an_impact():
     assert rbm.status == "collapsed"
     alpha, p = linear_rocking_parameters(model_from_config(cfg).column)
     motion = make_ground_motion(cfg.excitation, 0.9, None)
-    python = housner_linear_run(alpha, p, motion, restitution=1.0)
+    python = linear_run(alpha, p, motion, solver=SolverConfig(implementation="python"))
     block = linear_block(alpha, p, 1.0)
     compiled = run_closed_form(block, motion, 0.0, 0.0, SolverConfig())
     params = block.params.copy()
@@ -160,5 +160,5 @@ def test_a_restart_at_theta_zero_is_not_taken_for_an_impact():
     for lin in (python, compiled, rbm_convention):
         assert lin.status == "collapsed", lin.message
         assert lin.n_impacts == rbm.n_impacts == 174
-    assert abs(python.t_collapse - compiled.t_collapse) <= 1e-8
+    assert python.t_collapse == compiled.t_collapse
     assert abs(rbm_convention.t_collapse - rbm.t_collapse_s) <= 1e-7

@@ -18,8 +18,8 @@ from scipy.integrate import quad, tplquad
 from scipy.optimize import brentq
 
 from rbm_cli.config.types import ColumnConfig, SolverConfig
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.housner import housner_run
-from rbm_cli.models.housner_linear import housner_linear_run
 from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.restitution import block_restitution
@@ -169,7 +169,7 @@ def test_linear_halfsine_threshold(omega_over_p):
     expected = exact_halfsine_threshold(omega_over_p)
 
     def collapses(ratio):
-        out = housner_linear_run(ALPHA, P, half_sine(ratio * ALPHA, omega, t_end))
+        out = linear_run(ALPHA, P, half_sine(ratio * ALPHA, omega, t_end))
         return out.status == "collapsed"
 
     lo, hi = 0.5 * expected, 2.0 * expected
@@ -186,9 +186,7 @@ def test_linear_free_rocking_period(ratio):
     """T = (4/p) arccosh(1 / (1 - theta0/alpha)), from impact times, to 1e-9."""
     period = 4.0 / P * math.acosh(1.0 / (1.0 - ratio))
     events = []
-    out = housner_linear_run(
-        ALPHA, P, free(10.5 * period), initial=(ratio * ALPHA, 0.0), events=events
-    )
+    out = linear_run(ALPHA, P, free(10.5 * period), initial=(ratio * ALPHA, 0.0), events=events)
     t_imp = impact_times(events)
     assert len(t_imp) == 21
     assert 4.0 * t_imp[0] == pytest.approx(period, rel=1e-9)  # quarter period from release
@@ -202,7 +200,7 @@ def test_linear_peak_is_exact_after_pulse():
     alpha - sqrt(alpha^2 - 2 E / p^2), E from the state at the pulse end."""
     omega = math.pi / 0.5  # pulse end at t = 0.5 s, an exact sample time
     motion = half_sine(2.0 * ALPHA, omega, 10.0)
-    out = housner_linear_run(ALPHA, P, motion, record=True, output_dt=0.0625)
+    out = linear_run(ALPHA, P, motion, record=True, output_dt=0.0625)
     t, th, v = next(s for s in out.samples if s[0] == 0.5)
     th, v = th[0], v[0]
     during = max(abs(s[1][0]) for s in out.samples if s[0] <= 0.5)
@@ -261,7 +259,7 @@ def test_housner_converges_to_linear(ratio, w_over_p, cycles, e, quantity):
         assert p == pytest.approx(math.sqrt(3 * G / 8.0), rel=1e-13)
         omega = w_over_p * p
         motion = harmonic(ratio * alpha, omega, cycles * 2 * math.pi / omega)
-        lin = housner_linear_run(geo.slenderness, p, motion, restitution=e)
+        lin = linear_run(geo.slenderness, p, motion, restitution=e)
         nl = housner_run(geo, motion, restitution=e, solver=SolverConfig(rtol=1e-11))
         assert lin.status == nl.status and lin.n_impacts == nl.n_impacts
         a, b = getattr(lin, quantity), getattr(nl, quantity)
@@ -296,16 +294,14 @@ def test_housner_top_displacement_at_collapse():
     assert out.status == "collapsed" and out.collapse_interface == 1
     u = geo.half_base + (geo.height - geo.centre_height) * math.sin(alpha)
     assert out.max_top == pytest.approx(u, rel=1e-12)
-    lin = housner_linear_run(
-        alpha, geo.frequency_parameter, harmonic(0.5, math.pi, 10.0), height=5.0
-    )
+    lin = linear_run(alpha, geo.frequency_parameter, harmonic(0.5, math.pi, 10.0), height=5.0)
     assert lin.max_top == pytest.approx(5.0 * alpha, rel=1e-14)
 
 
 # --------------------------------------------------------------------------- both models
 def run_model(model, motion, **kw):
     if model == "linear":
-        return housner_linear_run(ALPHA, P, motion, **kw)
+        return linear_run(ALPHA, P, motion, **kw)
     geo = block_geometry(rectangle(ALPHA, half_diagonal=3 * G / (4 * P * P)))
     return housner_run(geo, motion, solver=SolverConfig(rtol=1e-11), **kw)
 
@@ -336,8 +332,8 @@ def test_mirror_symmetry(model, ratio, omega):
 def test_linear_mirror_property(ratio, w_over_p, phase):
     motion_a = harmonic(ratio * ALPHA, w_over_p * P, 3.0, phase)
     motion_b = harmonic(ratio * ALPHA, w_over_p * P, 3.0, phase + math.pi)
-    a = housner_linear_run(ALPHA, P, motion_a, restitution=0.85)
-    b = housner_linear_run(ALPHA, P, motion_b, restitution=0.85)
+    a = linear_run(ALPHA, P, motion_a, restitution=0.85)
+    b = linear_run(ALPHA, P, motion_b, restitution=0.85)
     assert a.status == b.status
     assert a.max_ratio[0] == pytest.approx(b.max_ratio[0], rel=1e-7)
 
@@ -399,7 +395,7 @@ def test_early_stop_keeps_the_peak(model, ratio):
 
 
 def test_linear_samples_grid():
-    out = housner_linear_run(ALPHA, P, harmonic(0.22, 4.0, 2.0), record=True, output_dt=0.01)
+    out = linear_run(ALPHA, P, harmonic(0.22, 4.0, 2.0), record=True, output_dt=0.01)
     assert out.status == "survived" and out.n_impacts > 0
     t = np.array([s[0] for s in out.samples])
     np.testing.assert_allclose(t, 0.01 * np.arange(len(t)), rtol=0, atol=1e-12)
@@ -440,7 +436,7 @@ def test_rigid_rbm_is_housner_linear(kind, amplitude_g, frequency_hz):
     omega = 2 * math.pi * frequency_hz
     pulse_end = duration if kind == "harmonic" else math.pi / omega
     motion = GroundMotion(kind, amplitude_g * G, omega, 0.0, pulse_end, duration)
-    lin = housner_linear_run(B / H, p, motion, height=H)
+    lin = linear_run(B / H, p, motion, height=H)
     assert rbm.status == lin.status == "collapsed"
     assert rbm.n_impacts == lin.n_impacts
     assert rbm.t_collapse_s == pytest.approx(lin.t_collapse, rel=1e-8)

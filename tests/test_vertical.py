@@ -26,7 +26,7 @@ from .record_files import half_sine_csv
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "drums": 1}
 MODELS = [("rbm", "compiled"), ("rbm", "python"), ("housner", "compiled"),
-          ("housner-linear", "compiled")]  # fmt: skip
+          ("housner-linear", "compiled"), ("housner-linear", "python")]  # fmt: skip
 SPAN = 12.0  # s: the vertical record lasts the whole run
 
 

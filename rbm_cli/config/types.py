@@ -56,7 +56,7 @@ MODELS = {
     "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True),
     "housner": ModelEntry("rbm_cli.models.housner:HousnerRunner", multi_drum=False),
     "housner-linear": ModelEntry(
-        "rbm_cli.models.housner_linear:HousnerLinearRunner", multi_drum=False
+        "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False
     ),
     "bullet": ModelEntry("rbm_cli.models.bullet.run:BulletRunner", multi_drum=True),
 }

@@ -1,7 +1,7 @@
-"""What the two rocking-block runs share (`housner` in rbm_cli.models.housner,
-`housner-linear` in rbm_cli.models.housner_linear): the recorder of the time history
-and the moving state of a run (time, side, rest, peak rotation, outcome), with the rest
-phase and the end of the run."""
+"""The moving parts of a run of Housner's block (`housner`, rbm_cli.models.housner): the
+recorder of the time history and the moving state of a run (time, side, rest, peak
+rotation, outcome), with the rest phase and the end of the run; the early stop's energy
+margin, which the block's closed form (rbm_cli.models.block.run) shares."""
 
 from __future__ import annotations
 

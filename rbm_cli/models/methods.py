@@ -1,14 +1,14 @@
 """Which method runs a config: `solver.method: auto` (the default) resolved.
 
 - model `rbm`: the rigid block's compiled closed form (`closed-form`,
-  rbm_cli.models.rbm.closed_form) where it applies -- a rigid monolithic column (one drum,
+  rbm_cli.models.block.closed_form) where it applies -- a rigid monolithic column (one drum,
   interface.stiffness rigid, xi 1, formulation relative or geometric), an excitation with a
   closed form (harmonic, free, the sine pulses, records exact per sample interval), no
   vertical record, `solver.implementation: compiled` -- else DOP853 (the step kernel, or
   kernel's source uncompiled with `implementation: python`);
-- `housner-linear`: `closed-form` whatever the method says (compiled, or the Python
-  closed form with `implementation: python`; a vertical record: the Python one, whose gam
-  is taken per piece);
+- `housner-linear`: `closed-form` whatever the method says (compiled, or its source run
+  uncompiled with `implementation: python`; under a vertical record too, gam taken per
+  piece);
 - `housner`: DOP853; `bullet`: its engine (the method does not apply).
 
 An explicit method is kept: `DOP853` on a rigid monolith runs the step kernel.
@@ -64,7 +64,7 @@ def compiled_code(config: Config) -> str | None:
     method = resolve_method(config)
     compiled = config.solver.implementation == "compiled"
     if config.model == "housner-linear":
-        return "closed-form" if compiled and config.excitation.vertical is None else None
+        return "closed-form" if compiled else None
     if config.model != "rbm" or not compiled:
         return None
     if method in ("closed-form", "exact"):

@@ -3,7 +3,7 @@
 Three runners report the same row (:func:`_row`): the RBM through
 :func:`rbm_cli.study.simulate.simulate`, the scipy baseline
 (:mod:`rbm_cli.models.rbm.baseline`) and the closed-form linearised Housner
-solution (:mod:`rbm_cli.models.housner_linear`).
+solution (:mod:`rbm_cli.models.block.closed_form`).
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
     if method == "exact":
         from rbm_cli.models.rbm.exact.integrate import warm_up
     elif method == "closed-form":
-        from rbm_cli.models.rbm.closed_form import warm_up
+        from rbm_cli.models.block.closed_form import warm_up
     else:
         from rbm_cli.models.rbm.step import warm_up
     warm_up()  # load the method's compiled code in this worker before timing runs
@@ -64,17 +64,18 @@ def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dic
 
 
 def _run_closed_form_chunk(cfg: Config, cells) -> list[dict]:
-    from rbm_cli.models.housner_linear import housner_linear_run
+    from rbm_cli.models.block.closed_form import linear_run, warm_up
     from rbm_cli.models.rbm.runner import model_from_config
     from rbm_cli.physics.closed_forms import linear_rocking_parameters
     from rbm_cli.physics.excitation import make_ground_motion
 
+    warm_up()  # load the compiled closed form in this worker before timing runs
     model = model_from_config(cfg)
     alpha, p = linear_rocking_parameters(model.column)
     rows = []
     for a, f in cells:
         start = time.perf_counter()
-        out = housner_linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f),
+        out = linear_run(alpha, p, make_ground_motion(cfg.excitation, a, f),
                                  restitution=model.restitution,
                                  collapse_ratio=cfg.collapse.ratio)  # fmt: skip
         rows.append(_row(a, f, out.status, out.t_collapse, float(np.max(out.max_ratio)),

@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.config.types import Config
+from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.events import first_crossing
-from rbm_cli.models.housner_linear import housner_linear_run
 from rbm_cli.physics.excitation import make_ground_motion
 
 
@@ -109,7 +109,7 @@ def linear_domain(config: Config, alpha: float, p: float, restitution: float) ->
     for f in config.grid.frequencies_hz:
         for a in config.grid.amplitudes_g:
             motion = make_ground_motion(config.excitation, a, f)
-            out = housner_linear_run(
+            out = linear_run(
                 alpha, p, motion, restitution=restitution, collapse_ratio=config.collapse.ratio
             )
             rows.append(

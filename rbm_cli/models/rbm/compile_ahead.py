@@ -37,7 +37,7 @@ POLL_S = 0.1
 #: needs_compile and warm_up, and its compiled function whose cache folder holds the lock.
 TARGETS = {
     "kernel": ("rbm_cli.models.rbm.step", "run_kernel"),
-    "closed-form": ("rbm_cli.models.rbm.closed_form", "run_block"),
+    "closed-form": ("rbm_cli.models.block.closed_form", "run_block"),
     "exact": ("rbm_cli.models.rbm.exact.integrate", "run_exact"),
 }
 #: What each is called in a note.

@@ -2,7 +2,7 @@
 kernel (compiled, or its source uncompiled with `solver.implementation: python`). With
 `solver.method: exact` the linear pieces are integrated in closed form instead
 (rbm_cli.models.rbm.exact; tests/test_exact.py holds it to the step kernel). A rigid
-monolith runs in the block's closed form (rbm_cli.models.rbm.closed_form) under
+monolith runs in the block's closed form (rbm_cli.models.block.closed_form) under
 `closed-form`, and under `auto` (the default) where that applies
 (rbm_cli.models.methods.resolve_method; tests/test_closed_form_jit.py)."""
 
@@ -58,7 +58,7 @@ class RbmRunner:
         to (closed-form or DOP853, rbm_cli.models.methods.resolve_method)."""
         method = resolve_method(self.config, solver)
         if method == "closed-form" and solver.method == "auto":
-            from rbm_cli.models.rbm.closed_form import why_not
+            from rbm_cli.models.block.closed_form import why_not
 
             if why_not(self.model) is not None:  # a model given in place of the config's
                 return STEP_DEFAULT
@@ -68,13 +68,8 @@ class RbmRunner:
         """The integrator of a method and implementation, imported only when a run needs
         it; the compiled one with this column's kernel inputs, prepared once."""
         if method == "closed-form":
-            from rbm_cli.models.rbm.closed_form import integrate_closed_form, rbm_block
+            from rbm_cli.models.block.closed_form import integrate_closed_form, rbm_block
 
-            if implementation != "compiled":
-                raise RbmError(
-                    "solver.method closed-form is compiled only for model rbm (use"
-                    " implementation compiled, or model housner-linear for the Python one)"
-                )
             return partial(integrate_closed_form, block=rbm_block(self.model))
         if method == "exact":
             from rbm_cli.models.rbm.exact.integrate import integrate_exact, prepare_exact
@@ -135,7 +130,7 @@ class RbmRunner:
 
 def _check_closed_form(model: Model, config: Config) -> None:
     """RbmError (one line) unless `closed-form` takes this model and excitation."""
-    from rbm_cli.models.rbm.closed_form import rbm_block
+    from rbm_cli.models.block.closed_form import rbm_block
 
     rbm_block(model)
     excitation = config.excitation

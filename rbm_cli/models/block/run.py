@@ -1,13 +1,21 @@
-"""The run loop of the rigid block's compiled closed form (numba): rest, uplift, pieces
-of closed-form motion (closed_form_jit), impacts, collapse and the early stop of free
-motion, in one compiled call per run; rbm_cli.models.housner_linear's algorithm.
+"""The run loop of the rigid block's closed form (numba-compatible; rbm_cli.base.jit):
+rest, uplift, pieces of closed-form motion (block.piece), impacts, collapse and the early
+stop of free motion, in one call per run.
 
 Mutable scalars live in small arrays: st = [t, theta, rate, side, at rest, peak,
-friction, next output time, samples written, t_collapse] (floats) and cnt = [uplifts,
-impacts, pieces, evaluations, events] (ints). A motion is mo = [pulse or record (0/1),
-amplitude, omega, phase, pulse_end, t_end] with its segments (start, end) and their
-forcings (exact_jit_modal); settings are se = [max_steps (pieces), max_events, deadline
+friction, next output time, samples written, t_collapse, events logged] (floats) and
+cnt = [uplifts, impacts, pieces, evaluations, events] (ints). A motion is mo = [pulse or
+record (0/1), amplitude, omega, phase, pulse_end, t_end] with its segments (start, end),
+their forcings (exact_jit_modal) and, under a vertical record, the upward acceleration
+on each segment, seg_v = [a_v at the forcing's t0 [m/s^2], its slope [m/s^3]] (no rows:
+no vertical motion); settings are se = [max_steps (pieces), max_events, deadline
 (time.monotonic) [s], early_stop, record, output_dt [s]] (as exact_jit_run's).
+
+A vertical record makes the weights act as under g + a_v: on a piece the block obeys
+theta'' = p^2 gam (theta - s alpha) + e a_g with gam = (g + a_v) / g taken at the middle
+of the piece (a piece under a record ends at the next sample: exact for a_v constant
+between samples, second order in the sample step otherwise), and it lifts when |a_g|
+exceeds the uplift level times (g + a_v) / g.
 """
 
 from __future__ import annotations
@@ -17,8 +25,8 @@ import math
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.housner_state import STOP_MARGIN
-from rbm_cli.models.rbm.closed_form_jit import (
+from rbm_cli.config.types import G
+from rbm_cli.models.block.piece import (
     A_EVALS,
     A_FRICTION,
     A_PEAK,
@@ -38,6 +46,7 @@ from rbm_cli.models.rbm.closed_form_jit import (
     scan_piece,
     start_piece,
 )
+from rbm_cli.models.housner_state import STOP_MARGIN
 from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.kernel_ground import sine_exceedance
 from rbm_cli.models.rbm.run_codes import (
@@ -52,8 +61,10 @@ from rbm_cli.models.rbm.run_codes import (
     guard_code,
 )
 
-T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE = range(10)
+T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG = range(11)
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)
+#: The kinds of the event log's rows (t [s], kind).
+LOG_UPLIFT, LOG_IMPACT, LOG_REST, LOG_COLLAPSE = 1, 2, 3, 4
 
 
 @jit
@@ -62,6 +73,40 @@ def energy(blk, theta, rate):
     a = abs(theta)
     p = blk[B_P]
     return 0.5 * rate * rate + p * p * (blk[B_ALPHA] * a - 0.5 * a * a)
+
+
+@jit
+def _note(st, log, kind):
+    """Log (t, kind) of an event at st[T] while the log has room."""
+    row = int(st[N_LOG])
+    if row < log.shape[0]:
+        log[row, 0], log[row, 1] = st[T], kind
+        st[N_LOG] += 1.0
+
+
+@jit
+def gravity_factor(fc, fv, t):
+    """(g + a_v(t)) / g [-] on a segment with the upward acceleration line fv (a_v =
+    fv[0] + fv[1] (t - t0), t0 the forcing's fc[4])."""
+    return 1.0 + (fv[0] + fv[1] * (t - fc[4])) / G
+
+
+@jit
+def vertical_exceedance(fc, fv, t0, level, t_stop):
+    """First t in [t0, t_stop) with |a_g(t)| > level (g + a_v(t)) / g under a linear
+    forcing fc and the upward line fv: t0 when already above, else where a_g meets
+    +-level (g + a_v) / g (both lines; -1 if not before t_stop [s])."""
+    a = f_accel(fc, t0)
+    if abs(a) > level * gravity_factor(fc, fv, t0):
+        return t0
+    b = f_accel(fc, t_stop)
+    if not abs(b) > level * gravity_factor(fc, fv, t_stop):
+        return -1.0
+    target = level if b > 0.0 else -level
+    f_a = a - target * gravity_factor(fc, fv, t0)
+    f_b = b - target * gravity_factor(fc, fv, t_stop)
+    t = min(max(t0 + (t_stop - t0) * (f_a / (f_a - f_b)), t0), t_stop)
+    return t if t < t_stop else -1.0
 
 
 @jit
@@ -80,10 +125,11 @@ def _emit(pc, st, samples, t_stop, dt, rest):
 
 
 @jit
-def _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, dt):
+def _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, dt, log):
     """The block at rest: 0 no ground motion left (rests to the end), 1 the segment ends
-    first, 2 it lifts (a harmonic's exceedance from its formula, a line's from the line)
-    on the side turning away from a_g."""
+    first, 2 it lifts (a harmonic's exceedance from its formula, a line's from the line,
+    under a vertical record (fv: its line, else empty) against the level times
+    (g + a_v) / g) on the side turning away from a_g."""
     t = st[T]
     kind_fc = int(fc[0])
     if kind_fc == ZERO:
@@ -92,7 +138,9 @@ def _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, dt):
         else:
             kind, t_stop = 0, mo[5]
     else:
-        if kind_fc == LINEAR:
+        if kind_fc == LINEAR and fv.size > 0:
+            t_up = vertical_exceedance(fc, fv, t, blk[B_UPLIFT], seg_end)
+        elif kind_fc == LINEAR:
             t_up = linear_exceedance(fc, t, blk[B_UPLIFT], seg_end)
         else:
             t_up = sine_exceedance(t, blk[B_UPLIFT], fc[1], fc[2], fc[3], min(mo[4], mo[5]))
@@ -107,32 +155,40 @@ def _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, dt):
     st[THETA], st[RATE], st[AT_REST] = 0.0, 0.0, 0.0
     st[SIDE] = -1.0 if f_accel(fc, t_stop) > 0.0 else 1.0
     cnt[UPLIFTS] += 1
+    _note(st, log, LOG_UPLIFT)
     return kind
 
 
 @jit
-def _event(blk, st, cnt, kind, se):
-    """Apply the event that ended a piece at st[T]. Returns a code."""
+def _event(blk, st, cnt, kind, se, log):
+    """Apply the event that ended a piece at st[T] (logged). Returns a code."""
     cnt[EVENTS] += 1
     if kind == COLLAPSE:
         st[T_COLLAPSE] = st[T]
         st[PEAK] = max(st[PEAK], blk[B_LIMIT])
+        _note(st, log, LOG_COLLAPSE)
         return COLLAPSED
     if cnt[EVENTS] > se[1]:
         return FAILED_EVENTS
     cnt[IMPACTS] += 1
+    _note(st, log, LOG_IMPACT)
     st[THETA], st[RATE], st[SIDE] = 0.0, blk[B_REST] * st[RATE], -st[SIDE]
     if abs(st[RATE]) < blk[B_REST_RATE]:
         st[RATE], st[AT_REST] = 0.0, 1.0
+        _note(st, log, LOG_REST)
     return GOING
 
 
 @jit
-def _piece(blk, st, cnt, fc, seg_end, can_stop, se, samples, pc, acc):
+def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log):
     """One piece from the current state up to its first event, a peak of free motion
-    below the barrier (can_stop) or seg_end [s]. Returns a code."""
+    below the barrier (can_stop) or seg_end [s]; under a vertical record (fv not empty) and
+    a linear forcing, with gam = (g + a_v) / g at the piece's middle. Returns a code."""
     t = st[T]
-    start_piece(blk, t, st[THETA], st[RATE], st[SIDE], fc, pc)
+    gam = 1.0
+    if fv.size > 0 and int(fc[0]) == LINEAR:
+        gam = gravity_factor(fc, fv, 0.5 * (t + seg_end))
+    start_piece(blk, t, st[THETA], st[RATE], st[SIDE], fc, gam, pc)
     cnt[PIECES] += 1
     acc[A_PEAK], acc[A_TAU_PEAK], acc[A_EVALS], acc[A_FRICTION] = 0.0, -1.0, 0.0, st[FRICTION]
     kind, tau = scan_piece(pc, blk, seg_end - t, acc)
@@ -152,16 +208,17 @@ def _piece(blk, st, cnt, fc, seg_end, can_stop, se, samples, pc, acc):
     if stop_here:
         return STOPPED_EARLY
     if kind == IMPACT or kind == COLLAPSE:
-        return _event(blk, st, cnt, kind, se)
+        return _event(blk, st, cnt, kind, se, log)
     return GOING
 
 
 @jit
-def _segment(blk, st, cnt, mo, se, fc, seg_end, can_stop, samples, pc, acc):
-    """Run up to seg_end [s] under the forcing fc. Returns a code."""
+def _segment(blk, st, cnt, mo, se, fc, fv, seg_end, can_stop, samples, pc, acc, log):
+    """Run up to seg_end [s] under the forcing fc (and the upward line fv). Returns a
+    code."""
     while st[T] < seg_end:
         if st[AT_REST] != 0.0:
-            kind = _leave_rest(blk, st, cnt, mo, seg_end, fc, pc, samples, se[5])
+            kind = _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, se[5], log)
             if kind == 0:
                 return AT_REST_END
             if kind == 1:
@@ -172,18 +229,22 @@ def _segment(blk, st, cnt, mo, se, fc, seg_end, can_stop, samples, pc, acc):
             code = guard_code(se[2])
             if code != GOING:
                 return code
-        code = _piece(blk, st, cnt, fc, seg_end, can_stop, se, samples, pc, acc)
+        code = _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log)
         if code != GOING:
             return code
     return GOING
 
 
 @jit
-def run_block(blk, seg_t, seg_fc, mo, se, theta0, rate0, samples):
-    """One run from (theta0 [rad], rate0 [rad/s]) at t = 0. Returns (code, st, cnt)."""
+def run_block(blk, seg_t, seg_fc, seg_v, mo, se, theta0, rate0, samples, log):
+    """One run from (theta0 [rad], rate0 [rad/s]) at t = 0: samples (rows t, theta, rate)
+    written when se asks for them, events (rows t [s], kind LOG_*) logged while log has
+    rows. Returns (code, st, cnt)."""
     side = 1.0 if theta0 > 0.0 else -1.0 if theta0 < 0.0 else (-1.0 if rate0 < 0.0 else 1.0)
     at_rest = 1.0 if theta0 == 0.0 and rate0 == 0.0 else 0.0
-    st = np.array([0.0, theta0, rate0, side, at_rest, abs(theta0), 0.0, 0.0, 0.0, math.nan])
+    st = np.array([0.0, theta0, rate0, side, at_rest, abs(theta0), 0.0, 0.0, 0.0, math.nan,
+                   0.0])  # fmt: skip
+    no_v = np.zeros(0)
     cnt = np.zeros(5, dtype=np.int64)
     pc, acc = np.zeros(PIECE_SIZE), np.zeros(4)
     if abs(theta0) >= blk[B_LIMIT]:
@@ -195,8 +256,9 @@ def run_block(blk, seg_t, seg_fc, mo, se, theta0, rate0, samples):
             continue
         free = int(seg_fc[i, 0]) == ZERO and seg_t[i, 0] >= mo[4]
         can_stop = se[3] != 0.0 and free and mo[0] != 0.0
-        code = _segment(blk, st, cnt, mo, se, seg_fc[i], seg_t[i, 1], can_stop, samples, pc,
-                        acc)  # fmt: skip
+        fv = seg_v[i] if seg_v.shape[0] > 0 else no_v
+        code = _segment(blk, st, cnt, mo, se, seg_fc[i], fv, seg_t[i, 1], can_stop, samples,
+                        pc, acc, log)  # fmt: skip
         if code != GOING:
             break
     if code == GOING:

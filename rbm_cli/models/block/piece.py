@@ -1,19 +1,23 @@
-"""The closed form of the piecewise-linear rocking block, compiled (numba): one piece of
-motion on one side, its events found by a scan that cannot miss one, refined by Brent's
-method to round-off. The run loop is closed_form_jit_run; closed_form runs it.
+"""One piece of the rigid block's closed form (numba-compatible; rbm_cli.base.jit): the
+motion on one side between two events, its events found by a scan that cannot miss one,
+refined by Brent's method to round-off. The run loop is block.run; block.closed_form runs
+it.
 
 On side s = +-1, between two events, the block obeys
 
-    theta'' = p^2 (theta - s alpha) + e a_g(t),
+    theta'' = p^2 gam (theta - s alpha) + e a_g(t),
 
 (Spanos and Koh's block: e = -p^2 / g; the rigid RBM monolith: e = -m (H/2) / I_0,
-closed_form.block_params), solved exactly for a forcing of the exact integrator's kinds
-(exact_jit_modal: zero, harmonic, or linear between two samples of a record):
+closed_form.rbm_block; gam = (g + a_v) / g under a vertical record, taken constant on the
+piece, else 1), solved exactly for a forcing of the exact integrator's kinds
+(exact_jit_modal: zero, harmonic, or linear between two samples of a record). With
+p_g = p sqrt(gam):
 
-    theta(tau) = s alpha + C sin(omega tau + phi0) + q0 + q1 tau + c1 e^(p tau) + c2 e^(-p tau)
+    theta(tau) = s alpha + C sin(omega tau + phi0) + q0 + q1 tau + c1 e^(p_g tau)
+                 + c2 e^(-p_g tau)
 
 with C = -e A / (p^2 + omega^2) under a_g = A sin(omega t + phase), and q0 + q1 tau =
--(e / p^2) a_g(t0 + tau) under a straight-line a_g.
+-(e / p_g^2) a_g(t0 + tau) under a straight-line a_g.
 
 Events (impact: s theta back to 0; collapse: s theta reaches the limit) and maxima are
 bracketed on intervals [a, b] on which s theta' has at most one zero, which is proved, not
@@ -37,7 +41,7 @@ from rbm_cli.models.rbm.brent import brent_step
 from rbm_cli.models.rbm.exact.modal import HARMONIC, LINEAR, f_phase
 
 #: A piece: start time t0 [s], side s, C [rad], omega [rad/s], phi0 [rad], q0 [rad],
-#: q1 [rad/s], c1, c2 [rad], alpha [rad], p [rad/s]; the ground acceleration on it,
+#: q1 [rad/s], c1, c2 [rad], alpha [rad], p_g [rad/s]; the ground acceleration on it,
 #: a_g(t0 + tau) = A sin(omega tau + phi0) + g0 + g1 tau (A [m/s^2], g0 [m/s^2],
 #: g1 [m/s^3]); the friction factors fa [s^2/m], fb [1/rad] (0: none).
 T0, SIDE, AMP, OM, PHI, Q0, Q1, C1, C2, ALPHA, P, GA, G0, G1, FA, FB = range(16)
@@ -67,10 +71,11 @@ MIN_WIDTH = 1e-12
 
 
 @jit
-def start_piece(blk, t, theta, rate, side, fc, pc):
+def start_piece(blk, t, theta, rate, side, fc, gam, pc):
     """Fill pc with the piece through (theta [rad], rate [rad/s]) at t [s] on side s
-    under the forcing fc (exact_jit_modal)."""
-    p, alpha, e = blk[B_P], blk[B_ALPHA], blk[B_E]
+    under the forcing fc (exact_jit_modal), the weights scaled by gam = (g + a_v) / g [-]
+    (1: no vertical motion)."""
+    p, alpha, e = blk[B_P] * math.sqrt(gam), blk[B_ALPHA], blk[B_E]
     p2 = p * p
     kind = int(fc[0])
     amp, om, phi, q0, q1, ga, g0, g1 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -150,10 +155,11 @@ def brent(pc, which, shift, xa, xb, acc):
 def impact_time(pc, blk, a, b, fa, acc):
     """The impact time in [a, b], s theta(b) + eps <= 0 < s theta(a) + eps. The RBM's
     convention (blk[B_AT_ZERO] 0, the step kernel's and the exact integrator's): where s
-    theta reaches -eps (the state is then projected onto theta = 0). housner-linear's
-    (housner_linear_piece.PieceScanner.impact): the root of s theta if s theta(a) > eps,
-    else (s theta(a) within round-off of 0) of s theta + eps then two Newton steps to
-    s theta = 0."""
+    theta reaches -eps (the state is then projected onto theta = 0). housner-linear's: the
+    root of s theta if s theta(a) > eps, else (s theta(a) within round-off of 0, as at a
+    restart from theta = 0, where the sign of s theta is round-off: a root of s theta
+    itself could be one of its sign changes next to a) of s theta + eps, then two Newton
+    steps to s theta = 0."""
     eps = blk[B_EPS]
     if blk[B_AT_ZERO] == 0.0:
         return brent(pc, 0, eps, a, b, acc)

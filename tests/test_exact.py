@@ -463,7 +463,7 @@ def test_the_wall_clock_budget_ends_a_compiled_exact_run():
 
 
 def test_ctrl_c_stops_a_compiled_exact_run():
-    """Ctrl-C (SIGINT) reaches the compiled exact loop through kernel_guard.poll and
+    """Ctrl-C (SIGINT) reaches the compiled exact loop through guard.poll and
     raises KeyboardInterrupt once the call has returned. Python's own SIGINT handler
     is installed for the test: a test runner started as a background job ignores SIGINT,
     and the test once skipped there."""

@@ -1,5 +1,5 @@
 """First use: the compiled code is compiled before the first run, one compile at a time
-(rbm_cli.models.rbm.compile_ahead), and the first run answers as every later run does.
+(rbm_cli.models.compile_ahead), and the first run answers as every later run does.
 
 The first `rbm run` on an empty compile cache once answered from the Python integrator
 while the compiled code compiled in the background: a cell in chaotic motion then got
@@ -30,7 +30,7 @@ import pytest
 from click.testing import CliRunner
 
 from rbm_cli.cli.main import cli
-from rbm_cli.models.rbm import compile_ahead
+from rbm_cli.models import compile_ahead
 
 from .paths import CONFIGS
 

@@ -22,7 +22,7 @@ from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
 from rbm_cli.models.block.closed_form import linear_run
-from rbm_cli.models.rbm.kernel_ground import next_uplift
+from rbm_cli.models.ground import next_uplift
 from rbm_cli.models.rbm.runner import model_from_config
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.excitation import make_ground_motion

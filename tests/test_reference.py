@@ -19,7 +19,7 @@ from scipy.optimize import brentq
 
 from rbm_cli.config.types import ColumnConfig, SolverConfig
 from rbm_cli.models.block.closed_form import linear_run
-from rbm_cli.models.housner import housner_run
+from rbm_cli.models.housner.runner import housner_run
 from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.restitution import block_restitution
@@ -446,7 +446,7 @@ def test_housner_event_is_the_earliest_crossing_of_either_row():
     """housner._earliest on a made-up step whose rotation dips below zero on (0.2, 0.3)
     (an impact) and passes the collapse limit at 0.9: the event is the impact at 0.2.
     A root of the minimum of the two rows, the earlier rule, may be the one at 0.9."""
-    from rbm_cli.models.housner import _earliest
+    from rbm_cli.models.housner.runner import _earliest
 
     limit, s, eps = 1.0, 1, 0.0
 

@@ -86,7 +86,7 @@ def first_use(cfg) -> None:
     before it runs. On a first use (not in numba's cache) the run waits for the compile, one
     note on stderr saying for what and about how long, and then answers with the compiled
     code, as every later run does; a compile another rbm process runs is waited for, not
-    repeated (rbm_cli.models.rbm.compile_ahead). Nothing to do for a run in Python
+    repeated (rbm_cli.models.compile_ahead). Nothing to do for a run in Python
     (``solver.implementation: python``) or a model without compiled code."""
     from rbm_cli.models.methods import compiled_code
 
@@ -95,7 +95,7 @@ def first_use(cfg) -> None:
         return
     import gc
 
-    from rbm_cli.models.rbm.compile_ahead import compile_once
+    from rbm_cli.models.compile_ahead import compile_once
 
     collecting = gc.isenabled()
     gc.enable()  # a compile's garbage is collected (peak 0.46 GB instead of 0.73 GB)

@@ -54,7 +54,7 @@ class ModelEntry:
 #: contact dynamics (PyBullet), any drums. A new model is one module and one line here.
 MODELS = {
     "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True),
-    "housner": ModelEntry("rbm_cli.models.housner:HousnerRunner", multi_drum=False),
+    "housner": ModelEntry("rbm_cli.models.housner.runner:HousnerRunner", multi_drum=False),
     "housner-linear": ModelEntry(
         "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False
     ),

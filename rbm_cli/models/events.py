@@ -16,6 +16,8 @@ EVENT_EPS = 1e-12
 #: (REST_RATE^2 / 2) theta_u = 5e-7 theta_u. This ends Zeno impact sequences
 #: (e < 1) and micro-chatter (e = 1, demand just above uplift) in finite work.
 REST_RATE = 1e-3
+#: Energy margin of the early stop of free motion [fraction of the barrier].
+STOP_MARGIN = 1e-9
 #: Stand-in for an infinite bound in the event distances.
 BIG = 1e30
 

@@ -11,7 +11,7 @@ time with a few numbers (``gain`` [m/s^2], ``omega`` [rad/s], ``phase`` [rad], `
   (a cosine computed as sin(y + pi/2), as the kernel does);
 - ``SAMPLED``: linear between samples (times, values), 0 before the first and after the last.
 
-The compiled kernel evaluates the same formulas (rbm_cli.models.rbm.kernel_ground), in the
+The compiled kernel evaluates the same formulas (rbm_cli.models.ground), in the
 same order of operations. Between consecutive ``knots`` a_g is monotone (the samples of a
 record; the extrema of a Ricker or MP pulse), which makes the search for the first time
 |a_g| exceeds a level (:func:`exceedance_on_pieces`) exact: linear for samples, bisection

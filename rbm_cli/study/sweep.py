@@ -399,7 +399,7 @@ def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str |
     codes = sorted({compiled_code(p.config) for p in points} - {None})
     if not (todo and codes):
         return 0.0, ""
-    from rbm_cli.models.rbm.compile_ahead import compile_once, needs_compile
+    from rbm_cli.models.compile_ahead import compile_once, needs_compile
 
     if backend == "dask" and scheduler and all(needs_compile(c) is False for c in codes):
         return 0.0, ""  # no cell runs here, and the workers find it in numba's cache

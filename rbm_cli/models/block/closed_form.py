@@ -37,6 +37,7 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.errors import RbmError
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import CLOSED_FORM_KINDS, G, SolverConfig
+from rbm_cli.models import status as cr
 from rbm_cli.models.block.run import (
     LOG_COLLAPSE,
     LOG_IMPACT,
@@ -46,11 +47,10 @@ from rbm_cli.models.block.run import (
     run_block,
 )
 from rbm_cli.models.events import EVENT_EPS, REST_RATE
+from rbm_cli.models.guard import arm, disarm
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
-from rbm_cli.models.rbm import run_codes as cr
 from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC, LINEAR
 from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings
-from rbm_cli.models.rbm.kernel_guard import arm, disarm
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -206,7 +206,7 @@ def run_closed_form(
     rows = 0 if events is None else LOG_ROWS
     while True:
         log = np.zeros((rows, 2))
-        armed = arm()  # Ctrl-C reaches the run through poll (kernel_guard)
+        armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.models.guard)
         try:
             code, st, cnt = run(block.params, seg_t, seg_fc, seg_v, mo, se, float(theta0),
                                 float(rate0), samples, log)  # fmt: skip

@@ -46,10 +46,10 @@ from rbm_cli.models.block.piece import (
     scan_piece,
     start_piece,
 )
-from rbm_cli.models.housner_state import STOP_MARGIN
+from rbm_cli.models.events import STOP_MARGIN
+from rbm_cli.models.ground import sine_exceedance
 from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
-from rbm_cli.models.rbm.kernel_ground import sine_exceedance
-from rbm_cli.models.rbm.run_codes import (
+from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
     FAILED_EVENTS,

@@ -18,8 +18,8 @@ References
 from __future__ import annotations
 
 from rbm_cli.config.types import SolverConfig
+from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.block.closed_form import linear_block, run_closed_form
-from rbm_cli.models.block_runner import BlockRunner
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.excitation import GroundMotion
 

@@ -163,7 +163,7 @@ def stack_slenderness(solids: tuple[DrumSolid, ...]) -> np.ndarray:
 
     alpha_i = atan(b_i / zbar_i), b_i the half-width of drum i's bottom face and
     zbar_i the height above that face of the true centre of mass of drums i..n.
-    For one drum this is Housner's slenderness alpha of :mod:`rbm_cli.models.housner`;
+    For one drum this is Housner's slenderness alpha of :mod:`rbm_cli.models.housner.runner`;
     tan(alpha_i) g is the horizontal acceleration that uplifts the rigid stack.
     """
     out = []

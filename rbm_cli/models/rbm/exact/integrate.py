@@ -15,13 +15,13 @@ import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
+from rbm_cli.models.guard import arm, disarm
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.model import ExactModel, exact_model, new_cache
 from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.rbm.exact.run import run_exact
 from rbm_cli.models.rbm.forcing_arrays import motion_arrays, run_settings
-from rbm_cli.models.rbm.kernel_guard import arm, disarm
-from rbm_cli.models.rbm.run_codes import (
+from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
     STOPPED_EARLY,
@@ -105,7 +105,7 @@ def integrate_exact(
     n = model.n
     mo, se = run_settings(motion, solver, early_stop, record, output_dt)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
-    armed = arm()  # Ctrl-C reaches the run through poll (kernel_guard)
+    armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.models.guard)
     try:
         run = run_exact if solver.implementation == "compiled" else plain(run_exact)
         code, st, cnt, maxima, fric = run(

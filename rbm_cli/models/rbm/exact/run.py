@@ -17,6 +17,7 @@ from collections import namedtuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
+from rbm_cli.models.ground import sine_exceedance
 from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.exact.model import energy1, friction
 from rbm_cli.models.rbm.exact.peaks import NOTES, new_notes, note_interval, settle_peaks
@@ -30,8 +31,7 @@ from rbm_cli.models.rbm.exact.piece import (
     set_point,
 )
 from rbm_cli.models.rbm.exact.search import SCRATCH, next_point
-from rbm_cli.models.rbm.kernel_ground import sine_exceedance
-from rbm_cli.models.rbm.run_codes import (
+from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
     FAILED_EVENTS,

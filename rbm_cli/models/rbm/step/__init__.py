@@ -26,8 +26,8 @@ Python that numba compiles: compiled by default, run by Python as written with
 ``solver.implementation: python`` (rbm_cli.base.jit.plain; the same bits, 30-100x
 slower). The modules: step.inputs (the kernel's four typed input records and
 prepare_kernel), step.stepper (the stepper), step.rk (Runge-Kutta), step.events (event
-location), step.state (the state change at an event), kernel_ground (the excitation),
-step.vertical (moving kinks under a vertical record), kernel_guard (wall-clock budget and
+location), step.state (the state change at an event), models.ground (the excitation),
+step.vertical (moving kinks under a vertical record), models.guard (wall-clock budget and
 Ctrl-C); this one runs a model from Python.
 """
 
@@ -40,15 +40,8 @@ import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
+from rbm_cli.models.guard import arm, disarm, poll
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
-from rbm_cli.models.rbm.kernel_guard import arm, disarm, poll
-from rbm_cli.models.rbm.run_codes import (
-    COLLAPSED,
-    FAILED_NONFINITE,
-    FAILED_STEP,
-    STOPPED_EARLY,
-    end_by_budget,
-)
 from rbm_cli.models.rbm.step.inputs import (
     PreparedModel,
     excitation,
@@ -57,6 +50,13 @@ from rbm_cli.models.rbm.step.inputs import (
     solver_settings,
 )
 from rbm_cli.models.rbm.step.stepper import run_kernel
+from rbm_cli.models.status import (
+    COLLAPSED,
+    FAILED_NONFINITE,
+    FAILED_STEP,
+    STOPPED_EARLY,
+    end_by_budget,
+)
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -96,7 +96,7 @@ def integrate(
     # a RunTask, as a plain tuple (step.inputs)
     task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), bool(early_stop),
             bool(record), float(output_dt), samples)  # fmt: skip
-    armed = arm()  # Ctrl-C reaches the kernel through poll (kernel_guard)
+    armed = arm()  # Ctrl-C reaches the kernel through poll (rbm_cli.models.guard)
     try:
         kernel = run_kernel if solver.implementation == "compiled" else plain(run_kernel)
         res = kernel(prepared.packed, excitation(motion), settings, task)

@@ -2,7 +2,7 @@
 transcriptions of rbm_cli.models.events (earliest crossing on the dense output,
 cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces); the moving kinks of
 a vertical record are step.vertical's (the exact uplift time of a rigid block at rest is
-in kernel_ground, time-history sampling in step.rk)."""
+in models.ground, time-history sampling in step.rk)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import numpy as np
 
 from rbm_cli.base.detmath import dot, matvec
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.brent import brent_step
+from rbm_cli.models.brent import brent_step
 from rbm_cli.models.rbm.step.rk import TAB_NP
 from rbm_cli.models.rbm.step.vertical import add_moving, moving_rate, moving_value
 

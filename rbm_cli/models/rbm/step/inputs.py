@@ -80,7 +80,7 @@ class ModelArrays(NamedTuple):
 
 class Excitation(NamedTuple):
     """The ground motion of one run (rbm_cli.physics.excitation.GroundMotion; its form's
-    numbers as rbm_cli.physics.ground_forms and kernel_ground read them)."""
+    numbers as rbm_cli.physics.ground_forms and models.ground read them)."""
 
     kind: int  #: KIND_CODES
     amplitude: float  #: peak |a_g| [m/s^2]

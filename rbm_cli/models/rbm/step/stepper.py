@@ -10,19 +10,8 @@ import numpy as np
 from rbm_cli.base.detmath import matvec, pow_pos
 from rbm_cli.base.jit import jit
 from rbm_cli.models.events import BIG, EVENT_EPS
-from rbm_cli.models.rbm.kernel_ground import ground_at, next_uplift, record_piece
-from rbm_cli.models.rbm.kernel_guard import POLL_STEPS
-from rbm_cli.models.rbm.run_codes import (
-    COLLAPSED,
-    FAILED_EVENTS,
-    FAILED_NONFINITE,
-    FAILED_STEP,
-    FAILED_STEPS,
-    GOING,
-    STOPPED_EARLY,
-    SURVIVED,
-    guard_code,
-)
+from rbm_cli.models.ground import ground_at, next_uplift, record_piece
+from rbm_cli.models.guard import POLL_STEPS
 from rbm_cli.models.rbm.step.events import (
     CHECK_INTERVALS,
     affine,
@@ -58,6 +47,17 @@ from rbm_cli.models.rbm.step.rk import (
 )
 from rbm_cli.models.rbm.step.state import IMPACT, REST, UPLIFT, settle, switch
 from rbm_cli.models.rbm.step.vertical import bound_now, moving_rows
+from rbm_cli.models.status import (
+    COLLAPSED,
+    FAILED_EVENTS,
+    FAILED_NONFINITE,
+    FAILED_STEP,
+    FAILED_STEPS,
+    GOING,
+    STOPPED_EARLY,
+    SURVIVED,
+    guard_code,
+)
 
 
 @jit
@@ -77,7 +77,7 @@ def run_kernel(model, motion, solver, task):
 
     Returns
     -------
-    tuple  (status code (run_codes), t_end [s], t_collapse [s], collapsed interface,
+    tuple  (status code (rbm_cli.models.status), t_end [s], t_collapse [s], collapsed interface,
         max_ratio (n,), max_top, friction (n,), n_uplifts, n_impacts, n_steps, n_rhs,
         n_events, n_samples).
     """
@@ -92,7 +92,7 @@ def run_kernel(model, motion, solver, task):
     amplitude, pulse_end, t_end = motion.amplitude, motion.pulse_end, motion.t_end
     knots, values, vertical, clipped = motion.knots, motion.values, motion.vertical, motion.clipped
     bounds, forced = motion.bounds, motion.forced
-    # the ground (kernel_ground): of the motion, and nothing (a free segment); a record
+    # the ground (rbm_cli.models.ground): of the motion, and nothing (a free segment); a record
     # one straight piece a step (record_piece)
     gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
                motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip

@@ -30,10 +30,10 @@ from scipy.integrate import DOP853, RK23, RK45
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import G, SolverConfig
-from rbm_cli.models.block_runner import BlockRunner
-from rbm_cli.models.events import EVENT_EPS, REST_RATE, first_crossing, hermite_dip
-from rbm_cli.models.housner_state import STOP_MARGIN, BlockRun, Recorder
-from rbm_cli.models.housner_steps import (
+from rbm_cli.models.block.base import BlockRunner
+from rbm_cli.models.events import EVENT_EPS, REST_RATE, STOP_MARGIN, first_crossing, hermite_dip
+from rbm_cli.models.housner.state import BlockRun, Recorder
+from rbm_cli.models.housner.steps import (
     HousnerBlock,
     HousnerRun,
     HousnerSide,

@@ -7,7 +7,7 @@ leave the process."""
 from __future__ import annotations
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.kernel_guard import GO_ON, PAST_DEADLINE, poll
+from rbm_cli.models.guard import GO_ON, PAST_DEADLINE, poll
 
 GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
 FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
@@ -20,7 +20,7 @@ POLL_PIECES = 64
 
 @jit
 def guard_code(deadline):
-    """kernel_guard.poll as a code: GOING, FAILED_WALL (the monotonic clock past deadline
+    """guard.poll as a code: GOING, FAILED_WALL (the monotonic clock past deadline
     [s]) or INTERRUPTED (Ctrl-C)."""
     guard = poll(deadline)
     if guard == GO_ON:

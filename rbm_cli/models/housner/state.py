@@ -1,7 +1,6 @@
-"""The moving parts of a run of Housner's block (`housner`, rbm_cli.models.housner): the
+"""The moving parts of a run of Housner's block (`housner`, rbm_cli.models.housner.runner): the
 recorder of the time history and the moving state of a run (time, side, rest, peak
-rotation, outcome), with the rest phase and the end of the run; the early stop's energy
-margin, which the block's closed form (rbm_cli.models.block.run) shares."""
+rotation, outcome), with the rest phase and the end of the run."""
 
 from __future__ import annotations
 
@@ -13,9 +12,6 @@ import numpy as np
 
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.excitation import GroundMotion
-
-#: Energy margin of the early stop of free motion [fraction of the barrier].
-STOP_MARGIN = 1e-9
 
 
 class Recorder:

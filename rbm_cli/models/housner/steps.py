@@ -13,7 +13,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from rbm_cli.config.types import SolverConfig
-from rbm_cli.models.housner_state import BlockRun
+from rbm_cli.models.housner.state import BlockRun
 from rbm_cli.models.outcome import Outcome
 
 

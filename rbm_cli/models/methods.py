@@ -1,72 +1,207 @@
-"""Which method runs a config: `solver.method: auto` (the default) resolved.
+"""The methods that run a config's cells, in one table (:data:`METHODS`).
 
-- model `rbm`: the rigid block's compiled closed form (`closed-form`,
-  rbm_cli.models.block.closed_form) where it applies -- a rigid monolithic column (one drum,
-  interface.stiffness rigid, xi 1, formulation relative or geometric), an excitation with a
-  closed form (harmonic, free, the sine pulses, records exact per sample interval), no
-  vertical record, `solver.implementation: compiled` -- else DOP853 (the step kernel, or
-  kernel's source uncompiled with `implementation: python`);
-- `housner-linear`: `closed-form` whatever the method says (compiled, or its source run
-  uncompiled with `implementation: python`; under a vertical record too, gam taken per
-  piece);
+Each row says which models a method runs and, per model, the compiled code it needs (a
+target of rbm_cli.models.compile_ahead, None where it runs no compiled code), where it does
+not apply (a one-line reason), and, for the Rigid Beam Model, the integrator it prepares
+once per column (an :class:`Integrator`). `solver.method: auto` (the default) is resolved
+here and nowhere else (:func:`resolve`):
+
+- model `rbm`: the rigid block's closed form (`closed-form`, rbm_cli.models.block) where it
+  applies -- a rigid monolithic column (one drum, interface.stiffness rigid, xi 1,
+  formulation relative or geometric), an excitation with a closed form (harmonic, free, the
+  sine pulses, records exact per sample interval), no vertical record, `solver.implementation:
+  compiled` -- else DOP853 (the step integrator, rbm_cli.models.rbm.step);
+- `housner-linear`: `closed-form`, whatever the method says;
 - `housner`: DOP853; `bullet`: its engine (the method does not apply).
 
-An explicit method is kept: `DOP853` on a rigid monolith runs the step kernel.
+An explicit method is kept where it applies (`DOP853` on a rigid monolith runs the step
+integrator) and refused in one line where it does not. Every compiled method also runs its
+own source uncompiled with `solver.implementation: python` (rbm_cli.base.jit.plain).
+
+Adding a method is one row here (and its name in rbm_cli.config.types.METHODS).
 """
 
 from __future__ import annotations
 
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import CLOSED_FORM_KINDS, STEP_DEFAULT, Config, SolverConfig
+from rbm_cli.models.outcome import Outcome
+from rbm_cli.physics.equations import Model
+from rbm_cli.physics.excitation import GroundMotion
 
 
-def closed_form_applies(config: Config, solver: SolverConfig | None = None) -> bool:
-    """Whether `auto` runs the RBM of this config in closed form (solver: the one a run
-    is given, default the config's)."""
-    solver = config.solver if solver is None else solver
-    interface, excitation = config.interface, config.excitation
-    return (
-        config.model == "rbm"
-        and solver.implementation == "compiled"
-        and config.column.n_drums == 1
-        and interface.stiffness.kind == "rigid"
-        and interface.xi == 1.0
-        and interface.formulation in ("relative", "geometric")
-        and excitation.type in CLOSED_FORM_KINDS
-        and excitation.vertical is None
+class Integrator(Protocol):
+    """What a method prepares for one RBM column: one run from an initial state [rad,
+    rad/s] under a motion, with a run's solver settings, to an Outcome."""
+
+    def __call__(
+        self,
+        model: Model,
+        motion: GroundMotion,
+        theta0: np.ndarray,
+        rate0: np.ndarray,
+        solver: SolverConfig,
+        *,
+        record: bool,
+        output_dt: float,
+        early_stop: bool,
+    ) -> Outcome: ...
+
+
+def _closed_form_why_not(config: Config, model: Model | None) -> str | None:
+    if config.model == "housner-linear":
+        return None
+    if model is not None:
+        from rbm_cli.models.block.closed_form import why_not
+
+        reason = why_not(model)
+        if reason is not None:
+            return f"solver.method closed-form: {reason}; use DOP853 (or auto)"
+    else:
+        interface = config.interface
+        if config.column.n_drums != 1 or interface.stiffness.kind != "rigid":
+            return (
+                "solver.method closed-form: it takes a rigid monolithic column only (one drum,"
+                " interface.stiffness rigid); use DOP853 (or auto)"
+            )
+        if interface.xi != 1.0:
+            return (
+                "solver.method closed-form: it takes one law piece a side only (interface.xi"
+                " 1); use DOP853 (or auto)"
+            )
+        if interface.formulation not in ("relative", "geometric"):
+            return (
+                "solver.method closed-form: it takes interface.formulation relative or"
+                " geometric; use DOP853 (or auto)"
+            )
+    excitation = config.excitation
+    if excitation.type not in CLOSED_FORM_KINDS or excitation.vertical is not None:
+        what = "a vertical record" if excitation.vertical is not None else excitation.type
+        return (
+            f"solver.method closed-form does not take {what} (no closed form): use DOP853 (or auto)"
+        )
+    return None
+
+
+def _exact_why_not(config: Config, model: Model | None) -> str | None:
+    from rbm_cli.models.rbm.exact.motion import exact_why_not
+
+    excitation = config.excitation
+    return exact_why_not(
+        config.interface.formulation, excitation.type, excitation.vertical is not None
     )
 
 
-def resolve_method(config: Config, solver: SolverConfig | None = None) -> str:
+@dataclass(frozen=True)
+class Method:
+    """One row of the table.
+
+    Attributes
+    ----------
+    name : str  As written in solver.method
+    runs : dict  Model name -> the compiled code a run of that model needs with
+        `solver.implementation: compiled` (a compile_ahead target), or None
+    prepare : str  "module:function" making the :class:`Integrator` of an RBM Model, or ""
+        (the model's runner integrates itself)
+    why_not : callable  (config, model or None) -> one-line reason it does not apply, or None
+    """
+
+    name: str
+    runs: dict[str, str | None]
+    prepare: str = ""
+    why_not: Callable[[Config, Model | None], str | None] = field(
+        default=lambda config, model: None
+    )
+
+    def integrator(self, model: Model) -> Integrator:
+        """This method's integrator for one RBM column, imported only when asked for."""
+        module, _, function = self.prepare.partition(":")
+        return getattr(importlib.import_module(module), function)(model)
+
+    def compiled_code(self, config: Config) -> str | None:
+        """The compiled code the cells of config run with this method (None: none)."""
+        if config.solver.implementation != "compiled":
+            return None
+        return self.runs.get(config.model)
+
+
+_STEP = "rbm_cli.models.rbm.step:prepare"
+
+#: The methods, by name: where each applies, what it prepares, what it compiles.
+METHODS: dict[str, Method] = {
+    m.name: m
+    for m in (
+        Method(
+            "closed-form",
+            {"rbm": "closed-form", "housner-linear": "closed-form"},
+            "rbm_cli.models.block.closed_form:prepare",
+            _closed_form_why_not,
+        ),
+        Method(
+            "exact", {"rbm": "exact"}, "rbm_cli.models.rbm.exact.integrate:prepare", _exact_why_not
+        ),
+        Method("DOP853", {"rbm": "kernel", "housner": None}, _STEP),
+        Method("RK45", {"rbm": "kernel", "housner": None}, _STEP),
+        Method("RK23", {"rbm": "kernel", "housner": None}, _STEP),
+        Method("engine", {"bullet": None}),
+    )
+}
+
+
+def resolve(
+    config: Config, solver: SolverConfig | None = None, model: Model | None = None
+) -> Method:
     """The method that runs this config's cells: solver.method, or what `auto` stands for
-    (see the module); 'engine' for `bullet`."""
+    (see the module). solver: the one a run is given (default the config's); model: the
+    column's equations when a runner has them (a model given in place of the config's).
+    RbmError in one line where the method does not apply."""
     solver = config.solver if solver is None else solver
     if config.model == "bullet":
-        return "engine"
+        return METHODS["engine"]
     if config.model == "housner-linear":
-        return "closed-form"
-    if solver.method != "auto":
-        return solver.method
-    if closed_form_applies(config, solver):
-        return "closed-form"
-    return STEP_DEFAULT
+        return METHODS["closed-form"]
+    if solver.method == "auto":
+        closed = METHODS["closed-form"]
+        if (
+            config.model == "rbm"
+            and solver.implementation == "compiled"
+            and closed.why_not(config, model) is None
+        ):
+            return closed
+        return METHODS[STEP_DEFAULT]
+    method = METHODS[solver.method]
+    if config.model not in method.runs:
+        steps = ", ".join(name for name, m in METHODS.items() if config.model in m.runs)
+        raise RbmError(
+            f"solver.method {solver.method} is for model rbm (its piecewise-linear equations);"
+            f" model {config.model} takes auto, {steps}"
+        )
+    reason = method.why_not(config, model)
+    if reason is not None:
+        raise RbmError(reason)
+    return method
+
+
+def resolve_method(config: Config, solver: SolverConfig | None = None) -> str:
+    """The name of the method that runs this config's cells (:func:`resolve`)."""
+    return resolve(config, solver).name
 
 
 def step_method(solver: SolverConfig) -> str:
-    """The Runge-Kutta pair of a step integrator: solver.method, DOP853 for `auto`."""
+    """The Runge-Kutta pair of a step integrator called with a solver as written:
+    solver.method, DOP853 (the table's default step method) for `auto`."""
     return STEP_DEFAULT if solver.method == "auto" else solver.method
 
 
 def compiled_code(config: Config) -> str | None:
-    """Which compiled code the cells of this config run: 'kernel' (the step kernel),
-    'exact' (the compiled exact integrator), 'closed-form' (the block's closed form), or
-    None (Python, or a model without compiled code): a target of
-    rbm_cli.models.rbm.compile_ahead."""
-    method = resolve_method(config)
-    compiled = config.solver.implementation == "compiled"
-    if config.model == "housner-linear":
-        return "closed-form" if compiled else None
-    if config.model != "rbm" or not compiled:
-        return None
-    if method in ("closed-form", "exact"):
-        return method
-    return "kernel"
+    """Which compiled code the cells of this config run: 'kernel' (the step integrator),
+    'exact', 'closed-form', or None (Python, or a model without compiled code): a target
+    of rbm_cli.models.compile_ahead."""
+    return resolve(config).compiled_code(config)

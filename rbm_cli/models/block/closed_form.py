@@ -29,6 +29,7 @@ its cache; base/compile_cache keys that cache on these modules' sources).
 from __future__ import annotations
 
 import math
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -321,6 +322,12 @@ def integrate_closed_form(
     block = rbm_block(model) if block is None else block
     return run_closed_form(block, motion, float(theta0[0]), float(rate0[0]), solver,
                            record=record, output_dt=output_dt, early_stop=early_stop)  # fmt: skip
+
+
+def prepare(model: Model):
+    """The closed form of one rigid RBM monolith (rbm_cli.models.methods.Integrator): its
+    Block made once, for every run of the column (RbmError in one line if it is not one)."""
+    return partial(integrate_closed_form, block=rbm_block(model))
 
 
 def needs_compile() -> bool | None:

@@ -28,8 +28,8 @@ import math
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 
-from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import G, SolverConfig
+from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.events import EVENT_EPS, REST_RATE, STOP_MARGIN, first_crossing, hermite_dip
 from rbm_cli.models.housner.state import BlockRun, Recorder
@@ -332,11 +332,11 @@ class HousnerRunner(BlockRunner):
 
     def __init__(self, config) -> None:
         super().__init__(config)
-        _check_method(config.solver)
+        methods.resolve(config)  # an explicit method that does not apply: refused
 
     def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
-        _check_method(solver)
-        solver = dataclasses.replace(solver, method=step_method(solver))  # auto: DOP853
+        method = methods.resolve(self.config, solver).name
+        solver = dataclasses.replace(solver, method=method)  # auto: DOP853
         out = housner_run(
             self.geometry,
             motion,
@@ -348,13 +348,3 @@ class HousnerRunner(BlockRunner):
         )
         out.method = solver.method
         return out
-
-
-def _check_method(solver: SolverConfig) -> None:
-    """Housner's equations are not piecewise linear: no `exact` or `closed-form` method
-    (one-line RbmError); `auto` is DOP853."""
-    if step_method(solver) not in _METHODS:
-        raise RbmError(
-            f"solver.method {solver.method} is for model rbm (its piecewise-linear equations);"
-            f" model housner takes auto, {', '.join(_METHODS)}"
-        )

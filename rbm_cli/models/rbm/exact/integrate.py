@@ -9,6 +9,7 @@ The modes of every set of law pieces met are cached across the runs of one colum
 from __future__ import annotations
 
 import math
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -118,6 +119,12 @@ def integrate_exact(
     if record:
         out.samples = sample_rows(samples, int(st[5]), n)
     return out
+
+
+def prepare(model: Model):
+    """The exact integrator of one column (rbm_cli.models.methods.Integrator): its modal
+    arrays prepared once, for every run of the column."""
+    return partial(integrate_exact, prepared=prepare_exact(model))
 
 
 def needs_compile() -> bool | None:

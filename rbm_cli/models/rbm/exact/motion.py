@@ -55,26 +55,35 @@ class Forcing:
     a1: float = 0.0
 
 
-def check_exact(model: Model, kind: str, vertical: bool = False) -> None:
-    """Raise RbmError (one line) unless the exact method takes this model and excitation
-    (vertical: whether the excitation has a vertical record)."""
-    if model.formulation == "absolute":
-        raise RbmError(
+def exact_why_not(formulation: str, kind: str, vertical: bool = False) -> str | None:
+    """Why the exact method does not take an interface formulation and an excitation type
+    (vertical: whether the excitation has a vertical record), in one line; None if it does."""
+    if formulation == "absolute":
+        return (
             "solver.method exact needs interface.formulation relative or geometric (absolute"
             " is not symmetric): use a Runge-Kutta method (DOP853) for absolute"
         )
     if kind in _NOT_EXACT:
-        raise RbmError(
+        return (
             f"solver.method exact does not take excitation.type {kind} ({_NOT_EXACT[kind]}):"
             " use a Runge-Kutta method (DOP853)"
         )
     if kind not in EXACT_KINDS:
-        raise RbmError(f"solver.method exact does not take excitation.type {kind}")
+        return f"solver.method exact does not take excitation.type {kind}"
     if vertical:
-        raise RbmError(
+        return (
             "solver.method exact does not take excitation.vertical (the weights vary with"
             " g + a_v(t): no constant-coefficient pieces): use a Runge-Kutta method (DOP853)"
         )
+    return None
+
+
+def check_exact(model: Model, kind: str, vertical: bool = False) -> None:
+    """Raise RbmError (one line) unless the exact method takes this model and excitation
+    (vertical: whether the excitation has a vertical record)."""
+    reason = exact_why_not(model.formulation, kind, vertical)
+    if reason is not None:
+        raise RbmError(reason)
 
 
 def forcing_segments(motion: GroundMotion) -> list[tuple[float, float, Forcing]]:

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import time
+from functools import partial
 
 import numpy as np
 
@@ -103,6 +104,12 @@ def integrate(
     finally:
         disarm(armed)
     return _outcome(res, samples, n, record, solver)
+
+
+def prepare(model: Model):
+    """The step integrator of one column (rbm_cli.models.methods.Integrator): its kernel
+    inputs prepared once, for every run of the column."""
+    return partial(integrate, prepared=prepare_kernel(model))
 
 
 def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> Outcome:

@@ -111,26 +111,6 @@ class Pieces:
         return sys_
 
 
-def hermite_peaks(z0, z1, d0, d1, dt):
-    """Largest |z| inside [0, dt] of the cubic Hermite interpolant, per row,
-    for rows whose derivative changes sign (else the end values bound it)."""
-    out = np.maximum(np.abs(z0), np.abs(z1))
-    rows = np.nonzero(d0 * d1 < 0)[0]
-    for r in rows:
-        # z(s) = h00 z0 + h10 dt d0 + h01 z1 + h11 dt d1, s in [0, 1]
-        p0, m0, p1, m1 = z0[r], dt * d0[r], z1[r], dt * d1[r]
-        # derivative coefficients of the cubic a s^3 + b s^2 + c s + d
-        a = 2 * p0 + m0 - 2 * p1 + m1
-        b = -3 * p0 - 2 * m0 + 3 * p1 - m1
-        c = m0
-        roots = np.roots([3 * a, 2 * b, c]) if abs(a) + abs(b) > 0 else []
-        for s in np.real(roots[np.isreal(roots)]) if len(roots) else []:
-            if 0.0 < s < 1.0:
-                val = ((a * s + b) * s + c) * s + p0
-                out[r] = max(out[r], abs(val))
-    return out
-
-
 def _lowest_dip(d0, d1, r0, r1, dt):
     """(time from the start, row) of the lowest interior minimum below zero of the
     cubic Hermite interpolants of the distances d, or None. Only rows turning

@@ -4,7 +4,7 @@ and the accuracy targets. Imports pandas and matplotlib: imported when the bench
 
 from __future__ import annotations
 
-from rbm_cli.base.files import save_figure_atomic
+from rbm_cli.api.domains import save_figure
 from rbm_cli.report.bench_figures import scaling_figure, work_precision_figure
 from rbm_cli.study.bench import check_targets, run_bench
 
@@ -12,7 +12,7 @@ __all__ = [
     "check_targets",
     "run_bench",
     "run_scaling",
-    "save_figure_atomic",
+    "save_figure",
     "scaling_figure",
     "work_precision_figure",
 ]

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config
-from rbm_cli.base.files import save_figure_atomic
 from rbm_cli.config.types import Config
 from rbm_cli.study.domain import axis_columns, domain_config, read_domain
 from rbm_cli.study.domain import compare as compare_domains
@@ -24,8 +24,16 @@ __all__ = [
     "draw_domain",
     "plot_domain",
     "read_domain",
-    "save_figure_atomic",
+    "save_figure",
 ]
+
+
+def save_figure(fig, path: str | os.PathLike) -> Path:
+    """Save a matplotlib figure to ``path`` in one step (rbm_cli.base.files.save_figure_atomic:
+    its type from the suffix, 150 dpi); returns the path."""
+    from rbm_cli.base import files
+
+    return files.save_figure_atomic(fig, path)
 
 
 def check_regression(a: pd.DataFrame, b: pd.DataFrame):

@@ -53,7 +53,7 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references, 
     from rbm_cli.api.bench import (
         check_targets,
         run_bench,
-        save_figure_atomic,
+        save_figure,
         scaling_figure,
         work_precision_figure,
     )
@@ -66,12 +66,12 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references, 
         table = run_bench(quick=quick, jobs=jobs, output=output, reference_dir=references,
                           problems=tuple(problems) or None, reuse_references=reuse_references,
                           pair=pair, log=log)  # fmt: skip
-        save_figure_atomic(work_precision_figure(table), Path(output) / "bench.png")
+        save_figure(work_precision_figure(table), Path(output) / "bench.png")
         if scaling:
             from rbm_cli.api.bench import run_scaling
 
             scaling_table = run_scaling(output=output, log=log)
-            save_figure_atomic(scaling_figure(scaling_table), Path(output) / "scaling.png")
+            save_figure(scaling_figure(scaling_table), Path(output) / "scaling.png")
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     click.echo(f"output: {output}/bench.csv, {output}/bench.png")

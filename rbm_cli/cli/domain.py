@@ -77,7 +77,7 @@ def plot_domain_cmd(
     """
     from matplotlib.backend_bases import FigureCanvasBase
 
-    from rbm_cli.api.domains import draw_domain, read_domain, save_figure_atomic
+    from rbm_cli.api.domains import draw_domain, read_domain, save_figure
 
     if png is not None and not png.strip():
         raise UserError("--output must name an image file (e.g. domain.png), got ''")
@@ -99,7 +99,7 @@ def plot_domain_cmd(
         configs = [_config_for(p, None) for p in others] if dimensionless else None
         fig = draw_domain(df, cfg, compare=dfs, labels=labels, dimensionless=dimensionless,
                             layout=layout, compare_configs=configs, where=domain_csv)  # fmt: skip
-        save_figure_atomic(fig, target)
+        save_figure(fig, target)
     except RbmError as exc:
         raise UserError("--" + one_line(exc) if _names_a_layout(exc) else one_line(exc)) from None
     except OSError as exc:

@@ -233,7 +233,7 @@ def test_rbm_is_a_thin_face_of_rbm_cli_api():
 
 def test_the_docstring_examples_run(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    for module in (rbm_cli.api, rbm):
+    for module in (rbm_cli.api.configs, rbm_cli.api.cells, rbm_cli.api.sweeps, rbm):
         result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
         assert result.failed == 0 and result.attempted > 0, module.__name__
     assert list(tmp_path.iterdir()) == []  # the examples leave no files

@@ -1,6 +1,7 @@
 """The structure of rbm_cli keeps its rule (docs/architecture.md): imports only go down the
 levels base -> config -> physics -> models -> study -> report -> api -> cli, no two modules
-import each other round a circle. Imports inside functions count: a lazy import up a level is
+import each other round a circle, and the CLI stands on the API alone (it imports no other
+module of the package). Imports inside functions count: a lazy import up a level is
 still an import up a level. Modules are split where their meaning splits, not by a count of
 lines: no size is checked here."""
 
@@ -102,6 +103,42 @@ def test_the_check_sees_an_upward_import(tmp_path):
     assert "rbm_cli.report.plots" in found and level("rbm_cli.report.plots") > level(
         "rbm_cli.physics.x"
     )
+
+
+def cli_reaches_past_the_api(graph: dict[str, set[str]]) -> list[str]:
+    """'importer imports module' for every module of rbm_cli.cli that imports a module of
+    the package outside rbm_cli.api and rbm_cli.cli."""
+    allowed = ("rbm_cli.api", "rbm_cli.cli")
+    return sorted(
+        f"{m} imports {d}"
+        for m, deps in graph.items()
+        if m == "rbm_cli.cli" or m.startswith("rbm_cli.cli.")
+        for d in deps
+        if not any(d == a or d.startswith(a + ".") for a in allowed)
+    )
+
+
+def test_the_cli_imports_only_the_api():
+    """Every module of rbm_cli/cli imports, of the package, only rbm_cli.api... and
+    rbm_cli.cli... (function-level imports included): the CLI stands on the library."""
+    found = cli_reaches_past_the_api(graph())
+    assert not found, "\n".join(found)
+
+
+def test_the_check_sees_a_cli_import_past_the_api(tmp_path):
+    """The checker itself finds a lazy import of a lower floor in a CLI module, and lets an
+    import of the API through."""
+    path = tmp_path / "x.py"
+    path.write_text(
+        "from rbm_cli.api.configs import load_config\n"
+        "def f():\n    from rbm_cli.study.domain import read_domain\n"
+        "def g():\n    import rbm_cli.base.files\n"
+    )
+    deps = imports(path, "rbm_cli.cli.x", set(modules()))
+    assert cli_reaches_past_the_api({"rbm_cli.cli.x": deps}) == [
+        "rbm_cli.cli.x imports rbm_cli.base.files",
+        "rbm_cli.cli.x imports rbm_cli.study.domain",
+    ]
 
 
 def private_imports() -> set[tuple[str, str, str]]:

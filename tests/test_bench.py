@@ -112,7 +112,7 @@ def test_reference_flags_follow_tolerance_nudge_and_event_counts(monkeypatch):
             rows.append(dict(row, n_uplifts=u, n_impacts=u))
         return pd.DataFrame(rows), 0.0
 
-    monkeypatch.setattr(bench, "_cells", lambda cfg: cells)
+    monkeypatch.setattr(bench, "bench_cells", lambda cfg: cells)
     monkeypatch.setattr(bench, "_with_solver", lambda cfg, *a: cfg)
     monkeypatch.setattr(bench, "run_cells", fake_run_cells)
     monkeypatch.setattr(bench, "member_config", lambda cfg, a, m: (cfg, a))

@@ -98,10 +98,10 @@ def test_the_api_hands_the_child_only_its_own_figure(tmp_path, monkeypatch):
     """run_sweep(figure_process=...) has the child draw rbm_cli.api's domain figure; any
     other figure (a caller's, or a test's replacement of it) is drawn here, and the child,
     not asked, is killed and reaped when closed."""
-    import rbm_cli.api
+    import rbm_cli.api.sweeps
 
     cfg = rigid()
-    real = rbm_cli.api.domain_figure
+    real = rbm_cli.api.sweeps.domain_figure
     with started() as proc:
         pid = proc.pid
         run_sweep(cfg, tmp_path / "child", jobs=1, figure_process=proc)
@@ -117,7 +117,7 @@ def test_the_api_hands_the_child_only_its_own_figure(tmp_path, monkeypatch):
         run_sweep(cfg, tmp_path / "mine", jobs=1, figure=mine, figure_process=proc)
         assert drawn == [6] and proc.pid == pid  # drawn here, the child not asked
     assert gone(pid)
-    monkeypatch.setattr(rbm_cli.api, "domain_figure", mine)
+    monkeypatch.setattr(rbm_cli.api.sweeps, "domain_figure", mine)
     with started() as proc:
         run_sweep(cfg, tmp_path / "patched", jobs=1, figure_process=proc)
     assert drawn == [6, 6]

@@ -15,7 +15,8 @@ from rbm_cli.models.result import History
 from rbm_cli.physics.column import build_column
 from rbm_cli.report.bench_figures import work_precision_figure
 from rbm_cli.report.plots import plot_joint_rotations, plot_shapes
-from rbm_cli.report.run_folder import _history_figure, _run_column, run_summary, run_title
+from rbm_cli.report.run_figures import history_figure, run_column, run_title
+from rbm_cli.report.run_folder import run_summary
 from rbm_cli.report.shape_geometry import base_slip, drum_outlines, round_factor
 from rbm_cli.study.bench import PEAK_TARGET, PROBLEMS
 from rbm_cli.study.simulate import simulate
@@ -124,10 +125,10 @@ def test_history_figure_names_the_config_and_the_cell_and_shows_the_joints(two_d
     cfg, result, summary = two_drum_run
     title = run_title(summary)
     assert title == "two (harmonic): A = 0.4 g, f = 1.5 Hz"
-    joints = _run_column(summary)
+    joints = run_column(summary)
     column = build_column(cfg.column, cfg.interface)
     assert joints[0].rotation_capacity == pytest.approx(column.rotation_capacity)
-    fig = _history_figure(result.history, None, title, joints)
+    fig = history_figure(result.history, None, title, joints)
     assert fig._suptitle.get_text() == title
     assert len(fig.axes) == 3
     panel = fig.axes[2]
@@ -136,8 +137,8 @@ def test_history_figure_names_the_config_and_the_cell_and_shows_the_joints(two_d
     assert panel.lines[1].get_ydata() == pytest.approx(phi2)
     # a monolith keeps the two displacement panels; an unknown summary gives no title
     mono = _history(theta[:, :1], [2.0])
-    assert len(_history_figure(mono, None, None, None).axes) == 2
-    assert run_title({"status": "x"}) is None and _run_column({}) is None
+    assert len(history_figure(mono, None, None, None).axes) == 2
+    assert run_title({"status": "x"}) is None and run_column({}) is None
 
 
 # --------------------------------------------------------------------------- bench

@@ -23,8 +23,8 @@ from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.ground import next_uplift
-from rbm_cli.models.rbm.runner import model_from_config
 from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.assembly import model_from_config
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.physics.pulses import mavroeidis_papageorgiou, ricker_wavelet
 

@@ -268,12 +268,12 @@ def _no_result(folder: Path) -> None:
 def test_case06_a_plot_failure_publishes_nothing(small, tmp_path, straight, monkeypatch):
     """Defect: domain.csv, boundary.csv and meta.json were written before the PNG: a plot
     failure left files that looked finished."""
-    import rbm_cli.api
+    import rbm_cli.api.sweeps
 
     def broken(*args, **kwargs):
         raise ValueError("the figure cannot be drawn")
 
-    monkeypatch.setattr(rbm_cli.api, "domain_figure", broken)
+    monkeypatch.setattr(rbm_cli.api.sweeps, "domain_figure", broken)
     res = invoke("sweep", small, "-o", tmp_path / "out", "--jobs", "1", "--quiet")
     one_line_error(res, "cannot draw domain.png", "--resume")
     folder = tmp_path / "out" / "small"
@@ -286,12 +286,12 @@ def test_case06_a_plot_failure_publishes_nothing(small, tmp_path, straight, monk
 
 
 def test_case06_ctrl_c_while_drawing_publishes_nothing(small, tmp_path, monkeypatch):
-    import rbm_cli.api
+    import rbm_cli.api.sweeps
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(rbm_cli.api, "domain_figure", interrupted)
+    monkeypatch.setattr(rbm_cli.api.sweeps, "domain_figure", interrupted)
     res = invoke("sweep", small, "-o", tmp_path / "out", "--jobs", "1", "--quiet")
     one_line_error(res, f"{N_CELLS} of {N_CELLS} cells are kept", "--resume", code=130)
     _no_result(tmp_path / "out" / "small")

@@ -26,9 +26,9 @@ import pytest
 
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.rbm.runner import SHAPE_CHANGE, model_from_config
 from rbm_cli.models.rbm.step import integrate
 from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.assembly import SHAPE_CHANGE, model_from_config
 from rbm_cli.physics.excitation import make_ground_motion
 from rbm_cli.physics.records import write_csv
 

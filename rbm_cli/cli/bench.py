@@ -1,4 +1,4 @@
-"""`rbm bench`: the work-precision benchmark (thin, over rbm_cli.study.bench)."""
+"""`rbm bench`: the work-precision benchmark (thin, over rbm_cli.api.bench)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from rbm_cli.base.errors import RbmError
+from rbm_cli.api.errors import RbmError
 from rbm_cli.cli.common import UserError, check_output, cli, one_line
 
 
@@ -50,9 +50,13 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references, 
         rbm bench --pair --reuse-references --problem multidrum
         rbm bench -o bench --scaling
     """
-    from rbm_cli.base.files import save_figure_atomic
-    from rbm_cli.report.bench_figures import scaling_figure, work_precision_figure
-    from rbm_cli.study.bench import check_targets, run_bench
+    from rbm_cli.api.bench import (
+        check_targets,
+        run_bench,
+        save_figure,
+        scaling_figure,
+        work_precision_figure,
+    )
 
     def log(line: str) -> None:
         click.echo(line)
@@ -62,12 +66,12 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references, 
         table = run_bench(quick=quick, jobs=jobs, output=output, reference_dir=references,
                           problems=tuple(problems) or None, reuse_references=reuse_references,
                           pair=pair, log=log)  # fmt: skip
-        save_figure_atomic(work_precision_figure(table), Path(output) / "bench.png")
+        save_figure(work_precision_figure(table), Path(output) / "bench.png")
         if scaling:
-            from rbm_cli.study.bench_scaling import run_scaling
+            from rbm_cli.api.bench import run_scaling
 
             scaling_table = run_scaling(output=output, log=log)
-            save_figure_atomic(scaling_figure(scaling_table), Path(output) / "scaling.png")
+            save_figure(scaling_figure(scaling_table), Path(output) / "scaling.png")
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     click.echo(f"output: {output}/bench.csv, {output}/bench.png")

@@ -3,7 +3,7 @@
 Command modules (run, domain, bench) import from here; nothing here imports them.
 
 Each command loads a config, calls one library function and writes or prints
-the result. Errors a user can cause (:class:`rbm_cli.base.errors.RbmError`, bad
+the result. Errors a user can cause (:class:`rbm_cli.api.errors.RbmError`, bad
 options) end in one line ``Error: ...`` on stderr and exit status 2.
 """
 
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import click
 
-from rbm_cli import __version__
-from rbm_cli.base.errors import RbmError
+from rbm_cli.api import __version__
+from rbm_cli.api.errors import RbmError
 
 #: Exit status of a user error (bad input, unwritable output).
 EXIT_USER_ERROR = 2
@@ -72,7 +72,7 @@ def work_starts() -> None:
 
 def load(config_path: str):
     """Load a config, turning every library error into a one-line CLI error."""
-    from rbm_cli.config.load import load_config
+    from rbm_cli.api.configs import load_config
 
     try:
         return load_config(config_path)
@@ -81,26 +81,20 @@ def load(config_path: str):
 
 
 def first_use(cfg) -> None:
-    """Compile (or load) the compiled code a run of this config needs (the kernel, the exact
-    integrator, or the rigid block's closed form: rbm_cli.models.methods.compiled_code)
-    before it runs. On a first use (not in numba's cache) the run waits for the compile, one
-    note on stderr saying for what and about how long, and then answers with the compiled
-    code, as every later run does; a compile another rbm process runs is waited for, not
-    repeated (rbm_cli.models.compile_ahead). Nothing to do for a run in Python
+    """Compile (or load) the compiled code a run of this config needs before it runs
+    (rbm_cli.api.cells.compile_ahead). On a first use (not in numba's cache) the run waits
+    for the compile, one note on stderr saying for what and about how long, and then answers
+    with the compiled code, as every later run does; a compile another rbm process runs is
+    waited for, not repeated. Nothing to do for a run in Python
     (``solver.implementation: python``) or a model without compiled code."""
-    from rbm_cli.models.methods import compiled_code
-
-    code = compiled_code(cfg)
-    if code is None:
-        return
     import gc
 
-    from rbm_cli.models.compile_ahead import compile_once
+    from rbm_cli.api.cells import compile_ahead
 
     collecting = gc.isenabled()
     gc.enable()  # a compile's garbage is collected (peak 0.46 GB instead of 0.73 GB)
     try:
-        compile_once(code, notify=lambda text: click.echo(f"note: {text}", err=True))
+        compile_ahead(cfg, notify=lambda text: click.echo(f"note: {text}", err=True))
     finally:
         if not collecting:
             gc.disable()  # work_starts then freezes what the load made, as before

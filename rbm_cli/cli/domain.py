@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from rbm_cli.base.errors import RbmError
+from rbm_cli.api.errors import RbmError
 from rbm_cli.cli.common import UserError, cli, load, one_line
 
 
@@ -77,9 +77,7 @@ def plot_domain_cmd(
     """
     from matplotlib.backend_bases import FigureCanvasBase
 
-    from rbm_cli.base.files import save_figure_atomic
-    from rbm_cli.report.domain_figure import domain_figure
-    from rbm_cli.study.domain import read_domain
+    from rbm_cli.api.domains import draw_domain, read_domain, save_figure
 
     if png is not None and not png.strip():
         raise UserError("--output must name an image file (e.g. domain.png), got ''")
@@ -99,9 +97,9 @@ def plot_domain_cmd(
             )
         labels = [Path(domain_csv).parent.name or "domain"] + [Path(p).parent.name for p in others]
         configs = [_config_for(p, None) for p in others] if dimensionless else None
-        fig = domain_figure(df, cfg, compare=dfs, labels=labels, dimensionless=dimensionless,
+        fig = draw_domain(df, cfg, compare=dfs, labels=labels, dimensionless=dimensionless,
                             layout=layout, compare_configs=configs, where=domain_csv)  # fmt: skip
-        save_figure_atomic(fig, target)
+        save_figure(fig, target)
     except RbmError as exc:
         raise UserError("--" + one_line(exc) if _names_a_layout(exc) else one_line(exc)) from None
     except OSError as exc:
@@ -118,7 +116,7 @@ def _config_for(domain_csv: str, config_path: str | None):
     """The config of a domain: given, or the one stored in meta.json beside it (as the
     user wrote it); None when neither is there (the plot then lacks the curves that
     need the column)."""
-    from rbm_cli.study.domain import domain_config
+    from rbm_cli.api.domains import domain_config
 
     if config_path:
         return load(config_path)
@@ -131,7 +129,7 @@ def _config_for(domain_csv: str, config_path: str | None):
 def _print_shifts(shifts) -> None:
     """The boundary shifts, one line per frequency (and point of any axes over config
     keys, whose columns come first)."""
-    from rbm_cli.study.domain import axis_columns
+    from rbm_cli.api.domains import axis_columns
 
     axes = axis_columns(shifts.columns)
     head = "".join(f"{p:>22} " for p in axes)
@@ -176,8 +174,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         rbm compare results/spanos_koh_slender/domain.csv out/spanos_koh_slender/domain.csv \\
             --max-cells 0.01 --max-shift 0.05
     """
-    from rbm_cli.study.domain import compare as compare_domains
-    from rbm_cli.study.domain import read_domain
+    from rbm_cli.api.domains import compare_domains, read_domain
 
     for name, value in (("--max-cells", max_cells), ("--max-shift", max_shift)):
         if value is not None and not value >= 0:
@@ -205,9 +202,9 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
     _print_shifts(cmp.shifts)
     failed = []
     if "robust" in dom_a.columns:
-        from rbm_cli.study.regression import check
+        from rbm_cli.api.domains import check_regression
 
-        rule = check(dom_a, dom_b)
+        rule = check_regression(dom_a, dom_b)
         click.echo(f"regression rule: {rule.summary()}")
         if not rule.ok:
             failed.append("the regression rule fails (robust cells must not differ)")

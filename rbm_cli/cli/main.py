@@ -1,7 +1,7 @@
 """Command line of rbm: thin click commands over the library.
 
 Each command loads a config, calls one library function and writes or prints
-the result. Errors a user can cause (:class:`rbm_cli.base.errors.RbmError`, bad
+the result. Errors a user can cause (:class:`rbm_cli.api.errors.RbmError`, bad
 options) end in one line ``Error: ...`` on stderr and exit status 2.
 
 The group and its shared helpers are in :mod:`rbm_cli.cli.common`; each command

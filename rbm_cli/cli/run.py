@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from rbm_cli.base.errors import RbmError
+from rbm_cli.api.errors import RbmError
 from rbm_cli.cli.common import (
     EXIT_RUN_FAILED,
     Interrupted,
@@ -24,31 +24,16 @@ from rbm_cli.cli.common import (
 )
 
 
-def _check_excitation(kind: str, amplitude: float | None, frequency: float | None):
-    """Validate --amplitude [g] and --frequency [Hz] for the excitation type (the
-    grid's ranges, rbm_cli.config.load.AMPLITUDE_RANGE_G and FREQUENCY_RANGE_HZ).
-    Returns (amplitude [g], frequency [Hz] or None for a record)."""
-    from rbm_cli.config.load import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ
+def _check_excitation(cfg, amplitude: float | None, frequency: float | None):
+    """Validate --amplitude [g] and --frequency [Hz] for the config's excitation type (the
+    grid's ranges: rbm_cli.api.configs.check_options). Returns (amplitude [g], frequency
+    [Hz] or None for a record)."""
+    from rbm_cli.api.configs import check_options
 
-    if amplitude is not None and not (math.isfinite(amplitude) and amplitude >= 0.0):
-        raise UserError(f"--amplitude must be a finite number >= 0 [g], got {amplitude:g}")
-    if frequency is not None and not (math.isfinite(frequency) and frequency > 0.0):
-        raise UserError(f"--frequency must be a finite number > 0 [Hz], got {frequency:g}")
-    for name, value, (lo, hi), unit in (
-        ("--amplitude", amplitude, AMPLITUDE_RANGE_G, "g"),
-        ("--frequency", frequency, FREQUENCY_RANGE_HZ, "Hz"),
-    ):
-        if value is not None and not lo <= value <= hi:
-            raise UserError(f"{name} must be in [{lo:g}, {hi:g}] [{unit}], got {value:g}")
-    if kind == "free":
-        return 0.0, 0.0
-    if amplitude is None:
-        raise UserError(f"--amplitude [g] is required for excitation.type '{kind}'")
-    if kind == "record":
-        return float(amplitude), None
-    if frequency is None:
-        raise UserError(f"--frequency [Hz] is required for excitation.type '{kind}'")
-    return float(amplitude), float(frequency)
+    try:
+        return check_options(cfg, amplitude, frequency)
+    except RbmError as exc:
+        raise UserError(one_line(exc)) from None
 
 
 def _print_summary(result, folder: Path) -> None:
@@ -127,7 +112,7 @@ def run(
     """
     cfg = load(config)
     kind = cfg.excitation.type
-    amplitude_g, frequency_hz = _check_excitation(kind, amplitude, frequency)
+    amplitude_g, frequency_hz = _check_excitation(cfg, amplitude, frequency)
     if kind == "free" and (amplitude is not None or frequency is not None):
         click.echo("note: excitation.type is 'free': --amplitude/--frequency are ignored", err=True)
     if kind == "record" and frequency is not None:
@@ -135,7 +120,7 @@ def run(
     _check_output_dt(cfg, output_dt)
     _say_which_point(cfg)
 
-    from rbm_cli.report.figure_process import RUN_IMPORTS, FigureProcess
+    from rbm_cli.api.sweeps import RUN_IMPORTS, FigureProcess
 
     # before numba and matplotlib are imported: the child imports the figures' while this
     # process loads the integrator and runs (issue 18)
@@ -149,8 +134,8 @@ def run(
 
 
 def _check_output_dt(cfg, output_dt: float | None) -> None:
-    """--dt checked as the library checks output_dt (rbm_cli.api.check_output_dt)."""
-    from rbm_cli.api import check_output_dt
+    """--dt checked as the library checks output_dt (rbm_cli.api.configs.check_output_dt)."""
+    from rbm_cli.api.configs import check_output_dt
 
     try:
         check_output_dt(cfg, output_dt)
@@ -161,67 +146,26 @@ def _check_output_dt(cfg, output_dt: float | None) -> None:
 def _say_which_point(cfg) -> None:
     """A note when the config's grid has axes over config keys (a suite of records, a
     column.height axis...): one run is the config's own point, named here."""
-    axes = cfg.grid.axes
-    if not axes:
-        return
-    n_points = math.prod(len(axis.points) for axis in axes)
-    own = ", ".join(f"{path} = {_value_at(cfg, path)}" for path in cfg.grid.axis_paths)
-    click.echo(
-        f"note: the grid has {n_points} points over {', '.join(cfg.grid.axis_paths)};"
-        f" this run is the config's own point ({own}): set another value in the config"
-        " to run it, or sweep them all with rbm sweep",
-        err=True,
-    )
+    from rbm_cli.api.info import own_point_note
 
-
-def _value_at(cfg, path: str) -> str:
-    """The value a run of the config takes for a grid axis's key path, as written."""
-    from rbm_cli.config.grid import VIRTUAL_PATHS
-
-    if path in VIRTUAL_PATHS:
-        return "as written"
-    if path in ("excitation.file", "excitation.vertical"):  # a suite's first record
-        return str(getattr(cfg.excitation, path.split(".")[1]))
-    node = cfg.written or {}
-    for key in path.split("."):
-        node = node.get(key) if isinstance(node, dict) else None
-    if node is None:
-        return "its default"
-    return str(node) if not isinstance(node, dict) else "as written"
+    note = own_point_note(cfg)
+    if note is not None:
+        click.echo(f"note: {note}", err=True)
 
 
 def _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter):
     """The body of `rbm run` once its inputs are checked: (RunResult, run folder). painter:
     the FigureProcess that draws history.png and shapes.png, or None to draw them here."""
-    from rbm_cli.api import run as run_cell
-    from rbm_cli.base.files import check_writable_dir
-    from rbm_cli.physics.column import build_column
-    from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
+    from rbm_cli.api.cells import check_run_output, write_run_folder
+    from rbm_cli.api.cells import run as run_cell
 
     try:
-        check_writable_dir(Path(output) / cfg.name)
-        column = build_column(cfg.column, cfg.interface)
+        column = check_run_output(cfg, output)
         first_use(cfg)  # compiled before the run: the answer of every later run
         work_starts()
         result = run_cell(cfg, amplitude_g, frequency_hz, output_dt=output_dt).result
-        summary = run_summary(
-            result,
-            cfg,
-            config_path=config,
-            amplitude_g=amplitude_g,
-            frequency_hz=frequency_hz,
-            output_dt=output_dt,
-        )
-        folder = write_run(
-            output,
-            cfg.name,
-            run_folder_name(amplitude_g, frequency_hz, cfg.excitation.type),
-            result,
-            summary,
-            widths=column.widths,
-            elevations=list(column.bottoms) + [column.height],
-            figure_process=painter,
-        )
+        folder = write_run_folder(cfg, column, result, output, config, amplitude_g,
+                                  frequency_hz, output_dt, figure_process=painter)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except KeyboardInterrupt:
@@ -231,83 +175,6 @@ def _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter):
 
 
 # --------------------------------------------------------------------------- info
-
-
-def _fmt(value, spec: str = ".4g") -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float) and math.isinf(value):
-        return "inf"
-    if isinstance(value, int | float):
-        return format(value, spec)
-    return str(value)
-
-
-#: Columns of the per-interface table of ``rbm info``: (key, header, unit).
-INTERFACE_COLUMNS = (
-    ("interface", "i", "-"),
-    ("width_m", "B_i", "m"),
-    ("drum_height_m", "h_i", "m"),
-    ("drum_mass_kg", "m_i", "kg"),
-    ("drum_inertia_kgm2", "I_Gi", "kg m2"),
-    ("normal_force_N", "N_i", "N"),
-    ("moment_capacity_Nm", "M_u,i", "N m"),
-    ("rotation_capacity_rad", "theta_u,i", "rad"),
-    ("stiffness_Nm_per_rad", "K_M,i", "N m/rad"),
-    ("normal_stiffness_Pa_per_m", "k_n,i", "Pa/m"),
-    ("elastic_limit_rad", "elastic lim", "rad"),
-)
-
-
-def format_info(info: dict) -> str:
-    """The text printed by ``rbm info``: global figures, then one row per interface."""
-    n = info.get("n_drums")
-    freqs = info.get("elastic_frequencies_hz") or []
-    rows = [
-        ("name", info.get("name")),
-        ("drums", n),
-        ("formulation", info.get("formulation")),
-        ("total mass", f"{_fmt(info.get('total_mass_kg'))} kg"),
-        ("height", f"{_fmt(info.get('height_m'))} m"),
-        ("static multiplier", f"{_fmt(info.get('static_multiplier_g'))} g"),
-        (
-            "uplift acceleration",
-            f"{_fmt(info.get('uplift_acceleration_g'))} g"
-            if info.get("uplift_acceleration_g") is not None
-            else "- (elastic interfaces)",
-        ),
-        ("rocking p", f"{_fmt(info.get('rocking_p_rad_s'))} rad/s"),
-        ("rocking frequency", f"{_fmt(info.get('rocking_frequency_hz'))} Hz"),
-        (
-            "elastic frequencies",
-            (", ".join(_fmt(f) for f in freqs) + " Hz") if freqs else "- (rigid)",
-        ),
-    ]
-    if info.get("engine_uplift_g") is not None:
-        rows.append(
-            (
-                "engine uplift",
-                f"{_fmt(info['engine_uplift_g'])} g (model: bullet, true solids, friction "
-                f"{_fmt(info.get('friction'))}; the figures above are the RBM's)",
-            )
-        )
-    width = max(len(k) for k, _ in rows)
-    lines = [f"{k + ':':<{width + 1}} {v}" for k, v in rows]
-
-    table = [[h for _, h, _ in INTERFACE_COLUMNS], [f"[{u}]" for _, _, u in INTERFACE_COLUMNS]]
-    for row in info.get("interfaces", []):
-        table.append(
-            [
-                _fmt(row.get(key), "d" if key == "interface" else ".4g")
-                for key, _, _ in INTERFACE_COLUMNS
-            ]
-        )
-    widths = [max(len(r[c]) for r in table) for c in range(len(INTERFACE_COLUMNS))]
-    lines.append("")
-    lines.append("interfaces (i = 1 at the ground):")
-    for r in table:
-        lines.append("  ".join(cell.rjust(w) for cell, w in zip(r, widths, strict=True)))
-    return "\n".join(lines)
 
 
 @cli.command()
@@ -327,18 +194,11 @@ def info(config: str, as_json: bool) -> None:
         rbm info configs/harmonic_multidrum.yaml
         rbm info configs/spanos_koh_thick.yaml --json
     """
-    from rbm_cli.report.info import describe
+    from rbm_cli.api.info import describe, format_info, info_json
 
     cfg = load(config)
     try:
-        figures = describe(cfg)
+        text = info_json(cfg) if as_json else format_info(describe(cfg))
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
-    if as_json:
-        import json
-
-        from rbm_cli.base.files import json_ready
-
-        click.echo(json.dumps(json_ready(figures), indent=2))
-    else:
-        click.echo(format_info(figures))
+    click.echo(text)

@@ -6,7 +6,7 @@ import contextlib
 
 import click
 
-from rbm_cli.base.errors import RbmError
+from rbm_cli.api.errors import RbmError
 from rbm_cli.cli.common import (
     Interrupted,
     UserError,
@@ -94,7 +94,7 @@ def sweep(
     cfg = load(config)
     if scheduler and backend != "dask":
         raise UserError("--scheduler needs --backend dask")
-    from rbm_cli.report.figure_process import FigureProcess
+    from rbm_cli.api.sweeps import FigureProcess
 
     # before numba and matplotlib are imported: the child imports the figure's while
     # this process runs the cells (issue 18)
@@ -107,7 +107,7 @@ def _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensembl
            painter) -> None:  # fmt: skip
     """The body of `rbm sweep` once the config is loaded (painter: the FigureProcess that
     draws domain.png, or None to draw it in this process)."""
-    from rbm_cli.api import SweepInterrupted, run_sweep
+    from rbm_cli.api.sweeps import SweepInterrupted, run_sweep
     from rbm_cli.cli.progress import Progress
 
     reporter = None if quiet else Progress(cfg.name)

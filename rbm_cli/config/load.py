@@ -20,7 +20,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from rbm_cli.base.errors import ConfigError
+from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.excitation import excitation_section
 from rbm_cli.config.grid import (
     AMPLITUDE_RANGE_G,
@@ -47,6 +47,7 @@ from rbm_cli.config.validate import (
     fmt,
     in_bounds,
     integer,
+    is_number,
     join,
     mapping,
     number,
@@ -56,7 +57,13 @@ from rbm_cli.config.validate import (
 from rbm_cli.config.written import plain_copy
 from rbm_cli.config.yaml_reader import read_yaml
 
-__all__ = ["AMPLITUDE_RANGE_G", "FREQUENCY_RANGE_HZ", "load_config", "parse_config"]
+__all__ = [
+    "AMPLITUDE_RANGE_G",
+    "FREQUENCY_RANGE_HZ",
+    "check_cell",
+    "load_config",
+    "parse_config",
+]
 
 TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
 COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
@@ -96,6 +103,77 @@ WALL_TIME_RANGE = (0.0, 1e6)
 MAX_FILE_BYTES = 1_000_000
 DRUM_SUM_RTOL = 1e-9
 NAME_RE = re.compile(r"[A-Za-z0-9_.\-]{1,100}")
+
+
+def check_cell(
+    kind: str, amplitude: Any, frequency: Any, *, options: bool = False
+) -> tuple[float, float | None]:
+    """(amplitude [g], frequency [Hz] or None) of one cell of an excitation of type ``kind``,
+    checked against the grid's ranges (:data:`AMPLITUDE_RANGE_G`, :data:`FREQUENCY_RANGE_HZ`):
+    the one check of a cell's amplitude and frequency, for the library and the command line.
+
+    Parameters
+    ----------
+    kind : str  excitation.type: ``free`` has neither (0, 0), a ``record`` no frequency (None)
+    amplitude : number or None  Peak ground acceleration [g]
+    frequency : number or None  Excitation frequency [Hz]
+    options : bool  Name them as the command line's options (``--amplitude``,
+        ``--frequency``, checked when given whatever the type) instead of as the library's
+        arguments (``amplitude_g``, ``frequency_hz``, numbers, not booleans)
+
+    Raises
+    ------
+    RbmError  One line naming the argument, its range and the value given
+    """
+    ranges = {"amplitude": (AMPLITUDE_RANGE_G, "g"), "frequency": (FREQUENCY_RANGE_HZ, "Hz")}
+    if options:
+        if amplitude is not None and not (math.isfinite(amplitude) and amplitude >= 0.0):
+            raise RbmError(f"--amplitude must be a finite number >= 0 [g], got {amplitude:g}")
+        if frequency is not None and not (math.isfinite(frequency) and frequency > 0.0):
+            raise RbmError(f"--frequency must be a finite number > 0 [Hz], got {frequency:g}")
+        for name, value in (("amplitude", amplitude), ("frequency", frequency)):
+            (lo, hi), unit = ranges[name]
+            if value is not None and not lo <= value <= hi:
+                raise RbmError(f"--{name} must be in [{lo:g}, {hi:g}] [{unit}], got {value:g}")
+    if kind == "free":
+        return 0.0, 0.0
+    given = [("amplitude", amplitude)] + ([] if kind == "record" else [("frequency", frequency)])
+    for name, value in given:
+        (lo, hi), unit = ranges[name]
+        if value is None:
+            if options:
+                raise RbmError(f"--{name} [{unit}] is required for excitation.type '{kind}'")
+            raise RbmError(f"{name}_{unit.lower()} [{unit}] is required for excitation.type {kind}")
+        if not options and not (finite_number(value) and lo <= value <= hi):
+            raise RbmError(
+                f"{name}_{unit.lower()} must be a number in [{lo:g}, {hi:g}] [{unit}],"
+                f" got {shown(value)}"
+            )
+    return float(amplitude), None if kind == "record" else float(frequency)
+
+
+def finite_number(value: Any) -> bool:
+    """A finite real number: int, float or a numpy number (a 0-d array's), not a boolean."""
+    import numpy as np
+
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        return False
+    return not isinstance(value, np.complexfloating) and math.isfinite(value)
+
+
+def shown(value: Any) -> str:
+    """A value as a message shows it: numbers as written (a numpy number as its number),
+    anything else by its repr, cut to 60 characters."""
+    import numpy as np
+
+    if isinstance(value, np.generic | np.ndarray) and np.ndim(value) == 0:
+        value = value.item()
+    if is_number(value):
+        return fmt(value)
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def load_config(path: str | os.PathLike[str]) -> Config:

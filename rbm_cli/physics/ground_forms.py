@@ -27,7 +27,7 @@ from functools import lru_cache
 import numpy as np
 
 from rbm_cli.config.types import G
-from rbm_cli.physics.pulses import _mp_shape
+from rbm_cli.physics.pulses import mp_shape
 
 SINE, RICKER, MP, SAMPLED = 0, 1, 2, 3
 
@@ -199,19 +199,19 @@ def ricker_knots(omega: float, center: float) -> np.ndarray:
 
 @lru_cache(maxsize=256)
 def _mp_extrema(gamma: float, nu: float) -> tuple[float, ...]:
-    """Extrema of the MP shape (pulses._mp_shape) over s in [-gamma/2, gamma/2] [cycles]:
+    """Extrema of the MP shape (pulses.mp_shape) over s in [-gamma/2, gamma/2] [cycles]:
     sign changes of its slope on 400 points a cycle, each refined by Brent's method."""
     from scipy.optimize import minimize_scalar  # here: no scipy at import (issue 18)
 
     half = gamma / 2.0
     s = np.linspace(-half, half, int(400 * gamma) + 1)
-    v = _mp_shape(s, gamma, nu)
+    v = mp_shape(s, gamma, nu)
     slope = np.diff(v)
     out = []
     for i in np.nonzero(slope[:-1] * slope[1:] < 0.0)[0]:
         sign = 1.0 if slope[i] > 0.0 else -1.0  # rising then falling: a maximum
         best = minimize_scalar(
-            lambda x, sign=sign: -sign * float(_mp_shape(x, gamma, nu)),
+            lambda x, sign=sign: -sign * float(mp_shape(x, gamma, nu)),
             bounds=(s[i], s[i + 2]),
             method="bounded",
             options={"xatol": 1e-13 * max(1.0, gamma)},

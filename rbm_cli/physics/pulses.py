@@ -237,7 +237,7 @@ def mavroeidis_papageorgiou_duration(frequency_hz: float, gamma: float) -> float
     return g / f
 
 
-def _mp_shape(s, gamma: float, nu: float):
+def mp_shape(s, gamma: float, nu: float):
     """MP acceleration over f_p for a unit velocity amplitude, s = f_p (t - t0) [cycles]."""
     x = 2.0 * np.pi * s
     return -(np.pi / gamma) * (
@@ -247,16 +247,16 @@ def _mp_shape(s, gamma: float, nu: float):
 
 @lru_cache(maxsize=256)
 def _mp_peak(gamma: float, nu: float) -> float:
-    """max |_mp_shape| over the pulse: dense sampling, then Brent on the best bracket."""
+    """max |mp_shape| over the pulse: dense sampling, then Brent on the best bracket."""
     half = gamma / 2.0
     s = np.linspace(-half, half, int(256 * gamma) + 1)
-    values = np.abs(_mp_shape(s, gamma, nu))
+    values = np.abs(mp_shape(s, gamma, nu))
     k = int(np.argmax(values))
     lo, hi = s[max(k - 1, 0)], s[min(k + 1, s.size - 1)]
     from scipy.optimize import minimize_scalar  # here: no scipy at import (issue 18)
 
     best = minimize_scalar(
-        lambda x: -abs(float(_mp_shape(x, gamma, nu))),
+        lambda x: -abs(float(mp_shape(x, gamma, nu))),
         bounds=(lo, hi),
         method="bounded",
         options={"xatol": 1e-12 * max(1.0, gamma)},
@@ -331,7 +331,7 @@ def mavroeidis_papageorgiou(t, amplitude: float, frequency_hz: float, gamma: flo
     f, g, nu = _mp_check(frequency_hz, gamma, nu)
     t0 = g / (2.0 * f)
     scale = amp / _mp_peak(g, nu)
-    return _on_support(t, 2.0 * t0, lambda s: scale * _mp_shape(f * (s - t0), g, nu))
+    return _on_support(t, 2.0 * t0, lambda s: scale * mp_shape(f * (s - t0), g, nu))
 
 
 #: Pulse name -> (acceleration function, duration function), for a later config axis.

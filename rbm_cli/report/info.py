@@ -1,11 +1,13 @@
-"""Derived properties a user checks first (`rbm info`)."""
+"""Derived properties a user checks first (`rbm info`): the figures, their text, and the
+note naming the grid point a run of the config is."""
 
 from __future__ import annotations
 
 import math
 
+from rbm_cli.config.grid import VIRTUAL_PATHS
 from rbm_cli.config.types import Config, G
-from rbm_cli.models.rbm.runner import model_from_config
+from rbm_cli.physics.assembly import model_from_config
 
 
 def normal_stiffness(col, i: int) -> float:
@@ -69,3 +71,110 @@ def describe(config: Config) -> dict:
         "interfaces": interfaces,
         **engine,
     }
+
+
+def _fmt(value, spec: str = ".4g") -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float) and math.isinf(value):
+        return "inf"
+    if isinstance(value, int | float):
+        return format(value, spec)
+    return str(value)
+
+
+#: Columns of the per-interface table of ``rbm info``: (key, header, unit).
+INTERFACE_COLUMNS = (
+    ("interface", "i", "-"),
+    ("width_m", "B_i", "m"),
+    ("drum_height_m", "h_i", "m"),
+    ("drum_mass_kg", "m_i", "kg"),
+    ("drum_inertia_kgm2", "I_Gi", "kg m2"),
+    ("normal_force_N", "N_i", "N"),
+    ("moment_capacity_Nm", "M_u,i", "N m"),
+    ("rotation_capacity_rad", "theta_u,i", "rad"),
+    ("stiffness_Nm_per_rad", "K_M,i", "N m/rad"),
+    ("normal_stiffness_Pa_per_m", "k_n,i", "Pa/m"),
+    ("elastic_limit_rad", "elastic lim", "rad"),
+)
+
+
+def format_info(info: dict) -> str:
+    """The text printed by ``rbm info``: global figures, then one row per interface."""
+    n = info.get("n_drums")
+    freqs = info.get("elastic_frequencies_hz") or []
+    rows = [
+        ("name", info.get("name")),
+        ("drums", n),
+        ("formulation", info.get("formulation")),
+        ("total mass", f"{_fmt(info.get('total_mass_kg'))} kg"),
+        ("height", f"{_fmt(info.get('height_m'))} m"),
+        ("static multiplier", f"{_fmt(info.get('static_multiplier_g'))} g"),
+        (
+            "uplift acceleration",
+            f"{_fmt(info.get('uplift_acceleration_g'))} g"
+            if info.get("uplift_acceleration_g") is not None
+            else "- (elastic interfaces)",
+        ),
+        ("rocking p", f"{_fmt(info.get('rocking_p_rad_s'))} rad/s"),
+        ("rocking frequency", f"{_fmt(info.get('rocking_frequency_hz'))} Hz"),
+        (
+            "elastic frequencies",
+            (", ".join(_fmt(f) for f in freqs) + " Hz") if freqs else "- (rigid)",
+        ),
+    ]
+    if info.get("engine_uplift_g") is not None:
+        rows.append(
+            (
+                "engine uplift",
+                f"{_fmt(info['engine_uplift_g'])} g (model: bullet, true solids, friction "
+                f"{_fmt(info.get('friction'))}; the figures above are the RBM's)",
+            )
+        )
+    width = max(len(k) for k, _ in rows)
+    lines = [f"{k + ':':<{width + 1}} {v}" for k, v in rows]
+
+    table = [[h for _, h, _ in INTERFACE_COLUMNS], [f"[{u}]" for _, _, u in INTERFACE_COLUMNS]]
+    for row in info.get("interfaces", []):
+        table.append(
+            [
+                _fmt(row.get(key), "d" if key == "interface" else ".4g")
+                for key, _, _ in INTERFACE_COLUMNS
+            ]
+        )
+    widths = [max(len(r[c]) for r in table) for c in range(len(INTERFACE_COLUMNS))]
+    lines.append("")
+    lines.append("interfaces (i = 1 at the ground):")
+    for r in table:
+        lines.append("  ".join(cell.rjust(w) for cell, w in zip(r, widths, strict=True)))
+    return "\n".join(lines)
+
+
+def own_point_note(config: Config) -> str | None:
+    """The note of a run of a config whose grid has axes over config keys (a suite of
+    records, a column.height axis...): one run is the config's own point, named here;
+    None without such axes."""
+    axes = config.grid.axes
+    if not axes:
+        return None
+    n_points = math.prod(len(axis.points) for axis in axes)
+    own = ", ".join(f"{path} = {_value_at(config, path)}" for path in config.grid.axis_paths)
+    return (
+        f"the grid has {n_points} points over {', '.join(config.grid.axis_paths)};"
+        f" this run is the config's own point ({own}): set another value in the config"
+        " to run it, or sweep them all with rbm sweep"
+    )
+
+
+def _value_at(config: Config, path: str) -> str:
+    """The value a run of the config takes for a grid axis's key path, as written."""
+    if path in VIRTUAL_PATHS:
+        return "as written"
+    if path in ("excitation.file", "excitation.vertical"):  # a suite's first record
+        return str(getattr(config.excitation, path.split(".")[1]))
+    node = config.written or {}
+    for key in path.split("."):
+        node = node.get(key) if isinstance(node, dict) else None
+    if node is None:
+        return "its default"
+    return str(node) if not isinstance(node, dict) else "as written"

@@ -58,7 +58,7 @@ def run_title(summary: dict) -> str | None:
     return f"{name} ({kind}): {cell}"
 
 
-def _run_column(summary: dict):
+def run_column(summary: dict):
     """(Column, formulation, collapse ratio) of the config a summary.json holds, or None."""
     from rbm_cli.base.errors import RbmError
     from rbm_cli.config.load import parse_config
@@ -72,7 +72,7 @@ def _run_column(summary: dict):
     return column, config.interface.formulation, config.collapse.ratio
 
 
-def _history_figure(
+def history_figure(
     history: History,
     t_collapse: float | None,
     title: str | None = None,
@@ -111,7 +111,7 @@ def _history_figure(
     return fig
 
 
-def _shapes_figure(
+def shapes_figure(
     history: History, widths, elevations, t_collapse: float | None, title: str | None = None
 ):
     from matplotlib.figure import Figure
@@ -146,13 +146,13 @@ def png_bytes(fig) -> bytes:
 
 def history_png(history: History, t_collapse: float | None, summary: dict) -> bytes:
     """history.png of one run (see :func:`run_pngs` for the arguments)."""
-    figure = _history_figure(history, t_collapse, run_title(summary), _run_column(summary))
+    figure = history_figure(history, t_collapse, run_title(summary), run_column(summary))
     return png_bytes(figure)
 
 
 def shapes_png(history: History, t_collapse: float | None, summary: dict, widths, elevations):
     """shapes.png of one run (see :func:`run_pngs` for the arguments), as bytes."""
-    figure = _shapes_figure(history, widths, elevations, t_collapse, run_title(summary))
+    figure = shapes_figure(history, widths, elevations, t_collapse, run_title(summary))
     return png_bytes(figure)
 
 

@@ -32,9 +32,6 @@ from rbm_cli.models.result import History, RunResult
 from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figures, here before)
     N_SHAPES,
     RUN_PNGS,
-    _history_figure,
-    _run_column,
-    _shapes_figure,
     run_png_calls,
     run_pngs,
     run_title,

@@ -57,7 +57,7 @@ from rbm_cli.config.load import load_config
 from rbm_cli.config.types import STEP_DEFAULT, Config, GridConfig, SolverConfig
 from rbm_cli.models.methods import resolve_method
 from rbm_cli.study.bench_runs import run_cells
-from rbm_cli.study.bench_scoring import _key, agreement, errors
+from rbm_cli.study.bench_scoring import agreement, cell_keys, errors
 from rbm_cli.study.robustness import MEMBERS, member_config, members
 
 ROOT = Path(__file__).resolve().parents[2]  # the repository (rbm_cli/study/bench.py)
@@ -119,7 +119,7 @@ def problem_config(problem: Problem, stride: int = 1) -> Config:
     return dataclasses.replace(cfg, grid=grid, name=f"bench_{problem.name}")
 
 
-def _cells(cfg: Config) -> list[tuple[float, float]]:
+def bench_cells(cfg: Config) -> list[tuple[float, float]]:
     return [(a, f) for f in cfg.grid.frequencies_hz for a in cfg.grid.amplitudes_g]
 
 
@@ -145,7 +145,7 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
     references the runs at rtol 1e-11, 1e-12 and the nudged one must also count
     the same uplifts and impacts (one 8-drum cell kept its early peak in all three
     while its trajectories had parted: 2225 to 3431 uplifts)."""
-    cells = _cells(cfg)
+    cells = bench_cells(cfg)
     nudged = [(a * (1.0 + 1e-9), f) for a, f in cells]
     if problem.reference == "closed-form":
         ref, _ = run_cells("closed-form", cfg, cells, jobs)
@@ -238,7 +238,7 @@ def run_bench(
     rows = []
     for prob in chosen:
         cfg = problem_config(prob, stride=4 if quick else 1)
-        cells = _cells(cfg)
+        cells = bench_cells(cfg)
         ref = _reference(prob, cfg, cells, ref_dir, quick, reuse_references, jobs, log)
         sample = _sample(cells, QUICK_SAMPLE if quick else SAMPLE[prob.name])
         results = _run_methods(cfg, cells, sample, quick or pair, jobs)
@@ -315,8 +315,10 @@ def _method_rows(
     """One table row per method of `results` (from :func:`_run_methods`): times and errors."""
     default = _default_method(problem_config(prob, stride=40))
     # paired times: each method's run times summed over the sample's cells
-    on_sample = set(_key(pd.DataFrame(sample, columns=["amplitude_g", "frequency_hz"])))
-    paired = [float(d.loc[_key(d).isin(on_sample), "wall_time_s"].sum()) for _, d, _, _ in results]
+    on_sample = set(cell_keys(pd.DataFrame(sample, columns=["amplitude_g", "frequency_hz"])))
+    paired = [
+        float(d.loc[cell_keys(d).isin(on_sample), "wall_time_s"].sum()) for _, d, _, _ in results
+    ]
     base_sum = paired[-1]
     k_default = next(k for k, r in enumerate(results) if r[0] == default)
     rows = []

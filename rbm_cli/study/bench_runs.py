@@ -49,7 +49,7 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
 
 def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dict]:
     from rbm_cli.models.rbm.baseline import baseline_run
-    from rbm_cli.models.rbm.runner import model_from_config
+    from rbm_cli.physics.assembly import model_from_config
     from rbm_cli.physics.excitation import make_ground_motion
 
     model = model_from_config(cfg)
@@ -65,7 +65,7 @@ def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dic
 
 def _run_closed_form_chunk(cfg: Config, cells) -> list[dict]:
     from rbm_cli.models.block.closed_form import linear_run, warm_up
-    from rbm_cli.models.rbm.runner import model_from_config
+    from rbm_cli.physics.assembly import model_from_config
     from rbm_cli.physics.closed_forms import linear_rocking_parameters
     from rbm_cli.physics.excitation import make_ground_motion
 

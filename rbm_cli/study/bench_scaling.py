@@ -44,7 +44,7 @@ def _config(drums: int = 8, k_n: float = 5e9, duration: float = 10.0, method="DO
 
 
 def _elastic_hz(cfg) -> float:
-    from rbm_cli.models.rbm.runner import model_from_config
+    from rbm_cli.physics.assembly import model_from_config
 
     return max(model_from_config(cfg).elastic_frequencies_hz())
 
@@ -88,7 +88,7 @@ def run_scaling(output: str | os.PathLike = "bench", log=print) -> pd.DataFrame:
     The figure (scaling.png) is drawn by the caller from the returned table
     (:func:`rbm_cli.report.bench_figures.scaling_figure`)."""
     from rbm_cli.base.files import write_text_atomic
-    from rbm_cli.study.bench import PROBLEMS, _cells, problem_config, run_cells
+    from rbm_cli.study.bench import PROBLEMS, bench_cells, problem_config, run_cells
 
     rows = _series("drums", DRUMS, lambda n, m: _config(drums=n, method=m), log)
     rows += _series("k_n", STIFFNESS, lambda k, m: _config(drums=4, k_n=k, method=m), log)
@@ -97,7 +97,7 @@ def run_scaling(output: str | os.PathLike = "bench", log=print) -> pd.DataFrame:
         if prob.name not in ("slender", "multidrum"):
             continue
         cfg = problem_config(prob, stride=1 if prob.name == "slender" else 4)
-        cells = _cells(cfg)
+        cells = bench_cells(cfg)
         walls = {}
         for jobs in (1, 2):
             start = time.perf_counter()

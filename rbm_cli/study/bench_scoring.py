@@ -17,13 +17,13 @@ import pandas as pd
 from rbm_cli.study.domain import compare
 
 
-def _key(df: pd.DataFrame) -> pd.Series:
+def cell_keys(df: pd.DataFrame) -> pd.Series:
     return df["amplitude_g"].round(9).astype(str) + "|" + df["frequency_hz"].round(9).astype(str)
 
 
 def errors(run: pd.DataFrame, ref: pd.DataFrame) -> dict:
     """Errors of a run's rows against the reference rows of the same cells."""
-    m = run.assign(key=_key(run)).merge(ref.assign(key=_key(ref)), on="key",
+    m = run.assign(key=cell_keys(run)).merge(ref.assign(key=cell_keys(ref)), on="key",
                                         suffixes=("", "_ref"))  # fmt: skip
     n_failed = int((m["status"] == "failed").sum())
     conv = m[(m["converged"] == 1) & (m["status"] != "failed")]
@@ -69,10 +69,10 @@ def agreement(run: pd.DataFrame, other: pd.DataFrame, ref: pd.DataFrame) -> dict
     well-conditioned reference peak that survive in both; a chaotic cell agrees with no
     other run), and the paired time ratio other / run (run times summed over all common
     cells)."""
-    m = run.assign(key=_key(run)).merge(other.assign(key=_key(other)), on="key",
+    m = run.assign(key=cell_keys(run)).merge(other.assign(key=cell_keys(other)), on="key",
                                         suffixes=("", "_other"))  # fmt: skip
     own, theirs = float(m["wall_time_s"].sum()), float(m["wall_time_s_other"].sum())
-    flags = ref.assign(key=_key(ref))[["key", "converged", "peak_converged"]]
+    flags = ref.assign(key=cell_keys(ref))[["key", "converged", "peak_converged"]]
     m = m.merge(flags, on="key")
     ok = (m["status"] != "failed") & (m["status_other"] != "failed") & (m["converged"] == 1)
     differ = int((m.loc[ok, "collapsed"] != m.loc[ok, "collapsed_other"]).sum())

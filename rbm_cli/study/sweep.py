@@ -1,13 +1,16 @@
-"""Sweeps: run a grid of amplitude x frequency cells in parallel, resumably.
+"""Sweeps: run a grid of amplitude x frequency cells in parallel, in memory or resumably
+into a folder.
 
 The sweep knows runs, not physics. Cells are run in chunks by workers
 (rbm_cli.study.parallel; each worker assembles the model once per chunk and returns its rows;
-nothing accumulates in globals). The output folder is a transactional store
-(rbm_cli.study.store): locked for one sweep, finished chunks appended to a validated journal,
-``domain.partial.jsonl``, so an interrupted, killed or doubled sweep keeps every finished
-cell and leaves no file that looks complete, and ``resume=True`` finishes it without
-redoing finished cells. The result is published in one step at the end, in grid order,
-so the same config gives the same ``domain.csv`` whatever the number of workers.
+nothing accumulates in globals): :func:`run_cells` hands each finished chunk's rows to a
+callback. :func:`sweep_rows` is the sweep in memory: cells in, rows out, nothing written.
+:func:`run_sweep` is the same with a transactional store around it (rbm_cli.study.store):
+the output folder is locked for one sweep, finished chunks are appended to a validated
+journal, ``domain.partial.jsonl``, so an interrupted, killed or doubled sweep keeps every
+finished cell and leaves no file that looks complete, and ``resume=True`` finishes it
+without redoing finished cells. The result is published in one step at the end, in grid
+order, so the same config gives the same ``domain.csv`` whatever the number of workers.
 """
 
 from __future__ import annotations
@@ -39,6 +42,7 @@ from rbm_cli.study.cells import (
     row_key,
     tasks,
 )
+from rbm_cli.study.domain import csv_text
 from rbm_cli.study.parallel import run_chunks
 from rbm_cli.study.robustness import member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
@@ -127,6 +131,141 @@ def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict
     return rows
 
 
+# --------------------------------------------------------------------------- in memory
+
+
+def run_cells(config: Config, points: list[GridPoint], cells: list[Cell],
+              on_rows: Callable[[list[dict]], None], jobs: int = 1, backend: str = "loky",
+              scheduler: str | None = None, ensemble: int = 1,
+              progress: Callable[[int, int], None] | None = None, n_done: int = 0,
+              n_cells: int | None = None, stop_after: int | None = None,
+              placed: dict | None = None) -> None:  # fmt: skip
+    """Run cells of a config's grid points in chunks on workers (rbm_cli.study.parallel);
+    ``on_rows(rows)`` gets each finished chunk's rows (:func:`run_chunk`), in the order
+    the chunks finish.
+
+    Parameters
+    ----------
+    config : Config  The checked config; points : its grid points (rbm_cli.study.cells)
+    cells : list of Cell  The cells to run (amplitude [g], frequency [Hz], point values)
+    on_rows : callable(list of dict)  Takes each finished chunk's rows
+    jobs, backend, scheduler : As :func:`run_sweep`
+    ensemble : int  Runs per cell (:func:`run_chunk`)
+    progress : callable(done, total)  Called before the first chunk runs, as chunks finish
+        and now and then between; done counts from ``n_done`` (cells finished before)
+    n_cells : int  The total progress names (default: n_done + len(cells))
+    stop_after : int  Run only this many chunks (tests of interruption)
+    placed : dict  Filled with "workers" (rbm_cli.study.parallel.run_chunks)
+    """
+    n_cells = n_done + len(cells) if n_cells is None else n_cells
+    chunks = tasks(config, points, cells, jobs)
+    if stop_after is not None:
+        chunks = chunks[:stop_after]
+    work = [(cfg, c, ensemble) for cfg, c in _probe_first(chunks)]
+    if progress:
+        progress(n_done, n_cells)
+    sizes = [len(c) for _, c, _ in work]  # what a pool pays for (parallel)
+    for rows in run_chunks(run_chunk, work, jobs, backend, scheduler, sizes, placed):
+        if rows is not None:
+            on_rows(rows)
+            n_done += len(rows)
+        if progress:
+            progress(n_done, n_cells)
+
+
+@dataclass(frozen=True)
+class SweepRows:
+    """A sweep's rows in memory: domain.csv's rows, in grid order, without a file.
+
+    Attributes
+    ----------
+    rows : list of dict  One per cell, in grid order (as domain.csv lists them)
+    fields : tuple of str  domain.csv's columns
+    compile_s : float  Compiling (or loading) the compiled code [s], not in wall_time_s
+    wall_time_s : float  Running the cells [s]
+    workers : int or None  Worker processes or threads the cells ran on (0: this process)
+    """
+
+    rows: list[dict]
+    fields: tuple[str, ...]
+    compile_s: float = 0.0
+    wall_time_s: float = 0.0
+    workers: int | None = None
+
+    def csv(self) -> str:
+        """domain.csv's text for these rows (what a folder sweep of the config writes)."""
+        return csv_text(self.rows, self.fields)
+
+    def frame(self) -> pd.DataFrame:
+        """The DataFrame rbm_cli.study.domain.read_domain gives for domain.csv's text: read
+        from :meth:`csv`, so that the types are those of a stored domain's."""
+        import io
+
+        import pandas as pd
+
+        df = pd.read_csv(io.StringIO(self.csv()), keep_default_na=True)
+        for col in ("amplitude_g", "frequency_hz"):  # float, as read_domain leaves them
+            df[col] = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
+        return df
+
+
+def sweep_fields(config: Config, ensemble: int = 1) -> tuple[str, ...]:
+    """domain.csv's columns for a sweep of ``config`` with ``ensemble`` runs per cell."""
+    return domain_fields(config, CSV_FIELDS) + (ENSEMBLE_FIELDS if ensemble > 1 else ())
+
+
+def sweep_rows(
+    config: Config,
+    jobs: int = 1,
+    backend: str = "loky",
+    scheduler: str | None = None,
+    ensemble: int = 1,
+    force: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+    notify: Callable[[str], None] | None = None,
+) -> SweepRows:
+    """Run the grid of a config in memory: cells in, rows out, nothing written.
+
+    The same cells, chunks and rows as :func:`run_sweep` (which is this with a
+    transactional store around it): the rows are those of the domain.csv it writes.
+
+    Parameters
+    ----------
+    config : Config  Validated config with a non-empty grid
+    jobs, backend, scheduler, ensemble, force, progress : As :func:`run_sweep`
+    notify : callable(str)  One-line notes (what a compile waits for)
+
+    Returns
+    -------
+    SweepRows  The rows in grid order, their columns, compile and wall times [s]
+
+    Raises
+    ------
+    RbmError  Bad arguments (one line), before any cell runs
+    """
+    _check_request(config, jobs, ensemble, backend, scheduler, force)
+    points = _check_points(grid_points(config))
+    cells = grid_cells(config, points)
+    paths = config.grid.axis_paths
+    done: dict = {}
+
+    def keep(rows: list[dict]) -> None:
+        for row in rows:
+            done[row_key(row, paths)] = row
+
+    placed: dict = {}
+    compile_s, _ = warm_up(points, cells, backend, scheduler, notify or (lambda text: None))
+    start = time.perf_counter()
+    run_cells(config, points, cells, keep, jobs, backend, scheduler, ensemble, progress,
+              placed=placed)  # fmt: skip
+    wall = time.perf_counter() - start
+    return SweepRows([done[key(c)] for c in cells], sweep_fields(config, ensemble), compile_s,
+                     wall, placed.get("workers"))  # fmt: skip
+
+
+# --------------------------------------------------------------------------- in a folder
+
+
 def _check_request(
     config: Config, jobs: int, ensemble: int, backend: str, scheduler: str | None, force: bool
 ) -> int:
@@ -166,7 +305,7 @@ def _is_int(value) -> bool:
 def _check_points(points: list[GridPoint]) -> list[GridPoint]:
     """The points, once every point's RBM has finite derived quantities (or one line
     naming the point)."""
-    from rbm_cli.models.rbm.runner import model_from_config
+    from rbm_cli.physics.assembly import model_from_config
 
     for point in points:
         if point.config.model == "rbm":
@@ -235,7 +374,7 @@ def run_sweep(
     cells = grid_cells(config, points)
     folder = Path(output) / config.name
     digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
-    fields = domain_fields(config, CSV_FIELDS) + (ENSEMBLE_FIELDS if ensemble > 1 else ())
+    fields = sweep_fields(config, ensemble)
     resume_command = resume_command or f"rbm sweep CONFIG.yaml -o {output} --resume"
     note = notify or (lambda text: None)
     with SweepStore(folder) as store:
@@ -291,7 +430,7 @@ class _Run:
     done: dict
     placed: dict = dataclasses.field(default_factory=dict)  # where the cells ran (parallel)
     note: Callable[[str], None] = lambda text: None  # what the compile waits for
-    compiled: str = ""  # what the compile time was spent on (_warm_up)
+    compiled: str = ""  # what the compile time was spent on (warm_up)
 
     def cells_kept(self) -> int:
         """Cells kept after a Ctrl-C, counted from the journal: Ctrl-C may land between a
@@ -302,18 +441,32 @@ class _Run:
         return max(len(self.done), len(read.rows))
 
     def run(self, todo, jobs, backend, scheduler, progress, stop_after) -> tuple[float, float]:
-        """Run the cells still to do; (compile time, wall time) [s]."""
+        """Run the cells still to do (:func:`run_cells`), each finished chunk's rows into the
+        journal (fsync'ed), then into ``done``; (compile time, wall time) [s]."""
         n_cells = len(self.cells)
+        paths = self.config.grid.axis_paths
+
+        def journal(rows: list[dict]) -> None:
+            self.store.append(rows, self.digest)
+            for row in rows:
+                self.done[row_key(row, paths)] = row
+
         try:
-            compile_s, self.compiled = _warm_up(self.points, todo, backend, scheduler, self.note)
+            compile_s, self.compiled = warm_up(self.points, todo, backend, scheduler, self.note)
             start = time.perf_counter()
-            chunks = tasks(self.config, self.points, todo, jobs)
-            if stop_after is not None:
-                chunks = chunks[:stop_after]
-            work = [(cfg, c, self.ensemble) for cfg, c in _probe_first(chunks)]
-            _run_tasks(self.store, work, jobs, backend, scheduler, self.digest, self.done,
-                       n_cells, progress, self.resume_command,
-                       self.config.grid.axis_paths, self.placed)  # fmt: skip
+            try:
+                self.store.open_journal()
+                run_cells(self.config, self.points, todo, journal, jobs, backend, scheduler,
+                          self.ensemble, progress, len(self.done), n_cells, stop_after,
+                          self.placed)  # fmt: skip
+            except OSError as exc:
+                raise RbmError(
+                    f"cannot write the journal {self.store.journal}: {exc.strerror or exc}; the"
+                    f" {len(self.done)} finished cells are kept: make room, then run"
+                    f" {self.resume_command}"
+                ) from None
+            finally:
+                self.store.close_journal()
         except KeyboardInterrupt:
             raise SweepInterrupted(self.store.folder, self.cells_kept(), n_cells,
                                    self.resume_command) from None  # fmt: skip
@@ -322,32 +475,6 @@ class _Run:
                 f"sweep stopped after {stop_after} chunks (journal kept in {self.store.journal})"
             )
         return compile_s, time.perf_counter() - start
-
-
-def _run_tasks(store, tasks, jobs, backend, scheduler, digest, done, n_cells, progress,
-               resume_command, paths, placed) -> None:  # fmt: skip
-    """Run the chunks; each one's rows go to the journal (fsync'ed), then into done."""
-    n_done = len(done)
-    if progress:
-        progress(n_done, n_cells)
-    store.open_journal()
-    try:
-        sizes = [len(cells) for _, cells, _ in tasks]  # what a pool pays for (parallel)
-        for rows in run_chunks(run_chunk, tasks, jobs, backend, scheduler, sizes, placed):
-            if rows is not None:
-                store.append(rows, digest)
-                for row in rows:
-                    done[row_key(row, paths)] = row
-                n_done += len(rows)
-            if progress:
-                progress(n_done, n_cells)
-    except OSError as exc:
-        raise RbmError(
-            f"cannot write the journal {store.journal}: {exc.strerror or exc}; the"
-            f" {len(done)} finished cells are kept: make room, then run {resume_command}"
-        ) from None
-    finally:
-        store.close_journal()
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -388,8 +515,8 @@ def _probe_first(chunks: list) -> list:
     return pieces + chunks[1:]
 
 
-def _warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | None,
-             note: Callable[[str], None]) -> tuple[float, str]:  # fmt: skip
+def warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | None,
+            note: Callable[[str], None]) -> tuple[float, str]:  # fmt: skip
     """Compile (or load) the compiled code of the cells once here, if this process runs
     cells (every backend but a Dask scheduler's; loky runs its first chunks here) or if it
     must be compiled (then workers load it from numba's cache instead of each compiling it):

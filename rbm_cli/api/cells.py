@@ -1,0 +1,195 @@
+"""One cell for the library: run a config's model under one ground motion, draw its
+history, and (for ``rbm run``) write its run folder and compile its code ahead."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rbm_cli.api.configs import as_config, check_cell, check_output_dt
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import Config
+from rbm_cli.models.result import RunResult
+from rbm_cli.report.plots import plot_history as _plot_history
+from rbm_cli.report.run_folder import history_frame
+from rbm_cli.study.simulate import simulate
+
+if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` never does
+    import pandas as pd
+
+__all__ = [
+    "CellRun",
+    "check_run_output",
+    "compile_ahead",
+    "plot_history",
+    "run",
+    "write_run_folder",
+]
+
+
+@dataclass(frozen=True)
+class CellRun:
+    """One cell's run: its outcome, times and (when recorded) its history.
+
+    Attributes
+    ----------
+    config : Config  The config it ran
+    result : RunResult  Every figure of the run (rbm_cli.models.result.RunResult): amplitude_g
+        [g], frequency_hz [Hz], max_rotation_ratio [-], max_top_displacement_m [m],
+        n_uplifts, n_impacts, wall_time_s [s], ...
+    status : str  'collapsed', 'survived' or 'failed'
+    t_collapse_s : float  Time of collapse [s]; nan if none
+    """
+
+    config: Config
+    result: RunResult
+
+    @property
+    def status(self) -> str:
+        return self.result.status
+
+    @property
+    def t_collapse_s(self) -> float:
+        return self.result.t_collapse_s
+
+    @cached_property
+    def history(self) -> pd.DataFrame | None:
+        """history.csv's table (None unless recorded): t_s [s], ag_m_s2 [m/s^2] and ug_m [m]
+        (ground), u1_m..u{n+1}_m (nodes, relative to the ground) [m], theta1_rad.. [rad]."""
+        return None if self.result.history is None else history_frame(self.result.history)
+
+
+def run(
+    config: Config | str | os.PathLike | Mapping[str, Any],
+    amplitude_g: float | None = None,
+    frequency_hz: float | None = None,
+    *,
+    record: bool = True,
+    output_dt: float | None = None,
+) -> CellRun:
+    """Run one cell of a config: its model under one ground motion.
+
+    Parameters
+    ----------
+    config : Config, path or mapping  The config (else loaded with :func:`load_config`)
+    amplitude_g : float  Peak ground acceleration [g], in [0, 1000] (not used by `free`)
+    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by `free`)
+    record : bool  Keep the history, as ``rbm run`` (the run goes on to the end of the
+        motion or to collapse); False: as a sweep, stop once the outcome cannot change
+    output_dt : float, optional  Sampling interval of the history [s]; default 0.002 s
+
+    Returns
+    -------
+    CellRun  ``.status``, ``.t_collapse_s`` [s], ``.history`` (a DataFrame), ``.result``
+
+    Raises
+    ------
+    RbmError  A missing or out-of-range amplitude or frequency, a bad config (one line)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> calm = rbm.run(cfg, amplitude_g=0.1, frequency_hz=1.0)  # below B/H = 0.25 g
+    >>> calm.status, float(calm.history["theta1_rad"].abs().max())
+    ('survived', 0.0)
+    >>> list(calm.history.columns)
+    ['t_s', 'ag_m_s2', 'ug_m', 'u1_m', 'u2_m', 'theta1_rad']
+    >>> rbm.run(cfg, amplitude_g=2.5, frequency_hz=0.5).status  # ten times B/H
+    'collapsed'
+    """
+    cfg = as_config(config)
+    amplitude_g, frequency_hz = check_cell(cfg, amplitude_g, frequency_hz)
+    output_dt = check_output_dt(cfg, output_dt)
+    result = simulate(cfg, amplitude_g, frequency_hz, record=record, output_dt=output_dt)
+    return CellRun(config=cfg, result=result)
+
+
+def plot_history(run: CellRun | RunResult, ax=None):
+    """Draw a run's base and top displacement [m] against time [s] on a matplotlib axes.
+
+    Parameters
+    ----------
+    run : CellRun or RunResult  A recorded run; its collapse time is marked
+    ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
+
+    Returns
+    -------
+    matplotlib Axes
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> ax = rbm.plot_history(rbm.run(cfg, amplitude_g=2.5, frequency_hz=0.5))
+    >>> ax.get_xlabel()
+    'time [s]'
+    """
+    result = run.result if isinstance(run, CellRun) else run
+    if not isinstance(result, RunResult):
+        raise RbmError(f"plot_history takes a run, got a value of type {type(run).__name__}")
+    if result.history is None:
+        raise RbmError("this run kept no history: run it with record=True")
+    return _plot_history(result.history, ax=ax, t_collapse=result.t_collapse_s)
+
+
+# --------------------------------------------------------------------------- rbm run
+
+
+def compile_ahead(config: Config, notify: Callable[[str], None]) -> None:
+    """Compile (or load) the compiled code a run of ``config`` needs (the kernel, the exact
+    integrator, or the rigid block's closed form: rbm_cli.models.methods.compiled_code)
+    before it runs; a compile another rbm process runs is waited for, not repeated
+    (rbm_cli.models.compile_ahead.compile_once), and ``notify`` is told what it waits
+    for. Nothing to do for a run in Python (``solver.implementation: python``) or a model
+    without compiled code."""
+    from rbm_cli.models.methods import compiled_code
+
+    code = compiled_code(config)
+    if code is None:
+        return
+    from rbm_cli.models.compile_ahead import compile_once
+
+    compile_once(code, notify=notify)
+
+
+def check_run_output(config: Config, output: str | os.PathLike):
+    """Before a run: OUTPUT/<name>/ can be written, and the column can be built; returns
+    the column (rbm_cli.physics.column.build_column) that :func:`write_run_folder` draws.
+
+    Raises
+    ------
+    RbmError  An unwritable folder or a bad column (one line)
+    """
+    from rbm_cli.base.files import check_writable_dir
+    from rbm_cli.physics.column import build_column
+
+    check_writable_dir(Path(output) / config.name)
+    return build_column(config.column, config.interface)
+
+
+def write_run_folder(config: Config, column, result: RunResult, output: str | os.PathLike,
+                     config_path: str | None, amplitude_g: float, frequency_hz: float | None,
+                     output_dt: float | None, figure_process=None) -> Path:  # fmt: skip
+    """Write a run's folder OUTPUT/<name>/run_A<A>_f<F>/ (history.csv, history.png,
+    shapes.png, summary.json: rbm_cli.report.run_folder.write_run); returns the folder.
+    figure_process: the rbm_cli.report.figure_process.FigureProcess that draws the
+    figures, or None to draw them here."""
+    from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
+
+    summary = run_summary(result, config, config_path=config_path, amplitude_g=amplitude_g,
+                          frequency_hz=frequency_hz, output_dt=output_dt)  # fmt: skip
+    return write_run(
+        output,
+        config.name,
+        run_folder_name(amplitude_g, frequency_hz, config.excitation.type),
+        result,
+        summary,
+        widths=column.widths,
+        elevations=list(column.bottoms) + [column.height],
+        figure_process=figure_process,
+    )

@@ -1,0 +1,91 @@
+"""Domains for the library and ``rbm plot-domain`` / ``rbm compare``: read a stored one,
+find the config stored beside it, compare two, check the regression rule, draw one."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rbm_cli.api.configs import as_config
+from rbm_cli.config.types import Config
+from rbm_cli.study.domain import axis_columns, domain_config, read_domain
+from rbm_cli.study.domain import compare as compare_domains
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = [
+    "axis_columns",
+    "check_regression",
+    "compare_domains",
+    "domain_config",
+    "draw_domain",
+    "plot_domain",
+    "read_domain",
+    "save_figure",
+]
+
+
+def save_figure(fig, path: str | os.PathLike) -> Path:
+    """Save a matplotlib figure to ``path`` in one step (rbm_cli.base.files.save_figure_atomic:
+    its type from the suffix, 150 dpi); returns the path."""
+    from rbm_cli.base import files
+
+    return files.save_figure_atomic(fig, path)
+
+
+def check_regression(a: pd.DataFrame, b: pd.DataFrame):
+    """The regression rule of domain B against the reference A (rbm_cli.study.regression.check:
+    robust cells must not differ; B an ensemble within its bound of sensitive cells)."""
+    from rbm_cli.study.regression import check
+
+    return check(a, b)
+
+
+def draw_domain(df: pd.DataFrame, config: Config | None, **options):
+    """domain.png's figure of a domain (rbm_cli.report.domain_figure.domain_figure: compare,
+    labels, dimensionless, layout, compare_configs, where); matplotlib imported here."""
+    from rbm_cli.report.domain_figure import domain_figure
+
+    return domain_figure(df, config, **options)
+
+
+def plot_domain(
+    df: pd.DataFrame,
+    ax=None,
+    config: Config | str | os.PathLike | Mapping[str, Any] | None = None,
+    *,
+    dimensionless: bool = False,
+    layout: str = "auto",
+    **options,
+):
+    """Draw a safe-unsafe domain (frequency [Hz] x amplitude [g]) on a matplotlib axes.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame  A domain: :func:`sweep`'s or :func:`read_domain`'s
+    ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
+    config : Config, path or mapping, optional  The config swept: adds the level [g] where
+        the column starts to rock (B/H for a rigid monolith) and the closed forms that apply
+    dimensionless : bool  Axes omega / p and A / (g tan alpha) instead (read from the domain's
+        scale columns, or computed from ``config`` for domains written before them)
+    layout : str  A domain over more axes than amplitude and frequency: 'panels' (one per
+        point of the others), 'overlay' (each point's boundary a line) or 'auto'
+        (rbm_cli.report.domain_view: with one frequency the innermost axis goes on x)
+    **options  For rbm_cli.report.plot_domain.plot_domain (compare, labels, ...)
+
+    Returns
+    -------
+    matplotlib Axes  (panels: the list of their axes, in the place of ``ax``)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> ax = rbm.plot_domain(rbm.read_domain("out/block/domain.csv"))  # doctest: +SKIP
+    """
+    from rbm_cli.report.domain_figure import draw_domain_on  # matplotlib, pandas: when drawn
+
+    cfg = None if config is None else as_config(config)
+    return draw_domain_on(df, ax, cfg, dimensionless=dimensionless, layout=layout, **options)

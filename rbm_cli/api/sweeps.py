@@ -1,0 +1,103 @@
+"""Sweeps for the library and ``rbm sweep``: a config's grid in memory (nothing written)
+or into a folder (domain.csv, boundary.csv, domain.png, meta.json)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rbm_cli.api.configs import as_config
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.types import Config
+from rbm_cli.report.figure_process import DOMAIN_IMPORTS, RUN_IMPORTS, FigureProcess, domain_figure
+from rbm_cli.study.domain import read_domain
+from rbm_cli.study.sweep import SweepInterrupted, SweepSummary, sweep_rows
+from rbm_cli.study.sweep import run_sweep as _run_sweep
+
+if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` never does
+    import pandas as pd
+
+__all__ = [
+    "DOMAIN_IMPORTS",
+    "RUN_IMPORTS",
+    "FigureProcess",
+    "SweepInterrupted",
+    "SweepSummary",
+    "run_sweep",
+    "sweep",
+]
+
+#: The settings of a sweep in memory (rbm_cli.study.sweep.sweep_rows) besides jobs.
+IN_MEMORY_OPTIONS = ("backend", "scheduler", "ensemble", "force", "progress", "notify")
+
+
+def run_sweep(
+    config: Config,
+    output: str | os.PathLike = "out",
+    *args,
+    figure: Callable[[pd.DataFrame, Config], object] | None = None,
+    figure_process=None,
+    **kwargs,
+) -> SweepSummary:
+    """Run a config's grid into OUTPUT/<name>/ (domain.csv, boundary.csv, domain.png, meta.json):
+    rbm_cli.study.sweep.run_sweep with the domain figure (or `figure`; the CLI's figure_process
+    draws the former in its child). Same parameters; :func:`sweep` returns the domain itself."""
+    draw = figure if figure is not None else domain_figure
+    if figure_process is not None and draw is figure_process.draws:
+        draw = figure_process.figure
+    return _run_sweep(config, output, *args, figure=draw, **kwargs)
+
+
+def sweep(
+    config: Config | str | os.PathLike | Mapping[str, Any],
+    output: str | os.PathLike | None = None,
+    *,
+    jobs: int = 1,
+    **options,
+) -> pd.DataFrame:
+    """Run a config's grid and return its domain: the rows of domain.csv.
+
+    Parameters
+    ----------
+    config : Config, path or mapping  A config with a grid (amplitudes [g], frequencies [Hz])
+    output : path, optional  Output root: writes OUTPUT/<name>/ (domain.csv, boundary.csv,
+        domain.png, meta.json) as ``rbm sweep -o OUTPUT``; None: the sweep runs in memory
+        and writes nothing (rbm_cli.study.sweep.sweep_rows)
+    jobs : int  Worker processes; 1 (the default) runs in this process
+    **options  Other settings of rbm_cli.study.sweep.run_sweep (resume, force, ensemble...);
+        without an output folder those of sweep_rows (backend, scheduler, ensemble, force,
+        progress, notify)
+
+    Returns
+    -------
+    pandas.DataFrame  The rows of domain.csv, one per cell (amplitude_g [g], frequency_hz
+        [Hz], status, collapsed, t_collapse_s [s], ...); ``attrs["folder"]``: the folder
+        (None without an output folder)
+
+    Raises
+    ------
+    RbmError  Bad arguments (one line); an option that needs an output folder without one
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5},
+    ...     "grid": {"amplitudes": [0.1, 2.5], "frequencies": [0.5, 1.0]}})
+    >>> df = rbm.sweep(cfg)
+    >>> df[["amplitude_g", "frequency_hz", "status"]].values.tolist()
+    [[0.1, 0.5, 'survived'], [2.5, 0.5, 'collapsed'], [0.1, 1.0, 'survived'], [2.5, 1.0, 'collapsed']]
+    """  # noqa: E501
+    cfg = as_config(config)
+    if output is None:
+        folder_only = sorted(set(options) - set(IN_MEMORY_OPTIONS))
+        if folder_only:
+            raise RbmError(f"{', '.join(folder_only)}: needs an output folder (output=...)")
+        df = sweep_rows(cfg, jobs=jobs, **options).frame()
+        df.attrs["folder"] = None
+        return df
+    summary = run_sweep(cfg, output, jobs=jobs, **options)
+    df = read_domain(Path(summary.folder) / "domain.csv")
+    df.attrs["folder"] = str(summary.folder)
+    return df

@@ -49,7 +49,7 @@ class Progress:
         self.total = 0
 
     def rate(self, now: float) -> float:
-        """Cells a second run in this session (NaN before the first finished)."""
+        """Cells a second run by this invocation (NaN before the first finished)."""
         run = self.done - self.done0
         elapsed = now - self.start if self.start is not None else 0.0
         return run / elapsed if run > 0 and elapsed > 0 else math.nan

@@ -1,4 +1,4 @@
-"""Measure the numbers and draw the figures of docs/engine.md (issue 7: `model: bullet`).
+"""Measure the numbers and draw the figures of docs/engine.md (`model: bullet`).
 
     python docs/make_engine.py impact      # the engine's impact loss vs Housner's e (~1 min)
     python docs/make_engine.py grid        # 6 x 5 grid, engine vs housner, 3 time steps (~5 min)
@@ -71,7 +71,7 @@ COLUMNS = {
     "block 2 x 1 m": {"height": 2.0, "base_width": 1.0, "depth": 1.0},
     "tapered 5 m column": {"height": 5.0, "base_width": 0.96, "top_width": 0.66},
 }
-#: The issue's 6 x 5 harmonic grid (g, Hz), for both monolithic columns.
+#: The study's 6 x 5 harmonic grid (g, Hz), for both monolithic columns.
 GRID_AMPLITUDES = (0.3, 0.5, 0.7, 0.9, 1.1, 1.3)
 GRID_FREQUENCIES = (0.5, 1.0, 1.5, 2.0, 2.5)
 TIME_STEPS = (1e-4, 2e-4, 5e-4)

@@ -1,4 +1,4 @@
-"""Hypothesis strategies over the configurations a user can write (issue 6).
+"""Hypothesis strategies over the configurations a user can write.
 
 Every strategy builds a plain mapping, as a YAML file would hold, and passes it
 through :func:`rbm_cli.config.load.parse_config`, so each drawn example is a config

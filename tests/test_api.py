@@ -1,8 +1,8 @@
 """The Python API (`import rbm`, rbm_cli.api): configs from dicts, changed values, one cell,
-a sweep, plots on a given axes, and the notebook-style example of docs/ (issue 16).
+a sweep, plots on a given axes, and the notebook-style example of docs/.
 
 The block is rigid and monolithic, H = 2 m, B = 0.5 m: the RBM's rigid monolith starts to
-rock when |a_g| > g B/H = 0.25 g (SPEC section 2), so at 0.1 g nothing moves. At 2.5 g
+rock when |a_g| > g B/H = 0.25 g (alpha = B/H), so at 0.1 g nothing moves. At 2.5 g
 (ten times B/H) and 0.5 Hz it overturns: p = sqrt(3 g / (4 R)) = 2.67 rad/s for R = 1.03 m,
 so w/p = 1.18, and the first half-cycle of the sine is a half-sine pulse of 10 alpha, far
 above Housner's threshold sqrt(1 + (w/p)^2) alpha = 1.55 alpha for such a pulse.
@@ -25,7 +25,7 @@ import rbm
 import rbm_cli.api
 from tests.paths import ROOT
 
-G = 9.81  # [m/s^2], SPEC
+G = 9.81  # [m/s^2], as the library
 H, B = 2.0, 0.5  # [m]
 UPLIFT_G = B / H  # [g]
 EXAMPLE = ROOT / "docs" / "examples" / "api_example.py"

@@ -5,7 +5,7 @@ corner inertia from the independent polynomial integrals of `housner`
 (themselves checked against triple integrals in test_reference.py), Housner's
 impact formula e = 1 - 1.5 sin^2(alpha) written here, the statics of a rigid
 block (no motion below tan(alpha) g), and Housner's model itself run with the
-engine's measured impact loss. CI runs the issue's 6 x 5 grid with 3 s of
+engine's measured impact loss. CI runs the study's 6 x 5 grid with 3 s of
 excitation per cell (docs/make_engine.py runs it for 10 s).
 """
 
@@ -243,7 +243,7 @@ def test_same_cell_same_answer():
 
 # ------------------------------------------------------------ against Housner
 
-#: The issue's 6 x 5 harmonic grid (the one docs/make_engine.py runs for 10 s).
+#: The study's 6 x 5 harmonic grid (the one docs/make_engine.py runs for 10 s).
 GRID_AMPLITUDES = (0.3, 0.5, 0.7, 0.9, 1.1, 1.3)  # g
 GRID_FREQUENCIES = (0.5, 1.0, 1.5, 2.0, 2.5)  # Hz
 #: CI runs it with 3 s of excitation instead of 10 s (both models see the same motion).
@@ -252,7 +252,7 @@ CI_DURATION = 3.0  # s
 
 @pytest.mark.parametrize("column", [BLOCK, TAPER], ids=["block", "tapered"])
 def test_engine_agrees_with_housner(column):
-    """The issue's bar: a monolithic block and the tapered column agree with
+    """The 95 % bar: a monolithic block and the tapered column agree with
     `housner` (run with the engine's measured impact loss) on >= 95 % of the cells
     of a 6 x 5 harmonic grid (here 3 s of excitation; 10 s in docs/engine.md)."""
     engine = config(column, duration=CI_DURATION)
@@ -307,7 +307,7 @@ def test_rbm_run_writes_the_engine_history(tmp_path):
 
 
 def test_engine_settings_are_the_scoped_ones():
-    """The issue's scoping values; a change must be deliberate."""
+    """The scoping values of docs/engine.md; a change must be deliberate."""
     s = EngineSettings()
     assert (s.time_step, s.solver_iterations, s.erp, s.friction) == (1e-4, 100, 0.2, 1.0)
     assert dataclasses.replace(s, friction=0.5).friction == 0.5

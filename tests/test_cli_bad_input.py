@@ -1,4 +1,4 @@
-"""Bad input through the command line (issue 6): every case a user can get wrong.
+"""Bad input through the command line: every case a user can get wrong.
 
 Each case goes through the CLI (click's CliRunner, files in tmp_path only) and must end
 in one line ``Error: ...`` that names the problem, exit status 2, no traceback, and no

@@ -123,7 +123,7 @@ def _facts(run):
 
 
 def test_the_rbm_block_is_the_linear_block_of_its_mapping():
-    """The RBM's closed form against Spanos and Koh's block with the SPEC's mapping (alpha,
+    """The RBM's closed form against Spanos and Koh's block of its mapping (alpha,
     p), and housner-linear compiled against python (its source uncompiled): same outcome
     and events, peaks and collapse times within 1e-9 where a 1e-10 change of the amplitude
     moves the peak by < 1e-9 (the RBM places an impact EVENT_EPS theta_u past zero,

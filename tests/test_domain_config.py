@@ -1,7 +1,7 @@
 """A stored domain keeps the config as the user wrote it (meta.json's config_written), and
 `rbm plot-domain` draws it with that config.
 
-Guards the defect of issue 15: plot-domain rebuilt a YAML config from meta.json's derived
+Guards a past defect: plot-domain rebuilt a YAML config from meta.json's derived
 values and lost fields, so a bullet domain swept with friction 0.1 was re-drawn at the
 default friction 1.0 (its uplift level min(tan alpha, friction) at 0.25 g instead of 0.1 g)
 and solver settings were lost.

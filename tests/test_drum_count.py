@@ -1,4 +1,4 @@
-"""The drum-count study (issue 16): the tapered column in 1, 2, 4, 8 and 16 drums.
+"""The drum-count study: the tapered column in 1, 2, 4, 8 and 16 drums.
 
 configs/drum_count.yaml sweeps the drum count as a grid axis (column.drums). Two of its points
 are columns the project already stores, each from a config written by hand and swept on its

@@ -26,7 +26,7 @@ def _dist(rows):
 
 
 def test_first_crossing_takes_a_dip_before_a_later_crossing():
-    """Guards the bug of issue 6 failure 2: row 0 dips below zero on (0.2, 0.3) and
+    """Guards a past bug (found by the property suite): row 0 dips below zero on (0.2, 0.3) and
     comes back; row 1 ends below zero, crossing at t = 0.9. Root finding on the
     minimum over rows may converge on 0.9; the first event is at 0.2."""
     rows = [

@@ -6,7 +6,7 @@ forms, against its own bounds sampled densely, and against the step kernel.
 - the bounds that make sampling certain (exact.bounds, exact.search) hold on densely
   sampled random pieces of an 8-drum column: no crossing can hide in a certified interval;
 - a rigid monolith: the exact linear half-sine threshold, the free rocking period, and
-  housner-linear (the same equation in closed form, with SPEC section 2's mapping);
+  housner-linear (the same equation in closed form: alpha = B/H, p from the true inertia);
 - an elastic monolith forced at its natural frequency: the undamped resonance
   theta = C (sin wt - wt cos wt), and an 8-drum column at its first mode against the
   step kernel at rtol 1e-12;
@@ -240,7 +240,7 @@ def test_free_rocking_period():
 
 
 def test_rigid_monolith_equals_housner_linear():
-    """The rigid RBM with n = 1 is housner-linear (alpha = B/H, p from SPEC section 2):
+    """The rigid RBM with n = 1 is housner-linear (alpha = B/H, p from the true inertia):
     on sub-grids of spanos_koh_slender and housner_halfsine the exact method and the
     closed form give the same outcome and event counts, and peaks and collapse times within
     1e-8 where the closed form is well-conditioned (a 1e-10 change of the amplitude moves

@@ -1,4 +1,4 @@
-"""Fault injection (issue 14): kill, interrupt, corrupt and starve a sweep at random
+"""Fault injection: kill, interrupt, corrupt and starve a sweep at random
 points, and check that nothing finished is lost and nothing unfinished looks finished.
 
 A trial is one sweep of a small 8-drum grid, driven to its end through a random sequence

@@ -1,5 +1,5 @@
-"""domain.png drawn by a child forked as `rbm sweep` starts (issue 18,
-rbm_cli.report.figure_process): the same file as drawn in the sweep's own process, a
+"""domain.png drawn by a child forked as `rbm sweep` starts
+(rbm_cli.report.figure_process): the same file as drawn in the sweep's own process, a
 child that is not asked is killed and reaped, one that died is replaced by drawing here,
 and a drawing error is the sweep's error.
 

@@ -1,4 +1,4 @@
-"""No fixed cost a user waits for (issue 18): a sweep starts a worker pool only when the
+"""No fixed cost a user waits for: a sweep starts a worker pool only when the
 pool saves more time than it costs; the rows do not depend on where a chunk ran; a pool
 is stopped, its workers reaped, once its chunks are done; workers and the CLI import only
 what they need."""
@@ -257,7 +257,7 @@ PARENT_MODULES = parent_modules("pandas", "rbm_cli.study.sweep")
 @pytest.mark.parametrize("extra", [[], ["--ensemble", "2"]], ids=["plain", "ensemble"])
 def test_the_sweep_process_never_imports_pandas(tmp_path, extra):
     """`rbm sweep` writes domain.csv and boundary.csv from its rows and sends them to the
-    figure's child, which builds the DataFrame (issue 18): pandas is not imported in the
+    figure's child, which builds the DataFrame: pandas is not imported in the
     sweep's own process, a ~0.15 s import."""
     config = tmp_path / "small.yaml"
     config.write_text(SMALL)

@@ -1,4 +1,4 @@
-"""`rbm fragility DOMAIN.csv` (issue 17): a record-suite domain to fragility files and figures.
+"""`rbm fragility DOMAIN.csv`: a record-suite domain to fragility files and figures.
 
 The domain is made here by hand from a known lognormal: each of 200 records has a capacity
 drawn from lognormal(median THETA, dispersion BETA) and collapses at every intensity at or

@@ -1,4 +1,4 @@
-"""Grid axes over any config key (issue 16): parsing, refusals, sweeps, resume, compare.
+"""Grid axes over any config key: parsing, refusals, sweeps, resume, compare.
 
 Expected values come from the config itself (a point must equal the config written by hand
 with that value), from closed forms (the RBM's p and alpha of a rectangular block) and from
@@ -155,7 +155,7 @@ def test_a_plain_grid_hashes_as_before_the_axes_existed():
 
 
 def rbm_p_alpha(height: float, width: float) -> tuple[float, float]:
-    """The RBM's rigid rectangular monolith as the linear model (closed form, SPEC 2):
+    """The RBM's rigid rectangular monolith as the linear model (closed form, alpha = B/H):
     tan alpha = B / H, p^2 = 6 g H / (4 H^2 + B^2)."""
     return math.atan(width / height), math.sqrt(6.0 * G * height / (4 * height**2 + width**2))
 

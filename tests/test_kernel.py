@@ -62,7 +62,7 @@ def test_rigid_block_below_uplift_costs_nothing():
 
 
 def test_kernel_energy_jump_reproducer():
-    """Issue 6's energy-jump case (tests/test_stress.py::test_energy_jump_reproducer)
+    """The property suite's energy-jump case (tests/test_stress.py::test_energy_jump_reproducer)
     through the kernel: 6 drums, ultra-stiff joints, e = 1, free motion, >800
     impacts; the earliest crossing in a step must win, or energy jumps by 5e-4."""
     from rbm_cli.config.load import parse_config

@@ -1,5 +1,5 @@
 """The kernel's Runge-Kutta tableaux (written out in models/rbm/step/tableaux.py so the
-compiled path does not import scipy.integrate, issue 18) are scipy's, bit for bit: the
+compiled path does not import scipy.integrate) are scipy's, bit for bit: the
 kernel's step sequence is scipy's only if every coefficient is."""
 
 from __future__ import annotations

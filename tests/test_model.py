@@ -1,4 +1,4 @@
-"""The Rigid Beam Model against closed forms, invariants and limits (issue 2)."""
+"""The Rigid Beam Model against closed forms, invariants and limits."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The RBM's model error against the exact block (`housner`), issue 16.
+"""The RBM's model error against the exact block (`housner`).
 
 The stored `<study>_housner` domains are the RBM studies' configs with `model: housner`
 and nothing else changed; tests/test_regression.py re-makes them with the others. Here:
@@ -78,10 +78,11 @@ def test_fraction_of_differing_cells_is_as_stated(study):
     assert (err.count(UNCONSERVATIVE), err.count(CONSERVATIVE)) == (unconservative, conservative)
 
 
-def test_the_issue_s_two_examples():
-    """Issue 16's measurements, with Housner's restitution: at 1 Hz the thick block's RBM
-    collapses from 0.8 g where the exact block needs 1.25 g (conservative); at 1.75 Hz the
-    slender block's RBM boundary is 1.3 g where the exact block's is 1.0 g (unconservative)."""
+def test_two_examples_with_housners_restitution():
+    """Two measurements of the stored studies with Housner's restitution: at 1 Hz the thick
+    block's RBM collapses from 0.8 g where the exact block needs 1.25 g (conservative); at
+    1.75 Hz the slender block's RBM boundary is 1.3 g where the exact block's is 1.0 g
+    (unconservative)."""
     thick = model_error(*stored("spanos_koh_thick_housner_e")).shifts.set_index("frequency_hz")
     slender = model_error(*stored("spanos_koh_slender_housner_e")).shifts.set_index("frequency_hz")
     assert thick.loc[1.0, ["boundary_model_g", "boundary_reference_g"]].tolist() == [0.8, 1.25]
@@ -89,7 +90,7 @@ def test_the_issue_s_two_examples():
 
 
 def test_the_rbm_is_not_conservative_everywhere():
-    """The issue's finding: somewhere the RBM survives where the exact block collapses."""
+    """What the stored studies show: somewhere the RBM survives where the exact block collapses."""
     unconservative = sum(model_error(*stored(s)).count(UNCONSERVATIVE) for s in STUDIES)
     assert unconservative > 0
 

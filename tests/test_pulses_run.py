@@ -5,7 +5,7 @@ Expected values are independent of the code under test: below the uplift level a
 block does not move; a one-sine pulse is one period of the harmonic; a ground
 acceleration of the opposite sign mirrors the rotation; the pulse formulas equal
 physics/pulses.py's; the rigid RBM (the kernel evaluating each formula) equals
-housner-linear under the exact mapping of SPEC section 2, which integrates a Ricker or
+housner-linear under the exact mapping (alpha = B/H, true p), which integrates a Ricker or
 MP pulse sampled at 2000 points a period, so the sampling error is shown negligible;
 uplift times agree with a brute-force scan.
 """
@@ -143,8 +143,8 @@ def test_ground_displacement_of_the_sine_pulses():
     "kind, extra", [p for p in PULSES if p[0] in ("ricker", "mavroeidis-papageorgiou")]
 )
 def test_rigid_rbm_equals_housner_linear_under_sampled_pulse(kind, extra):
-    """The rigid n = 1 RBM is housner-linear with alpha = B/H and the RBM's p (SPEC
-    section 2). The kernel evaluates the pulse's formula; housner-linear integrates it
+    """The rigid n = 1 RBM is housner-linear with alpha = B/H and the RBM's p (from
+    the true inertia). The kernel evaluates the pulse's formula; housner-linear integrates it
     sampled at 2000 points a period: the same outcomes on a grid, collapse times within
     1e-4 s and peaks within 1e-4 (the sampling error is negligible)."""
     cfg = _config(kind, extra, duration=10.0)

@@ -1,5 +1,5 @@
-"""The rigid RBM with n = 1 against housner-linear with the SPEC section 2 mapping
-(issue 4).
+"""The rigid RBM with n = 1 against housner-linear with the mapping of the RBM's
+rigid monolith to the linear block: alpha = B/H, p from the true inertia.
 
 The two are the same equation (alpha = B/H, p^2 = m g (H/2) / (I_G + m H^2/4)); the
 RBM integrates it numerically, housner-linear solves it in closed form (cosh/sinh

@@ -1,4 +1,4 @@
-"""Reference single-block models (SPEC section 2): `housner` and `housner-linear`.
+"""Reference single-block models : `housner` and `housner-linear`.
 
 Expected values come from reasons independent of the code under test: closed
 forms derived here (the exact half-sine threshold, the free rocking period,
@@ -83,10 +83,10 @@ def test_uniform_cylinder_inertia():
 
 
 def test_paper_column_slenderness():
-    """SPEC: the paper's tapered square column (H 5, B 0.96 -> 0.66) has alpha 'about 0.219'.
+    """The paper's tapered square column (H 5, B 0.96 -> 0.66) has alpha 'about 0.219'.
 
     Its true centre of mass (frustum centroid H (B1^2 + 2 B1 Bt + 3 Bt^2) /
-    (4 (B1^2 + B1 Bt + Bt^2))) gives b / z_c = 0.2187, the SPEC's 0.219 (a
+    (4 (B1^2 + B1 Bt + Bt^2))) gives b / z_c = 0.2187, the paper's 0.219 (a
     ratio, like its theta_u = B/H = 0.192), and alpha = atan(b / z_c) = 0.2153.
     """
     H, b1, bt = 5.0, 0.96, 0.66
@@ -151,7 +151,8 @@ def test_geometry_is_monolithic_only():
 
 # --------------------------------------------------------------------------- housner-linear
 def exact_halfsine_threshold(omega_over_p):
-    """A / alpha of SPEC section 2: (w/p) sin(psi) - cos(psi) = exp(-(pi - psi) p / w)."""
+    """The exact linear half-sine threshold A / alpha:
+    (w/p) sin(psi) - cos(psi) = exp(-(pi - psi) p / w)."""
     r = omega_over_p
 
     def condition(psi):
@@ -414,7 +415,7 @@ def test_linear_samples_grid():
     ],
 )
 def test_rigid_rbm_is_housner_linear(kind, amplitude_g, frequency_hz):
-    """SPEC section 2: the rigid monolithic RBM is housner-linear with alpha = B/H and
+    """The rigid monolithic RBM is housner-linear with alpha = B/H and
     p^2 = m g (H/2) / (I_G + m H^2/4); the collapse times agree to the solver's tolerance.
 
     Survived runs are not compared peak by peak: near-chatter runs amplify

@@ -50,10 +50,10 @@ STUDIES = {
     "housner_halfsine_housner": CONFIGS / "housner_halfsine_housner.yaml",
     "spanos_koh_slender_housner_e": CONFIGS / "spanos_koh_slender_housner_e.yaml",
     "spanos_koh_slender_housner_e_housner": CONFIGS / "spanos_koh_slender_housner_e_housner.yaml",
-    # grids over config keys (issue 16): the size effect, the drum count
+    # grids over config keys: the size effect, the drum count
     "size_effect": CONFIGS / "size_effect.yaml",
     "drum_count": CONFIGS / "drum_count.yaml",
-    # record suites (issue 17): the monolith whole, the 8-drum column by its CI band
+    # record suites: the monolith whole, the 8-drum column by its CI band
     "suite_monolithic": CONFIGS / "suite_monolithic.yaml",
     "suite_multidrum_ci": CONFIGS / "ci" / "suite_multidrum_ci.yaml",
 }

@@ -1,4 +1,4 @@
-"""The same answer on any machine (issue 13).
+"""The same answer on any machine.
 
 1. Other machines, proved from this one: the 8-drum CI sub-grid is re-made in
    subprocesses that change what differs between x86-64 machines: numba's

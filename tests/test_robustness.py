@@ -1,7 +1,7 @@
-"""Issue 14: a sweep that never loses work, never hangs, never gives a wrong answer quietly.
+"""A sweep that never loses work, never hangs, never gives a wrong answer quietly.
 
-One test (or a few) per numbered case of the issue, through the command line (click's
-CliRunner, or a subprocess where a hang or a signal is the point), each bounded by a
+A test (or a few) per way a sweep can be interrupted or fed bad input, through the command
+line (click's CliRunner, or a subprocess where a hang or a signal is the point), each bounded by a
 timeout. Each would fail if its defect came back: the checks are on what the defect did
 (files deleted, rows trusted, a loop that does not end, a traceback, an answer with no
 word). Files only under tmp_path.

@@ -1,5 +1,5 @@
-"""`rbm run`'s figures drawn by a child forked as the command starts (issue 18,
-rbm_cli.report.figure_process): the run's own process imports neither matplotlib nor
+"""`rbm run`'s figures drawn by a child forked as the command starts
+(rbm_cli.report.figure_process): the run's own process imports neither matplotlib nor
 pandas, the run folder is the same byte for byte as drawn here (history.csv written without
 pandas is pandas' file), a dead child is replaced by drawing here, and no child outlives
 its run (killed by kill -9, or Ctrl-C to the terminal's process group).

@@ -1,8 +1,8 @@
-"""Housner's size effect and the dimensionless collapse (issue 16), on the stored study.
+"""Housner's size effect and the dimensionless collapse, on the stored study.
 
 configs/size_effect.yaml sweeps geometrically similar rigid blocks (H/B = 4, heights 1-20 m)
 under half-sine pulses. The similarity law says a block feels a pulse only through
-A / (g tan alpha) and omega / p, and for the rigid RBM monolith (the linear model, SPEC 2) the
+A / (g tan alpha) and omega / p, and for the rigid RBM monolith (the linear model, alpha = B/H) the
 minimum overturning amplitude in those axes is a closed form
 (rbm_cli.physics.closed_forms.linear_halfsine_threshold, checked against an ODE bisection in
 tests/test_closed_forms.py). So in dimensionless axes every size must fall on that one curve.

@@ -1,4 +1,4 @@
-"""Property tests that try to break rbm (issue 6): hypothesis over the configuration space.
+"""Property tests that try to break rbm: hypothesis over the configuration space.
 
 Each invariant is its own test, derandomized (the conftest profile), with a bounded
 example count so that the file runs in a few minutes. The same invariants run with

@@ -116,7 +116,7 @@ def test_boundary_and_compare_on_synthetic_domains():
 
 
 def test_boundary_from_rows_without_pandas():
-    """boundary.csv from a sweep's rows in plain Python (issue 18): one line per point and
+    """boundary.csv from a sweep's rows in plain Python: one line per point and
     frequency, sorted, empty where nothing collapses or nothing survives below; a failed
     cell is neither; a record's (no frequency) is one line. boundary(df) is the same rule."""
 

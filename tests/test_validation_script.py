@@ -2,8 +2,8 @@
 numbers it writes agree with closed forms computed here (not with the script's own code).
 
 The closed forms used, for the slender block of the report (rectangle H = 4 m, B = 1 m):
-- the RBM mapping (SPEC section 2): alpha = B/H, p^2 = m g (H/2) / (I_G + m H^2/4) with
-  I_G = m (H^2 + B^2) / 12, i.e. p^2 = 6 g H / (4 H^2 + B^2);
+- the RBM mapping (rigid monolith as linear block): alpha = B/H,
+  p^2 = m g (H/2) / (I_G + m H^2/4) with I_G = m (H^2 + B^2) / 12, i.e. p^2 = 6 g H / (4 H^2 + B^2);
 - Housner's block: alpha = atan(B/H), p^2 = m g R / I_O = 3 g / (4 R), R = sqrt(H^2 + B^2)/2;
 - the free-rocking period of the linear equation T = (4/p) arccosh(1 / (1 - theta0/alpha));
 - Housner's half-sine threshold A/alpha = sqrt(1 + (w/p)^2).

@@ -4,8 +4,8 @@ numba keeps a compiled function (``@njit(cache=True)``) in an index file checked
 a stamp of the one source file the function is written in (its modification time and
 size). The compiled code of a function holds its callees and the values of the globals
 it reads, frozen at compile time; a change to a callee or a constant in another module
-goes unseen (numba's documentation says so; numba issues 1833, 6845). After a change to
-``step/rk.py`` the cached ``run_kernel`` of ``step/stepper.py`` still ran (issue 18).
+goes unseen (numba's documentation says so, and numba's issue tracker). After a change to
+``step/rk.py`` the cached ``run_kernel`` of ``step/stepper.py`` still ran the old code.
 
 Here every cached function of the package gets the stamp ``(numba's stamp, "rbm sources
 sha256:<digest>")``, where the digest covers the contents of

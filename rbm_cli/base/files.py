@@ -25,7 +25,7 @@ from rbm_cli.base.errors import RbmError
 if TYPE_CHECKING:
     import pandas as pd
 
-#: Significant digits of every float written to CSV (SPEC section 5).
+#: Significant digits of every float written to CSV.
 FLOAT_FORMAT = "%.12g"
 
 

@@ -186,7 +186,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         raise UserError(one_line(exc)) from None
     if cmp.n_common == 0:
         raise UserError("the two domains have no cell in common")
-    if cmp.only_a or cmp.only_b:  # an incomplete domain is not "OK" (issue 14)
+    if cmp.only_a or cmp.only_b:  # an incomplete domain is not "OK"
         first = cmp.first_missing
         raise UserError(
             f"the domains do not cover the same cells: {cmp.only_a} only in {a_csv}, "

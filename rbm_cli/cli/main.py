@@ -27,7 +27,7 @@ __all__ = ["cli", "main"]
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point (``rbm``): the process ends with it, so what it holds is
     frozen out of the garbage collector first, and the exit does not traverse it (a
-    sweep's ~200,000 objects: ~0.2-0.4 s of its wall time, issue 18). The collector is
+    sweep's ~200,000 objects: ~0.2-0.4 s of its wall time). The collector is
     off while the command imports and loads (collections of the young objects of module
     imports, which all live to the end: ~10 % of the start-up's CPU) and on again, with
     what was loaded frozen, once its work starts (rbm_cli.cli.common.work_starts)."""

@@ -1,9 +1,9 @@
 """Progress of a sweep, on stderr: a bar on a terminal, plain lines otherwise.
 
-The rate and the ETA count only the cells run in this session, from the moment the
+The rate and the ETA count only the cells run by this invocation, from the moment the
 first one could start (after the compile and the resumed cells): click's bar counted
-resumed cells as work done in no time and included the compile, so its ETA was 10x off
-(issue 14). Without a terminal (a log file, nohup, CI) a line is printed at most every
+resumed cells as work done in no time and included the compile, so its ETA was 10x off.
+Without a terminal (a log file, nohup, CI) a line is printed at most every
 LINE_INTERVAL_S seconds, and at the end.
 """
 
@@ -49,7 +49,7 @@ class Progress:
         self.total = 0
 
     def rate(self, now: float) -> float:
-        """Cells a second run in this session (NaN before the first finished)."""
+        """Cells a second run by this invocation (NaN before the first finished)."""
         run = self.done - self.done0
         elapsed = now - self.start if self.start is not None else 0.0
         return run / elapsed if run > 0 and elapsed > 0 else math.nan

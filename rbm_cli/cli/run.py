@@ -123,7 +123,7 @@ def run(
     from rbm_cli.api.sweeps import RUN_IMPORTS, FigureProcess
 
     # before numba and matplotlib are imported: the child imports the figures' while this
-    # process loads the integrator and runs (issue 18)
+    # process loads the integrator and runs (a shorter wall time)
     with FigureProcess.start(RUN_IMPORTS) or contextlib.nullcontext() as painter:
         result, folder = _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter)
     _print_summary(result, folder)

@@ -73,7 +73,7 @@ def sweep(
 ) -> None:
     """Run the config's amplitude x frequency grid and write the safe-unsafe domain.
 
-    Writes OUTPUT/<name>/domain.csv (one row per cell, SPEC section 5),
+    Writes OUTPUT/<name>/domain.csv (one row per cell, the columns of CSV_FIELDS),
     boundary.csv (lowest unsafe amplitude per frequency), meta.json (resolved
     config, versions, wall time, workers) and domain.png, all published in one
     step at the end. One sweep at a time writes a folder (a second one is
@@ -97,7 +97,7 @@ def sweep(
     from rbm_cli.api.sweeps import FigureProcess
 
     # before numba and matplotlib are imported: the child imports the figure's while
-    # this process runs the cells (issue 18)
+    # this process runs the cells (a shorter wall time)
     with FigureProcess.start() or contextlib.nullcontext() as painter:
         _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensemble, quiet,
                painter)  # fmt: skip
@@ -150,7 +150,7 @@ def _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensembl
 
 
 def _where(summary, jobs: int) -> str:
-    """Where the cells ran: a sweep starts a pool only when it pays (issue 18)."""
+    """Where the cells ran: a sweep starts a pool only when it pays."""
     if summary.workers == 0:
         return "in this process"
     n = jobs if summary.workers is None else summary.workers

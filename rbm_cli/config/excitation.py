@@ -1,4 +1,4 @@
-"""The ``excitation`` section of a config (SPEC section 3) and its record files.
+"""The ``excitation`` section of a config and its record files.
 
 Keys, by excitation type (a key of another type is refused, naming it):
 
@@ -86,7 +86,7 @@ EXCITATION_KEYS = (
     "vertical",
 )
 INITIAL_KEYS = ("rotations", "velocities")
-#: Default ``excitation.duration`` per type [s] (SPEC section 3).
+#: Default ``excitation.duration`` per type [s].
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
 DEFAULT_DURATION.update({kind: 20.0 for kind in PULSES})  # as the half-sine [assumption]
 #: Mavroeidis-Papageorgiou's gamma [-] (> 1; their fits 1.5-3; a long train above 20 is

@@ -3,8 +3,8 @@
 The stiffness is written with its unit explicit: ``rigid``, ``{rotational: K_M}``
 (a joint bending stiffness [N m/rad], one value or one per interface) or
 ``{normal: k_n}`` (a joint normal stiffness [Pa/m], from which K_M,i follows). A bare
-number or list is refused: 5e9 read as K_M is a column 20x stiffer than 5e9 read as k_n
-(issue 14), and the file cannot say which the user meant.
+number or list is refused: 5e9 read as K_M is a column 20x stiffer than 5e9 read as k_n,
+and the file cannot say which the user meant.
 """
 
 from __future__ import annotations

@@ -4,8 +4,8 @@ Every user error raises :class:`rbm_cli.base.errors.ConfigError` with one line t
 the YAML key path and the allowed range or values, e.g.
 ``cfg.yaml: column.height must be a number > 0 [m], got -1``.
 
-The schema is SPEC section 4, plus ``excitation.initial`` (SPEC section 3) and a
-``solver`` section (our extension: integrator settings). Lengths are in m,
+The schema is the README's Configuration section: the column, interface, excitation (with
+``excitation.initial``), grid and ``solver`` (integrator settings) sections. Lengths are in m,
 stiffnesses in N m/rad (K_M) or Pa/m (k_n), times in s, angles in rad; the grid
 keeps amplitudes in g and frequencies in Hz, the edge units.
 """
@@ -79,7 +79,7 @@ SOLVER_KEYS = (
     "max_wall_time",
 )
 
-#: Models of SPEC section 2 that this version does not implement yet.
+#: Models of the config's ``model`` key that this version does not implement yet.
 PLANNED_MODELS: tuple[str, ...] = ()
 #: Models that accept any number of drums (the reference blocks are monolithic).
 MULTI_DRUM_MODELS = tuple(name for name, entry in MODELS.items() if entry.multi_drum)
@@ -93,7 +93,7 @@ HEIGHT_RANGE = (1e-3, 1e3)
 #: Widths, depth and drum heights [m] and density [kg/m^3] the tool accepts [assumption]:
 #: wide enough for any stone column or laboratory model, narrow enough that masses,
 #: inertias and moments stay far inside floating point (density 1e307 overflowed them
-#: and reported a collapsing column as survived: issue 14).
+#: and reported a collapsing column as survived).
 LENGTH_RANGE = (1e-4, 1e3)
 DENSITY_RANGE = (1.0, 1e5)
 #: Largest step and event budgets (a 64-bit count; 1e300 failed in the compiled kernel).
@@ -231,7 +231,7 @@ def parse_config(
 
     Parameters
     ----------
-    data : mapping  Parsed YAML or a dict (keys of SPEC section 4; numpy numbers allowed)
+    data : mapping  Parsed YAML or a dict (the README's config keys; numpy numbers allowed)
     source : str  Where ``data`` came from, prefixed to error messages
     base_dir : path or None  Folder that relative paths in the config (a record's
         ``excitation.file``) are taken from; None: the current directory.

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-#: Acceleration of gravity [m/s^2] (SPEC: g = 9.81).
+#: Acceleration of gravity [m/s^2] (g = 9.81, the value the paper and the reference blocks use).
 G = 9.81
 
 SECTIONS = ("rectangular", "circular")

@@ -181,7 +181,7 @@ def first_crossing(dist, t0, t1, intervals=CHECK_INTERVALS, xtol=1e-14):
     own crossing is found by Brent's method and the earliest wins. Root finding on
     the minimum over rows instead can return a later root when one row dips below
     zero and back while another ends below zero: the first crossing is then lost
-    (issue 6, test_energy_jump_reproducer). The end-of-step cubic alone also misses
+    (test_energy_jump_reproducer). The end-of-step cubic alone also misses
     dips of long steps, where the higher derivatives matter.
     """
     ts = np.linspace(t0, t1, intervals + 1)
@@ -206,7 +206,7 @@ def first_crossing(dist, t0, t1, intervals=CHECK_INTERVALS, xtol=1e-14):
         if dip is not None and row_value(a + dip[0], dip[1]) < 0.0:
             cands.append((a + dip[0], dip[1]))
         if cands:
-            from scipy.optimize import brentq  # here: no scipy at import (issue 18)
+            from scipy.optimize import brentq  # here: no scipy at import (a shorter start-up)
 
             roots = [(brentq(row_value, a, hi, args=(r,), xtol=xtol), r) for hi, r in cands]
             return min(roots)

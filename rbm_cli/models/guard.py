@@ -1,4 +1,4 @@
-"""Guards of the compiled kernel: a wall-clock budget and Ctrl-C (issue 14, case 7).
+"""Guards of the compiled kernel: a wall-clock budget and Ctrl-C.
 
 A numba kernel does not return to Python until it ends, so neither a deadline nor a
 KeyboardInterrupt can reach it from outside. The kernel calls :func:`poll` every

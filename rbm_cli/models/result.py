@@ -8,7 +8,7 @@ import numpy as np
 
 STATUSES = ("collapsed", "survived", "failed")
 
-#: Columns of domain.csv, in order (SPEC section 5).
+#: Columns of domain.csv, in order.
 CSV_FIELDS = (
     "amplitude_g",
     "frequency_hz",

@@ -1,4 +1,4 @@
-"""The true rigid-body geometry of a monolithic column (SPEC section 2): mass, true centre of
+"""The true rigid-body geometry of a monolithic column (for `housner`): mass, true centre of
 mass, corner inertia, slenderness alpha and frequency parameter p of the block that the
 reference models `housner` and `housner-linear` rock; its top displacement and energy."""
 
@@ -15,7 +15,7 @@ from rbm_cli.config.types import ColumnConfig, Config, G
 
 @dataclass(frozen=True)
 class BlockGeometry:
-    """True rigid-body geometry of a monolithic column (SPEC section 2).
+    """True rigid-body geometry of a monolithic column (Housner's block).
 
     height : float  H [m]
     half_base : float  b = B_1 / 2 [m]

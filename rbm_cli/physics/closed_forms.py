@@ -1,4 +1,4 @@
-"""Closed-form results of the piecewise-linear rocking block (SPEC section 2).
+"""Closed-form results of the piecewise-linear rocking block (Spanos and Koh's linear block).
 
 Pure functions for plots and tests: minimum overturning amplitudes of pulses,
 the free rocking period, and the mapping of a rigid monolithic RBM column to
@@ -93,7 +93,7 @@ def _halfsine_psi(ratio: float) -> float:
     hi = 0.5 * math.pi
     if f(hi) <= 0.0:  # k so small that sin(pi/2 - k) rounds the sign away
         return hi
-    from scipy.optimize import brentq  # here: no scipy at import (issue 18)
+    from scipy.optimize import brentq  # here: no scipy at import (a shorter start-up)
 
     return brentq(f, 0.0, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
 
@@ -252,7 +252,7 @@ def linear_rocking_parameters(column: Column) -> tuple[float, float]:
 
     References
     ----------
-    SPEC section 2; the paper, section 3.2.
+    Baraldi, Milani and Sarhosis, the Rigid Beam Model paper, section 3.2.
     """
     if column.n != 1:
         raise ValueError(

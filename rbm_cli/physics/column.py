@@ -136,7 +136,7 @@ def build_column(column: ColumnConfig, interface: InterfaceConfig) -> Column:
     exact volume of the tapered drum; the RBM puts each drum's weight at its
     mid-height (lever arms h_i / 2), and so do zbar_i and the inertias:
     rectangle I_G = m (h^2 + w^2) / 12, cylinder I_G = m (h^2 / 12 + d^2 / 16),
-    w or d the drum's mean width [assumption, SPEC section 1].
+    w or d the drum's mean width [assumption: the paper is silent].
 
     M_u,i = (B_i / 2) N_i (paper eq. 6); theta_u,i = (B_i / 2) / zbar_i with
     zbar_i = sum_{j>=i} P_j (z_j + h_j / 2 - z_i) / N_i [assumption: Housner's

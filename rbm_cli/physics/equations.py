@@ -142,7 +142,7 @@ class Model:
         if self.rigid:
             return []
         slopes = np.array([law.slopes[0] for law in self.laws])
-        from scipy.linalg import eig  # here: no scipy at import (issue 18)
+        from scipy.linalg import eig  # here: no scipy at import (a shorter start-up)
 
         w2 = np.real(eig(self.stiffness(slopes), self.mass, right=False))
         return sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
@@ -181,7 +181,7 @@ class Model:
         c = product(self.diff.T, intercepts)
         return -product(minv, stiff), -product(minv, c), -product(minv, self.ground_load)
 
-    # ---- vertical shaking: the weight and non-weight parts of the laws (SPEC "Vertical")
+    # ---- vertical shaking: the weight and non-weight parts of the laws
     @cached_property
     def slope_parts(self) -> tuple[np.ndarray, np.ndarray]:
         """(weight, elastic) parts of every piece's slope, (n, max pieces) each, padded with 0
@@ -282,7 +282,7 @@ def build_model(
     column : Column  Derived properties (rbm_cli.physics.column.build_column)
     xi : float  Smoothing parameter of the law, 0 < xi <= 1
     restitution : float  e in (0, 1]
-    formulation : str  'relative', 'absolute' or 'geometric' (SPEC section 1)
+    formulation : str  'relative', 'absolute' or 'geometric' (README, Assumptions)
     collapse_ratio : float  c in (0, 1]
     """
     n = column.n

@@ -1,4 +1,4 @@
-"""Ground motions of a config (SPEC section 3), SI inside: a_g [m/s^2], t [s], omega [rad/s].
+"""Ground motions of a config, SI inside: a_g [m/s^2], t [s], omega [rad/s].
 
 :func:`make_ground_motion` turns a config's excitation, an amplitude [g] and a frequency
 [Hz] (the grid's, at this edge only) into the :class:`~rbm_cli.physics.motion.GroundMotion`

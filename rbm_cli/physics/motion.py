@@ -1,4 +1,4 @@
-"""The ground motion every model integrates (SPEC section 3), SI inside: a_g [m/s^2], t [s].
+"""The ground motion every model integrates, SI inside: a_g [m/s^2], t [s].
 
 A :class:`GroundMotion` is a horizontal ground acceleration a_g(t) in one of the forms of
 :mod:`rbm_cli.physics.ground_forms` (a sine, a Ricker or Mavroeidis-Papageorgiou pulse, or

@@ -4,7 +4,7 @@ A :class:`Record` holds the horizontal ground acceleration a_g(t) [m/s^2] (SI in
 strictly increasing sample times t [s]. Its conventions, which the integrator relies on:
 
 - **Sign.** A positive value is a ground acceleration in the +x direction of the model, the
-  same a_g as the harmonic and half-sine excitations (SPEC section 1).
+  same a_g as the harmonic and half-sine excitations.
 - **Clock.** The simulation starts at t = 0. An ``.AT2`` record's k-th value (k = 0, 1, ...)
   is at t = k DT, so its first sample is at t = 0. A CSV record keeps the times of its file
   (no shift); a first time > 0 means the ground is at rest before it: :meth:`Record.at`

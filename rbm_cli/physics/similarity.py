@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 from rbm_cli.config.types import Config, InterfaceConfig, StiffnessConfig
 
-#: The columns a domain gets from :func:`cell_scales` (domain.csv, SPEC section 5).
+#: The columns a domain gets from :func:`cell_scales` (domain.csv).
 SCALE_FIELDS = ("alpha_rad", "p_rad_s", "static_multiplier", "a_over_g_alpha", "omega_over_p")
 
 

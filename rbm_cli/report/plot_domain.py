@@ -383,7 +383,7 @@ def plot_domain(
     gaps where nothing collapses). In an ensemble domain it is the majority's (a cell
     collapsed where collapse_fraction >= 0.5), labelled so, and member 0's boundary is
     drawn beside it, dotted in the same colour, labelled "member 0's boundary". The
-    closed forms use the mapping of SPEC section 2
+    closed forms use the mapping of the RBM's rigid monolith to the linear block
     (:func:`rbm_cli.physics.closed_forms.linear_rocking_parameters`): the rigid RBM
     monolith is the piecewise-linear block with alpha = B_1/H.
     The amplitude axis starts at 0 and stops just above the largest amplitude

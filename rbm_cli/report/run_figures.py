@@ -1,7 +1,7 @@
 """history.png and shapes.png of one run (`rbm run`): the figures of the run folder.
 
 Drawn by :func:`run_pngs`, which returns the PNG files' bytes: `rbm run` has it run in the
-figure's child forked as the command starts (rbm_cli.report.figure_process, issue 18), so
+figure's child forked as the command starts (rbm_cli.report.figure_process), so
 the run's own process imports no matplotlib and the child writes no file; the run folder
 (rbm_cli.report.run_folder.write_run) writes the bytes it gets back. matplotlib is imported
 where a figure is built, not with this module.

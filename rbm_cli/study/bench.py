@@ -5,7 +5,7 @@ and tolerance rbm offers is run over the whole grid, timed on `jobs`
 workers, and compared with a reference:
 
 - rigid monolithic columns: the closed-form `housner-linear` solution with
-  the RBM's inertia (SPEC section 2 mapping), exact to round-off;
+  the RBM's inertia (alpha = B/H, p from the true inertia), exact to round-off;
   A peak counts only where it is well-conditioned: a 1e-9 relative change of
   the amplitude moves the closed-form peak by at most 1e-6 relative;
 - otherwise: converged compiled DOP853 runs at rtol 1e-10, 1e-11 and 1e-12.
@@ -104,7 +104,7 @@ QUICK_SAMPLE = 4
 REFERENCE_RTOLS = (1e-10, 1e-11, 1e-12)
 #: Relative agreement of the peak at rtol 1e-11 and 1e-12 for a converged peak.
 PEAK_CONVERGED = 1e-6
-#: Accuracy target of the peak rotation (issue 5), runs that survive.
+#: Accuracy target of the peak rotation, runs that survive.
 PEAK_TARGET = 1e-4
 REFERENCE_DIR = ROOT / "results" / "bench"
 

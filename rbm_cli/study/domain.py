@@ -1,10 +1,10 @@
 """Safe-unsafe domains as tables: rows, CSV text, boundary, comparison.
 
-A domain is a pandas DataFrame with the columns of SPEC section 5
+A domain is a pandas DataFrame with the columns of domain.csv
 (:data:`rbm_cli.models.result.CSV_FIELDS`), one row per (amplitude, frequency) cell, or
 the list of its rows (dicts) a sweep makes. pandas is imported where a DataFrame is built
 or read, not with this module: a sweep writes domain.csv and boundary.csv from its rows
-(:func:`csv_text`, :func:`boundary_table`) without it (issue 18).
+(:func:`csv_text`, :func:`boundary_table`) without it.
 
 The boundary (boundary.csv) is rbm_cli.study.boundary_lines': its table, the order of its
 lines and, for an ensemble, the majority's rule. This module names them too.
@@ -194,7 +194,7 @@ def _check_fraction(df: pd.DataFrame, path: Path, got) -> None:
 def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
     """collapsed is 0 or 1 on every row and says what status says (collapsed <=> 1):
     compare counts cells from collapsed and draws boundaries from status, so a row where
-    they disagree would make the two disagree quietly (issue 14). Converts it to int."""
+    they disagree would make the two disagree quietly. Converts it to int."""
     import pandas as pd
 
     raw = df["collapsed"]

@@ -2,7 +2,7 @@
 
 A row is a finished cell of one config: the config's hash, a cell of the grid, a status
 of STATUSES with collapsed agreeing, and every other domain.csv field of its type and
-range. A hand-made or damaged row fails here and its cell is run again (issue 14).
+range. A hand-made or damaged row fails here and its cell is run again.
 """
 
 from __future__ import annotations

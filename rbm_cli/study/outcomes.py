@@ -117,7 +117,7 @@ def read_suite_domain_hashed(path: str | Path) -> tuple[pd.DataFrame, str]:
 
     Parameters
     ----------
-    path : str or pathlib.Path  The domain CSV (one row per run; SPEC section 5 columns
+    path : str or pathlib.Path  The domain CSV (one row per run; domain.csv's columns
         plus ``record``, the name of the record of each row)
 
     Returns

@@ -4,7 +4,7 @@ Backends: ``loky`` (worker processes, the default), ``threading``, ``sequential`
 ``dask`` (a Dask distributed cluster).
 
 A pool costs a fixed time before it saves any (its workers start, import and load the
-kernel; POOL_COST_S), so ``loky`` starts one only when it pays (issue 18): the chunks
+kernel; POOL_COST_S), so ``loky`` starts one only when it pays: the chunks
 run in this process, one at a time, and once PROBE_S of them has been timed, the time
 those left would take here is estimated from the time per cell so far; as soon as a
 pool of J workers (J = --jobs, at most one per processor) would save more than it costs,
@@ -14,7 +14,7 @@ first chunk is cut small: rbm_cli.study.sweep); the rows do not depend on where 
 ran. A pool is stopped once its chunks are done (its
 workers are killed, not waited for: nothing of theirs is left to read).
 
-Interruption is part of the contract (issue 14):
+Interruption is part of the contract:
 
 - loky workers ignore SIGINT (a Ctrl-C in the terminal reaches the whole process group:
   only the sweep itself handles it; they start with it blocked) and watch their parent:
@@ -190,7 +190,7 @@ def _loky(fn: Callable, args: Iterable[tuple], jobs: int, placed: dict | None = 
 
 class _Starter:
     """The first submits, in which loky starts the workers, in a thread of their own
-    created with SIGINT blocked (issue 18). The workers inherit that thread's mask (exec
+    created with SIGINT blocked. The workers inherit that thread's mask (exec
     keeps it), so a Ctrl-C to the group while they import stays pending in them until
     _worker_init ignores it (before, it printed a worker's traceback). The sweep's own
     thread keeps its SIGINT handler and its mask (blocked only while the starter is

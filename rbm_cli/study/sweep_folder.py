@@ -237,7 +237,7 @@ def status_counts(rows: list[dict]) -> dict[str, int]:
 def draw_figure(figure, rows: list[dict], fields: tuple[str, ...], config: Config):
     """domain.png's figure (an object with savefig): ``figure.from_rows(rows, fields,
     config)`` where the figure takes the rows (the CLI's figure process, which builds the
-    DataFrame in its own process: the sweep's process does not import pandas, issue 18),
+    DataFrame in its own process: the sweep's process does not import pandas),
     else ``figure(DataFrame, config)`` with the DataFrame built here, now."""
     from_rows = getattr(figure, "from_rows", None)
     if from_rows is not None:
@@ -274,7 +274,7 @@ def _version(name: str) -> str:
     """A library's version without importing it here: its ``__version__`` if it is
     imported, else its installed distribution's (the same string; a sweep that ran in
     this process never imports joblib nor pandas, and its figure may be drawn in another
-    process, rbm_cli.report.figure_process, issue 18)."""
+    process, rbm_cli.report.figure_process)."""
     module = sys.modules.get(name)
     if module is not None:
         return module.__version__

@@ -1,4 +1,4 @@
-"""`housner-linear` (SPEC section 2): the config's monolithic column as Spanos and Koh's
+"""`housner-linear` (the linear reference block): the config's monolithic column as Spanos and Koh's
 piecewise-linear rocking block of the true geometry, run in closed form
 (rbm_cli.models.block.closed_form).
 

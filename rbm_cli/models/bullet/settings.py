@@ -18,7 +18,7 @@ MAX_FRICTION = 10.0
 
 @dataclass(frozen=True)
 class EngineSettings:
-    """Bullet settings of a run (SPEC: the issue's scoping values).
+    """Bullet settings of a run (the scoping values of the contact engine's study, docs/engine.md).
 
     time_step : float  Fixed engine step [s]
     solver_iterations : int  Sequential-impulse iterations per step

@@ -1,4 +1,4 @@
-"""Housner's rigid rocking block (`housner`, SPEC section 2): true geometry, large rotations.
+"""Housner's rigid rocking block (`housner`): true geometry, large rotations.
 
 A monolithic column as one rigid block rocking on the corners of its base:
 

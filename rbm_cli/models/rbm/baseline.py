@@ -24,7 +24,7 @@ from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.ground_forms import SINE
 
-#: Tolerances of the baseline (the issue's: RK45, rtol 1e-6); atol in units of
+#: Tolerances of the baseline (a naive per-cell scipy solve: RK45, rtol 1e-6); atol in units of
 #: theta_u for rotations and 10 theta_u for rates, as rbm's own solver.
 BASELINE_RTOL = 1e-6
 BASELINE_ATOL = 1e-9

@@ -14,7 +14,6 @@ a named tuple costs more to pass, see run_kernel):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -22,11 +21,12 @@ import numpy as np
 
 from rbm_cli.base.detmath import matmul, matvec
 from rbm_cli.base.jit import jit
-from rbm_cli.models.events import REST_RATE
 from rbm_cli.models.methods import step_method
+from rbm_cli.models.rbm.pieces import rest_levels
 from rbm_cli.models.rbm.step.rk import METHOD_CODES
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.law import law_arrays
 
 #: excitation kind -> code in the kernel
 KIND_CODES = {
@@ -135,23 +135,6 @@ class PreparedModel:
 
 
 # ---------------------------------------------------------------- preparation
-def _pad_laws(model: Model):
-    n = model.n
-    ne = max(len(law.edges) for law in model.laws)
-    edges = np.full((n, max(ne, 1)), np.inf)
-    inter = np.zeros((n, ne + 1))
-    slopes = np.zeros((n, ne + 1))
-    nedges = np.zeros(n, dtype=np.int64)
-    for i, law in enumerate(model.laws):
-        m = len(law.edges)
-        edges[i, :m] = law.edges
-        inter[i, : m + 1] = law.intercepts
-        slopes[i, : m + 1] = law.slopes
-        nedges[i] = m
-    rigid = np.array([law.rigid for law in model.laws], dtype=np.bool_)
-    return edges, nedges, inter, slopes, rigid
-
-
 @jit
 def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
     """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es)."""
@@ -177,19 +160,6 @@ def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
     return event_rows, same, md, mg, track, es
 
 
-def _early_stop_levels(model: Model) -> tuple[float, float, float]:
-    """(uplift level [rad/s^2 of ground demand], rest rate [rad/s], energy barrier [J]) of the
-    model: the levels the early stop and the rest of a rigid block compare with."""
-    tu = float(model.column.rotation_capacity.min())
-    uplift = model.uplift_level
-    barrier = math.nan
-    if model.n == 1:
-        theta_c = model.collapse_ratio * model.column.rotation_capacity
-        barrier = float(model.energy(theta_c, np.zeros(1))[0])
-    rest_rate = REST_RATE * model.rocking_p * tu
-    return -1.0 if uplift is None else uplift, rest_rate, barrier
-
-
 def model_arrays(model: Model) -> ModelArrays:
     """The model's arrays as the kernel reads them (assembled once per column)."""
     col = model.column
@@ -198,12 +168,13 @@ def model_arrays(model: Model) -> ModelArrays:
     cmap = model.collapse_map / model.collapse_limit[:, None]
     top = col.heights.astype(float)
     impulse_dir, impulse_w = model.impulse_directions
-    edges, nedges, inter, slopes, rigid = _pad_laws(model)
+    edges, nedges, inter, slopes, rigid = law_arrays(model.laws)
     event_rows, same, md, mg, track, es = _derived(argmap, tu, cmap, top, model.mass_inv,
                                           model.diff.astype(float), model.gravity,
                                           model.ground_load)  # fmt: skip
     n = model.n
-    uplift, rest_rate, barrier = _early_stop_levels(model)
+    uplift, rest_rate, barrier = rest_levels(model)
+    uplift = -1.0 if uplift is None else uplift
     return ModelArrays(
         mass=model.mass, argmap=argmap, arg_inv=model.arg_inverse,
         gravity=model.gravity, edges=edges, nedges=nedges, intercepts=inter, slopes=slopes,

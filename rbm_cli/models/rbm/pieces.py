@@ -1,9 +1,9 @@
 """The law pieces of a column's interfaces, as the compiled integrators (step and exact) keep
 them: which piece of its moment-rotation law each interface is on, the piece's bounds and
 event rows, locating the pieces of a state and crossing to the next piece (uplift, kink,
-impact), the silent impacts, and what both integrators compute from the pieces (a law's
-potential, the friction demand) or from the model once (the levels of the early stop and of
-a rigid block's rest).
+impact), the silent impacts, and what both integrators compute from the pieces (an impact's
+loss of rate, a law's potential, the friction demand) or from the model once (the levels of
+the early stop and of a rigid block's rest).
 
 A law is odd and piecewise linear (rbm_cli.physics.law): on x >= 0 its piece k is
 f = a_k + b_k x on [x_k, x_{k+1}), the edges x_1 < x_2 < ... padded with inf
@@ -144,6 +144,17 @@ def settle(awaiting, argmap, y, side):
     return hits
 
 
+@jit(inline=True)
+def restitute(i, xdot, e_rest, impulse_dir, impulse_w, rate):
+    """An impact at interface i with restitution e_rest [-] < 1: the rates rate [rad/s] (n,)
+    take the impulse (e_rest - 1) xdot / w_i along direction i (Model.impulse_directions:
+    impulse_dir (n, n), impulse_w (n,)), xdot [rad/s] the argument's rate at the impact;
+    in place."""
+    lam = (e_rest - 1.0) * xdot / impulse_w[i]
+    for j in range(rate.size):
+        rate[j] += impulse_dir[j, i] * lam
+
+
 @jit
 def law_potential(i, x, edges, nedges, intercepts, slopes):
     """F_i(x) [J]: interface i's law integrated from 0 to x [rad] (Law.potential)."""
@@ -207,6 +218,7 @@ __all__ = [
     "n_below",
     "piece_bounds",
     "rest_levels",
+    "restitute",
     "settle",
     "silent_impact",
     "zero_active",

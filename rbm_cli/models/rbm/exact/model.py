@@ -10,7 +10,7 @@ import numpy as np
 
 from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.pieces import law_potential, rest_levels
-from rbm_cli.physics.equations import Model
+from rbm_cli.physics.equations import Model, event_families
 from rbm_cli.physics.law import law_arrays
 
 ExactModel = namedtuple(
@@ -28,8 +28,8 @@ def exact_model(model: Model) -> ExactModel:
     tu = col.rotation_capacity
     edges, nedges, intercepts, slopes, rigid = law_arrays(model.laws)
     chol = np.linalg.cholesky(model.mass)
-    cmap = model.collapse_map / model.collapse_limit[:, None]
-    gf = np.vstack([model.arg_map / tu[:, None], cmap, col.heights[None, :]])
+    args, cmap, top = event_families(model)
+    gf = np.vstack([args, cmap, top[None, :]])
     directions, w = model.impulse_directions
     level, rest_rate, barrier = rest_levels(model)
     return ExactModel(

@@ -30,6 +30,7 @@ from rbm_cli.models.rbm.pieces import (
     friction_demand,
     locate,
     piece_bounds,
+    restitute,
     silent_impact,
 )
 from rbm_cli.models.status import (
@@ -190,7 +191,7 @@ def _handle(mdl, pc, row, s, se):
         s.cnt[IMPACTS] += 1
         if mdl.restitution < 1.0:
             xdot = mdl.argmap[i] @ s.rate
-            s.rate[:] += mdl.imp_dir[:, i] * ((mdl.restitution - 1.0) * xdot / mdl.imp_w[i])
+            restitute(i, xdot, mdl.restitution, mdl.imp_dir, mdl.imp_w, s.rate)
         if mdl.rigid_mono and abs(s.rate[0]) < mdl.rest_rate:
             s.theta[:] = 0.0
             s.rate[:] = 0.0

@@ -24,7 +24,7 @@ from rbm_cli.base.jit import jit
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.rbm.pieces import rest_levels
 from rbm_cli.models.rbm.step.rk import METHOD_CODES
-from rbm_cli.physics.equations import Model
+from rbm_cli.physics.equations import Model, event_families
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.law import law_arrays
 
@@ -136,14 +136,15 @@ class PreparedModel:
 
 # ---------------------------------------------------------------- preparation
 @jit
-def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
-    """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es)."""
-    n = argmap.shape[0]
+def _derived(args, cmap, top, minv, diff, gravity, ground_load):
+    """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es),
+    from the event families (physics.equations.event_families: args, cmap, top)."""
+    n = args.shape[0]
     event_rows = np.empty((4 * n, n))
     for i in range(n):
         for j in range(n):
-            event_rows[i, j] = argmap[i, j] / tu[i]
-            event_rows[n + i, j] = -argmap[i, j] / tu[i]
+            event_rows[i, j] = args[i, j]
+            event_rows[n + i, j] = -args[i, j]
             event_rows[2 * n + i, j] = -cmap[i, j]
             event_rows[3 * n + i, j] = cmap[i, j]
     gx, gc = event_rows[:n], event_rows[3 * n :]
@@ -165,11 +166,10 @@ def model_arrays(model: Model) -> ModelArrays:
     col = model.column
     tu = col.rotation_capacity.astype(float)
     argmap = model.arg_map.astype(float)
-    cmap = model.collapse_map / model.collapse_limit[:, None]
-    top = col.heights.astype(float)
     impulse_dir, impulse_w = model.impulse_directions
     edges, nedges, inter, slopes, rigid = law_arrays(model.laws)
-    event_rows, same, md, mg, track, es = _derived(argmap, tu, cmap, top, model.mass_inv,
+    args, cmap, top = event_families(model)
+    event_rows, same, md, mg, track, es = _derived(args, cmap, top, model.mass_inv,
                                           model.diff.astype(float), model.gravity,
                                           model.ground_load)  # fmt: skip
     n = model.n

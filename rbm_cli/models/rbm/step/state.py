@@ -13,7 +13,7 @@ runs, measured).
 from __future__ import annotations
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.pieces import IMPACT, cross
+from rbm_cli.models.rbm.pieces import IMPACT, cross, restitute
 
 #: An impact after which a rigid monolith rests (switch returns it, or what pieces.cross
 #: returns: UPLIFT, KINK, IMPACT).
@@ -31,9 +31,7 @@ def _restitution(model, i, y, n):
         for j in range(n):
             y[n + j] += arg_inv[j, i] * (e_rest - 1.0) * xdot
     else:
-        lam = (e_rest - 1.0) * xdot / model.impulse_w[i]
-        for j in range(n):
-            y[n + j] += model.impulse_dir[j, i] * lam
+        restitute(i, xdot, e_rest, model.impulse_dir, model.impulse_w, y[n:])
 
 
 @jit(inline=True)

@@ -333,3 +333,21 @@ def build_model(
         formulation=formulation,
         xi=float(xi),
     )
+
+
+def event_families(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The quantities linear in theta [rad] that a run watches, one row each: where they
+    cross a bound is an event, their peaks are its maxima.
+
+    Returns
+    -------
+    arguments : (n, n)  Each interface's law argument over its rotation capacity theta_u
+        (arg_map / theta_u) [-/rad].
+    collapse : (n, n)  Each interface's collapse ratio (collapse_map / collapse_limit),
+        collapse at Model.collapse_ratio [-/rad].
+    top : (n,)  The top's horizontal displacement (the drums' heights) [m/rad].
+    """
+    column = model.column
+    arguments = model.arg_map / column.rotation_capacity[:, None]
+    collapse = model.collapse_map / model.collapse_limit[:, None]
+    return arguments, collapse, column.heights.astype(float)

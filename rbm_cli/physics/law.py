@@ -121,3 +121,33 @@ def make_law(
         rigid=rigid,
         elastic_limit=float(elastic_limit),
     )
+
+
+def law_arrays(laws) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The pieces of n laws as padded arrays (the form compiled code reads).
+
+    Parameters
+    ----------
+    laws : sequence of Law  One law per interface.
+
+    Returns
+    -------
+    edges : (n, max(m, 1))  Each law's edges [rad], padded with inf (m the most edges of a law).
+    nedges : (n,) int64  Number of edges of each law.
+    intercepts, slopes : (n, m + 1)  Each law's pieces [N m], [N m/rad], padded with 0.
+    rigid : (n,) bool  Rigid laws.
+    """
+    n = len(laws)
+    m = max(len(law.edges) for law in laws)
+    edges = np.full((n, max(m, 1)), np.inf)
+    intercepts = np.zeros((n, m + 1))
+    slopes = np.zeros((n, m + 1))
+    nedges = np.zeros(n, dtype=np.int64)
+    for i, law in enumerate(laws):
+        e = len(law.edges)
+        edges[i, :e] = law.edges
+        intercepts[i, : e + 1] = law.intercepts
+        slopes[i, : e + 1] = law.slopes
+        nedges[i] = e
+    rigid = np.array([law.rigid for law in laws], dtype=np.bool_)
+    return edges, nedges, intercepts, slopes, rigid

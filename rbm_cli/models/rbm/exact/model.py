@@ -1,6 +1,5 @@
 """The model as the exact integrator reads it: its arrays (made once per column), the
-empty cache of modes, and what the run loop computes from them (numba): the friction
-demand and the energy of a monolith."""
+empty cache of modes, and the energy of a monolith (numba)."""
 
 from __future__ import annotations
 
@@ -10,8 +9,9 @@ from collections import namedtuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.events import REST_RATE
-from rbm_cli.physics.equations import Model
+from rbm_cli.models.rbm.pieces import law_potential, rest_levels
+from rbm_cli.physics.equations import Model, event_families
+from rbm_cli.physics.law import law_arrays
 
 ExactModel = namedtuple(
     "ExactModel",
@@ -26,32 +26,20 @@ def exact_model(model: Model) -> ExactModel:
     n = model.n
     col = model.column
     tu = col.rotation_capacity
-    me = max(len(law.edges) for law in model.laws)
-    edges = np.full((n, max(me, 1)), np.inf)
-    intercepts = np.zeros((n, me + 1))
-    slopes = np.zeros((n, me + 1))
-    for i, law in enumerate(model.laws):
-        edges[i, : len(law.edges)] = law.edges
-        intercepts[i, : len(law.intercepts)] = law.intercepts
-        slopes[i, : len(law.slopes)] = law.slopes
+    edges, nedges, intercepts, slopes, rigid = law_arrays(model.laws)
     chol = np.linalg.cholesky(model.mass)
-    cmap = model.collapse_map / model.collapse_limit[:, None]
-    gf = np.vstack([model.arg_map / tu[:, None], cmap, col.heights[None, :]])
+    args, cmap, top = event_families(model)
+    gf = np.vstack([args, cmap, top[None, :]])
     directions, w = model.impulse_directions
-    barrier = math.nan
-    if n == 1:
-        barrier = float(model.energy(np.array([model.collapse_ratio * tu[0]]), np.zeros(1))[0])
-    level = model.uplift_level
+    level, rest_rate, barrier = rest_levels(model)
     return ExactModel(
         n, model.mass.copy(), chol, np.linalg.inv(chol), model.ground_load.copy(),
         np.ascontiguousarray(model.diff.T), model.arg_map.copy(), model.gravity.copy(), gf,
-        edges, np.array([len(law.edges) for law in model.laws], dtype=np.int64), intercepts,
-        slopes, np.array([law.rigid for law in model.laws]), model.silent_impacts.copy(),
-        tu.copy(), float(model.collapse_ratio), model.arg_inverse.copy(), directions.copy(),
+        edges, nedges, intercepts, slopes, rigid, model.silent_impacts.copy(), tu.copy(),
+        float(model.collapse_ratio), model.arg_inverse.copy(), directions.copy(),
         np.asarray(w, dtype=float), float(model.restitution), level is not None,
-        math.nan if level is None else float(level),
-        REST_RATE * model.rocking_p * float(tu.min()), barrier, model.centre_map.copy(),
-        col.masses.copy(), col.normal_forces.copy(),
+        math.nan if level is None else float(level), rest_rate, barrier,
+        model.centre_map.copy(), col.masses.copy(), col.normal_forces.copy(),
     )  # fmt: skip
 
 
@@ -69,38 +57,10 @@ def new_cache(n: int) -> tuple:
 
 
 @jit
-def friction(mdl, acc, ag, out):
-    """Raise out (n) to the friction demand |T_i / N_i| for drum accelerations acc
-    [rad/s^2] and ground acceleration ag [m/s^2] (the shear ratios of physics/equations)."""
-    n = acc.size
-    shear = 0.0
-    for i in range(n - 1, -1, -1):
-        a = ag
-        for j in range(n):
-            a += mdl.centre[i, j] * acc[j]
-        shear += a * mdl.masses[i]
-        out[i] = max(out[i], abs(shear) / mdl.normal_forces[i])
-
-
-@jit
-def _potential(mdl, i, x):
-    """Law potential F_i(x) [J] (Law.potential)."""
-    ax = abs(x)
-    cum, start = 0.0, 0.0
-    k = 0
-    while k < mdl.nedges[i] and mdl.edges[i, k] <= ax:
-        end = mdl.edges[i, k]
-        a, b = mdl.intercepts[i, k], mdl.slopes[i, k]
-        cum += a * (end - start) + 0.5 * b * (end * end - start * start)
-        start = end
-        k += 1
-    a, b = mdl.intercepts[i, k], mdl.slopes[i, k]
-    return cum + a * (ax - start) + 0.5 * b * (ax * ax - start * start)
-
-
-@jit
 def energy1(mdl, theta, rate):
-    """Energy [J] of a monolith (the energy of physics/equations, n = 1)."""
+    """Energy [J] of a monolith at rotation theta [rad] and rate rate [rad/s] (the energy of
+    physics/equations, n = 1)."""
     x = mdl.argmap[0, 0] * theta
-    return (0.5 * mdl.mass[0, 0] * rate * rate + _potential(mdl, 0, x)
+    potential = law_potential(0, x, mdl.edges, mdl.nedges, mdl.intercepts, mdl.slopes)
+    return (0.5 * mdl.mass[0, 0] * rate * rate + potential
             - 0.5 * mdl.gravity[0, 0] * theta * theta)  # fmt: skip

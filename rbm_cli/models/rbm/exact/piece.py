@@ -1,6 +1,6 @@
-"""One linear piece of the exact integrator (numba): the law pieces each interface is on
-(rbm_cli.models.events.Pieces), the modes of a set of pieces, a linear piece's rows, and
-its points.
+"""One linear piece of the exact integrator (numba): the modes of a set of law pieces (the
+pieces each interface is on: rbm_cli.models.rbm.pieces), a linear piece's rows, and its
+points.
 
 The modes solve the symmetric pencil K phi = lam M phi (through the Cholesky factor of M:
 M symmetric positive definite in the `relative` and `geometric` formulations, K symmetric,
@@ -25,8 +25,8 @@ from collections import namedtuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.events import BIG, EVENT_EPS
 from rbm_cli.models.rbm.exact.modal import HARMONIC, advance, f_accel
+from rbm_cli.models.rbm.pieces import bound_rows
 
 #: A linear piece: modes (lam, phi, tom = Phi^T M), modal loads f, g, the eligible modes
 #: and their frequencies w (exact.bounds), family rows gf = Gf Phi and |gf|, event rows
@@ -35,66 +35,6 @@ from rbm_cli.models.rbm.exact.modal import HARMONIC, advance, f_accel
 SCRATCH_SLOT = 2
 
 Piece = namedtuple("Piece", "lam phi tom f g elig w gf absgf sgn off fam silent fc n nf")
-
-
-# ------------------------------------------------------------------ law pieces
-@jit
-def zero_active(i, k, pending, rigid):
-    return rigid[i] or pending[i]
-
-
-@jit
-def piece_bounds(i, side, k, pending, rigid, edges, nedges):
-    """(lo, hi) [rad] of interface i's current piece (events.Pieces.bounds)."""
-    ki = k[i]
-    start = 0.0 if ki == 0 else edges[i, ki - 1]
-    end = edges[i, ki] if ki < nedges[i] else np.inf
-    if ki == 0 and not zero_active(i, k, pending, rigid):
-        start = -end
-    if side[i] > 0:
-        return start, end
-    return -end, -start
-
-
-@jit
-def locate(x, rate, side, k, pending, rigid, edges, nedges):
-    """Pieces at law arguments x [rad] and their rates (events.Pieces.locate)."""
-    for i in range(x.size):
-        if x[i] > 0.0:
-            side[i] = 1
-        elif x[i] < 0.0:
-            side[i] = -1
-        else:
-            side[i] = 1 if rate[i] >= 0.0 else -1
-        kk = 0
-        while kk < nedges[i] and edges[i, kk] <= abs(x[i]):
-            kk += 1
-        k[i] = kk
-        pending[i] = kk > 0 and not rigid[i]
-
-
-@jit
-def cross(i, going_up, side, k, pending, awaiting, rigid, silent):
-    """Move interface i to its next piece (events.Pieces.cross): 0 uplift, 1 kink, 2 impact."""
-    s, ki = side[i], k[i]
-    if ki == 0 and not zero_active(i, k, pending, rigid):
-        side[i] = 1 if going_up else -1
-        k[i] = 1
-        pending[i] = True
-        awaiting[i] = False
-        return 0
-    if going_up == (s > 0):
-        k[i] = ki + 1
-        return 1
-    if ki > 0:
-        k[i] = ki - 1
-        if ki == 1 and silent[i]:
-            pending[i] = False
-            awaiting[i] = True
-        return 1
-    side[i] = -s
-    pending[i] = False
-    return 2
 
 
 # ------------------------------------------------------------------ modes (cached)
@@ -161,14 +101,13 @@ def _rows(mdl, side, k, pending, awaiting):
     m = 4 * n + ns
     sgn, off, fam = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
     silent = np.empty(ns, dtype=np.int64)
-    c = mdl.c_ratio
+    bound_rows(side, k, pending, mdl.rigid, mdl.edges, mdl.nedges, mdl.tu, mdl.c_ratio,
+               np.empty(n), np.empty(n), off)  # fmt: skip
     for i in range(n):
-        lo, hi = piece_bounds(i, side, k, pending, mdl.rigid, mdl.edges, mdl.nedges)
-        tu = mdl.tu[i]
-        sgn[i], off[i], fam[i] = 1.0, min(-lo / tu, BIG) + EVENT_EPS, i
-        sgn[n + i], off[n + i], fam[n + i] = -1.0, min(hi / tu, BIG) + EVENT_EPS, i
-        sgn[2 * n + i], off[2 * n + i], fam[2 * n + i] = -1.0, c + EVENT_EPS, n + i
-        sgn[3 * n + i], off[3 * n + i], fam[3 * n + i] = 1.0, c + EVENT_EPS, n + i
+        sgn[i], fam[i] = 1.0, i
+        sgn[n + i], fam[n + i] = -1.0, i
+        sgn[2 * n + i], fam[2 * n + i] = -1.0, n + i
+        sgn[3 * n + i], fam[3 * n + i] = 1.0, n + i
     j = 0
     for i in range(n):
         if awaiting[i]:

@@ -19,18 +19,20 @@ import numpy as np
 from rbm_cli.base.jit import jit
 from rbm_cli.models.ground import sine_exceedance
 from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
-from rbm_cli.models.rbm.exact.model import energy1, friction
+from rbm_cli.models.rbm.exact.model import energy1
 from rbm_cli.models.rbm.exact.peaks import NOTES, new_notes, note_interval, settle_peaks
-from rbm_cli.models.rbm.exact.piece import (
-    cross,
-    eval_point,
-    locate,
-    make_piece,
-    piece_bounds,
-    row_at,
-    set_point,
-)
+from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, row_at, set_point
 from rbm_cli.models.rbm.exact.search import SCRATCH, next_point
+from rbm_cli.models.rbm.pieces import (
+    IMPACT,
+    UPLIFT,
+    cross,
+    friction_demand,
+    locate,
+    piece_bounds,
+    restitute,
+    silent_impact,
+)
 from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
@@ -90,7 +92,8 @@ def _accel_and_friction(mdl, pc, pts, i, fric):
     ag = f_accel(pc.fc, pts[i, 0])
     for j in range(n):
         from_modes[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
-    friction(mdl, pc.phi @ from_modes, ag, fric)
+    friction_demand(ag, 1.0, mdl.centre, pc.phi @ from_modes, mdl.masses, mdl.normal_forces,
+                    fric)  # fmt: skip
 
 
 @jit
@@ -164,9 +167,7 @@ def _handle(mdl, pc, row, s, se):
     """Apply the event of a row at the state. Returns a code."""
     n = s.theta.size
     if row >= 4 * n:
-        i = pc.silent[row - 4 * n]
-        s.side[i] = -s.side[i]
-        s.awaiting[i] = False
+        silent_impact(pc.silent[row - 4 * n], s.side, s.awaiting)
         s.cnt[IMPACTS] += 1
         return GOING
     s.cnt[EVENTS] += 1
@@ -184,13 +185,13 @@ def _handle(mdl, pc, row, s, se):
     x_i = mdl.argmap[i] @ s.theta
     s.theta[:] += mdl.arg_inv[:, i] * (bound - x_i)
     kind = cross(i, going_up, s.side, s.k, s.pending, s.awaiting, mdl.rigid, mdl.silent)
-    if kind == 0:
+    if kind == UPLIFT:
         s.cnt[UPLIFTS] += 1
-    elif kind == 2:
+    elif kind == IMPACT:
         s.cnt[IMPACTS] += 1
         if mdl.restitution < 1.0:
             xdot = mdl.argmap[i] @ s.rate
-            s.rate[:] += mdl.imp_dir[:, i] * ((mdl.restitution - 1.0) * xdot / mdl.imp_w[i])
+            restitute(i, xdot, mdl.restitution, mdl.imp_dir, mdl.imp_w, s.rate)
         if mdl.rigid_mono and abs(s.rate[0]) < mdl.rest_rate:
             s.theta[:] = 0.0
             s.rate[:] = 0.0

@@ -27,8 +27,9 @@ Python that numba compiles: compiled by default, run by Python as written with
 slower). The modules: step.inputs (the kernel's four typed input records and
 prepare_kernel), step.stepper (the stepper), step.rk (Runge-Kutta), step.events (event
 location), step.state (the state change at an event), models.ground (the excitation),
-step.vertical (moving kinks under a vertical record), models.guard (wall-clock budget and
-Ctrl-C); this one runs a model from Python.
+step.vertical (moving kinks under a vertical record), models.rbm.pieces (the law pieces, as
+the exact integrator keeps them too), models.guard (wall-clock budget and Ctrl-C); this one
+runs a model from Python.
 """
 
 from __future__ import annotations

@@ -1,8 +1,9 @@
-"""Event search and law bookkeeping for the compiled kernel (numba): the
-transcriptions of rbm_cli.models.events (earliest crossing on the dense output,
-cubic Hermite dips) and rbm_cli.models.events.Pieces (law pieces); the moving kinks of
-a vertical record are step.vertical's (the exact uplift time of a rigid block at rest is
-in models.ground, time-history sampling in step.rk)."""
+"""Event search for the compiled kernel (numba): the earliest crossing on the dense output
+and cubic Hermite dips (as rbm_cli.models.events), the event distances of a state, and the
+linear system and energy of the current law pieces (the pieces themselves:
+rbm_cli.models.rbm.pieces); the moving kinks of a vertical record are step.vertical's (the
+exact uplift time of a rigid block at rest is in models.ground, time-history sampling in
+step.rk)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import numpy as np
 from rbm_cli.base.detmath import dot, matvec
 from rbm_cli.base.jit import jit
 from rbm_cli.models.brent import brent_step
+from rbm_cli.models.rbm.pieces import law_potential
 from rbm_cli.models.rbm.step.rk import TAB_NP
 from rbm_cli.models.rbm.step.vertical import add_moving, moving_rate, moving_value
 
@@ -236,28 +238,7 @@ def first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, 
     return -1.0, -1
 
 
-# ---------------------------------------------------------------- laws, pieces
-@jit
-def n_below(edges, ne, x):
-    k = 0
-    while k < ne and edges[k] <= x:
-        k += 1
-    return k
-
-
-@jit
-def piece_bounds(i, side, k, pending, rigid, edges, nedges, lo, hi):
-    ne = nedges[i]
-    start = 0.0 if k[i] == 0 else edges[i, k[i] - 1]
-    end = edges[i, k[i]] if k[i] < ne else np.inf
-    if k[i] == 0 and not (rigid[i] or pending[i]):
-        start = -end
-    if side[i] > 0:
-        lo[i], hi[i] = start, end
-    else:
-        lo[i], hi[i] = -end, -start
-
-
+# ---------------------------------------------------------------- the equations, the rows
 @jit
 def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
     """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place into
@@ -325,37 +306,12 @@ def surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
 
 @jit
 def energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
-    """Model.energy for one state."""
+    """Model.energy [J] of one state: rotations theta [rad], rates rate [rad/s] (n,)."""
     n = theta.size
     e = 0.5 * dot(rate, matvec(mass, rate, np.empty(n))) - 0.5 * dot(
         theta, matvec(gravity, theta, np.empty(n))
     )
     x = matvec(argmap, theta, np.empty(n))
     for i in range(n):
-        ax = abs(x[i])
-        ne = nedges[i]
-        cum, x0 = 0.0, 0.0
-        kk = n_below(edges[i], ne, ax)
-        for q in range(kk):
-            x1 = edges[i, q]
-            cum += intercepts[i, q] * (x1 - x0) + 0.5 * slopes[i, q] * (x1 * x1 - x0 * x0)
-            x0 = x1
-        e += cum + intercepts[i, kk] * (ax - x0) + 0.5 * slopes[i, kk] * (ax * ax - x0 * x0)
+        e += law_potential(i, x[i], edges, nedges, intercepts, slopes)
     return e
-
-
-@jit(inline=True)
-def friction_demand(g_new, gam, centre_map, acc, masses, normal_forces, friction):
-    """Friction demand |T_i| / N_i at each interface at the step's end, kept in friction
-    if larger: the shear from the drums above, their absolute accelerations g_new [m/s^2]
-    (the ground) + centre_map @ acc (theta'' [rad/s^2]); N_i times gam = (g + a_v) / g."""
-    n = acc.size
-    shear = 0.0
-    for i in range(n - 1, -1, -1):
-        a_abs = g_new
-        for j in range(n):
-            a_abs += centre_map[i, j] * acc[j]
-        shear += a_abs * masses[i]
-        fr = abs(shear) / (normal_forces[i] * gam)
-        if fr > friction[i]:
-            friction[i] = fr

@@ -14,7 +14,6 @@ a named tuple costs more to pass, see run_kernel):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -22,11 +21,12 @@ import numpy as np
 
 from rbm_cli.base.detmath import matmul, matvec
 from rbm_cli.base.jit import jit
-from rbm_cli.models.events import REST_RATE
 from rbm_cli.models.methods import step_method
+from rbm_cli.models.rbm.pieces import rest_levels
 from rbm_cli.models.rbm.step.rk import METHOD_CODES
-from rbm_cli.physics.equations import Model
+from rbm_cli.physics.equations import Model, event_families
 from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.physics.law import law_arrays
 
 #: excitation kind -> code in the kernel
 KIND_CODES = {
@@ -135,32 +135,16 @@ class PreparedModel:
 
 
 # ---------------------------------------------------------------- preparation
-def _pad_laws(model: Model):
-    n = model.n
-    ne = max(len(law.edges) for law in model.laws)
-    edges = np.full((n, max(ne, 1)), np.inf)
-    inter = np.zeros((n, ne + 1))
-    slopes = np.zeros((n, ne + 1))
-    nedges = np.zeros(n, dtype=np.int64)
-    for i, law in enumerate(model.laws):
-        m = len(law.edges)
-        edges[i, :m] = law.edges
-        inter[i, : m + 1] = law.intercepts
-        slopes[i, : m + 1] = law.slopes
-        nedges[i] = m
-    rigid = np.array([law.rigid for law in model.laws], dtype=np.bool_)
-    return edges, nedges, inter, slopes, rigid
-
-
 @jit
-def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
-    """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es)."""
-    n = argmap.shape[0]
+def _derived(args, cmap, top, minv, diff, gravity, ground_load):
+    """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es),
+    from the event families (physics.equations.event_families: args, cmap, top)."""
+    n = args.shape[0]
     event_rows = np.empty((4 * n, n))
     for i in range(n):
         for j in range(n):
-            event_rows[i, j] = argmap[i, j] / tu[i]
-            event_rows[n + i, j] = -argmap[i, j] / tu[i]
+            event_rows[i, j] = args[i, j]
+            event_rows[n + i, j] = -args[i, j]
             event_rows[2 * n + i, j] = -cmap[i, j]
             event_rows[3 * n + i, j] = cmap[i, j]
     gx, gc = event_rows[:n], event_rows[3 * n :]
@@ -177,33 +161,20 @@ def _derived(argmap, tu, cmap, top, minv, diff, gravity, ground_load):
     return event_rows, same, md, mg, track, es
 
 
-def _early_stop_levels(model: Model) -> tuple[float, float, float]:
-    """(uplift level [rad/s^2 of ground demand], rest rate [rad/s], energy barrier [J]) of the
-    model: the levels the early stop and the rest of a rigid block compare with."""
-    tu = float(model.column.rotation_capacity.min())
-    uplift = model.uplift_level
-    barrier = math.nan
-    if model.n == 1:
-        theta_c = model.collapse_ratio * model.column.rotation_capacity
-        barrier = float(model.energy(theta_c, np.zeros(1))[0])
-    rest_rate = REST_RATE * model.rocking_p * tu
-    return -1.0 if uplift is None else uplift, rest_rate, barrier
-
-
 def model_arrays(model: Model) -> ModelArrays:
     """The model's arrays as the kernel reads them (assembled once per column)."""
     col = model.column
     tu = col.rotation_capacity.astype(float)
     argmap = model.arg_map.astype(float)
-    cmap = model.collapse_map / model.collapse_limit[:, None]
-    top = col.heights.astype(float)
     impulse_dir, impulse_w = model.impulse_directions
-    edges, nedges, inter, slopes, rigid = _pad_laws(model)
-    event_rows, same, md, mg, track, es = _derived(argmap, tu, cmap, top, model.mass_inv,
+    edges, nedges, inter, slopes, rigid = law_arrays(model.laws)
+    args, cmap, top = event_families(model)
+    event_rows, same, md, mg, track, es = _derived(args, cmap, top, model.mass_inv,
                                           model.diff.astype(float), model.gravity,
                                           model.ground_load)  # fmt: skip
     n = model.n
-    uplift, rest_rate, barrier = _early_stop_levels(model)
+    uplift, rest_rate, barrier = rest_levels(model)
+    uplift = -1.0 if uplift is None else uplift
     return ModelArrays(
         mass=model.mass, argmap=argmap, arg_inv=model.arg_inverse,
         gravity=model.gravity, edges=edges, nedges=nedges, intercepts=inter, slopes=slopes,

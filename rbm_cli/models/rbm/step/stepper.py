@@ -9,18 +9,22 @@ import numpy as np
 
 from rbm_cli.base.detmath import matvec, pow_pos
 from rbm_cli.base.jit import jit
-from rbm_cli.models.events import BIG, EVENT_EPS
 from rbm_cli.models.ground import ground_at, next_uplift, record_piece
 from rbm_cli.models.guard import POLL_STEPS
+from rbm_cli.models.rbm.pieces import (
+    IMPACT,
+    UPLIFT,
+    bound_rows,
+    friction_demand,
+    locate,
+    settle,
+)
 from rbm_cli.models.rbm.step.events import (
     CHECK_INTERVALS,
     affine,
     brentq,
     energy1,
     first_crossing,
-    friction_demand,
-    n_below,
-    piece_bounds,
     poly_val,
     row_poly,
     surfaces,
@@ -45,7 +49,7 @@ from rbm_cli.models.rbm.step.rk import (
     rhs,
     rk_attempt,
 )
-from rbm_cli.models.rbm.step.state import IMPACT, REST, UPLIFT, settle, switch
+from rbm_cli.models.rbm.step.state import REST, switch
 from rbm_cli.models.rbm.step.vertical import bound_now, moving_rows
 from rbm_cli.models.status import (
     COLLAPSED,
@@ -168,11 +172,7 @@ def run_kernel(model, motion, solver, task):
             at_rest = False
     x0 = matvec(argmap, y[:n], np.empty(n))
     r0 = matvec(argmap, y[n:], np.empty(n))
-    for i in range(n):
-        s = 1 if x0[i] > 0 else (-1 if x0[i] < 0 else (1 if r0[i] >= 0 else -1))
-        side[i] = s
-        k[i] = n_below(edges[i], nedges[i], abs(x0[i]))
-        pending[i] = k[i] > 0 and not rigid[i]
+    locate(x0, r0, side, k, pending, rigid, edges, nedges)
 
     for seg in range(bounds.size - 1):
         seg_end = bounds[seg + 1]
@@ -210,12 +210,7 @@ def run_kernel(model, motion, solver, task):
                 h_carry = -1.0
 
             system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs)
-            for i in range(n):
-                piece_bounds(i, side, k, pending, rigid, edges, nedges, lo, hi)
-                h0[i] = min(-lo[i] / tu[i], BIG) + EVENT_EPS
-                h0[n + i] = min(hi[i] / tu[i], BIG) + EVENT_EPS
-                h0[2 * n + i] = c_ratio + EVENT_EPS
-                h0[3 * n + i] = c_ratio + EVENT_EPS
+            bound_rows(side, k, pending, rigid, edges, nedges, tu, c_ratio, lo, hi, h0)
             if vert:
                 moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv_w)
 

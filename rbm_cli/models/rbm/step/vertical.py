@@ -13,9 +13,9 @@ record's steps end at its samples), so the row is the dense output's polynomial 
 E m(gam(t)) / theta_u, evaluated exactly.
 
 The event rows' bookkeeping: mv_e[r] (0 for a fixed row) and mv_w[r] describe the moving
-part of rows r < 2n (the law bounds, step.events.piece_bounds): row i (lower bound) is
-x_i / theta_u - lo_i / theta_u, row n + i (upper) is hi_i / theta_u - x_i / theta_u; the
-moving part is mv_e m(gam; mv_w), and the row's h0 keeps only EVENT_EPS.
+part of rows r < 2n (the law bounds, rbm_cli.models.rbm.pieces.piece_bounds): row i (lower
+bound) is x_i / theta_u - lo_i / theta_u, row n + i (upper) is hi_i / theta_u - x_i / theta_u;
+the moving part is mv_e m(gam; mv_w), and the row's h0 keeps only EVENT_EPS.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ def add_moving(t, gr, mv_e, mv_w, d, dd, d2):
 
 @jit
 def _end(i, k, ne, rigid, pending):
-    """(edge, sign) of the start and end of interface i's piece k (step.events.piece_bounds):
+    """(edge, sign) of the start and end of interface i's piece k (pieces.piece_bounds):
     edge -1 for 0 or infinity."""
     q_end = k if k < ne else -1
     if k == 0 and not (rigid or pending):

@@ -1,0 +1,225 @@
+"""The law pieces of a column's interfaces, as the compiled integrators (step and exact) keep
+them: which piece of its moment-rotation law each interface is on, the piece's bounds and
+event rows, locating the pieces of a state and crossing to the next piece (uplift, kink,
+impact), the silent impacts, and what both integrators compute from the pieces (an impact's
+loss of rate, a law's potential, the friction demand) or from the model once (the levels of
+the early stop and of a rigid block's rest).
+
+A law is odd and piecewise linear (rbm_cli.physics.law): on x >= 0 its piece k is
+f = a_k + b_k x on [x_k, x_{k+1}), the edges x_1 < x_2 < ... padded with inf
+(rbm_cli.physics.law.law_arrays). Interface i's piece is its side s_i = +-1 (the sign of its
+argument) and its index k_i; ``pending[i]`` marks an excursion beyond the elastic branch
+(piece 0 is then bounded by 0: the next zero crossing is an impact), ``awaiting[i]`` an
+interface back on piece 0 whose zero crossing is silent (counted, not stopped at:
+Model.silent_impacts). The arrays are changed in place.
+
+The same bookkeeping, in Python, is rbm_cli.models.events.Pieces (the scipy baseline's).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rbm_cli.base.jit import jit
+from rbm_cli.models.events import BIG, EVENT_EPS, REST_RATE
+from rbm_cli.physics.equations import Model
+
+#: What crossing a bound of a piece is (cross returns it): leaving the elastic branch, another
+#: piece of the same side, a zero crossing after an excursion (the side flips).
+UPLIFT, KINK, IMPACT = 0, 1, 2
+
+
+@jit(inline=True)
+def n_below(edges, ne, x):
+    """Number of the first ne edges [rad] at or below x [rad] (the index of x's piece)."""
+    k = 0
+    while k < ne and edges[k] <= x:
+        k += 1
+    return k
+
+
+@jit(inline=True)
+def zero_active(i, pending, rigid):
+    """Whether interface i's piece 0 ends at x = 0 (a rigid law, or after an excursion)."""
+    return rigid[i] or pending[i]
+
+
+@jit(inline=True)
+def piece_bounds(i, side, k, pending, rigid, edges, nedges):
+    """(lo, hi) [rad]: the bounds of interface i's argument on its current piece."""
+    ki = k[i]
+    start = 0.0 if ki == 0 else edges[i, ki - 1]
+    end = edges[i, ki] if ki < nedges[i] else np.inf
+    if ki == 0 and not zero_active(i, pending, rigid):
+        start = -end
+    if side[i] > 0:
+        return start, end
+    return -end, -start
+
+
+@jit
+def bound_rows(side, k, pending, rigid, edges, nedges, tu, c_ratio, lo, hi, off):
+    """The bounds lo, hi [rad] (n,) of the current pieces and the offsets off[:4n] [-] of the
+    event rows, in their order: argument over theta_u above lo (x / tu + off[i]), below hi
+    (-x / tu + off[n + i]), and the collapse ratio below c_ratio on either side (off[2n + i],
+    off[3n + i]); each offset with EVENT_EPS, an infinite bound at BIG."""
+    n = side.size
+    for i in range(n):
+        lo[i], hi[i] = piece_bounds(i, side, k, pending, rigid, edges, nedges)
+        off[i] = min(-lo[i] / tu[i], BIG) + EVENT_EPS
+        off[n + i] = min(hi[i] / tu[i], BIG) + EVENT_EPS
+        off[2 * n + i] = c_ratio + EVENT_EPS
+        off[3 * n + i] = c_ratio + EVENT_EPS
+
+
+@jit
+def locate(x, rate, side, k, pending, rigid, edges, nedges):
+    """The pieces at law arguments x [rad] with rates rate [rad/s] (n,): the side of x (of
+    the rate at x = 0), the piece holding |x|, pending beyond the elastic branch."""
+    for i in range(x.size):
+        if x[i] > 0.0:
+            side[i] = 1
+        elif x[i] < 0.0:
+            side[i] = -1
+        else:
+            side[i] = 1 if rate[i] >= 0.0 else -1
+        k[i] = n_below(edges[i], nedges[i], abs(x[i]))
+        pending[i] = k[i] > 0 and not rigid[i]
+
+
+@jit
+def cross(i, going_up, side, k, pending, awaiting, rigid, silent):
+    """Move interface i to its next piece as its argument crosses the current piece's upper
+    (going_up) or lower bound.
+
+    Returns
+    -------
+    int  UPLIFT, KINK or IMPACT.
+    """
+    s, ki = side[i], k[i]
+    if ki == 0 and not zero_active(i, pending, rigid):
+        side[i] = 1 if going_up else -1
+        k[i] = 1
+        pending[i] = True
+        awaiting[i] = False
+        return UPLIFT
+    if going_up == (s > 0):
+        k[i] = ki + 1
+        return KINK
+    if ki > 0:
+        k[i] = ki - 1
+        if ki == 1 and silent[i]:
+            pending[i] = False
+            awaiting[i] = True
+        return KINK
+    side[i] = -s
+    pending[i] = False
+    return IMPACT
+
+
+@jit(inline=True)
+def silent_impact(i, side, awaiting):
+    """Interface i's silent zero crossing: its side flips, it awaits no more."""
+    side[i] = -side[i]
+    awaiting[i] = False
+
+
+@jit(inline=True)
+def settle(awaiting, argmap, y, side):
+    """Count the silent impacts up to the state y (rotations y[:n] [rad]): the interfaces
+    awaiting one whose argument (argmap @ y[:n]) has changed sign, each a silent_impact.
+    Returns how many."""
+    n = side.size
+    hits = 0
+    for i in range(n):
+        if awaiting[i]:
+            x_i = 0.0
+            for j in range(n):
+                x_i += argmap[i, j] * y[j]
+            if side[i] * x_i < 0.0:
+                silent_impact(i, side, awaiting)
+                hits += 1
+    return hits
+
+
+@jit(inline=True)
+def restitute(i, xdot, e_rest, impulse_dir, impulse_w, rate):
+    """An impact at interface i with restitution e_rest [-] < 1: the rates rate [rad/s] (n,)
+    take the impulse (e_rest - 1) xdot / w_i along direction i (Model.impulse_directions:
+    impulse_dir (n, n), impulse_w (n,)), xdot [rad/s] the argument's rate at the impact;
+    in place."""
+    lam = (e_rest - 1.0) * xdot / impulse_w[i]
+    for j in range(rate.size):
+        rate[j] += impulse_dir[j, i] * lam
+
+
+@jit
+def law_potential(i, x, edges, nedges, intercepts, slopes):
+    """F_i(x) [J]: interface i's law integrated from 0 to x [rad] (Law.potential)."""
+    ax = abs(x)
+    cum, start = 0.0, 0.0
+    kk = n_below(edges[i], nedges[i], ax)
+    for q in range(kk):
+        end = edges[i, q]
+        cum += intercepts[i, q] * (end - start) + 0.5 * slopes[i, q] * (end * end - start * start)
+        start = end
+    return cum + intercepts[i, kk] * (ax - start) + 0.5 * slopes[i, kk] * (ax * ax - start * start)
+
+
+@jit(inline=True)
+def friction_demand(ag, gam, centre_map, acc, masses, normal_forces, out):
+    """Raise out (n) to the friction demand |T_i| / (N_i gam) [-] of each interface: T_i the
+    shear [N] of the drums above it, from their absolute accelerations ag [m/s^2] (the
+    ground's) + centre_map @ acc (acc the drums' theta'' [rad/s^2]), masses [kg]; N_i the
+    normal force [N] at rest, gam = (g + a_v) / g [-] (1 without vertical motion)."""
+    n = acc.size
+    shear = 0.0
+    for i in range(n - 1, -1, -1):
+        a_abs = ag
+        for j in range(n):
+            a_abs += centre_map[i, j] * acc[j]
+        shear += a_abs * masses[i]
+        fr = abs(shear) / (normal_forces[i] * gam)
+        if fr > out[i]:
+            out[i] = fr
+
+
+def rest_levels(model: Model) -> tuple[float | None, float, float]:
+    """The levels a run compares with, made once per model.
+
+    Returns
+    -------
+    uplift : float or None  Ground acceleration [m/s^2] that uplifts a rigid monolith at rest
+        (Model.uplift_level; None: no rigid monolith).
+    rest_rate : float  Rate [rad/s] below which a rigid monolith comes to rest after an
+        impact: REST_RATE p theta_u (p the rocking frequency [rad/s], theta_u the smallest
+        rotation capacity [rad]).
+    barrier : float  Energy [J] of a monolith at its collapse ratio at rest (the early stop
+        of free motion compares with it); NaN unless n = 1.
+    """
+    tu = model.column.rotation_capacity
+    barrier = math.nan
+    if model.n == 1:
+        barrier = float(model.energy(model.collapse_ratio * tu, np.zeros(1))[0])
+    return model.uplift_level, REST_RATE * model.rocking_p * float(tu.min()), barrier
+
+
+__all__ = [
+    "IMPACT",
+    "KINK",
+    "UPLIFT",
+    "bound_rows",
+    "cross",
+    "friction_demand",
+    "law_potential",
+    "locate",
+    "n_below",
+    "piece_bounds",
+    "rest_levels",
+    "restitute",
+    "settle",
+    "silent_impact",
+    "zero_active",
+]

@@ -4,10 +4,15 @@ error bookkeeping on hand-made frames (so the scoring itself can fail)."""
 from __future__ import annotations
 
 import pandas as pd
+import pytest
 from click.testing import CliRunner
 
 from rbm_cli.cli.main import cli
 from rbm_cli.study.bench import PEAK_TARGET, check_targets, errors
+
+#: Slow (whole domains re-made, processes killed, contact-engine runs):
+#: `pytest -m 'not slow'` leaves this file out.
+pytestmark = pytest.mark.slow
 
 
 def frame(rows):

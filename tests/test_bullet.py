@@ -42,6 +42,10 @@ from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.restitution import block_restitution
 from rbm_cli.study.simulate import simulate
 
+#: Slow (whole domains re-made, processes killed, contact-engine runs):
+#: `pytest -m 'not slow'` leaves this file out.
+pytestmark = pytest.mark.slow
+
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}  # Spanos-Koh slender, H/B = 4
 TAPER = {"height": 5.0, "base_width": 0.96, "top_width": 0.66}  # the paper's column
 

@@ -51,6 +51,10 @@ from rbm_cli.config.load import load_config
 from rbm_cli.study.store import JOURNAL, STATE, SweepStore
 from rbm_cli.study.sweep import config_hash, grid_cells
 
+#: Slow (whole domains re-made, processes killed, contact-engine runs):
+#: `pytest -m 'not slow'` leaves this file out.
+pytestmark = pytest.mark.slow
+
 CONFIG = """\
 name: faults
 column: {height: 5.0, base_width: 0.96, top_width: 0.66, drums: 8}

@@ -43,6 +43,10 @@ from rbm_cli.api import run_sweep
 from rbm_cli.config.load import load_config
 from rbm_cli.study.store import JOURNAL
 
+#: Slow (whole domains re-made, processes killed, contact-engine runs):
+#: `pytest -m 'not slow'` leaves this file out.
+pytestmark = pytest.mark.slow
+
 RECORDS = Path(__file__).resolve().parents[1] / "configs" / "records" / "synthetic"
 CONFIG = """\
 name: suite

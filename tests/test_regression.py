@@ -32,6 +32,10 @@ from rbm_cli.study.robustness import MEMBERS, RULE
 
 from .paths import CONFIGS, RESULTS
 
+#: Slow (whole domains re-made, processes killed, contact-engine runs):
+#: `pytest -m 'not slow'` leaves this file out.
+pytestmark = pytest.mark.slow
+
 STUDIES = {
     # stored result name: config
     "spanos_koh_slender": CONFIGS / "spanos_koh_slender.yaml",

@@ -37,6 +37,10 @@ from rbm_cli.study.regression import check, sensitive_bound
 
 from .paths import CONFIGS, RESULTS, ROOT
 
+#: Slow (whole domains re-made, processes killed, contact-engine runs):
+#: `pytest -m 'not slow'` leaves this file out.
+pytestmark = pytest.mark.slow
+
 CI_CONFIG = CONFIGS / "ci" / "harmonic_multidrum_ci.yaml"
 CI_STORED = RESULTS / "harmonic_multidrum_ci" / "domain.csv"
 

@@ -29,6 +29,10 @@ from rbm_cli.study.simulate import simulate
 
 from .record_files import half_sine_csv
 
+#: Slow (whole domains re-made, processes killed, contact-engine runs):
+#: `pytest -m 'not slow'` leaves this file out.
+pytestmark = pytest.mark.slow
+
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}  # Spanos-Koh slender, tan(alpha) 0.25
 #: Friction high enough that the block does not slide (docs/engine.md: with 2.0 the block
 #: agrees with `housner` on 30 of 30 cells).

@@ -147,7 +147,7 @@ def settle(awaiting, argmap, y, side):
 @jit(inline=True)
 def restitute(i, xdot, e_rest, impulse_dir, impulse_w, rate):
     """An impact at interface i with restitution e_rest [-] < 1: the rates rate [rad/s] (n,)
-    take the impulse (e_rest - 1) xdot / w_i along direction i (Model.impulse_directions:
+    take the impulse (e_rest - 1) xdot / w_i along direction i (the equations' impulse directions:
     impulse_dir (n, n), impulse_w (n,)), xdot [rad/s] the argument's rate at the impact;
     in place."""
     lam = (e_rest - 1.0) * xdot / impulse_w[i]

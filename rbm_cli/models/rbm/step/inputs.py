@@ -138,7 +138,7 @@ class PreparedModel:
 @jit
 def _derived(args, cmap, top, minv, diff, gravity, ground_load):
     """The kernel's products of the model's arrays: (event_rows, same, md, mg, track, es),
-    from the event families (physics.equations.event_families: args, cmap, top)."""
+    from the event families args, cmap, top that physics.equations makes once."""
     n = args.shape[0]
     event_rows = np.empty((4 * n, n))
     for i in range(n):

@@ -1,6 +1,6 @@
 """One iteration of Brent's root finder (scipy's brentq, zeros.c; R. P. Brent 1973), shared
 by the compiled loops that refine events to round-off: the step kernel's
-(step.events.brentq) and the rigid block's closed form (closed_form_jit.brent). The
+(step.events.brentq) and the rigid block's closed form (block.piece.brent). The
 caller evaluates its function at the point a step returns."""
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ On side s = +-1, between two events, the block obeys
 (Spanos and Koh's block: e = -p^2 / g; the rigid RBM monolith: e = -m (H/2) / I_0,
 closed_form.rbm_block; gam = (g + a_v) / g under a vertical record, taken constant on the
 piece, else 1), solved exactly for a forcing of the exact integrator's kinds
-(exact_jit_modal: zero, harmonic, or linear between two samples of a record). With
+(rbm_cli.models.rbm.exact.modal: zero, harmonic, or linear between two samples of a record). With
 p_g = p sqrt(gam):
 
     theta(tau) = s alpha + C sin(omega tau + phi0) + q0 + q1 tau + c1 e^(p_g tau)
@@ -73,7 +73,7 @@ MIN_WIDTH = 1e-12
 @jit
 def start_piece(blk, t, theta, rate, side, fc, gam, pc):
     """Fill pc with the piece through (theta [rad], rate [rad/s]) at t [s] on side s
-    under the forcing fc (exact_jit_modal), the weights scaled by gam = (g + a_v) / g [-]
+    under the forcing fc (exact.modal), the weights scaled by gam = (g + a_v) / g [-]
     (1: no vertical motion)."""
     p, alpha, e = blk[B_P] * math.sqrt(gam), blk[B_ALPHA], blk[B_E]
     p2 = p * p

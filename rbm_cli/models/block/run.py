@@ -6,10 +6,10 @@ Mutable scalars live in small arrays: st = [t, theta, rate, side, at rest, peak,
 friction, next output time, samples written, t_collapse, events logged] (floats) and
 cnt = [uplifts, impacts, pieces, evaluations, events] (ints). A motion is mo = [pulse or
 record (0/1), amplitude, omega, phase, pulse_end, t_end] with its segments (start, end),
-their forcings (exact_jit_modal) and, under a vertical record, the upward acceleration
+their forcings (exact.modal) and, under a vertical record, the upward acceleration
 on each segment, seg_v = [a_v at the forcing's t0 [m/s^2], its slope [m/s^3]] (no rows:
 no vertical motion); settings are se = [max_steps (pieces), max_events, deadline
-(time.monotonic) [s], early_stop, record, output_dt [s]] (as exact_jit_run's).
+(time.monotonic) [s], early_stop, record, output_dt [s]] (as exact.run's).
 
 A vertical record makes the weights act as under g + a_v: on a piece the block obeys
 theta'' = p^2 gam (theta - s alpha) + e a_g with gam = (g + a_v) / g taken at the middle

@@ -97,13 +97,19 @@ def keys_of(df: pd.DataFrame) -> list[tuple[str, ...]]:
 
 def read_domain(path: str | Path) -> pd.DataFrame:
     """Read a domain CSV; a missing file or missing columns is an RbmError."""
-    import pandas as pd
-
     path = Path(path)
     if not path.is_file():
         raise RbmError(f"domain file not found: {path}")
+    return parse_domain(path, path)
+
+
+def parse_domain(source, path: str | Path) -> pd.DataFrame:
+    """A domain CSV read from ``source`` (a path or a text buffer), checked as
+    :func:`read_domain` checks a file; ``path`` names it in an error (RbmError)."""
+    import pandas as pd
+
     try:
-        df = pd.read_csv(path, keep_default_na=True)
+        df = pd.read_csv(source, keep_default_na=True)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         reason = " ".join(str(exc).split())
         raise RbmError(f"cannot read {path} as a domain CSV: {reason}") from None

@@ -42,7 +42,7 @@ from rbm_cli.study.cells import (
     row_key,
     tasks,
 )
-from rbm_cli.study.domain import csv_text
+from rbm_cli.study.domain import csv_text, parse_domain
 from rbm_cli.study.parallel import run_chunks
 from rbm_cli.study.robustness import member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
@@ -198,15 +198,10 @@ class SweepRows:
 
     def frame(self) -> pd.DataFrame:
         """The DataFrame rbm_cli.study.domain.read_domain gives for domain.csv's text: read
-        from :meth:`csv`, so that the types are those of a stored domain's."""
+        from :meth:`csv` by the same reader, so that the types are those of a stored domain's."""
         import io
 
-        import pandas as pd
-
-        df = pd.read_csv(io.StringIO(self.csv()), keep_default_na=True)
-        for col in ("amplitude_g", "frequency_hz"):  # float, as read_domain leaves them
-            df[col] = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
-        return df
+        return parse_domain(io.StringIO(self.csv()), "the sweep's rows")
 
 
 def sweep_fields(config: Config, ensemble: int = 1) -> tuple[str, ...]:

@@ -55,32 +55,39 @@ class Integrator(Protocol):
     ) -> Outcome: ...
 
 
+def column_why_not(one_rigid_drum: bool, one_piece: bool, formulation: str) -> str | None:
+    """Why the block's closed form does not take an RBM column: one rigid drum or not, one
+    law piece a side (xi 1) or not, and the formulation; None if it takes it."""
+    if not one_rigid_drum:
+        return "it takes a rigid monolithic column only (one drum, interface.stiffness rigid)"
+    if not one_piece:
+        return "it takes one law piece a side only (interface.xi 1)"
+    if formulation == "absolute":
+        return "it takes interface.formulation relative or geometric"
+    return None
+
+
+def model_why_not(model: Model) -> str | None:
+    """Why the block's closed form does not take this RBM model (:func:`column_why_not` of
+    its column), or None if it does."""
+    law = model.laws[0]
+    return column_why_not(model.n == 1 and law.rigid, len(law.edges) == 0, model.formulation)
+
+
 def _closed_form_why_not(config: Config, model: Model | None) -> str | None:
     if config.model == "housner-linear":
         return None
-    if model is not None:
-        from rbm_cli.models.block.closed_form import why_not
-
-        reason = why_not(model)
-        if reason is not None:
-            return f"solver.method closed-form: {reason}; use DOP853 (or auto)"
+    if model is not None:  # the runner's model, which may stand in for the config's
+        reason = model_why_not(model)
     else:
         interface = config.interface
-        if config.column.n_drums != 1 or interface.stiffness.kind != "rigid":
-            return (
-                "solver.method closed-form: it takes a rigid monolithic column only (one drum,"
-                " interface.stiffness rigid); use DOP853 (or auto)"
-            )
-        if interface.xi != 1.0:
-            return (
-                "solver.method closed-form: it takes one law piece a side only (interface.xi"
-                " 1); use DOP853 (or auto)"
-            )
-        if interface.formulation not in ("relative", "geometric"):
-            return (
-                "solver.method closed-form: it takes interface.formulation relative or"
-                " geometric; use DOP853 (or auto)"
-            )
+        reason = column_why_not(
+            config.column.n_drums == 1 and interface.stiffness.kind == "rigid",
+            interface.xi == 1.0,
+            interface.formulation,
+        )
+    if reason is not None:
+        return f"solver.method closed-form: {reason}; use DOP853 (or auto)"
     excitation = config.excitation
     if excitation.type not in CLOSED_FORM_KINDS or excitation.vertical is not None:
         what = "a vertical record" if excitation.vertical is not None else excitation.type

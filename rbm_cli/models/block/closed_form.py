@@ -49,6 +49,7 @@ from rbm_cli.models.block.run import (
 )
 from rbm_cli.models.events import EVENT_EPS, REST_RATE
 from rbm_cli.models.guard import arm, disarm
+from rbm_cli.models.methods import model_why_not
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC, LINEAR
 from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings
@@ -71,20 +72,9 @@ def _params(p, alpha, e, limit, restitution, rest_rate, uplift, barrier, eps, fa
                      fb, at_zero], dtype=float)  # fmt: skip
 
 
-def why_not(model: Model) -> str | None:
-    """Why the closed form does not take this RBM model, or None if it does."""
-    if model.n != 1 or not model.laws[0].rigid:
-        return "it takes a rigid monolithic column only (one drum, interface.stiffness rigid)"
-    if len(model.laws[0].edges) != 0:
-        return "it takes one law piece a side only (interface.xi 1)"
-    if model.formulation == "absolute":
-        return "it takes interface.formulation relative or geometric"
-    return None
-
-
 def rbm_block(model: Model) -> Block:
     """The Block of a rigid RBM monolith (RbmError in one line if it is not one)."""
-    reason = why_not(model)
+    reason = model_why_not(model)
     if reason is not None:
         raise RbmError(f"solver.method closed-form: {reason}; use DOP853 (or auto)")
     law, col = model.laws[0], model.column

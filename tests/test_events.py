@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rbm_cli.models.events import first_crossing, hermite_dip, within_reach
+from rbm_cli.models.events import first_crossing, hermite_dip
+from rbm_cli.models.rbm.step.events import within_reach
 
 
 def _dist(rows):
@@ -83,7 +84,8 @@ def test_end_of_step_cubic_misses_a_dip_that_first_crossing_finds():
 
     d0, d1, r0, r1, a0, a1 = (np.array([v]) for v in (d(0), d(h), r(0), r(h), a(0), a(h)))
     assert d0[0] > 0 and d1[0] > 0 and hermite_dip(d0, d1, r0, r1, h) is None
-    assert within_reach(d0, d1, r0, r1, a0, a1, h)
+    mask = np.zeros(1, dtype=np.bool_)
+    assert within_reach(d0, d1, r0, r1, a0, a1, h, mask) and mask[0]
     t, row = first_crossing(_dist([(d, r)]), 0.0, h)
     assert row == 0
     assert t == pytest.approx(np.arcsin(delta) / w, abs=1e-12)
@@ -91,4 +93,6 @@ def test_end_of_step_cubic_misses_a_dip_that_first_crossing_finds():
 
 def test_within_reach_false_far_from_every_surface():
     one = np.array([1.0])
-    assert not within_reach(one, one, 0.1 * one, -0.1 * one, one, one, 0.01)
+    mask = np.ones(1, dtype=np.bool_)
+    assert not within_reach(one, one, 0.1 * one, -0.1 * one, one, one, 0.01, mask)
+    assert not mask[0]

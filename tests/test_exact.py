@@ -36,12 +36,13 @@ from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.models.rbm.exact.bounds import FULL, THIRD, empty_bounds, row_lower, track_upper
 from rbm_cli.models.rbm.exact.integrate import integrate_exact
 from rbm_cli.models.rbm.exact.modal import advance, forcing_array
-from rbm_cli.models.rbm.exact.model import exact_model, new_cache
+from rbm_cli.models.rbm.exact.model import new_cache
 from rbm_cli.models.rbm.exact.motion import Forcing, sampled_segments
 from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, point_size, set_point
 from rbm_cli.models.rbm.exact.search import bounds_of
 from rbm_cli.models.rbm.step import integrate
 from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.arrays import column_arrays
 from rbm_cli.physics.closed_forms import (
     free_rocking_period,
     linear_halfsine_threshold,
@@ -160,7 +161,7 @@ def test_bounds_hold_on_dense_samples():
     upper bound, at 400 points per interval."""
     cfg = load_config(CONFIGS / "harmonic_multidrum.yaml")
     model = model_from_config(cfg)
-    mdl, cache = exact_model(model), new_cache(model.n)
+    mdl, cache = column_arrays(model), new_cache(model.n)
     rng = np.random.default_rng(7)
     n = model.n
     nf, of = 2 * n + 1, 1 + 2 * n

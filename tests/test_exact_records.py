@@ -162,11 +162,25 @@ def test_the_step_method_still_takes_them():
     assert simulate(cfg, 0.5, 2.0, runner=make_runner(cfg)).status in ("survived", "collapsed")
 
 
+def _record_segments(motion):
+    """The oracle: a record's segments as Forcing objects, one per sample interval of
+    positive length (exact.motion.sampled_segments), with rest before the first sample and
+    free motion after the last, split at pulse_end."""
+    from rbm_cli.models.rbm.exact.motion import Forcing, sampled_segments
+
+    knots, values = motion.knots, motion.values
+    inner = [s for s in sampled_segments(knots, values, motion.t_end) if s[2].kind == "linear"]
+    cuts = sorted({0.0, float(knots[0]), float(knots[-1]), motion.pulse_end, motion.t_end})
+    rest = [(a, min(b, motion.t_end), Forcing("zero"))
+            for a, b in zip(cuts[:-1], cuts[1:], strict=False)
+            if b > a and (b <= knots[0] or a >= knots[-1]) and a < motion.t_end]  # fmt: skip
+    return sorted(rest + inner, key=lambda s: s[0])
+
+
 def test_the_record_arrays_are_the_record_segments():
-    """The arrays of a record (record_arrays, vectorised) and its segments
-    (record_segments, one Forcing per interval) are the same, a jump (a time written
-    twice) and rest before the first sample included."""
-    from rbm_cli.models.rbm.exact.motion import record_segments
+    """The arrays of a record (record_arrays, vectorised) and its segments as Forcing
+    objects, one per interval, are the same, a jump (a time written twice) and rest before
+    the first sample included."""
     from rbm_cli.models.rbm.forcing_arrays import record_arrays
     from rbm_cli.models.rbm.forcing_arrays import segment_arrays as _segments
     from rbm_cli.physics.motion import GroundMotion
@@ -176,7 +190,7 @@ def test_the_record_arrays_are_the_record_segments():
     motion = GroundMotion("record", 0.5, 0.0, 0.0, 0.8, 1.8, gain=1.0, knots=knots,
                           values=values)  # fmt: skip
     seg_t, seg_fc = record_arrays(motion)
-    ref_t, ref_fc = _segments(record_segments(motion))
+    ref_t, ref_fc = _segments(_record_segments(motion))
     assert np.array_equal(seg_t, ref_t) and np.array_equal(seg_fc, ref_fc)
     assert seg_t.tolist() == [[0.0, 0.5], [0.5, 0.6], [0.6, 0.7], [0.7, 0.8], [0.8, 1.8]]
     # each interval's line through its samples (the jump at 0.7: before, then after)

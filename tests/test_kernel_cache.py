@@ -233,3 +233,50 @@ def test_every_compiled_function_carries_the_key():
         if not compile_cache.is_keyed(d._cache._cache_file._source_stamp)
     ]
     assert not unkeyed, f"compiled before rbm_cli.base.compile_cache.key_numba_cache(): {unkeyed}"
+
+
+class _Gone:
+    """A type a cache index names, then removed (as a renamed record of arrays is)."""
+
+
+def test_an_index_naming_a_type_that_no_longer_exists_is_stale(tmp_path, monkeypatch):
+    """An index written by another version of the package may name a type this version
+    does not have; numba unpickles it before it compares the stamp. Read as empty (the
+    function is compiled again), not raised (this once stopped every run of the exact
+    integrator after its record of arrays was renamed)."""
+    import pickle
+
+    import numba
+    from numba.core import caching
+
+    import rbm_cli.base.jit  # noqa: F401  (keys numba's cache when imported)
+
+    index = caching.IndexDataCacheFile(str(tmp_path), "gone-1.py311", ("stamp", 1))
+    with open(index._index_path, "wb") as f:
+        pickle.dump(numba.__version__, f)
+        f.write(pickle.dumps((("stamp", 1), {(_Gone(),): "an overload"})))
+    assert index._load_index() != {}  # readable while the type exists
+    monkeypatch.delattr(sys.modules[__name__], "_Gone")
+    assert index._load_index() == {}
+
+
+def test_a_cache_that_cannot_be_written_leaves_the_function_running(tmp_path):
+    """A compiled function whose cache cannot be written (here a file size limit of 512
+    bytes, as a full disk) still runs: numba's cache is keyed by rbm (its import), and a
+    failed write is skipped instead of raised (a sweep on a full disk once ended in numba's
+    traceback before it could say what it could not write)."""
+    import resource
+
+    (tmp_path / "tiny.py").write_text(
+        "import numba\n\n\n@numba.njit(cache=True)\ndef add_one(x):\n    return x + 1\n"
+    )
+    code = "import rbm_cli.base.jit, tiny; print(tiny.add_one(41))"
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (512, 512))
+
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, preexec_fn=limit, timeout=120)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "42"

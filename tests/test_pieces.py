@@ -1,5 +1,5 @@
 """The law pieces of the compiled integrators (rbm_cli.models.rbm.pieces) against the Python
-bookkeeping of the scipy baseline (rbm_cli.models.events.Pieces), the laws' potential
+bookkeeping of tests/piece_oracle.py (Pieces), the laws' potential
 (Law.potential), the shear ratios and the energy of the model (physics/equations); and the
 compiled functions against their uncompiled versions, bit for bit."""
 
@@ -13,12 +13,14 @@ import pytest
 
 from rbm_cli.base.jit import plain
 from rbm_cli.config.load import load_config
-from rbm_cli.models.events import BIG, EVENT_EPS, Pieces
+from rbm_cli.models.events import BIG, EVENT_EPS
 from rbm_cli.models.rbm import pieces as compiled
+from rbm_cli.physics.arrays import rest_levels
 from rbm_cli.physics.assembly import model_from_config
 from rbm_cli.physics.law import law_arrays
 
 from .paths import CONFIGS
+from .piece_oracle import Pieces
 
 KINDS = {compiled.UPLIFT: "uplift", compiled.KINK: "kink", compiled.IMPACT: "impact"}
 
@@ -41,7 +43,7 @@ MODELS = {
 
 def _walk(model, fns, seed, steps=400):
     """A random walk of the pieces through fns (the module, or its uncompiled functions),
-    beside events.Pieces: locate at random arguments, then crossings of finite bounds.
+    beside piece_oracle.Pieces: locate at random arguments, then crossings of finite bounds.
     Returns what the compiled side saw, in order (for the bit comparison)."""
     rng = np.random.default_rng(seed)
     n = model.n
@@ -90,7 +92,7 @@ def _walk(model, fns, seed, steps=400):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_pieces_follow_the_python_bookkeeping_and_plain_gives_the_same(name):
-    """locate, cross, settle, piece_bounds and bound_rows agree with events.Pieces along a
+    """locate, cross, settle, piece_bounds and bound_rows agree with piece_oracle.Pieces along a
     random walk through every kind of crossing; the uncompiled functions see the same."""
     model = MODELS[name]()
     seen = _walk(model, compiled, seed=3)
@@ -148,11 +150,11 @@ def test_rest_levels():
     """The early stop's barrier is the monolith's energy at its collapse ratio at rest, the
     rest rate scales with p and theta_u; a column of drums has neither barrier nor uplift."""
     block = MODELS["rigid block"]()
-    uplift, rest_rate, barrier = compiled.rest_levels(block)
+    uplift, rest_rate, barrier = rest_levels(block)
     tu = block.column.rotation_capacity
     assert uplift == block.uplift_level and uplift > 0.0
     assert barrier == pytest.approx(block.energy(block.collapse_ratio * tu, np.zeros(1))[0])
     assert barrier > 0.0
     assert 0.0 < rest_rate < block.rocking_p * tu[0]
-    uplift, _, barrier = compiled.rest_levels(MODELS["8 drums, bilinear"]())
+    uplift, _, barrier = rest_levels(MODELS["8 drums, bilinear"]())
     assert uplift is None and math.isnan(barrier)

@@ -22,10 +22,10 @@ from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
 from rbm_cli.models.block.closed_form import linear_run
-from rbm_cli.models.ground import next_uplift
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.assembly import model_from_config
 from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.physics.ground import next_uplift
 from rbm_cli.physics.pulses import mavroeidis_papageorgiou, ricker_wavelet
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "drums": 1}
@@ -107,7 +107,7 @@ def test_opposite_acceleration_mirrors_the_rotation(kind, extra, model, impl):
 
 
 def test_pulse_formulas_are_those_of_pulses_py():
-    """The integrators' scalar formulas (ground_forms) equal physics/pulses.py's."""
+    """The integrators' scalar formulas (physics.ground) equal physics/pulses.py's."""
     t = np.linspace(-0.1, 3.5, 2001)
     for kind, extra, reference in [
         ("ricker", {}, lambda tt: ricker_wavelet(tt, 0.7 * G, 1.1)),

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import pickle
 import re
 import sys
 from functools import cache
@@ -196,6 +197,8 @@ def key_numba_cache() -> bool:
         classes = _impl_class(caching)._locator_classes
         if not any(getattr(c, "rbm_sources", False) for c in classes):
             classes.insert(0, _locator_class(caching))
+        _tolerate_old_indexes(caching.IndexDataCacheFile)
+        _tolerate_unwritable_cache(caching.Cache)
     except (ImportError, AttributeError, TypeError):
         return False
     for dispatcher in package_dispatchers():
@@ -204,6 +207,46 @@ def key_numba_cache() -> bool:
         if stamp is not None and not is_keyed(stamp) and not dispatcher.overloads:
             index._source_stamp = _stamp(stamp)
     return True
+
+
+def _tolerate_old_indexes(index_class) -> None:
+    """Make numba read an index it cannot unpickle as an empty one (stale: compiled again).
+
+    numba unpickles an index before it compares its stamp; the signatures in it name the
+    types they were compiled for, and an index written by another version of the package
+    can name a type that no longer exists (a renamed record of arrays): the load then
+    raises instead of finding the cache stale. Patched once per process."""
+    load = index_class._load_index
+    if getattr(load, "rbm_tolerant", False):
+        return
+
+    def _load_index(self):
+        try:
+            return load(self)
+        except (AttributeError, ImportError, EOFError, pickle.UnpicklingError):
+            return {}
+
+    _load_index.rbm_tolerant = True
+    index_class._load_index = _load_index
+
+
+def _tolerate_unwritable_cache(cache_class) -> None:
+    """Make numba go on, without a cache, when it cannot write one (a full disk, a file
+    size limit, a read-only folder): the function just compiled runs, and the next process
+    compiles it again. numba raises instead, and a run on a full disk then ended in a
+    traceback before it could say what it could not write. Patched once per process."""
+    save = cache_class.save_overload
+    if getattr(save, "rbm_tolerant", False):
+        return
+
+    def save_overload(self, sig, data):
+        try:
+            save(self, sig, data)
+        except OSError:
+            pass
+
+    save_overload.rbm_tolerant = True
+    cache_class.save_overload = save_overload
 
 
 def is_keyed(stamp) -> bool:

@@ -17,7 +17,7 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import PULSES, ExcitationConfig, G
-from rbm_cli.physics.ground_forms import mp_knots, ricker_knots
+from rbm_cli.physics.ground import mp_knots, ricker_knots
 from rbm_cli.physics.motion import PULSE_KINDS, SAMPLES_PER_PERIOD, GroundMotion
 from rbm_cli.physics.pulses import (
     mavroeidis_papageorgiou_duration,

@@ -1,7 +1,7 @@
 """The ground motion every model integrates, SI inside: a_g [m/s^2], t [s].
 
 A :class:`GroundMotion` is a horizontal ground acceleration a_g(t) in one of the forms of
-:mod:`rbm_cli.physics.ground_forms` (a sine, a Ricker or Mavroeidis-Papageorgiou pulse, or
+:mod:`rbm_cli.physics.ground` (a sine, a Ricker or Mavroeidis-Papageorgiou pulse, or
 a sampled record, linear between its samples, with its upward acceleration a_v(t) if any),
 its segments (the intervals on which a_g is continuous: an integrator restarts between
 them), where the pulse or record ends and the run ends. :mod:`rbm_cli.physics.excitation`
@@ -18,16 +18,17 @@ from functools import cached_property
 import numpy as np
 
 from rbm_cli.config.types import PULSES, G
-from rbm_cli.physics.ground_forms import (
+from rbm_cli.physics.ground import (
     FORM_OF_KIND,
     MP,
     RICKER,
     SAMPLED,
     SINE,
-    exceedance_on_pieces,
-    gravity_factor,
+    as_samples,
+    form_function,
+    next_uplift,
     sampled_displacement,
-    scalar_form,
+    vertical_factor,
 )
 from rbm_cli.physics.pulses import mavroeidis_papageorgiou, ricker_wavelet
 
@@ -51,7 +52,7 @@ class GroundMotion:
         acceleration is a cosine; nu for Mavroeidis-Papageorgiou)
     pulse_end : float  Time after which a_g = 0 [s] (the harmonic: its duration)
     t_end : float  Maximum simulated time [s]
-    gain : float or None  Multiplier of the form (ground_forms) [m/s^2]; None: amplitude
+    gain : float or None  Multiplier of the form (physics.ground) [m/s^2]; None: amplitude
         (a sine or Ricker pulse); amplitude / peak of the unit shape (MP); 1 (a record,
         whose values are in m/s^2)
     center : float  Centre t0 of a Ricker or MP pulse [s]
@@ -82,7 +83,7 @@ class GroundMotion:
 
     @property
     def form(self) -> int:
-        """The form of a_g (ground_forms: SINE, RICKER, MP or SAMPLED)."""
+        """The form of a_g (physics.ground: SINE, RICKER, MP or SAMPLED)."""
         return FORM_OF_KIND[self.kind]
 
     @property
@@ -103,7 +104,7 @@ class GroundMotion:
 
     @cached_property
     def _scalar(self):
-        return scalar_form(
+        return form_function(
             self.form,
             self.shape_gain,
             self.omega,
@@ -124,8 +125,8 @@ class GroundMotion:
         (no vertical motion: the integrators keep their expressions without it)."""
         if not forced or self.vertical is None:
             return None
-        knots, vertical = self.knots, self.vertical
-        return lambda tt: gravity_factor(tt, knots, vertical)
+        knots, vertical = as_samples(self.knots), as_samples(self.vertical)
+        return lambda tt: vertical_factor(tt, knots, vertical)
 
     @cached_property
     def lift_off(self) -> float | None:
@@ -156,7 +157,7 @@ class GroundMotion:
     def accel(self, t: float | np.ndarray) -> np.ndarray | float:
         """Ground acceleration a_g(t) [m/s^2] (0 after the pulse), vectorised: a Ricker or
         MP pulse by physics/pulses.py (the integrators evaluate the same formula,
-        ground_forms.scalar_form, to round-off)."""
+        physics.ground.ground_at, to round-off)."""
         if self.amplitude == 0.0:
             return np.zeros_like(t) if isinstance(t, np.ndarray) else 0.0
         tt = np.asarray(t, dtype=float)
@@ -223,38 +224,30 @@ class GroundMotion:
         return self.amplitude > 0.0 and not self.after_pulse(seg_start)
 
     def next_exceedance(self, t0: float, level: float) -> float | None:
-        """First time t >= t0 with |a_g(t)| > level, or None before t_end.
-
-        With a vertical record the level is level (g + a_v(t)) / g.
-
-        Exact for the sine: |sin(psi)| > s with s = level / amplitude holds on
-        (asin(s) + k pi, pi - asin(s) + k pi). The returned time is where
-        |a_g| = level and rising (or t0 itself when already above). Other forms:
-        exact on their monotone pieces (ground_forms.exceedance_on_pieces).
-        """
+        """First time t >= t0 with |a_g(t)| > level [m/s^2], or None before the end of
+        the pulse or run: the compiled search the integrators share
+        (physics.ground.next_uplift: exact for the sine, exact on the monotone pieces of
+        the other forms; with a vertical record the level is level (g + a_v(t)) / g). The
+        time returned is where |a_g| = level and rising (t0 itself when already above)."""
         if self.amplitude <= level and self.vertical is None:
             return None
         last = min(self.pulse_end, self.t_end)
         if t0 >= last:
             return None
-        if self.form != SINE:
-            values = self.values if self.form == SAMPLED else None
-            return exceedance_on_pieces(
-                self._scalar, self.knots, t0, level, last, values, self.vertical
-            )
-        s = level / self.amplitude
-        psi0 = self.omega * t0 + self.phase
-        if abs(math.sin(psi0)) > s:
-            return t0
-        lo = math.asin(s)
-        k = math.ceil((psi0 - lo) / math.pi)
-        psi = lo + k * math.pi
-        if psi < psi0:
-            psi += math.pi
-        t = (psi - self.phase) / self.omega
-        if t >= last:
-            return None
-        return t
+        t = next_uplift(float(t0), float(level), float(self.amplitude), self._ground,
+                        *self._samples, float(last))  # fmt: skip
+        return None if t < 0.0 else t
+
+    @cached_property
+    def _ground(self) -> tuple:
+        """The motion's ground tuple, as the compiled functions read it (physics.ground)."""
+        return (int(self.form), float(self.shape_gain), float(self.omega), float(self.phase),
+                float(self.center), float(self.gamma), 0.0, 0.0, 0.0)  # fmt: skip
+
+    @cached_property
+    def _samples(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """knots, values and vertical as float64 arrays (empty for None)."""
+        return as_samples(self.knots), as_samples(self.values), as_samples(self.vertical)
 
     def rest_end(self, t: float, seg_end: float, level: float, forced: bool) -> tuple[str, float]:
         """How the rest of a rigid block, at rest at time t, ends.

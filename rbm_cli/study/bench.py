@@ -31,7 +31,7 @@ where rtol 1e-11 and 1e-12 agree to 1e-6) and of the collapse time (runs that
 collapse in both), median and max.
 
 The baseline is scipy's solve_ivp (RK45, rtol 1e-6, events), once per cell
-(rbm_cli.models.rbm.baseline), on a sample of cells measured in the same run; its domain
+(rbm_cli.study.bench_baseline), on a sample of cells measured in the same run; its domain
 time is extrapolated from the mean time per run (marked `estimated`).
 
 `rbm bench --quick` runs the default method (and a few baseline cells) on a

@@ -2,7 +2,7 @@
 
 Three runners report the same row (:func:`_row`): the RBM through
 :func:`rbm_cli.study.simulate.simulate`, the scipy baseline
-(:mod:`rbm_cli.models.rbm.baseline`) and the closed-form linearised Housner
+(:mod:`rbm_cli.study.bench_baseline`) and the closed-form linearised Housner
 solution (:mod:`rbm_cli.models.block.closed_form`).
 """
 
@@ -48,9 +48,9 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
 
 
 def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dict]:
-    from rbm_cli.models.rbm.baseline import baseline_run
     from rbm_cli.physics.assembly import model_from_config
     from rbm_cli.physics.excitation import make_ground_motion
+    from rbm_cli.study.bench_baseline import baseline_run
 
     model = model_from_config(cfg)
     rows = []

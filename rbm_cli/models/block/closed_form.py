@@ -47,12 +47,13 @@ from rbm_cli.models.block.run import (
     N_LOG,
     run_block,
 )
-from rbm_cli.models.events import EVENT_EPS, REST_RATE
+from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.models.guard import arm, disarm
 from rbm_cli.models.methods import model_why_not
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
-from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC, LINEAR
-from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings
+from rbm_cli.models.rbm.exact.modal import LINEAR
+from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings, sine_arrays
+from rbm_cli.physics.arrays import REST_RATE, rest_levels
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -86,12 +87,12 @@ def rbm_block(model: Model) -> Block:
     scale = float(model.collapse_limit[0]) / abs(float(model.collapse_map[0, 0]))
     tu = float(col.rotation_capacity[0])
     c_ratio = float(model.collapse_ratio)
-    barrier = float(model.energy(np.array([c_ratio * tu]), np.zeros(1))[0]) / model.mass[0, 0]
+    uplift, rest_rate, barrier = rest_levels(model)
     centre, mass = float(model.centre_map[0, 0]), float(col.masses[0])
     ratio = mass / float(col.normal_forces[0])
     params = _params(
         math.sqrt(p2), alpha, e, c_ratio * scale, model.restitution,
-        REST_RATE * model.rocking_p * tu, float(model.uplift_level), barrier,
+        rest_rate, float(uplift), barrier / model.mass[0, 0],
         EVENT_EPS * tu, ratio * (1.0 + centre * e), ratio * centre * p2, 0.0,
     )  # fmt: skip
     return Block(params, scale, float(col.heights[0]), True)
@@ -126,10 +127,9 @@ def vertical_lines(motion: GroundMotion, seg_fc: np.ndarray) -> np.ndarray:
 def block_segments(
     motion: GroundMotion, vertical: bool = False
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(seg_t, seg_fc, seg_v) of a motion (forcing_arrays; a sine's segments as
-    exact_motion.forcing_segments makes them, without its objects; seg_v: vertical_lines);
-    RbmError in one line for a motion without a closed form here (a Ricker or
-    Mavroeidis-Papageorgiou pulse; a vertical record unless vertical)."""
+    """(seg_t, seg_fc, seg_v) of a motion (forcing_arrays: record_arrays or sine_arrays;
+    seg_v: vertical_lines); RbmError in one line for a motion without a closed form here
+    (a Ricker or Mavroeidis-Papageorgiou pulse; a vertical record unless vertical)."""
     if motion.kind not in CLOSED_FORM_KINDS:
         raise RbmError(f"solver.method closed-form does not take excitation.type {motion.kind}"
                        " (no closed form): use DOP853 (or auto)")  # fmt: skip
@@ -139,12 +139,7 @@ def block_segments(
     if motion.kind == "record":
         seg_t, seg_fc = record_arrays(motion)
         return seg_t, seg_fc, vertical_lines(motion, seg_fc)
-    segments = motion.segments()
-    seg_t = np.array(segments, dtype=float).reshape(-1, 2)
-    seg_fc = np.zeros((len(segments), FORCING_SIZE))
-    for i, (start, _) in enumerate(segments):
-        if motion.forced(start):
-            seg_fc[i, :4] = HARMONIC, motion.amplitude, motion.omega, motion.phase
+    seg_t, seg_fc = sine_arrays(motion)
     return seg_t, seg_fc, np.zeros((0, 2))
 
 

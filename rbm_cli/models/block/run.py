@@ -47,7 +47,6 @@ from rbm_cli.models.block.piece import (
     start_piece,
 )
 from rbm_cli.models.events import STOP_MARGIN
-from rbm_cli.models.ground import sine_exceedance
 from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.status import (
     AT_REST_END,
@@ -60,6 +59,7 @@ from rbm_cli.models.status import (
     SURVIVED,
     guard_code,
 )
+from rbm_cli.physics.ground import sine_exceedance
 
 T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG = range(11)
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)

@@ -31,7 +31,7 @@ from scipy.integrate import DOP853, RK23, RK45
 from rbm_cli.config.types import G, SolverConfig
 from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
-from rbm_cli.models.events import EVENT_EPS, REST_RATE, STOP_MARGIN, first_crossing, hermite_dip
+from rbm_cli.models.events import EVENT_EPS, STOP_MARGIN, first_crossing, hermite_dip
 from rbm_cli.models.housner.state import BlockRun, Recorder
 from rbm_cli.models.housner.steps import (
     HousnerBlock,
@@ -43,13 +43,14 @@ from rbm_cli.models.housner.steps import (
 from rbm_cli.models.knots import clip_at_knots
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import Outcome
+from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.block import (
     BlockGeometry,
     housner_energy,
     top_displacement,
 )
 from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.ground_forms import SINE
+from rbm_cli.physics.ground import SINE
 from rbm_cli.physics.restitution import block_restitution, resolve
 
 _METHODS = {m.__name__: clip_at_knots(m) for m in (DOP853, RK45, RK23)}

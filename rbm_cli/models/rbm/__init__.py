@@ -1,2 +1,2 @@
-"""The Rigid Beam Model: its runner and integrators (the step kernel, the exact integrator,
-the rigid block's closed form), and the naive scipy loop used as the bench's baseline."""
+"""The Rigid Beam Model: its runner and integrators (the step kernel, the exact integrator;
+a rigid monolith also runs the rigid block's closed form, rbm_cli.models.block)."""

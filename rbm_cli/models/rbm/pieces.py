@@ -2,8 +2,7 @@
 them: which piece of its moment-rotation law each interface is on, the piece's bounds and
 event rows, locating the pieces of a state and crossing to the next piece (uplift, kink,
 impact), the silent impacts, and what both integrators compute from the pieces (an impact's
-loss of rate, a law's potential, the friction demand) or from the model once (the levels of
-the early stop and of a rigid block's rest).
+loss of rate, a law's potential, the friction demand).
 
 A law is odd and piecewise linear (rbm_cli.physics.law): on x >= 0 its piece k is
 f = a_k + b_k x on [x_k, x_{k+1}), the edges x_1 < x_2 < ... padded with inf
@@ -13,18 +12,15 @@ argument) and its index k_i; ``pending[i]`` marks an excursion beyond the elasti
 interface back on piece 0 whose zero crossing is silent (counted, not stopped at:
 Model.silent_impacts). The arrays are changed in place.
 
-The same bookkeeping, in Python, is rbm_cli.models.events.Pieces (the scipy baseline's).
+tests/piece_oracle.py writes the same bookkeeping from the laws' objects, as a check.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.events import BIG, EVENT_EPS, REST_RATE
-from rbm_cli.physics.equations import Model
+from rbm_cli.models.events import BIG, EVENT_EPS
 
 #: What crossing a bound of a piece is (cross returns it): leaving the elastic branch, another
 #: piece of the same side, a zero crossing after an excursion (the side flips).
@@ -186,26 +182,6 @@ def friction_demand(ag, gam, centre_map, acc, masses, normal_forces, out):
             out[i] = fr
 
 
-def rest_levels(model: Model) -> tuple[float | None, float, float]:
-    """The levels a run compares with, made once per model.
-
-    Returns
-    -------
-    uplift : float or None  Ground acceleration [m/s^2] that uplifts a rigid monolith at rest
-        (Model.uplift_level; None: no rigid monolith).
-    rest_rate : float  Rate [rad/s] below which a rigid monolith comes to rest after an
-        impact: REST_RATE p theta_u (p the rocking frequency [rad/s], theta_u the smallest
-        rotation capacity [rad]).
-    barrier : float  Energy [J] of a monolith at its collapse ratio at rest (the early stop
-        of free motion compares with it); NaN unless n = 1.
-    """
-    tu = model.column.rotation_capacity
-    barrier = math.nan
-    if model.n == 1:
-        barrier = float(model.energy(model.collapse_ratio * tu, np.zeros(1))[0])
-    return model.uplift_level, REST_RATE * model.rocking_p * float(tu.min()), barrier
-
-
 __all__ = [
     "IMPACT",
     "KINK",
@@ -217,7 +193,6 @@ __all__ = [
     "locate",
     "n_below",
     "piece_bounds",
-    "rest_levels",
     "restitute",
     "settle",
     "silent_impact",

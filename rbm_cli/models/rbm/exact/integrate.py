@@ -18,7 +18,7 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
 from rbm_cli.models.guard import arm, disarm
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
-from rbm_cli.models.rbm.exact.model import ExactModel, exact_model, new_cache
+from rbm_cli.models.rbm.exact.model import new_cache
 from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.rbm.exact.run import run_exact
 from rbm_cli.models.rbm.forcing_arrays import motion_arrays, run_settings
@@ -28,6 +28,7 @@ from rbm_cli.models.status import (
     STOPPED_EARLY,
     end_by_budget,
 )
+from rbm_cli.physics.arrays import ColumnArrays, column_arrays
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -39,7 +40,7 @@ POOL, STACK = 256, 128
 class PreparedExact(NamedTuple):
     """A model's arrays and its cache of modes, made once per column."""
 
-    arrays: ExactModel
+    arrays: ColumnArrays
     cache: tuple
 
 
@@ -47,7 +48,7 @@ def prepare_exact(model: Model) -> PreparedExact:
     """The arrays and an empty cache of modes of a model the exact method takes
     (RbmError in one line otherwise)."""
     check_exact(model, "free")
-    return PreparedExact(exact_model(model), new_cache(model.n))
+    return PreparedExact(column_arrays(model), new_cache(model.n))
 
 
 def _outcome(code, st, cnt, maxima, fric, solver, n: int) -> Outcome:

@@ -1,46 +1,12 @@
-"""The model as the exact integrator reads it: its arrays (made once per column), the
-empty cache of modes, and the energy of a monolith (numba)."""
+"""What the exact integrator keeps besides the column's arrays (rbm_cli.physics.arrays):
+the empty cache of modes, and the energy of a monolith (numba)."""
 
 from __future__ import annotations
-
-import math
-from collections import namedtuple
 
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.pieces import law_potential, rest_levels
-from rbm_cli.physics.equations import Model, event_families
-from rbm_cli.physics.law import law_arrays
-
-ExactModel = namedtuple(
-    "ExactModel",
-    "n mass chol linv ground diff_t argmap gravity gf_theta edges nedges intercepts slopes "
-    "rigid silent tu c_ratio arg_inv imp_dir imp_w restitution rigid_mono uplift_level "
-    "rest_rate barrier centre masses normal_forces",
-)
-
-
-def exact_model(model: Model) -> ExactModel:
-    """The arrays of a model the compiled exact integrator reads (made once per column)."""
-    n = model.n
-    col = model.column
-    tu = col.rotation_capacity
-    edges, nedges, intercepts, slopes, rigid = law_arrays(model.laws)
-    chol = np.linalg.cholesky(model.mass)
-    args, cmap, top = event_families(model)
-    gf = np.vstack([args, cmap, top[None, :]])
-    directions, w = model.impulse_directions
-    level, rest_rate, barrier = rest_levels(model)
-    return ExactModel(
-        n, model.mass.copy(), chol, np.linalg.inv(chol), model.ground_load.copy(),
-        np.ascontiguousarray(model.diff.T), model.arg_map.copy(), model.gravity.copy(), gf,
-        edges, nedges, intercepts, slopes, rigid, model.silent_impacts.copy(), tu.copy(),
-        float(model.collapse_ratio), model.arg_inverse.copy(), directions.copy(),
-        np.asarray(w, dtype=float), float(model.restitution), level is not None,
-        math.nan if level is None else float(level), rest_rate, barrier,
-        model.centre_map.copy(), col.masses.copy(), col.normal_forces.copy(),
-    )  # fmt: skip
+from rbm_cli.models.rbm.pieces import law_potential
 
 
 def new_cache(n: int) -> tuple:

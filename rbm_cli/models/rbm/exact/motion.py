@@ -3,7 +3,8 @@ closed-form forcing (Forcing), and what it refuses.
 
 A sampled record (times t_k, accelerations a_k) is exact per sample interval as a
 piecewise-linear forcing, as Nigam and Jennings integrate response spectra:
-sampled_segments turns it into one 'linear' segment per interval. The sine pulses
+forcing_arrays.record_arrays turns it into one 'linear' segment per interval
+(sampled_segments for samples given by the caller). The sine pulses
 (half-sine, one-sine, cycloidal: a sine of phase 0 or pi/2 on [0, pulse_end]) are one
 harmonic segment, then free motion.
 
@@ -22,7 +23,6 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.physics.equations import Model
-from rbm_cli.physics.excitation import GroundMotion
 
 #: Ground motions the exact integrator takes: sines (one harmonic forcing a segment) and
 #: records (one linear forcing a sample interval).
@@ -86,21 +86,6 @@ def check_exact(model: Model, kind: str, vertical: bool = False) -> None:
         raise RbmError(reason)
 
 
-def forcing_segments(motion: GroundMotion) -> list[tuple[float, float, Forcing]]:
-    """(start [s], end [s], forcing) of the motion's smooth segments: a record's per
-    sample interval (record_segments), a sine's per segment of the motion."""
-    if motion.kind == "record":
-        return record_segments(motion)
-    out = []
-    for start, end in motion.segments():
-        if motion.forced(start):
-            forcing = Forcing("harmonic", motion.amplitude, motion.omega, motion.phase)
-        else:
-            forcing = Forcing("zero")
-        out.append((start, end, forcing))
-    return out
-
-
 def sampled_segments(
     times: np.ndarray, accel: np.ndarray, t_end: float
 ) -> list[tuple[float, float, Forcing]]:
@@ -122,29 +107,11 @@ def sampled_segments(
     return out
 
 
-def record_segments(motion: GroundMotion) -> list[tuple[float, float, Forcing]]:
-    """Segments of a record motion: rest up to its first sample, one linear forcing per
-    sample interval of positive length (a time written twice is a jump), then free
-    motion, split at pulse_end [s] (the free motion after the record starts there)."""
-    knots, values = np.asarray(motion.knots, dtype=float), np.asarray(motion.values, float)
-    inner = [s for s in sampled_segments(knots, values, motion.t_end) if s[2].kind == "linear"]
-    cuts = sorted({0.0, float(knots[0]), float(knots[-1]), motion.pulse_end, motion.t_end})
-    out = []
-    for a, b in zip(cuts[:-1], cuts[1:], strict=False):
-        if b > a and (b <= knots[0] or a >= knots[-1]) and a < motion.t_end:
-            out.append((a, min(b, motion.t_end), Forcing("zero")))
-    return sorted(out + inner, key=lambda s: s[0])
-
-
-def resolve_segments(model: Model, motion: GroundMotion, segments=None) -> list:
-    """The forcing segments of a run: the motion's (forcing_segments, which checks its kind),
-    or segments given by the caller (a sampled record: sampled_segments), for which the
-    motion gives only its end and kind. A rigid monolith rests until its uplift level is
-    exceeded, found from a harmonic's formula: under a given piecewise-linear forcing it
-    is not supported yet (one-line RbmError)."""
-    if segments is None:
-        check_exact(model, motion.kind, motion.has_vertical)
-        return forcing_segments(motion)
+def given_segments(model: Model, segments) -> list:
+    """Segments given by the caller (a sampled record: sampled_segments) instead of the
+    motion's, checked: a rigid monolith rests until its uplift level is exceeded, found
+    from a harmonic's formula; under a given piecewise-linear forcing it is not supported
+    yet (one-line RbmError)."""
     check_exact(model, "free")
     if model.uplift_level is not None and any(f.kind == "linear" for _, _, f in segments):
         raise RbmError(

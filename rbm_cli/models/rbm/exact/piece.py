@@ -86,7 +86,7 @@ def modes(mdl, cache, k):
     lam_s[i, :] = lam
     phi_s[i, :, :] = phi
     tom_s[i, :, :] = u.T @ mdl.chol.T
-    g_s[i, :] = -(phi.T @ mdl.ground)
+    g_s[i, :] = -(phi.T @ mdl.ground_load)
     return i
 
 
@@ -134,7 +134,7 @@ def make_piece(mdl, cache, side, k, pending, awaiting, fc):
     if int(fc[0]) == HARMONIC:
         elig &= lam >= 4.0 * fc[2] * fc[2]
     w = np.sqrt(np.where(elig, lam, 1.0))
-    gf = mdl.gf_theta @ phi
+    gf = mdl.families @ phi
     sgn, off, fam, silent = _rows(mdl, side, k, pending, awaiting)
     return Piece(lam, phi, tom, f, g, elig, w, gf, np.abs(gf), sgn, off, fam, silent, fc, n,
                  2 * n + 1)  # fmt: skip

@@ -17,7 +17,6 @@ from collections import namedtuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.ground import sine_exceedance
 from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
 from rbm_cli.models.rbm.exact.model import energy1
 from rbm_cli.models.rbm.exact.peaks import NOTES, new_notes, note_interval, settle_peaks
@@ -44,6 +43,7 @@ from rbm_cli.models.status import (
     SURVIVED,
     guard_code,
 )
+from rbm_cli.physics.ground import sine_exceedance
 
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
@@ -92,7 +92,7 @@ def _accel_and_friction(mdl, pc, pts, i, fric):
     ag = f_accel(pc.fc, pts[i, 0])
     for j in range(n):
         from_modes[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
-    friction_demand(ag, 1.0, mdl.centre, pc.phi @ from_modes, mdl.masses, mdl.normal_forces,
+    friction_demand(ag, 1.0, mdl.centre_map, pc.phi @ from_modes, mdl.masses, mdl.normal_forces,
                     fric)  # fmt: skip
 
 
@@ -189,9 +189,9 @@ def _handle(mdl, pc, row, s, se):
         s.cnt[UPLIFTS] += 1
     elif kind == IMPACT:
         s.cnt[IMPACTS] += 1
-        if mdl.restitution < 1.0:
+        if mdl.e_rest < 1.0:
             xdot = mdl.argmap[i] @ s.rate
-            restitute(i, xdot, mdl.restitution, mdl.imp_dir, mdl.imp_w, s.rate)
+            restitute(i, xdot, mdl.e_rest, mdl.impulse_dir, mdl.impulse_w, s.rate)
         if mdl.rigid_mono and abs(s.rate[0]) < mdl.rest_rate:
             s.theta[:] = 0.0
             s.rate[:] = 0.0

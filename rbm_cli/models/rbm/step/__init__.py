@@ -26,7 +26,7 @@ Python that numba compiles: compiled by default, run by Python as written with
 ``solver.implementation: python`` (rbm_cli.base.jit.plain; the same bits, 30-100x
 slower). The modules: step.inputs (the kernel's four typed input records and
 prepare_kernel), step.stepper (the stepper), step.rk (Runge-Kutta), step.events (event
-location), step.state (the state change at an event), models.ground (the excitation),
+location), step.state (the state change at an event), physics.ground (the excitation),
 step.vertical (moving kinks under a vertical record), models.rbm.pieces (the law pieces, as
 the exact integrator keeps them too), models.guard (wall-clock budget and Ctrl-C); this one
 runs a model from Python.
@@ -47,7 +47,6 @@ from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.step.inputs import (
     PreparedModel,
     excitation,
-    model_arrays,
     prepare_kernel,
     solver_settings,
 )
@@ -161,7 +160,6 @@ def warm_up() -> None:
 __all__ = [
     "PreparedModel",
     "integrate",
-    "model_arrays",
     "needs_compile",
     "prepare_kernel",
     "warm_up",

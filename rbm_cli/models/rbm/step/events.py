@@ -2,7 +2,7 @@
 and cubic Hermite dips (as rbm_cli.models.events), the event distances of a state, and the
 linear system and energy of the current law pieces (the pieces themselves:
 rbm_cli.models.rbm.pieces); the moving kinks of a vertical record are step.vertical's (the
-exact uplift time of a rigid block at rest is in models.ground, time-history sampling in
+exact uplift time of a rigid block at rest is in physics.ground, time-history sampling in
 step.rk)."""
 
 from __future__ import annotations
@@ -161,9 +161,15 @@ CHECK_INTERVALS = 8
 
 @jit
 def within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
-    """events.within_reach, row by row: mask[r] marks the rows within reach (only
-    they are searched in first_crossing; the others cannot cross by the same
-    criterion that lets a step with no row within reach go unchecked)."""
+    """Whether an event distance may reach zero inside a step, judged from its values d,
+    rates r and second derivatives a at both ends, with a wide margin; mask[r] marks the
+    rows within reach (only they are searched in first_crossing).
+
+    A row is within reach when min(d0, d1) <= dt (|r0| + |r1|) + dt^2 (|a0| + |a1|).
+    The cubic Hermite of a step's end values moves at most 4/27 dt (|r0| + |r1|) below
+    min(d0, d1), so the margin is several times that; it is not a proof (the interior of a
+    long step is judged from its ends), which is why it is wide. Steps far from every
+    surface (most of them) need no dense output."""
     anyrow = False
     for r in range(d0.size):
         reach = dt * (abs(r0[r]) + abs(r1[r])) + dt * dt * (abs(a0[r]) + abs(a1[r]))

@@ -11,7 +11,7 @@ import numpy as np
 import rbm_cli.models.rbm.step.tableaux as _tb
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.base.jit import jit
-from rbm_cli.models.ground import gravity_factor, ground
+from rbm_cli.physics.ground import gravity_factor, ground
 
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}

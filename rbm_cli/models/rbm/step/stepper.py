@@ -9,7 +9,6 @@ import numpy as np
 
 from rbm_cli.base.detmath import matvec, pow_pos
 from rbm_cli.base.jit import jit
-from rbm_cli.models.ground import ground_at, next_uplift, record_piece
 from rbm_cli.models.guard import POLL_STEPS
 from rbm_cli.models.rbm.pieces import (
     IMPACT,
@@ -31,7 +30,7 @@ from rbm_cli.models.rbm.step.events import (
     system,
     within_reach,
 )
-from rbm_cli.models.rbm.step.inputs import Excitation, ModelArrays, RunTask, SolverSettings
+from rbm_cli.models.rbm.step.inputs import Excitation, RunTask, SolverSettings
 from rbm_cli.models.rbm.step.rk import (
     MAX_FACTOR,
     MIN_FACTOR,
@@ -62,6 +61,8 @@ from rbm_cli.models.status import (
     SURVIVED,
     guard_code,
 )
+from rbm_cli.physics.arrays import ColumnArrays
+from rbm_cli.physics.ground import ground_at, next_uplift, record_piece
 
 
 @jit
@@ -74,7 +75,7 @@ def run_kernel(model, motion, solver, task):
 
     Parameters
     ----------
-    model : tuple  A step.inputs.ModelArrays (step.inputs.prepare_kernel).
+    model : tuple  A physics.arrays.ColumnArrays (step.inputs.prepare_kernel).
     motion : tuple  A step.inputs.Excitation: the ground motion.
     solver : tuple  A step.inputs.SolverSettings: method, tolerances, budgets, deadline.
     task : tuple  A step.inputs.RunTask: initial state, early stop, samples (in place).
@@ -85,7 +86,7 @@ def run_kernel(model, motion, solver, task):
         max_ratio (n,), max_top, friction (n,), n_uplifts, n_impacts, n_steps, n_rhs,
         n_events, n_samples).
     """
-    model, motion = ModelArrays(*model), Excitation(*motion)
+    model, motion = ColumnArrays(*model), Excitation(*motion)
     solver, task = SolverSettings(*solver), RunTask(*task)
     mass, argmap, gravity = model.mass, model.argmap, model.gravity
     edges, nedges, intercepts, slopes = model.edges, model.nedges, model.intercepts, model.slopes
@@ -96,7 +97,7 @@ def run_kernel(model, motion, solver, task):
     amplitude, pulse_end, t_end = motion.amplitude, motion.pulse_end, motion.t_end
     knots, values, vertical, clipped = motion.knots, motion.values, motion.vertical, motion.clipped
     bounds, forced = motion.bounds, motion.forced
-    # the ground (rbm_cli.models.ground): of the motion, and nothing (a free segment); a record
+    # the ground (rbm_cli.physics.ground): of the motion, and nothing (a free segment); a record
     # one straight piece a step (record_piece)
     gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
                motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip

@@ -1,12 +1,11 @@
 """The benchmark's baseline: the RBM as a researcher would first write it.
 
-scipy's ``solve_ivp`` (RK45, rtol 1e-6) called once per smooth piece, with
-terminal events for the law's kinks, the impacts and collapse (one Python
-function per event surface), restarted after each event. The physics is the
-same as the step kernel's (same pieces, same impact rule, same rest of a
-rigid block), so the benchmark compares integrators, not models. Only the
-outcome is kept: status, collapse time and peak rotation ratio (from the
-solver's steps and the event states).
+scipy's ``solve_ivp`` (RK45, rtol 1e-6) called once per smooth piece, with terminal events
+for the law's kinks, the impacts and collapse (one Python function per event surface),
+restarted after each event. The physics is the same as the step kernel's (the same law
+pieces, rbm_cli.models.rbm.pieces, the same impact rule, the same rest of a rigid block),
+so the benchmark compares integrators, not models. Only the outcome is kept: status,
+collapse time and peak rotation ratio (from the solver's steps and the event states).
 """
 
 from __future__ import annotations
@@ -18,11 +17,13 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.models.events import REST_RATE, Pieces
 from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.rbm.pieces import IMPACT, cross, locate, piece_bounds
+from rbm_cli.physics.arrays import rest_levels
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.ground_forms import SINE
+from rbm_cli.physics.ground import SINE
+from rbm_cli.physics.law import law_arrays
 
 #: Tolerances of the baseline (a naive per-cell scipy solve: RK45, rtol 1e-6); atol in units of
 #: theta_u for rotations and 10 theta_u for rates, as rbm's own solver.
@@ -39,7 +40,49 @@ def _event(row, offset):
     return ev
 
 
-def _surfaces(pieces: Pieces, argmap, cmap, c: float, n: int):
+class _Pieces:
+    """The law piece of each interface (side, index, pending: rbm_cli.models.rbm.pieces),
+    with the linear system of each set of pieces met, cached."""
+
+    def __init__(self, model: Model):
+        n = model.n
+        self.model = model
+        self.edges, self.nedges, self.intercepts, self.slopes, self.rigid = law_arrays(model.laws)
+        self.side = np.ones(n, dtype=np.int64)
+        self.k = np.zeros(n, dtype=np.int64)
+        self.pending = np.zeros(n, dtype=np.bool_)
+        self.awaiting = np.zeros(n, dtype=np.bool_)
+        self.silent = np.zeros(n, dtype=np.bool_)  # the baseline stops at every impact
+        self.systems: dict = {}
+        locate(np.zeros(n), np.zeros(n), self.side, self.k, self.pending, self.rigid,
+               self.edges, self.nedges)  # fmt: skip
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The bounds lo, hi [rad] of the law arguments on the current pieces."""
+        n = self.model.n
+        lo, hi = np.empty(n), np.empty(n)
+        for i in range(n):
+            lo[i], hi[i] = piece_bounds(i, self.side, self.k, self.pending, self.rigid,
+                                        self.edges, self.nedges)  # fmt: skip
+        return lo, hi
+
+    def system(self):
+        """(A, c, e) of the current pieces (Model.linear_system)."""
+        key = (tuple(self.side), tuple(self.k))
+        if key not in self.systems:
+            rows = np.arange(self.model.n)
+            self.systems[key] = self.model.linear_system(
+                self.side * self.intercepts[rows, self.k], self.slopes[rows, self.k]
+            )
+        return self.systems[key]
+
+    def cross(self, i: int, going_up: bool) -> bool:
+        """Move interface i to its next piece; whether the crossing is an impact."""
+        return cross(i, going_up, self.side, self.k, self.pending, self.awaiting, self.rigid,
+                     self.silent) == IMPACT  # fmt: skip
+
+
+def _surfaces(pieces: _Pieces, argmap, cmap, c: float, n: int):
     """The event functions of the current pieces.
 
     Returns lo, hi (the pieces' bounds of the law arguments), `events` (4 per interface:
@@ -85,7 +128,7 @@ def _solution_peak(sol, cmap, n: int, n_terminal: int, peak: float) -> float:
     return peak
 
 
-def _cross(model: Model, pieces: Pieces, y, i: int, going_up: bool, bounds, arg_inv, rest_rate):
+def _cross(model: Model, pieces: _Pieces, y, i: int, going_up: bool, bounds, arg_inv, rest_rate):
     """Put interface i's argument on the bound it crossed and move it to its next piece;
     at an impact apply the restitution and put a rigid block slower than rest_rate [rad/s]
     to rest. Returns the state and whether it rests."""
@@ -93,7 +136,7 @@ def _cross(model: Model, pieces: Pieces, y, i: int, going_up: bool, bounds, arg_
     lo, hi = bounds
     bound = hi[i] if going_up else lo[i]
     y[:n] += arg_inv[:, i] * (bound - float(argmap[i] @ y[:n]))
-    if pieces.cross(i, going_up) == "impact":
+    if pieces.cross(i, going_up):
         if model.restitution < 1.0:
             y[n:] = model.impact_rates(y[n:], i)
         if model.uplift_level is not None and abs(y[n]) < rest_rate:
@@ -118,19 +161,17 @@ def baseline_run(model: Model, motion: GroundMotion, budget_s: float = 600.0) ->
     start = time.perf_counter()
     n = model.n
     tu = model.column.rotation_capacity
-    pieces = Pieces(model)
+    pieces = _Pieces(model)
     argmap = model.arg_map
     arg_inv = model.arg_inverse
     cmap = model.collapse_map / model.collapse_limit[:, None]
     c = model.collapse_ratio
     atol = BASELINE_ATOL * np.concatenate([np.full(n, tu.min()), np.full(n, 10 * tu.min())])
-    uplift = model.uplift_level
-    rest_rate = REST_RATE * model.rocking_p * tu.min()
+    uplift, rest_rate, _ = rest_levels(model)
     y = np.zeros(2 * n)
     t = 0.0
     at_rest = uplift is not None
     peak = 0.0
-    pieces.locate(np.zeros(n), np.zeros(n))
     status, t_col = "survived", math.nan
     for seg_start, seg_end in motion.segments():
         forced = motion.forced(seg_start)

@@ -1,0 +1,152 @@
+"""A column's equations as the compiled integrators read them: one record of arrays and
+numbers (:class:`ColumnArrays`), assembled once per column by :func:`column_arrays` and taken
+by the step integrator (rbm_cli.models.rbm.step) and the exact one (rbm_cli.models.rbm.exact)
+alike: the matrices, the laws' pieces (physics.law.law_arrays), the rows of the quantities a
+run watches (physics.equations.event_families) and the levels of the early stop and of a
+rigid block's rest (:func:`rest_levels`).
+
+numba reads the fields of a named tuple of arrays and scalars at no cost; n interfaces, SI
+units, angles in rad.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from rbm_cli.base.detmath import matmul, matvec
+from rbm_cli.base.jit import jit
+from rbm_cli.physics.equations import Model, event_families
+from rbm_cli.physics.law import law_arrays
+
+#: A rigid block whose post-impact rate is below REST_RATE * p * theta_u is
+#: put to rest [assumption]: its next excursion would stay below
+#: (REST_RATE^2 / 2) theta_u = 5e-7 theta_u. This ends Zeno impact sequences
+#: (e < 1) and micro-chatter (e = 1, demand just above uplift) in finite work.
+REST_RATE = 1e-3
+
+
+class ColumnArrays(NamedTuple):
+    """A column as the compiled integrators read it (n interfaces; units SI, angles [rad])."""
+
+    mass: np.ndarray  #: mass matrix M (n, n)
+    chol: np.ndarray  #: its Cholesky factor L, M = L L^T (n, n)
+    linv: np.ndarray  #: the factor's inverse (n, n)
+    argmap: np.ndarray  #: drum rotations -> interface arguments (n, n)
+    arg_inv: np.ndarray  #: its inverse (n, n)
+    gravity: np.ndarray  #: gravity load (n, n)
+    ground_load: np.ndarray  #: ground load vector r (n,)
+    diff_t: np.ndarray  #: the difference matrix's transpose D^T (n, n)
+    edges: np.ndarray  #: kinks of each law [rad], padded with inf (n, max edges)
+    nedges: np.ndarray  #: number of kinks of each law (n,) int
+    intercepts: np.ndarray  #: the laws' pieces: intercepts, padded (n, max edges + 1)
+    slopes: np.ndarray  #: the laws' pieces: slopes, padded (n, max edges + 1)
+    rigid: np.ndarray  #: rigid interfaces (n,) bool
+    silent: np.ndarray  #: silent impacts (Model.silent_impacts) (n,) bool
+    tu: np.ndarray  #: rotation capacity theta_u of each interface [rad] (n,)
+    c_ratio: float  #: collapse ratio [-]
+    e_rest: float  #: coefficient of restitution [-]
+    literal_impact: bool  #: formulation "absolute"
+    impulse_dir: np.ndarray  #: impact impulse directions (n, n)
+    impulse_w: np.ndarray  #: their weights (n,)
+    centre_map: np.ndarray  #: state -> drum centre accelerations (n, n)
+    masses: np.ndarray  #: drum masses [kg] (n,)
+    normal_forces: np.ndarray  #: normal force at each interface [N] (n,)
+    rigid_mono: bool  #: a rigid monolith (it rests until the ground lifts it)
+    uplift_level: float  #: ground acceleration that uplifts a rigid monolith [m/s^2] (-1: none)
+    rest_rate: float  #: rate below which a rigid monolith comes to rest after an impact [rad/s]
+    barrier: float  #: energy barrier of the early stop [J] (NaN unless n = 1)
+    families: np.ndarray  #: watched rows: arguments / theta_u, collapse ratios, top (2n + 1, n)
+    event_rows: np.ndarray  #: event rows: argmap / tu, -argmap / tu, -cmap, cmap (4n, n)
+    gx: np.ndarray  #: event_rows[:n]
+    gc: np.ndarray  #: event_rows[3n:]
+    same: bool  #: gx equals gc (the same rows serve both)
+    md: np.ndarray  #: minv @ diff.T, minv the inverse mass matrix (n, n)
+    mg: np.ndarray  #: minv @ gravity (n, n)
+    track: np.ndarray  #: tracked ratios: the n collapse rows, then the top (n + 1, n)
+    es: np.ndarray  #: -minv @ ground_load (n,)
+    slope_parts: np.ndarray  #: weight and elastic parts of the slopes (2, n, max edges + 1)
+    edge_w: np.ndarray  #: weight share of each kink, 1: fixed (n, max edges), padded with 1
+
+
+def rest_levels(model: Model) -> tuple[float | None, float, float]:
+    """The levels a run compares with, made once per model.
+
+    Returns
+    -------
+    uplift : float or None  Ground acceleration [m/s^2] that uplifts a rigid monolith at rest
+        (Model.uplift_level; None: no rigid monolith).
+    rest_rate : float  Rate [rad/s] below which a rigid monolith comes to rest after an
+        impact: REST_RATE p theta_u (p the rocking frequency [rad/s], theta_u the smallest
+        rotation capacity [rad]).
+    barrier : float  Energy [J] of a monolith at its collapse ratio at rest (the early stop
+        of free motion compares with it); NaN unless n = 1.
+    """
+    tu = model.column.rotation_capacity
+    barrier = math.nan
+    if model.n == 1:
+        barrier = float(model.energy(model.collapse_ratio * tu, np.zeros(1))[0])
+    return model.uplift_level, REST_RATE * model.rocking_p * float(tu.min()), barrier
+
+
+@jit
+def _derived(args, cmap, top, minv, diff, gravity, ground_load):
+    """The step integrator's products of the model's arrays: (event_rows, same, md, mg,
+    track, es), from the event families args, cmap, top."""
+    n = args.shape[0]
+    event_rows = np.empty((4 * n, n))
+    for i in range(n):
+        for j in range(n):
+            event_rows[i, j] = args[i, j]
+            event_rows[n + i, j] = -args[i, j]
+            event_rows[2 * n + i, j] = -cmap[i, j]
+            event_rows[3 * n + i, j] = cmap[i, j]
+    gx, gc = event_rows[:n], event_rows[3 * n :]
+    same = True
+    for i in range(n):
+        for j in range(n):
+            same = same and gx[i, j] == gc[i, j]
+    md = matmul(minv, diff.T.copy())
+    mg = matmul(minv, gravity)
+    track = np.empty((n + 1, n))
+    track[:n, :] = cmap
+    track[n, :] = top
+    es = -matvec(minv, ground_load, np.empty(n))
+    return event_rows, same, md, mg, track, es
+
+
+def column_arrays(model: Model) -> ColumnArrays:
+    """The model's arrays as the compiled integrators read them (assembled once per
+    column)."""
+    col = model.column
+    n = model.n
+    impulse_dir, impulse_w = model.impulse_directions
+    edges, nedges, inter, slopes, rigid = law_arrays(model.laws)
+    args, cmap, top = event_families(model)
+    event_rows, same, md, mg, track, es = _derived(args, cmap, top, model.mass_inv,
+                                          model.diff.astype(float), model.gravity,
+                                          model.ground_load)  # fmt: skip
+    uplift, rest_rate, barrier = rest_levels(model)
+    chol = np.linalg.cholesky(model.mass)
+    return ColumnArrays(
+        mass=model.mass.copy(), chol=chol, linv=np.linalg.inv(chol),
+        argmap=model.arg_map.astype(float), arg_inv=model.arg_inverse.copy(),
+        gravity=model.gravity.copy(), ground_load=model.ground_load.copy(),
+        diff_t=np.ascontiguousarray(model.diff.T), edges=edges, nedges=nedges,
+        intercepts=inter, slopes=slopes, rigid=rigid, silent=model.silent_impacts.copy(),
+        tu=col.rotation_capacity.astype(float), c_ratio=float(model.collapse_ratio),
+        e_rest=float(model.restitution), literal_impact=model.formulation == "absolute",
+        impulse_dir=impulse_dir.copy(), impulse_w=np.asarray(impulse_w, dtype=float),
+        centre_map=model.centre_map.copy(), masses=col.masses.astype(float),
+        normal_forces=col.normal_forces.astype(float), rigid_mono=uplift is not None,
+        uplift_level=-1.0 if uplift is None else float(uplift), rest_rate=float(rest_rate),
+        barrier=float(barrier), families=np.vstack([args, cmap, top[None, :]]),
+        event_rows=event_rows, gx=event_rows[:n], gc=event_rows[3 * n :], same=bool(same),
+        md=md, mg=mg, track=track, es=es, slope_parts=np.stack(model.slope_parts),
+        edge_w=model.edge_weight_shares,
+    )  # fmt: skip
+
+
+__all__ = ["REST_RATE", "ColumnArrays", "column_arrays", "rest_levels"]

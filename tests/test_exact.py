@@ -35,9 +35,8 @@ from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.models.rbm.exact.bounds import FULL, THIRD, empty_bounds, row_lower, track_upper
 from rbm_cli.models.rbm.exact.integrate import integrate_exact
-from rbm_cli.models.rbm.exact.modal import advance, forcing_array
+from rbm_cli.models.rbm.exact.modal import advance
 from rbm_cli.models.rbm.exact.model import new_cache
-from rbm_cli.models.rbm.exact.motion import Forcing, sampled_segments
 from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, point_size, set_point
 from rbm_cli.models.rbm.exact.search import bounds_of
 from rbm_cli.models.rbm.step import integrate
@@ -51,6 +50,7 @@ from rbm_cli.physics.closed_forms import (
 from rbm_cli.physics.excitation import GroundMotion, make_ground_motion
 from rbm_cli.study.simulate import model_from_config, simulate
 
+from .exact_forcing import Forcing, forcing_array
 from .paths import CONFIGS
 
 
@@ -398,8 +398,8 @@ def test_housner_model_refuses_exact_in_one_line():
 
 @pytest.mark.parametrize("implementation", ["python", "compiled"])
 def test_piecewise_linear_forcing_is_exact(implementation):
-    """A sampled record's forcing (piecewise linear, exact.motion.sampled_segments) through
-    the run loop: an elastic monolith from rest under a_g = s t up to t1, then held at
+    """A record (piecewise linear, one linear forcing a sample interval) through the run
+    loop: an elastic monolith from rest under a_g = s t up to t1, then held at
     s t1. theta'' + w^2 theta = -(r / M) a_g gives theta = -(r s / M) [R(t) - R(t - t1)] / w^2
     with R(u) = u - sin(w u) / w for u > 0: the recorded history equals it to 1e-11 of its
     peak, compiled and uncompiled."""
@@ -408,12 +408,12 @@ def test_piecewise_linear_forcing_is_exact(implementation):
     w = 2 * math.pi * model.elastic_frequencies_hz()[0]
     t1, t_end, hold = 0.37, 1.5, 2e-3 * 9.81
     times = np.array([0.0, t1, t_end])
-    segments = sampled_segments(times, np.array([0.0, hold, hold]), t_end)
-    motion = GroundMotion("free", 0.0, 1.0, 0.0, 0.0, t_end)
+    motion = GroundMotion("record", hold, 0.0, 0.0, t_end, t_end, gain=1.0, knots=times,
+                          values=np.array([0.0, hold, hold]))  # fmt: skip
     zeros = np.zeros(1)
     solver = dataclasses.replace(cfg.solver, implementation=implementation)
     out = integrate_exact(model, motion, zeros, zeros, solver, record=True, output_dt=1e-3,
-                          early_stop=False, segments=segments)  # fmt: skip
+                          early_stop=False)  # fmt: skip
     t = np.array([s[0] for s in out.samples])
     theta = np.array([s[1][0] for s in out.samples])
 
@@ -429,15 +429,6 @@ def test_piecewise_linear_forcing_is_exact(implementation):
     tu = model.column.rotation_capacity[0]
     peak = np.abs(c * (ramp(fine) - ramp(fine - t1)) / w**2).max() / tu
     assert peak <= out.max_ratio[0] <= peak * (1 + 1e-9)
-
-
-def test_rigid_monolith_under_a_sampled_forcing_is_refused():
-    cfg = load_config(CONFIGS / "spanos_koh_slender.yaml")
-    model = model_from_config(cfg)
-    segments = sampled_segments(np.array([0.0, 1.0]), np.array([0.0, 1.0]), 2.0)
-    motion = GroundMotion("free", 0.0, 1.0, 0.0, 0.0, 2.0)
-    with pytest.raises(RbmError):
-        integrate_exact(model, motion, np.zeros(1), np.zeros(1), cfg.solver, segments=segments)
 
 
 # ------------------------------------------------------------------ guards of a compiled run

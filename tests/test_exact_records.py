@@ -164,9 +164,9 @@ def test_the_step_method_still_takes_them():
 
 def _record_segments(motion):
     """The oracle: a record's segments as Forcing objects, one per sample interval of
-    positive length (exact.motion.sampled_segments), with rest before the first sample and
+    positive length (exact_forcing.sampled_segments), with rest before the first sample and
     free motion after the last, split at pulse_end."""
-    from rbm_cli.models.rbm.exact.motion import Forcing, sampled_segments
+    from .exact_forcing import Forcing, sampled_segments
 
     knots, values = motion.knots, motion.values
     inner = [s for s in sampled_segments(knots, values, motion.t_end) if s[2].kind == "linear"]
@@ -182,8 +182,9 @@ def test_the_record_arrays_are_the_record_segments():
     objects, one per interval, are the same, a jump (a time written twice) and rest before
     the first sample included."""
     from rbm_cli.models.rbm.forcing_arrays import record_arrays
-    from rbm_cli.models.rbm.forcing_arrays import segment_arrays as _segments
     from rbm_cli.physics.motion import GroundMotion
+
+    from .exact_forcing import segment_arrays as _segments
 
     knots = np.array([0.5, 0.6, 0.7, 0.7, 0.8])
     values = np.array([0.3, -0.2, 0.4, -0.5, 0.1])

@@ -11,17 +11,10 @@ import time
 
 import numpy as np
 
-from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC, LINEAR, ZERO, forcing_array
-from rbm_cli.models.rbm.exact.motion import check_exact, given_segments
+from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC, LINEAR, ZERO
+from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
-
-
-def segment_arrays(segs: list) -> tuple[np.ndarray, np.ndarray]:
-    """(seg_t, seg_fc) of a list of (start [s], end [s], exact.motion.Forcing)."""
-    seg_t = np.array([[s, e] for s, e, _ in segs], dtype=float).reshape(-1, 2)
-    seg_fc = np.array([forcing_array(f) for _, _, f in segs]).reshape(-1, FORCING_SIZE)
-    return seg_t, seg_fc
 
 
 def record_arrays(motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:
@@ -65,16 +58,11 @@ def sine_arrays(motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:
     return seg_t, seg_fc
 
 
-def motion_arrays(
-    model: Model, motion: GroundMotion, segments: list | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """(seg_t, seg_fc) of a run of the exact integrator: the motion's (a record's or a
-    sine's; exact.motion.check_exact refuses what has no closed form in one line), or
-    segments given by the caller (exact.motion.given_segments)."""
-    if segments is None:
-        check_exact(model, motion.kind, motion.has_vertical)
-        return record_arrays(motion) if motion.kind == "record" else sine_arrays(motion)
-    return segment_arrays(given_segments(model, segments))
+def motion_arrays(model: Model, motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:
+    """(seg_t, seg_fc) of a run of the exact integrator: a record's or a sine's segments
+    (exact.motion.check_exact refuses what has no closed form, in one line)."""
+    check_exact(model, motion.kind, motion.has_vertical)
+    return record_arrays(motion) if motion.kind == "record" else sine_arrays(motion)
 
 
 def run_settings(

@@ -25,7 +25,7 @@ intervals, n_rhs the closed-form evaluations of the state.
 Formulations `relative` and `geometric` (symmetric stiffness) only; `absolute` stays with
 the Runge-Kutta methods. Excitations: harmonic, free, the sine pulses (half-sine, one-sine,
 cycloidal) and records, piecewise linear in time, which the closed form takes exactly per
-sample interval (a 'linear' Forcing); motion says what is refused and why.
+sample interval (a 'linear' forcing, forcing_arrays); motion says what is refused and why.
 
 The algorithm is written once, in the Python that numba compiles (run, piece, search,
 bounds, peaks, modal, model); integrate runs it compiled, or uncompiled with

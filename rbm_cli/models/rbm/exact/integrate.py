@@ -80,7 +80,6 @@ def integrate_exact(
     output_dt: float = 0.002,
     early_stop: bool = True,
     prepared: PreparedExact | None = None,
-    segments: list | None = None,
 ) -> Outcome:
     """Integrate one motion of a model from the initial state (theta0 [rad], rate0
     [rad/s]) exactly, piece by piece (rbm_cli.models.rbm.exact): compiled, or its
@@ -98,10 +97,8 @@ def integrate_exact(
     early_stop : bool  Stop free motion once its outcome cannot change
     prepared : PreparedExact, optional  prepare_exact(model), made once by a caller that
         runs one model many times (a sweep); made here when None.
-    segments : list, optional  (start [s], end [s], Forcing) to integrate instead of the
-        motion's segments (rbm_cli.models.rbm.exact.motion.sampled_segments)
     """
-    seg_t, seg_fc = motion_arrays(model, motion, segments)
+    seg_t, seg_fc = motion_arrays(model, motion)
     if prepared is None:
         prepared = prepare_exact(model)
     n = model.n
@@ -137,20 +134,18 @@ def needs_compile() -> bool | None:
 def warm_up() -> None:
     """Compile (or load from the cache) the exact integrator once, e.g. in a worker: a
     rigid monolith and an elastic 2-drum column (their model arrays type differently),
-    under a harmonic and a linear forcing."""
+    under a harmonic and a record (a harmonic and a linear forcing)."""
     from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig, StiffnessConfig
-    from rbm_cli.models.rbm.exact.motion import sampled_segments
     from rbm_cli.physics.column import build_column
     from rbm_cli.physics.equations import build_model
 
-    motion = GroundMotion("harmonic", 5.0, 6.0, 0.0, 0.1, 0.1)
-    segments = sampled_segments(np.array([0.0, 0.1]), np.array([0.0, 5.0]), 0.1)
+    knots = np.array([0.0, 0.05, 0.1])
+    record = GroundMotion("record", 5.0, 0.0, 0.0, 0.1, 0.1, gain=1.0, knots=knots,
+                          values=np.array([0.0, 5.0, -5.0]))  # fmt: skip
     elastic = InterfaceConfig(stiffness=StiffnessConfig("normal", (5e9,)))
     for drums, interface in (((2.0,), InterfaceConfig()), ((1.0, 1.0), elastic)):
         geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=drums)
         model = build_model(build_column(geometry, interface))
         zeros = np.zeros(model.n)
-        integrate_exact(model, motion, zeros, zeros, SolverConfig())
-        if model.uplift_level is None:  # a rigid monolith is refused a given linear forcing
-            integrate_exact(model, motion, zeros, zeros, SolverConfig(),
-                                     segments=segments)  # fmt: skip
+        for motion in (GroundMotion("harmonic", 5.0, 6.0, 0.0, 0.1, 0.1), record):
+            integrate_exact(model, motion, zeros, zeros, SolverConfig())

@@ -56,15 +56,6 @@ ZERO, HARMONIC, LINEAR = 0, 1, 2
 FORCING_SIZE = 7
 
 
-def forcing_array(forcing) -> np.ndarray:
-    """The fc array of a Forcing (rbm_cli.models.rbm.exact.motion)."""
-    kind = {"zero": ZERO, "harmonic": HARMONIC, "linear": LINEAR}[forcing.kind]
-    return np.array(
-        [kind, forcing.amplitude, forcing.omega, forcing.phase, forcing.t0, forcing.a0,
-         forcing.a1], dtype=np.float64,
-    )  # fmt: skip
-
-
 @jit
 def f_accel(fc, t):
     """a_g(t) [m/s^2]."""

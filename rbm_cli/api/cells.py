@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config, check_cell, check_output_dt
+from rbm_cli.api.motions import Motion, motion_config
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import RunResult
@@ -68,6 +69,7 @@ def run(
     amplitude_g: float | None = None,
     frequency_hz: float | None = None,
     *,
+    motion: Motion | None = None,
     record: bool = True,
     output_dt: float | None = None,
 ) -> CellRun:
@@ -76,8 +78,15 @@ def run(
     Parameters
     ----------
     config : Config, path or mapping  The config (else loaded with :func:`load_config`)
-    amplitude_g : float  Peak ground acceleration [g], in [0, 1000] (not used by `free`)
-    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by `free`)
+    amplitude_g : float  Peak ground acceleration [g], in [0, 1000] (not used by `free`);
+        of a record or a ``motion``: its PGA after scaling (``excitation.scale: pga``, the
+        default) or a plain scale factor [-] (``scale: factor``)
+    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by `free`,
+        a record or a ``motion``)
+    motion : Motion, optional  A ground motion given as arrays
+        (:func:`motion_from_arrays`), run as a record of the config would be: scaled as
+        the config's record excitation says (another excitation: scale pga, 5 s of free
+        motion after the last sample)
     record : bool  Keep the history, as ``rbm run`` (the run goes on to the end of the
         motion or to collapse); False: as a sweep, stop once the outcome cannot change
     output_dt : float, optional  Sampling interval of the history [s]; default 0.002 s
@@ -103,6 +112,12 @@ def run(
     'collapsed'
     """
     cfg = as_config(config)
+    if motion is not None:
+        if not isinstance(motion, Motion):
+            raise RbmError(
+                f"motion must be a motion (rbm.motion_from_arrays), got {type(motion).__name__}"
+            )
+        cfg = motion_config(cfg, [motion], axis=False)
     amplitude_g, frequency_hz = check_cell(cfg, amplitude_g, frequency_hz)
     output_dt = check_output_dt(cfg, output_dt)
     result = simulate(cfg, amplitude_g, frequency_hz, record=record, output_dt=output_dt)

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.motions import Motion, unique_names
 from rbm_cli.config.types import Axis, GridConfig
 from rbm_cli.config.validate import (
     MAX_GRID_VALUES,
@@ -160,6 +161,11 @@ def _values(value: Any, where: str, path: str, unique: bool = True) -> tuple[Any
         return grid_axis(value, where, unit, lo_open=False, bounds=None)
     if is_number(value) or isinstance(value, str | bool):
         return (value,)
+    if path == "excitation.file" and isinstance(value, Motion):
+        return (value,)
+    if path == "excitation.file" and isinstance(value, list | tuple):
+        if any(isinstance(v, Motion) for v in value):  # motions given as arrays
+            return unique_names(value, where)
     if not isinstance(value, list | tuple) or not value:
         raise ConfigError(
             f"{where} must be a value, a non-empty list, or {{start, stop, step | num}},"

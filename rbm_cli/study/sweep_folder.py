@@ -22,6 +22,7 @@ import numpy as np
 
 from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.motions import storable
 from rbm_cli.config.types import Config, hash_form
 from rbm_cli.study.cells import grid_points, key, max_drums
 from rbm_cli.study.domain import boundary_table, csv_text, domain_frame
@@ -320,7 +321,7 @@ def sweep_meta(
     return {
         "name": config.name,
         "config": config.resolved(),
-        "config_written": config.written,
+        "config_written": storable(config.written),  # a motion given as arrays: its identity
         "config_dir": where,
         "config_hash": digest,
         "solver_method": solver_methods(points),

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -17,8 +18,10 @@ if TYPE_CHECKING:
     import pandas as pd
 
 __all__ = [
+    "DomainComparison",
     "axis_columns",
     "check_regression",
+    "compare",
     "compare_domains",
     "domain_config",
     "draw_domain",
@@ -89,3 +92,68 @@ def plot_domain(
 
     cfg = None if config is None else as_config(config)
     return draw_domain_on(df, ax, cfg, dimensionless=dimensionless, layout=layout, **options)
+
+
+@dataclass(frozen=True)
+class DomainComparison:
+    """What ``rbm compare A B`` reports of two domains, as data.
+
+    n_common : int  Cells in both (matched on amplitude, frequency and any other axes)
+    n_differ : int  Common cells whose collapsed flag differs
+    fraction : float  n_differ / n_common [-] (nan without common cells)
+    only_a, only_b : int  Cells in one domain only
+    max_shift_g : float  Largest |boundary shift| [g]
+    shifts : pandas.DataFrame  One row per boundary line (frequency_hz [Hz], and the other
+        axes' values): boundary_a_g, boundary_b_g, shift_g [g] (a frequency without a
+        collapsed cell: one grid step above the highest amplitude)
+    regression : RegressionCheck or None  The regression rule, when A is an ensemble
+        domain (a ``robust`` column): ``.ok``, ``.summary()``, ``robust_differ`` ...
+    """
+
+    n_common: int
+    n_differ: int
+    fraction: float
+    only_a: int
+    only_b: int
+    max_shift_g: float
+    shifts: pd.DataFrame
+    regression: Any = None
+
+
+def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.PathLike
+            ) -> DomainComparison:  # fmt: skip
+    """Compare two domains cell by cell and boundary by boundary, as ``rbm compare`` does.
+
+    Parameters
+    ----------
+    a, b : pandas.DataFrame or path  Domains (:func:`sweep`'s or :func:`read_domain`'s
+        rows, or a domain.csv); A is the reference
+
+    Returns
+    -------
+    DomainComparison  Counts of cells in common, differing and in one domain only, the
+        boundary shift per line [g], and the regression rule when A has ``robust``
+
+    Raises
+    ------
+    RbmError  A domain that cannot be read (one line)
+
+    Examples
+    --------
+    >>> import pandas as pd, rbm
+    >>> a = pd.DataFrame({"amplitude_g": [0.1, 0.2, 0.3], "frequency_hz": 1.0,
+    ...                   "status": ["survived", "collapsed", "collapsed"]})
+    >>> b = a.assign(status=["survived", "survived", "collapsed"])
+    >>> c = rbm.compare(a, b)
+    >>> c.n_common, c.n_differ, round(c.max_shift_g, 6)  # the boundary moves up 0.1 g
+    (3, 1, 0.1)
+    """
+    frames = [read_domain(x) if isinstance(x, str | os.PathLike) else x for x in (a, b)]
+    for k, df in enumerate(frames):
+        if "collapsed" not in df.columns:
+            frames[k] = df.assign(collapsed=(df["status"] == "collapsed").astype(int))
+    cmp = compare_domains(*frames)
+    rule = check_regression(*frames) if "robust" in frames[0].columns else None
+    return DomainComparison(n_common=cmp.n_common, n_differ=cmp.n_differ, fraction=cmp.fraction,
+                            only_a=cmp.only_a, only_b=cmp.only_b, max_shift_g=cmp.max_shift_g,
+                            shifts=cmp.shifts, regression=rule)  # fmt: skip

@@ -93,13 +93,15 @@ def check_samples(where: str, t: np.ndarray, values: np.ndarray, units: str,
         bad = ~np.isfinite(series)
         if bad.any():
             k = int(np.argmax(bad))
-            raise RbmError(f"{where}: {at(k)}: non-finite value {series[k]!r}")
+            raise RbmError(f"{where}: {at(k)}: non-finite value {float(series[k])!r}")
     if t[0] < 0.0:
-        raise RbmError(f"{where}: {at(0)}: time must be >= 0 [s], got {t[0]!r}")
+        raise RbmError(f"{where}: {at(0)}: time must be >= 0 [s], got {float(t[0])!r}")
     steps = np.diff(t)
     if np.any(steps <= 0.0):
         k = int(np.argmax(steps <= 0.0)) + 1
-        raise RbmError(f"{where}: {at(k)}: time must increase, got {t[k]!r} after {t[k - 1]!r}")
+        raise RbmError(
+            f"{where}: {at(k)}: time must increase, got {float(t[k])!r} after {float(t[k - 1])!r}"
+        )
     _check_peak(where, t, values, UNITS[units])
 
 

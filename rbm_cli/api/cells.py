@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config, check_cell, check_output_dt
 from rbm_cli.api.motions import Motion, motion_config
-from rbm_cli.base.errors import RbmError
+from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import CSV_FIELDS, RunResult
 from rbm_cli.report.plots import plot_history as _plot_history
@@ -201,7 +201,7 @@ def run(
     cfg = as_config(config)
     if motion is not None:
         if not isinstance(motion, Motion):
-            raise RbmError(
+            raise ConfigError(
                 f"motion must be a motion (rbm.motion_from_arrays), got {type(motion).__name__}"
             )
         cfg = motion_config(cfg, [motion], axis=False)

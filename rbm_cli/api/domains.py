@@ -11,8 +11,9 @@ from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config
 from rbm_cli.config.types import Config
-from rbm_cli.study.domain import axis_columns, domain_config, read_domain
+from rbm_cli.study.domain import axis_columns, domain_config
 from rbm_cli.study.domain import compare as compare_domains
+from rbm_cli.study.domain import read_domain as _read_domain
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -108,6 +109,15 @@ class DomainComparison:
         collapsed cell: one grid step above the highest amplitude)
     regression : RegressionCheck or None  The regression rule, when A is an ensemble
         domain (a ``robust`` column): ``.ok``, ``.summary()``, ``robust_differ`` ...
+
+    Examples
+    --------
+    >>> import pandas as pd, rbm
+    >>> a = pd.DataFrame({"amplitude_g": [0.1, 0.3], "frequency_hz": 1.0,
+    ...                   "status": ["survived", "collapsed"]})
+    >>> same = rbm.compare(a, a)
+    >>> isinstance(same, rbm.DomainComparison), same.n_differ, same.max_shift_g
+    (True, 0, 0.0)
     """
 
     n_common: int
@@ -157,3 +167,35 @@ def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.Path
     return DomainComparison(n_common=cmp.n_common, n_differ=cmp.n_differ, fraction=cmp.fraction,
                             only_a=cmp.only_a, only_b=cmp.only_b, max_shift_g=cmp.max_shift_g,
                             shifts=cmp.shifts, regression=rule)  # fmt: skip
+
+
+def read_domain(path: str | os.PathLike) -> pd.DataFrame:
+    """A stored domain (a sweep's domain.csv) as a DataFrame, checked.
+
+    Parameters
+    ----------
+    path : str or path-like  The domain.csv
+
+    Returns
+    -------
+    pandas.DataFrame  One row per cell: amplitude_g [g], frequency_hz [Hz] (empty for a
+        record), status, collapsed (0/1), t_collapse_s [s], collapse_interface (Int64,
+        <NA> without a collapse), max_rotation_ratio [-], max_top_displacement_m [m],
+        the counts (int), and the axes' and scales' columns; the types are those of
+        :func:`sweep`'s frame
+
+    Raises
+    ------
+    RbmError  A missing file, missing columns, a bad value or a cell twice (one line
+        naming the file and line)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> rbm.read_domain("no/such/domain.csv")
+    Traceback (most recent call last):
+    ...
+    rbm_cli.base.errors.RbmError: domain file not found: no/such/domain.csv
+    >>> df = rbm.read_domain("out/block/domain.csv")  # doctest: +SKIP
+    """
+    return _read_domain(path)

@@ -66,7 +66,7 @@ def motion_config(config: Config, motions: Sequence[Motion], *, axis: bool) -> C
     frequencies (a record has none), validated again as a record config is. A record
     config keeps its scale, free time, units and vertical record; another keeps only its
     initial conditions, with the record's defaults (scale: pga, free_time: 5 s)."""
-    motions = unique_names(list(motions), "motions")
+    motions = unique_names(motions, "motions")
     if config.written is None:
         raise ConfigError("a config to run a motion needs the mapping it was written as")
     written = copy.deepcopy(dict(config.written))

@@ -21,7 +21,14 @@ from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.record_files import MAX_SAMPLES, UNITS, check_samples
 from rbm_cli.config.types import G
 
-__all__ = ["Motion", "holds_stored_motions", "motion_from_arrays", "storable", "unique_names"]
+__all__ = [
+    "Motion",
+    "holds_stored_motions",
+    "motion_from_arrays",
+    "named",
+    "storable",
+    "unique_names",
+]
 
 #: What a stored config (meta.json) holds in the place of a motion: its identity, not its
 #: samples (key -> what it says).
@@ -45,6 +52,13 @@ class Motion:
 
     Between samples the acceleration is linear, and 0 before the first and after the
     last, as a record file's (rbm_cli.physics.records).
+
+    Examples
+    --------
+    >>> import rbm
+    >>> m = rbm.motion_from_arrays([0.0, 0.1, 0.2], [0.0, 0.3, 0.0], name="tri")  # [s], [g]
+    >>> isinstance(m, rbm.Motion), m.duration_s, round(m.pga_g, 9), float(m.acceleration_m_s2[1])
+    (True, 0.2, 0.3, 2.943)
     """
 
     __slots__ = ("_a", "_t", "name", "sha256", "units")
@@ -194,6 +208,18 @@ def storable(data: Any) -> Any:
         return {k: storable(v) for k, v in data.items()}
     if isinstance(data, list | tuple):
         return [storable(v) for v in data]
+    return data
+
+
+def named(data: Any) -> Any:
+    """Plain data with each motion replaced by its name (as a config's hash and a domain's
+    rows write it: its samples are in the config's ``grid.records`` by SHA-256)."""
+    if isinstance(data, Motion):
+        return data.name
+    if isinstance(data, Mapping):
+        return {k: named(v) for k, v in data.items()}
+    if isinstance(data, list | tuple):
+        return type(data)(named(v) for v in data)
     return data
 
 

@@ -293,6 +293,13 @@ class Config:
     from (the config file's folder, or the current directory of the time it was parsed),
     so that ``written`` can be validated again as it was:
     ``parse_config(config.written, base_dir=config.base_dir)``.
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "b", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> cfg.column.height, cfg.column.density  # [m], [kg/m^3]
+    (2.0, 2700.0)
     """
 
     name: str

@@ -18,7 +18,10 @@ Keys, by excitation type (a key of another type is refused, naming it):
   ``vertical`` (a second file, same formats and units: the upward ground acceleration,
   scaled by the same factor as the horizontal record; every model takes it).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
-  sets ``ExcitationConfig.duration`` to that.
+  sets ``ExcitationConfig.duration`` to that. A mapping made in Python may give a motion
+  (:class:`rbm_cli.config.motions.Motion`, arrays checked when it was made) in the place
+  of the file, here or among the values of a grid axis over ``excitation.file``: its name
+  stands for the file as written, the SHA-256 of its samples for the file's.
 
 The record file is read and checked when the config is loaded: a missing or malformed file
 is a one-line :class:`~rbm_cli.base.errors.ConfigError` naming the key, the file and the

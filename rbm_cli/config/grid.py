@@ -155,7 +155,8 @@ def _path(key: Any, where: str) -> str:
 
 def _values(value: Any, where: str, path: str, unique: bool = True) -> tuple[Any, ...]:
     """The values of one axis: numbers through grid_axis (lists and ranges), or a list
-    of strings (restitution "housner", excitation.file ...)."""
+    of strings (restitution "housner", excitation.file ...); for excitation.file also
+    motions given as arrays (rbm_cli.config.motions), each name once."""
     unit = VIRTUAL_PATHS.get(path, "")
     if isinstance(value, Mapping):
         return grid_axis(value, where, unit, lo_open=False, bounds=None)

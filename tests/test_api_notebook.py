@@ -39,11 +39,12 @@ def block(**excitation) -> dict:
     }
 
 
-def half_sine(f_hz: float, name: str | None = None) -> rbm.Motion:
-    """A half-sine pulse of frequency f [Hz] and unit peak [g], sampled at N_INTERVALS + 1
-    points over its half period 1/(2f) (its peak, t = 1/(4f), is a sample)."""
+def half_sine(f_hz: float, name: str | None = None, peak_g: float = 1.0) -> rbm.Motion:
+    """A half-sine pulse of frequency f [Hz] and peak ``peak_g`` [g], sampled at
+    N_INTERVALS + 1 points over its half period 1/(2f) (its peak, t = 1/(4f), is a
+    sample)."""
     t = np.linspace(0.0, 0.5 / f_hz, N_INTERVALS + 1)
-    return rbm.motion_from_arrays(t, np.sin(2 * np.pi * f_hz * t), units="g", name=name)
+    return rbm.motion_from_arrays(t, peak_g * np.sin(2 * np.pi * f_hz * t), units="g", name=name)
 
 
 def csv_record(path, t, a):
@@ -63,9 +64,10 @@ def invoke(*args) -> str:
 
 
 def test_a_sampled_half_sine_runs_as_the_half_sine_excitation():
-    """A half-sine given as arrays in g (unit peak, scaled to the cell's PGA as a record's
-    `scale: pga`) gives the outcome of `excitation.type: half-sine` at every cell, and the
-    same collapse time to within a twentieth of the sampling step dt = 1/(2f N).
+    """A half-sine given as arrays in g (peak 0.37 g, scaled to the cell's PGA as a
+    record's `scale: pga`: multiplied by A / 0.37) gives the outcome of
+    `excitation.type: half-sine` at every cell, and the same collapse time to within a
+    twentieth of the sampling step dt = 1/(2f N).
 
     Why that tolerance: between samples the arrays are linear, and a chord of A sin(w t)
     is below it by at most A (w dt)^2 / 8, a fraction (pi/N)^2/8 = 3e-7 of the peak for
@@ -78,7 +80,7 @@ def test_a_sampled_half_sine_runs_as_the_half_sine_excitation():
     for f in (0.5, 1.0, 2.0):  # [Hz]
         dt = 0.5 / f / N_INTERVALS
         cfg = rbm.load_config(block(type="half-sine", duration=0.5 / f + 5.0))
-        motion = half_sine(f, name=f"half-sine {f:g} Hz")
+        motion = half_sine(f, name=f"half-sine {f:g} Hz", peak_g=0.37)
         for a in (1.2 * UPLIFT_G, 2 * UPLIFT_G, 4 * UPLIFT_G, 16 * UPLIFT_G):  # [g]
             pulse = rbm.run(cfg, a, f, record=False)
             given = rbm.run(cfg, a, motion=motion, record=False)
@@ -87,24 +89,24 @@ def test_a_sampled_half_sine_runs_as_the_half_sine_excitation():
             if pulse.status == "collapsed":
                 assert given.t_collapse_s == pytest.approx(pulse.t_collapse_s, abs=dt / 20)
                 assert given.result["collapse_interface"] == 1
-            # the run took the motion's peak as its PGA: a = A g at the pulse's middle
             assert given.config.excitation.type == "record"
     assert outcomes == {"collapsed", "survived"}  # the grid holds both outcomes
 
 
 def test_a_record_config_scales_a_motion_as_it_scales_its_records(tmp_path):
     """A record config with `scale: factor` multiplies the motion by the amplitude, as it
-    would its file: a unit half-sine at factor 16 B/H is the PGA-scaled one at 16 B/H;
-    the same arrays written as a CSV record file run the same cell to the same bits."""
+    would its file: a half-sine of peak 0.37 g at factor L is the PGA-scaled one at
+    0.37 L; the same arrays written as a CSV record file run the same cell to the same
+    bits."""
     f = 1.0
-    motion = half_sine(f, name="hs")
+    motion = half_sine(f, name="hs", peak_g=0.37)
     t, a = motion.time_s.tolist(), (motion.acceleration_m_s2 / G).tolist()
     csv = csv_record(tmp_path / "hs.csv", t, a)
     level = 16 * UPLIFT_G
     from_file = rbm.load_config(block(type="record", file=str(csv), scale="factor"))
     by_file = rbm.run(from_file, level, record=False)
     by_arrays = rbm.run(from_file, level, motion=motion, record=False)
-    by_pga = rbm.run(rbm.load_config(block()), level, motion=motion, record=False)
+    by_pga = rbm.run(rbm.load_config(block()), 0.37 * level, motion=motion, record=False)
     assert by_file.status == "collapsed"
     assert by_arrays.t_collapse_s == by_file.t_collapse_s
     assert by_pga.t_collapse_s == pytest.approx(by_file.t_collapse_s, rel=1e-12)
@@ -231,6 +233,8 @@ def test_motion_names_are_one_per_motion_and_motions_are_read_only():
     assert unnamed.name == "motion-" + unnamed.sha256[:8]
     in_ms2 = rbm.motion_from_arrays([0.0, 0.1], [0.0, 0.2 * G], units="m/s2")
     assert in_ms2.sha256 == unnamed.sha256  # the same samples in SI
+    uneven = rbm.motion_from_arrays([0.5, 0.51, 0.7, 2.0], [0.0, 0.1, -0.2, 0.0])  # as a CSV's
+    assert uneven.duration_s == 2.0 and uneven.pga_g == pytest.approx(0.2)
 
 
 # --------------------------------------------------------------------------- results

@@ -134,6 +134,11 @@ def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.Path
             ) -> DomainComparison:  # fmt: skip
     """Compare two domains cell by cell and boundary by boundary, as ``rbm compare`` does.
 
+    Where ``rbm compare`` refuses two domains that do not cover the same cells (or have
+    none in common), this returns the counts (``only_a``, ``only_b``, ``n_common``) and
+    leaves the judgement to the caller; its limits (``--max-cells``, ``--max-shift``) are
+    comparisons of ``fraction`` and ``max_shift_g``.
+
     Parameters
     ----------
     a, b : pandas.DataFrame or path  Domains (:func:`sweep`'s or :func:`read_domain`'s

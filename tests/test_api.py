@@ -13,6 +13,7 @@ from __future__ import annotations
 import ast
 import doctest
 import math
+import re
 import runpy
 
 import numpy as np
@@ -120,6 +121,7 @@ def test_run_below_the_uplift_level_nothing_moves_far_above_it_collapses():
     assert calm.history["t_s"].iloc[-1] == pytest.approx(cfg.excitation.duration)
     rough = rbm.run(cfg, amplitude_g=10 * UPLIFT_G, frequency_hz=0.5)
     assert rough.status == "collapsed" and rough.result.collapse_interface == 1
+    assert type(rough.result["collapse_interface"]) is int
     # Housner's pulse threshold is passed within the first half-cycle (1 s)
     assert 0.0 < rough.t_collapse_s < 1.0 / 0.5
     assert rough.history["t_s"].iloc[-1] == pytest.approx(rough.t_collapse_s, abs=0.01)
@@ -224,16 +226,41 @@ def test_rbm_is_a_thin_face_of_rbm_cli_api():
     assert rbm.__version__ == rbm_cli.__version__
     for name in rbm.__all__:
         assert getattr(rbm, name) is getattr(rbm_cli.api, name)
-    for name in ("load_config", "with_value", "with_values", "run", "sweep"):
-        doc = getattr(rbm, name).__doc__
-        assert "Examples\n    --------" in doc and ">>> import rbm" in doc, name
+    for name in rbm.__all__:
+        if name == "__version__":
+            continue
+        doc = getattr(rbm, name).__doc__ or ""
+        assert ">>> import" in doc and "rbm" in doc.split(">>> import", 1)[1], name
+        assert re.search(r"\[(g|Hz|s|m|-|kg|N m|rad/s|m/s\^2)\]", doc), name  # units
     for name in ("run", "sweep", "plot_domain"):
         assert "[g]" in rbm.__dict__[name].__doc__ and "[Hz]" in rbm.__dict__[name].__doc__
+    for name in ("load_config", "with_value", "with_values", "run", "sweep", "info",
+                 "motion_from_arrays", "fragility", "compare"):  # fmt: skip
+        doc = getattr(rbm, name).__doc__
+        assert all(part in doc for part in ("Parameters", "Returns", "Examples")), name
+
+
+def public_docstrings() -> list:
+    """Every public name of rbm with a docstring of its own (the classes' and the
+    functions'), and the package itself: the objects whose examples run."""
+    return [rbm] + [getattr(rbm, name) for name in rbm.__all__ if name != "__version__"]
 
 
 def test_the_docstring_examples_run(tmp_path, monkeypatch):
+    """The examples of every public name run (doctest), and leave no files."""
     monkeypatch.chdir(tmp_path)
-    for module in (rbm_cli.api.configs, rbm_cli.api.cells, rbm_cli.api.sweeps, rbm):
+    finder = doctest.DocTestFinder(recurse=False)
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    ran = set()
+    for obj in public_docstrings():
+        for test in finder.find(obj, getattr(obj, "__name__", "rbm"), globs={"rbm": rbm}):
+            if test.examples:
+                ran.add(test.name)
+                runner.run(test)
+    expected = {"rbm"} | {n for n in rbm.__all__ if n != "__version__"}
+    assert expected <= ran, sorted(expected - ran)  # every name has an example
+    assert runner.failures == 0 and runner.tries > 20
+    for module in (rbm_cli.api.configs, rbm_cli.api.cells, rbm_cli.api.sweeps):
         result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
         assert result.failed == 0 and result.attempted > 0, module.__name__
     assert list(tmp_path.iterdir()) == []  # the examples leave no files

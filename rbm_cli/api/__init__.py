@@ -4,15 +4,16 @@ package re-exports them (docs/api.md). Above report (it wires the report's figur
 study's runs), below the CLI, which imports nothing else of the package. Amplitudes in g
 (9.81 m/s^2), frequencies in Hz, times in s, lengths in m.
 
-Modules by surface: configs (load, change, check), cells (one run, ``rbm run``'s folder),
-sweeps (in memory or into a folder), domains (read, compare, draw), info (``rbm info``),
-fragility and bench (imported when those commands run), errors.
+Modules by surface: configs (load, change, check), motions (ground motions given as
+arrays), cells (one run, ``rbm run``'s folder), sweeps (in memory or into a folder),
+domains (read, compare, draw), info (``rbm info``), fragility (its fit imported when one is
+made) and bench (imported when that command runs), errors.
 """
 
 from __future__ import annotations
 
 from rbm_cli import __version__
-from rbm_cli.api.cells import CellRun, plot_history, run
+from rbm_cli.api.cells import CellResult, CellRun, plot_history, run
 from rbm_cli.api.configs import (
     MAX_HISTORY_SAMPLES,
     Config,
@@ -23,21 +24,31 @@ from rbm_cli.api.configs import (
     with_value,
     with_values,
 )
-from rbm_cli.api.domains import plot_domain, read_domain
+from rbm_cli.api.domains import DomainComparison, compare, plot_domain, read_domain
 from rbm_cli.api.errors import ConfigError, RbmError
+from rbm_cli.api.fragility import fragility  # the function, in the place of its module's name
+from rbm_cli.api.info import info  # the function, in the place of its module's name
+from rbm_cli.api.motions import Motion, motion_from_arrays
 from rbm_cli.api.sweeps import SweepInterrupted, run_sweep, sweep
 
 __all__ = [
     "MAX_HISTORY_SAMPLES",
+    "CellResult",
     "CellRun",
     "Config",
     "ConfigError",
+    "DomainComparison",
+    "Motion",
     "RbmError",
     "SweepInterrupted",
     "__version__",
     "check_cell",
     "check_output_dt",
+    "compare",
+    "fragility",
+    "info",
     "load_config",
+    "motion_from_arrays",
     "parse_config",
     "plot_domain",
     "plot_history",

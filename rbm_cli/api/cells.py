@@ -11,9 +11,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config, check_cell, check_output_dt
-from rbm_cli.base.errors import RbmError
+from rbm_cli.api.motions import Motion, motion_config
+from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.types import Config
-from rbm_cli.models.result import RunResult
+from rbm_cli.models.result import CSV_FIELDS, RunResult
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import history_frame
 from rbm_cli.study.simulate import simulate
@@ -22,6 +23,7 @@ if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` 
     import pandas as pd
 
 __all__ = [
+    "CellResult",
     "CellRun",
     "check_run_output",
     "compile_ahead",
@@ -31,22 +33,108 @@ __all__ = [
 ]
 
 
+class CellResult(Mapping):
+    """Every figure of one cell's run, read-only: a mapping and a record at once.
+
+    Keys (and attributes of the same names), in this order: domain.csv's columns of a
+    run, ``amplitude_g`` [g], ``frequency_hz`` [Hz] (None for a record), ``status``
+    ('collapsed', 'survived' or 'failed'), ``t_collapse_s`` [s] (nan if none),
+    ``collapse_interface`` (int, 1 at the ground; None without a collapse),
+    ``max_rotation_ratio`` [-] (the largest rotation over its collapse limit),
+    ``max_top_displacement_m`` [m], ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs``
+    (int), ``message``, then ``friction_demand`` (per interface, max |T/N| [-]),
+    ``wall_time_s`` [s] and ``method``
+    (the method that ran). Whole numbers are ints, real numbers floats.
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> r = rbm.run(cfg, amplitude_g=2.5, frequency_hz=0.5, record=False).result
+    >>> "max_rotation_ratio" in r, r["status"], r.collapse_interface, type(r["n_uplifts"])
+    (True, 'collapsed', 1, <class 'int'>)
+    >>> list(r)[:3]
+    ['amplitude_g', 'frequency_hz', 'status']
+    """
+
+    __slots__ = ("_run", "_values")
+
+    def __init__(self, run: RunResult) -> None:
+        values = {k: getattr(run, k) for k in FIELDS}
+        interface = values["collapse_interface"]
+        values["collapse_interface"] = None if interface is None else int(interface)
+        for k in ("n_uplifts", "n_impacts", "n_steps", "n_rhs"):
+            values[k] = int(values[k])
+        for k in ("amplitude_g", "t_collapse_s", "max_rotation_ratio", "max_top_displacement_m",
+                  "wall_time_s"):  # fmt: skip
+            values[k] = float(values[k])
+        values["friction_demand"] = tuple(float(v) for v in values["friction_demand"])
+        object.__setattr__(self, "_run", run)
+        object.__setattr__(self, "_values", values)
+
+    def __getitem__(self, key: str):
+        return self._values[key]
+
+    def __iter__(self):
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def __getattr__(self, name: str):
+        values = object.__getattribute__(self, "_values")
+        if name in values:
+            return values[name]
+        return getattr(object.__getattribute__(self, "_run"), name)  # history, row(), ...
+
+    def __setattr__(self, name, value):
+        raise AttributeError("a cell's result is read-only")
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{k}={self._values[k]!r}" for k in FIELDS[:6])
+        return f"CellResult({shown}, ...)"
+
+    @property
+    def run_result(self) -> RunResult:
+        """The model's RunResult it was read from (rbm_cli.models.result)."""
+        return self._run
+
+
+#: CellResult's keys, in order: domain.csv's columns of a run (the collapsed flag is
+#: status == 'collapsed'), then figures a domain does not keep.
+FIELDS = tuple(k for k in CSV_FIELDS if k != "collapsed") + (
+    "friction_demand",
+    "wall_time_s",
+    "method",
+)
+
+
 @dataclass(frozen=True)
 class CellRun:
     """One cell's run: its outcome, times and (when recorded) its history.
 
     Attributes
     ----------
-    config : Config  The config it ran
-    result : RunResult  Every figure of the run (rbm_cli.models.result.RunResult): amplitude_g
-        [g], frequency_hz [Hz], max_rotation_ratio [-], max_top_displacement_m [m],
-        n_uplifts, n_impacts, wall_time_s [s], ...
+    config : Config  The config it ran (for a ``motion``: the record config that ran it)
+    result : CellResult  Every figure of the run, a read-only mapping with attribute
+        access: amplitude_g [g], frequency_hz [Hz], max_rotation_ratio [-],
+        max_top_displacement_m [m], collapse_interface (int or None), n_uplifts,
+        n_impacts, wall_time_s [s], ...
     status : str  'collapsed', 'survived' or 'failed'
     t_collapse_s : float  Time of collapse [s]; nan if none
+    history : pandas.DataFrame or None  The history (with ``record=True``)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "block", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> cell = rbm.run(cfg, amplitude_g=0.1, frequency_hz=1.0)
+    >>> cell.status, cell.result["collapse_interface"]
+    ('survived', None)
     """
 
     config: Config
-    result: RunResult
+    result: CellResult
 
     @property
     def status(self) -> str:
@@ -68,6 +156,7 @@ def run(
     amplitude_g: float | None = None,
     frequency_hz: float | None = None,
     *,
+    motion: Motion | None = None,
     record: bool = True,
     output_dt: float | None = None,
 ) -> CellRun:
@@ -76,8 +165,15 @@ def run(
     Parameters
     ----------
     config : Config, path or mapping  The config (else loaded with :func:`load_config`)
-    amplitude_g : float  Peak ground acceleration [g], in [0, 1000] (not used by `free`)
-    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by `free`)
+    amplitude_g : float  Peak ground acceleration [g], in [0, 1000] (not used by `free`);
+        of a record or a ``motion``: its PGA after scaling (``excitation.scale: pga``, the
+        default) or a plain scale factor [-] (``scale: factor``)
+    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by `free`,
+        a record or a ``motion``)
+    motion : Motion, optional  A ground motion given as arrays
+        (:func:`motion_from_arrays`), run as a record of the config would be: scaled as
+        the config's record excitation says (another excitation: scale pga, 5 s of free
+        motion after the last sample)
     record : bool  Keep the history, as ``rbm run`` (the run goes on to the end of the
         motion or to collapse); False: as a sweep, stop once the outcome cannot change
     output_dt : float, optional  Sampling interval of the history [s]; default 0.002 s
@@ -103,10 +199,16 @@ def run(
     'collapsed'
     """
     cfg = as_config(config)
+    if motion is not None:
+        if not isinstance(motion, Motion):
+            raise ConfigError(
+                f"motion must be a motion (rbm.motion_from_arrays), got {type(motion).__name__}"
+            )
+        cfg = motion_config(cfg, [motion], axis=False)
     amplitude_g, frequency_hz = check_cell(cfg, amplitude_g, frequency_hz)
     output_dt = check_output_dt(cfg, output_dt)
     result = simulate(cfg, amplitude_g, frequency_hz, record=record, output_dt=output_dt)
-    return CellRun(config=cfg, result=result)
+    return CellRun(config=cfg, result=CellResult(result))
 
 
 def plot_history(run: CellRun | RunResult, ax=None):
@@ -114,7 +216,7 @@ def plot_history(run: CellRun | RunResult, ax=None):
 
     Parameters
     ----------
-    run : CellRun or RunResult  A recorded run; its collapse time is marked
+    run : CellRun, CellResult or RunResult  A recorded run; its collapse time is marked
     ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
 
     Returns
@@ -130,6 +232,8 @@ def plot_history(run: CellRun | RunResult, ax=None):
     'time [s]'
     """
     result = run.result if isinstance(run, CellRun) else run
+    if isinstance(result, CellResult):
+        result = result.run_result
     if not isinstance(result, RunResult):
         raise RbmError(f"plot_history takes a run, got a value of type {type(run).__name__}")
     if result.history is None:
@@ -172,15 +276,18 @@ def check_run_output(config: Config, output: str | os.PathLike):
     return build_column(config.column, config.interface)
 
 
-def write_run_folder(config: Config, column, result: RunResult, output: str | os.PathLike,
-                     config_path: str | None, amplitude_g: float, frequency_hz: float | None,
-                     output_dt: float | None, figure_process=None) -> Path:  # fmt: skip
+def write_run_folder(config: Config, column, result: RunResult | CellResult,
+                     output: str | os.PathLike, config_path: str | None, amplitude_g: float,
+                     frequency_hz: float | None, output_dt: float | None,
+                     figure_process=None) -> Path:  # fmt: skip
     """Write a run's folder OUTPUT/<name>/run_A<A>_f<F>/ (history.csv, history.png,
     shapes.png, summary.json: rbm_cli.report.run_folder.write_run); returns the folder.
     figure_process: the rbm_cli.report.figure_process.FigureProcess that draws the
     figures, or None to draw them here."""
     from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
 
+    if isinstance(result, CellResult):
+        result = result.run_result
     summary = run_summary(result, config, config_path=config_path, amplitude_g=amplitude_g,
                           frequency_hz=frequency_hz, output_dt=output_dt)  # fmt: skip
     return write_run(

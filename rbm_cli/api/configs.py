@@ -121,6 +121,20 @@ def with_value(config: Config, path: str, value: Any) -> Config:
 
     ``with_value(cfg, path, value)`` is ``with_values(cfg, {path: value})`` (which see).
 
+    Parameters
+    ----------
+    config : Config  A config from :func:`load_config`; it is not changed
+    path : str  A dotted key path (``column.height`` [m], ``interface.restitution`` [-])
+    value : any  The new value, in the config's units
+
+    Returns
+    -------
+    Config  The new config
+
+    Raises
+    ------
+    ConfigError  A malformed path, or a bad value (one line naming its key path)
+
     Examples
     --------
     >>> import rbm

@@ -5,20 +5,24 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config
 from rbm_cli.config.types import Config
-from rbm_cli.study.domain import axis_columns, domain_config, read_domain
+from rbm_cli.study.domain import axis_columns, domain_config
 from rbm_cli.study.domain import compare as compare_domains
+from rbm_cli.study.domain import read_domain as _read_domain
 
 if TYPE_CHECKING:
     import pandas as pd
 
 __all__ = [
+    "DomainComparison",
     "axis_columns",
     "check_regression",
+    "compare",
     "compare_domains",
     "domain_config",
     "draw_domain",
@@ -89,3 +93,114 @@ def plot_domain(
 
     cfg = None if config is None else as_config(config)
     return draw_domain_on(df, ax, cfg, dimensionless=dimensionless, layout=layout, **options)
+
+
+@dataclass(frozen=True)
+class DomainComparison:
+    """What ``rbm compare A B`` reports of two domains, as data.
+
+    n_common : int  Cells in both (matched on amplitude, frequency and any other axes)
+    n_differ : int  Common cells whose collapsed flag differs
+    fraction : float  n_differ / n_common [-] (nan without common cells)
+    only_a, only_b : int  Cells in one domain only
+    max_shift_g : float  Largest |boundary shift| [g]
+    shifts : pandas.DataFrame  One row per boundary line (frequency_hz [Hz], and the other
+        axes' values): boundary_a_g, boundary_b_g, shift_g [g] (a frequency without a
+        collapsed cell: one grid step above the highest amplitude)
+    regression : RegressionCheck or None  The regression rule, when A is an ensemble
+        domain (a ``robust`` column): ``.ok``, ``.summary()``, ``robust_differ`` ...
+
+    Examples
+    --------
+    >>> import pandas as pd, rbm
+    >>> a = pd.DataFrame({"amplitude_g": [0.1, 0.3], "frequency_hz": 1.0,
+    ...                   "status": ["survived", "collapsed"]})
+    >>> same = rbm.compare(a, a)
+    >>> isinstance(same, rbm.DomainComparison), same.n_differ, same.max_shift_g
+    (True, 0, 0.0)
+    """
+
+    n_common: int
+    n_differ: int
+    fraction: float
+    only_a: int
+    only_b: int
+    max_shift_g: float
+    shifts: pd.DataFrame
+    regression: Any = None
+
+
+def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.PathLike
+            ) -> DomainComparison:  # fmt: skip
+    """Compare two domains cell by cell and boundary by boundary, as ``rbm compare`` does.
+
+    Where ``rbm compare`` refuses two domains that do not cover the same cells (or have
+    none in common), this returns the counts (``only_a``, ``only_b``, ``n_common``) and
+    leaves the judgement to the caller; its limits (``--max-cells``, ``--max-shift``) are
+    comparisons of ``fraction`` and ``max_shift_g``.
+
+    Parameters
+    ----------
+    a, b : pandas.DataFrame or path  Domains (:func:`sweep`'s or :func:`read_domain`'s
+        rows, or a domain.csv); A is the reference
+
+    Returns
+    -------
+    DomainComparison  Counts of cells in common, differing and in one domain only, the
+        boundary shift per line [g], and the regression rule when A has ``robust``
+
+    Raises
+    ------
+    RbmError  A domain that cannot be read (one line)
+
+    Examples
+    --------
+    >>> import pandas as pd, rbm
+    >>> a = pd.DataFrame({"amplitude_g": [0.1, 0.2, 0.3], "frequency_hz": 1.0,
+    ...                   "status": ["survived", "collapsed", "collapsed"]})
+    >>> b = a.assign(status=["survived", "survived", "collapsed"])
+    >>> c = rbm.compare(a, b)
+    >>> c.n_common, c.n_differ, round(c.max_shift_g, 6)  # the boundary moves up 0.1 g
+    (3, 1, 0.1)
+    """
+    frames = [read_domain(x) if isinstance(x, str | os.PathLike) else x for x in (a, b)]
+    for k, df in enumerate(frames):
+        if "collapsed" not in df.columns:
+            frames[k] = df.assign(collapsed=(df["status"] == "collapsed").astype(int))
+    cmp = compare_domains(*frames)
+    rule = check_regression(*frames) if "robust" in frames[0].columns else None
+    return DomainComparison(n_common=cmp.n_common, n_differ=cmp.n_differ, fraction=cmp.fraction,
+                            only_a=cmp.only_a, only_b=cmp.only_b, max_shift_g=cmp.max_shift_g,
+                            shifts=cmp.shifts, regression=rule)  # fmt: skip
+
+
+def read_domain(path: str | os.PathLike) -> pd.DataFrame:
+    """A stored domain (a sweep's domain.csv) as a DataFrame, checked.
+
+    Parameters
+    ----------
+    path : str or path-like  The domain.csv
+
+    Returns
+    -------
+    pandas.DataFrame  One row per cell: amplitude_g [g], frequency_hz [Hz] (empty for a
+        record), status, collapsed (0/1), t_collapse_s [s], collapse_interface (Int64,
+        <NA> without a collapse), max_rotation_ratio [-], max_top_displacement_m [m],
+        the counts (int), and the axes' and scales' columns; the types are those of
+        :func:`sweep`'s frame
+
+    Raises
+    ------
+    RbmError  A missing file, missing columns, a bad value or a cell twice (one line
+        naming the file and line)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> rbm.read_domain("no/such/domain.csv")
+    Traceback (most recent call last):
+    ...
+    rbm_cli.base.errors.RbmError: domain file not found: no/such/domain.csv
+    >>> df = rbm.read_domain("out/block/domain.csv")  # doctest: +SKIP
+    """
+    return _read_domain(path)

@@ -1,10 +1,89 @@
-"""Fragility for ``rbm fragility``: a record-suite domain to its fragility files and figures
-(rbm_cli.report.fragility_run.run_fragility). Imports the fit: a command imports this
-module when it runs, not when its help is shown."""
+"""Fragility of a record-suite domain: ``rbm.fragility`` (the fit and its band as data) and
+``rbm fragility`` (its files and figures: rbm_cli.report.fragility_run.run_fragility). The
+fit is imported when one is made, not with the package: ``run_fragility`` and
+``MAX_RESAMPLES`` are read from their modules on first use."""
 
 from __future__ import annotations
 
-from rbm_cli.report.fragility_run import run_fragility
-from rbm_cli.study.fragility import MAX_RESAMPLES
+import os
+from typing import TYPE_CHECKING
 
-__all__ = ["MAX_RESAMPLES", "run_fragility"]
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from rbm_cli.study.fragility import FragilityResult
+
+__all__ = ["MAX_RESAMPLES", "fragility", "run_fragility"]  # noqa: F822 (read on first use)
+
+
+def __getattr__(name: str):
+    if name == "run_fragility":
+        from rbm_cli.report.fragility_run import run_fragility
+
+        return run_fragility
+    if name == "MAX_RESAMPLES":
+        from rbm_cli.study.fragility import MAX_RESAMPLES
+
+        return MAX_RESAMPLES
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def fragility(
+    domain: pd.DataFrame | str | os.PathLike,
+    *,
+    n_resamples: int = 500,
+    seed: int = 0,
+    ci_percentiles: tuple[float, float] = (5.0, 95.0),
+    intensity_column: str | None = None,
+) -> FragilityResult:
+    """The lognormal fragility of a record-suite domain, as data (what ``rbm fragility``
+    computes and writes to fragility.csv, fragility_curve.csv and fragility.json; no file
+    is written here).
+
+    Parameters
+    ----------
+    domain : pandas.DataFrame or path  A domain over records x intensities: the rows of
+        ``rbm.sweep(cfg, motions=[...])``, of a suite config's sweep, or its domain.csv
+        (columns ``record``, an intensity [g] such as ``amplitude_g``, ``status``,
+        ``collapsed``)
+    n_resamples : int  Bootstrap resamples of the records (0: no band, no intervals)
+    seed : int  Seed of the bootstrap (numpy PCG64), 0 to 2**64 - 1
+    ci_percentiles : (float, float)  Percentiles bounding the intervals and the band [%]
+    intensity_column : str, optional  Default: intensity_g, amplitude_g or intensity
+
+    Returns
+    -------
+    FragilityResult  ``fit`` (``median_g`` [g], ``beta`` [-], ``log_likelihood``; None
+        when the runs allow no fit, ``note`` says why), ``median_ci_g`` [g] and
+        ``beta_ci`` (the bootstrap intervals), ``curve`` (a DataFrame: intensity_g [g],
+        probability, lower, upper: the fitted curve and its band), ``table`` (per
+        intensity: intensity_g [g], n_records, n_failed, n_collapsed, fraction, fitted,
+        band_lower, band_upper), n_records, n_runs, n_failed
+
+    Raises
+    ------
+    RbmError  One line: not a suite domain (no ``record`` column), bad rows or options
+
+    Examples
+    --------
+    >>> import pandas as pd, rbm
+    >>> rows = [{"record": r, "amplitude_g": a, "collapsed": int(a >= c)}
+    ...         for r, c in (("r1", 0.3), ("r2", 0.5), ("r3", 0.7)) for a in (0.2, 0.4, 0.6, 0.8)]
+    >>> res = rbm.fragility(pd.DataFrame(rows), n_resamples=0)
+    >>> round(res.fit.median_g, 2), list(res.curve.columns)  # capacities' geometric mean: 0.47
+    (0.48, ['intensity_g', 'probability', 'lower', 'upper'])
+    """  # noqa: E501
+    import pandas as pd
+
+    from rbm_cli.study.fragility import check_options
+    from rbm_cli.study.fragility import fragility as fit
+    from rbm_cli.study.outcomes import prepare_outcomes, read_suite_domain
+
+    check_options(n_resamples, seed, ci_percentiles)
+    if isinstance(domain, str | os.PathLike):
+        domain = read_suite_domain(domain)
+    elif isinstance(domain, pd.DataFrame):
+        domain = domain.copy()
+    prepare_outcomes(domain, intensity_column)  # checked (one line) before the fit
+    return fit(domain, n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
+               intensity_column=intensity_column)  # fmt: skip

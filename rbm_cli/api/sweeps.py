@@ -4,11 +4,12 @@ or into a folder (domain.csv, boundary.csv, domain.png, meta.json)."""
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config
+from rbm_cli.api.motions import Motion, motion_config
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.report.figure_process import DOMAIN_IMPORTS, RUN_IMPORTS, FigureProcess, domain_figure
@@ -55,6 +56,7 @@ def sweep(
     output: str | os.PathLike | None = None,
     *,
     jobs: int = 1,
+    motions: Sequence[Motion] | None = None,
     **options,
 ) -> pd.DataFrame:
     """Run a config's grid and return its domain: the rows of domain.csv.
@@ -66,6 +68,14 @@ def sweep(
         domain.png, meta.json) as ``rbm sweep -o OUTPUT``; None: the sweep runs in memory
         and writes nothing (rbm_cli.study.sweep.sweep_rows)
     jobs : int  Worker processes; 1 (the default) runs in this process
+    motions : list of Motion, optional  Ground motions given as arrays
+        (:func:`motion_from_arrays`, each with its own name), swept as a suite of records
+        is: one row per motion and amplitude (grid.amplitudes: their PGA [g], or scale
+        factors [-] with ``excitation.scale: factor``; grid.frequencies are not used),
+        the motion's name in the ``record`` and ``excitation.file`` columns. They replace
+        the config's ground motion (a record config keeps its scale, free time and
+        vertical record). Their samples' SHA-256 is in the config's hash: a folder sweep
+        (``output``) does not resume over other arrays under the same names
     **options  Other settings of rbm_cli.study.sweep.run_sweep (resume, force, ensemble...);
         without an output folder those of sweep_rows (backend, scheduler, ensemble, force,
         progress, notify)
@@ -90,6 +100,8 @@ def sweep(
     [[0.1, 0.5, 'survived'], [2.5, 0.5, 'collapsed'], [0.1, 1.0, 'survived'], [2.5, 1.0, 'collapsed']]
     """  # noqa: E501
     cfg = as_config(config)
+    if motions is not None:
+        cfg = motion_config(cfg, motions, axis=True)
     if output is None:
         folder_only = sorted(set(options) - set(IN_MEMORY_OPTIONS))
         if folder_only:

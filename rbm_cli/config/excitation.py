@@ -18,7 +18,10 @@ Keys, by excitation type (a key of another type is refused, naming it):
   ``vertical`` (a second file, same formats and units: the upward ground acceleration,
   scaled by the same factor as the horizontal record; every model takes it).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
-  sets ``ExcitationConfig.duration`` to that.
+  sets ``ExcitationConfig.duration`` to that. A mapping made in Python may give a motion
+  (:class:`rbm_cli.config.motions.Motion`, arrays checked when it was made) in the place
+  of the file, here or among the values of a grid axis over ``excitation.file``: its name
+  stands for the file as written, the SHA-256 of its samples for the file's.
 
 The record file is read and checked when the config is loaded: a missing or malformed file
 is a one-line :class:`~rbm_cli.base.errors.ConfigError` naming the key, the file and the
@@ -41,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from rbm_cli.base.errors import ConfigError, RbmError
+from rbm_cli.config.motions import Motion
 from rbm_cli.config.record_files import read_file
 from rbm_cli.config.types import (
     DEFAULT_FREE_TIME,
@@ -120,6 +124,8 @@ class RecordFile:
     sha256 : str  SHA-256 of its bytes (hex)
     end : float  Time of its last sample [s]
     pga : float  Its peak ground acceleration [m/s^2]
+    motion : Motion or None  The motion given as arrays in place of a file (then
+        ``written`` is its name, ``path`` names it in messages, ``sha256`` is its digest)
     """
 
     written: str
@@ -127,6 +133,12 @@ class RecordFile:
     sha256: str
     end: float
     pga: float
+    motion: Motion | None = None
+
+    @property
+    def local_path(self) -> str | None:
+        """The file's absolute path (None for a motion given as arrays)."""
+        return None if self.motion is not None else self.path
 
 
 def resolve_record_path(value: str | os.PathLike, base_dir: str | os.PathLike | None) -> Path:
@@ -160,10 +172,14 @@ def record_file(
     ConfigError  ``<key>: <file>: [line N: ]<problem>`` for a value that is not one path,
         a missing, unreadable or malformed file (record_files' checks).
     """
+    if isinstance(value, Motion):  # arrays given in memory: checked when made
+        acc = value.acceleration_m_s2
+        return RecordFile(value.name, f"motion {value.name!r}", value.sha256, value.duration_s,
+                          float(np.max(np.abs(acc))), motion=value)  # fmt: skip
     if not isinstance(value, str) or not value.strip():
         raise ConfigError(
             f"{key} must be one record file (a path to a PEER NGA .AT2 or a .csv, as a"
-            f" string), got {describe(value)}"
+            f" string) or a motion (rbm.motion_from_arrays), got {describe(value)}"
         )
     try:
         path = resolve_record_path(value, base_dir)
@@ -223,7 +239,8 @@ def with_record(
         type="record",
         file=rec.written,
         file_sha256=rec.sha256,
-        file_path=rec.path,
+        file_path=rec.local_path,
+        motion=rec.motion,
         duration=duration,
     )
 
@@ -317,10 +334,14 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
     )
     rec = record_file(e["file"], "excitation.file", base_dir, units)
     _check_scalable(rec, scale, "excitation.file")
-    fields = dict(file=rec.written, file_sha256=rec.sha256, file_path=rec.path)
+    fields = dict(file=rec.written, file_sha256=rec.sha256, file_path=rec.local_path,
+                  motion=rec.motion)  # fmt: skip
     end = rec.end
     if "vertical" in e:
         ver = record_file(e["vertical"], "excitation.vertical", base_dir, units)
+        if ver.motion is not None:
+            raise ConfigError("excitation.vertical must be a record file; a motion given as"
+                              " arrays is horizontal")  # fmt: skip
         fields.update(vertical=ver.written, vertical_sha256=ver.sha256, vertical_path=ver.path)
         end = max(end, ver.end)
     return dict(

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
+from rbm_cli.config.motions import Motion, unique_names
 from rbm_cli.config.types import Axis, GridConfig
 from rbm_cli.config.validate import (
     MAX_GRID_VALUES,
@@ -154,12 +155,18 @@ def _path(key: Any, where: str) -> str:
 
 def _values(value: Any, where: str, path: str, unique: bool = True) -> tuple[Any, ...]:
     """The values of one axis: numbers through grid_axis (lists and ranges), or a list
-    of strings (restitution "housner", excitation.file ...)."""
+    of strings (restitution "housner", excitation.file ...); for excitation.file also
+    motions given as arrays (rbm_cli.config.motions), each name once."""
     unit = VIRTUAL_PATHS.get(path, "")
     if isinstance(value, Mapping):
         return grid_axis(value, where, unit, lo_open=False, bounds=None)
     if is_number(value) or isinstance(value, str | bool):
         return (value,)
+    if path == "excitation.file" and isinstance(value, Motion):
+        return (value,)
+    if path == "excitation.file" and isinstance(value, list | tuple):
+        if any(isinstance(v, Motion) for v in value):  # motions given as arrays
+            return unique_names(value, where)
     if not isinstance(value, list | tuple) or not value:
         raise ConfigError(
             f"{where} must be a value, a non-empty list, or {{start, stop, step | num}},"

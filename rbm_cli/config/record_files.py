@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 import re
 import stat
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from itertools import chain
 from pathlib import Path
 
@@ -57,9 +57,9 @@ def read_file(
     _check_text(path)
     if kind == "at2":
         t, values, title = read_at2(path)
+        _check_peak(path, t, values, UNITS[units])
     else:
-        (t, values), title = read_csv(path), ""
-    _check_peak(path, t, values, UNITS[units])
+        (t, values), title = read_csv(path, units), ""
     return t, values * UNITS[units], title
 
 
@@ -68,7 +68,7 @@ def read_file(
 MAX_ACCELERATION_G = 1e3
 
 
-def _check_peak(path: Path, t: np.ndarray, values: np.ndarray, unit: float) -> None:
+def _check_peak(path, t: np.ndarray, values: np.ndarray, unit: float) -> None:
     """Refuse a record whose largest |acceleration| is above MAX_ACCELERATION_G (checked in
     the file's units, before the conversion could overflow)."""
     k = int(np.argmax(np.abs(values)))
@@ -79,6 +79,30 @@ def _check_peak(path: Path, t: np.ndarray, values: np.ndarray, unit: float) -> N
             f" units), more than {MAX_ACCELERATION_G:g} g: not a ground motion (check"
             " excitation.units)"
         )
+
+
+def check_samples(where: str, t: np.ndarray, values: np.ndarray, units: str,
+                  at: Callable[[int], str]) -> None:  # fmt: skip
+    """The rules every record's samples meet, whatever they came from (a CSV file, or
+    arrays given in memory): finite times and values, the first time >= 0 [s], times
+    strictly increasing (steps may be uneven, as a CSV's), the largest |value| at most
+    MAX_ACCELERATION_G in ``units`` (a key of UNITS). ``where`` names the record, ``at(k)``
+    the place of sample k in it (``line 12`` of a file, ``sample 3`` of arrays); the
+    RbmError is one line, ``<where>: <at(k)>: <problem>``."""
+    for series in (t, values):
+        bad = ~np.isfinite(series)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise RbmError(f"{where}: {at(k)}: non-finite value {float(series[k])!r}")
+    if t[0] < 0.0:
+        raise RbmError(f"{where}: {at(0)}: time must be >= 0 [s], got {float(t[0])!r}")
+    steps = np.diff(t)
+    if np.any(steps <= 0.0):
+        k = int(np.argmax(steps <= 0.0)) + 1
+        raise RbmError(
+            f"{where}: {at(k)}: time must increase, got {float(t[k])!r} after {float(t[k - 1])!r}"
+        )
+    _check_peak(where, t, values, UNITS[units])
 
 
 def check_file(path: Path) -> None:
@@ -258,8 +282,9 @@ def _at2_npts_dt(path: Path, line4: str) -> tuple[int, float]:
     return npts, dt
 
 
-def read_csv(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Times [s] and accelerations (in the file's units) of a CSV record, checked."""
+def read_csv(path: Path, units: str = "g") -> tuple[np.ndarray, np.ndarray]:
+    """Times [s] and accelerations (in the file's ``units``) of a CSV record, checked
+    (:func:`check_samples`)."""
     times: list[np.ndarray] = []
     accels: list[np.ndarray] = []
     linenos: list[np.ndarray] = []
@@ -296,19 +321,7 @@ def read_csv(path: Path) -> tuple[np.ndarray, np.ndarray]:
     if total < 2:
         raise RbmError(f"{path}: needs at least 2 data rows after the header, has {total}")
     t, a, lines = np.concatenate(times), np.concatenate(accels), np.concatenate(linenos)
-    for values in (t, a):
-        bad = ~np.isfinite(values)
-        if bad.any():
-            k = int(np.argmax(bad))
-            raise RbmError(f"{path}: line {lines[k]}: non-finite value {values[k]!r}")
-    if t[0] < 0.0:
-        raise RbmError(f"{path}: line {lines[0]}: time must be >= 0 [s], got {t[0]!r}")
-    steps = np.diff(t)
-    if np.any(steps <= 0.0):
-        k = int(np.argmax(steps <= 0.0)) + 1
-        raise RbmError(
-            f"{path}: line {lines[k]}: time must increase, got {t[k]!r} after {t[k - 1]!r}"
-        )
+    check_samples(str(path), t, a, units, lambda k: f"line {lines[k]}")
     return t, a
 
 

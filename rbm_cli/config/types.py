@@ -9,6 +9,7 @@ edge of the program; physics code converts with :data:`G`.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 #: Acceleration of gravity [m/s^2] (g = 9.81, the value the paper and the reference blocks use).
 G = 9.81
@@ -135,7 +136,7 @@ class InitialConfig:
 _RECORD_FIELDS = ("file", "file_sha256", "units", "free_time", "scale")
 _VERTICAL_FIELDS = ("vertical", "vertical_sha256")
 _MP_FIELDS = ("gamma", "nu")
-_LOCAL_FIELDS = ("file_path", "vertical_path")
+_LOCAL_FIELDS = ("file_path", "vertical_path", "motion")
 
 
 @dataclass(frozen=True)
@@ -164,6 +165,9 @@ class ExcitationConfig:
     nu : float or None  Mavroeidis-Papageorgiou: phase of the harmonic [rad]
     file_path, vertical_path : str or None  Record: the files' absolute paths (resolved
         against the config's folder); not in :meth:`resolved`, not compared
+    motion : rbm_cli.config.motions.Motion or None  Record: the motion given as arrays in
+        place of a file (then ``file`` is its name and ``file_sha256`` the digest of its
+        samples, which identify it); not in :meth:`resolved`, not compared
     """
 
     type: str = "harmonic"
@@ -181,6 +185,7 @@ class ExcitationConfig:
     vertical_sha256: str | None = None
     file_path: str | None = field(default=None, compare=False)
     vertical_path: str | None = field(default=None, compare=False)
+    motion: Any = field(default=None, compare=False)
 
     def resolved(self) -> dict:
         """The settings that define the motion, as plain data: the fields of other
@@ -288,6 +293,13 @@ class Config:
     from (the config file's folder, or the current directory of the time it was parsed),
     so that ``written`` can be validated again as it was:
     ``parse_config(config.written, base_dir=config.base_dir)``.
+
+    Examples
+    --------
+    >>> import rbm
+    >>> cfg = rbm.load_config({"name": "b", "column": {"height": 2.0, "base_width": 0.5}})
+    >>> cfg.column.height, cfg.column.density  # [m], [kg/m^3]
+    (2.0, 2700.0)
     """
 
     name: str

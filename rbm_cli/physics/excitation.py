@@ -3,7 +3,8 @@
 :func:`make_ground_motion` turns a config's excitation, an amplitude [g] and a frequency
 [Hz] (the grid's, at this edge only) into the :class:`~rbm_cli.physics.motion.GroundMotion`
 every model integrates: a harmonic, a half-sine or near-fault pulse (physics/pulses.py),
-or a record read from its file (physics/records.py) with its vertical record if any.
+or a record read from its file (physics/records.py) or given as arrays
+(rbm_cli.config.motions.Motion), with its vertical record if any.
 """
 
 from __future__ import annotations
@@ -71,7 +72,12 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
     path = excitation.file_path or excitation.file
     if path is None:
         raise RbmError("excitation.file is required for type record")
-    rec = load_record(str(path), excitation.units, excitation.file_sha256)
+    if excitation.motion is not None:  # given as arrays: the same record, from memory
+        motion = excitation.motion
+        path = f"motion {motion.name!r}"
+        rec = Record(motion.time_s, motion.acceleration_m_s2, motion.name, "in memory")
+    else:
+        rec = load_record(str(path), excitation.units, excitation.file_sha256)
     with np.errstate(all="ignore"):  # checked below, with the file named
         if excitation.scale == "pga":
             factor = amplitude_g * G / rec.pga

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from rbm_cli.config.load import parse_config
+from rbm_cli.config.motions import Motion
 from rbm_cli.config.points import GridPoint, expand
 from rbm_cli.config.types import Config
 from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
@@ -60,6 +61,13 @@ def has_records(config: Config) -> bool:
     return config.excitation.type == "record"
 
 
+def record_name(config: Config) -> str:
+    """The name of a record config's record in a domain's ``record`` column: its file's
+    stem, or the name of a motion given as arrays."""
+    motion = config.excitation.motion
+    return motion.name if motion is not None else Path(str(config.excitation.file)).stem
+
+
 def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
     """domain.csv's columns: the axis paths, ``record`` (the record's name, for record
     excitations), the result's ``fields``, the scales."""
@@ -91,9 +99,9 @@ def max_drums(points: list[GridPoint]) -> int:
 def add_point(row: dict, config: Config, cell: Cell, scales=None) -> dict:
     """The row with its point's values and its column's scales."""
     a, f, values = cell
-    row.update(dict(values))
+    row.update({p: str(v) if isinstance(v, Motion) else v for p, v in values})
     if has_records(config):
-        row["record"] = Path(str(config.excitation.file)).stem
+        row["record"] = record_name(config)
     scales = scales or rocking_scales(config)
     row.update(scale_fields(scales, a, f))
     return row
@@ -109,6 +117,7 @@ __all__ = [
     "grid_points",
     "key",
     "max_drums",
+    "record_name",
     "row_key",
     "tasks",
 ]

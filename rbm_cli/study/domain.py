@@ -128,7 +128,37 @@ def parse_domain(source, path: str | Path) -> pd.DataFrame:
     _check_cells(df, path)
     if "collapsed" not in df.columns:
         df["collapsed"] = (df["status"] == "collapsed").astype(int)
+    _set_types(df)
     return df
+
+
+#: domain.csv's columns of whole numbers (a failed run, or a run without collapse for
+#: collapse_interface, leaves them empty) and of real numbers, by name.
+INTEGER_COLUMNS = ("collapsed", "collapse_interface", "n_uplifts", "n_impacts", "n_steps",
+                   "n_rhs", "robust")  # fmt: skip
+FLOAT_COLUMNS = ("t_collapse_s", "max_rotation_ratio", "max_top_displacement_m",
+                 "collapse_fraction", "alpha_rad", "p_rad_s", "static_multiplier",
+                 "a_over_g_alpha", "omega_over_p")  # fmt: skip
+
+
+def _set_types(df: pd.DataFrame) -> None:
+    """The columns' types as domain.csv writes them, in place: whole numbers as int64, or
+    as pandas' nullable Int64 where a field is empty (collapse_interface without a
+    collapse: <NA>, not a float nan); real numbers as float64 (a column whose fields all
+    happen to be whole, max_rotation_ratio = 1 at every collapse, stays float). A column
+    that does not hold such numbers is left as read."""
+    import pandas as pd
+
+    for col in INTEGER_COLUMNS:
+        if col in df.columns and pd.api.types.is_numeric_dtype(df[col]):
+            values = df[col]
+            whole = values.dropna()
+            if len(whole) and not (whole == whole.round()).all():
+                continue
+            df[col] = values.astype("Int64" if values.isna().any() else "int64")
+    for col in FLOAT_COLUMNS:
+        if col in df.columns and pd.api.types.is_numeric_dtype(df[col]):
+            df[col] = df[col].astype("float64")
 
 
 def _check_cells(df: pd.DataFrame, path: Path) -> None:
@@ -325,12 +355,14 @@ def domain_config(domain_csv: str | Path) -> Config | None:
 
     It is the config as the user wrote it (meta.json's ``config_written``), validated
     again: every setting the sweep had (a bullet domain's friction, the solver's
-    settings), none rebuilt from derived values. None when there is no meta.json or it
-    predates ``config_written``; RbmError when the stored config no longer validates.
+    settings), none rebuilt from derived values. None when there is no meta.json, it
+    predates ``config_written``, or the config ran motions given as arrays; RbmError when
+    the stored config no longer validates.
     """
     import json
 
     from rbm_cli.config.load import parse_config
+    from rbm_cli.config.motions import holds_stored_motions
 
     meta = Path(domain_csv).with_name("meta.json")
     try:
@@ -338,8 +370,8 @@ def domain_config(domain_csv: str | Path) -> Config | None:
         written, where = stored.get("config_written"), stored.get("config_dir")
     except (OSError, ValueError, AttributeError):
         return None
-    if not isinstance(written, dict):
-        return None
+    if not isinstance(written, dict) or holds_stored_motions(written):
+        return None  # (motions given as arrays are stored by identity, not samples)
     base = meta.parent / where if isinstance(where, str) else None  # relative record paths
     return parse_config(written, source=str(meta), base_dir=base)
 

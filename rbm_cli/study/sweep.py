@@ -473,7 +473,21 @@ class _Run:
 
 
 class SweepInterrupted(KeyboardInterrupt):
-    """Ctrl-C during a sweep: the finished cells are kept in the journal."""
+    """Ctrl-C during a sweep into a folder: the finished cells are kept in the journal.
+
+    Attributes
+    ----------
+    folder : pathlib.Path  The sweep's folder
+    n_kept, n_cells : int  Cells kept [-], cells of the grid (amplitudes [g] x
+        frequencies [Hz] x other axes) [-]
+    resume_command : str  What finishes it (``rbm.sweep(cfg, output, resume=True)`` does)
+
+    Examples
+    --------
+    >>> import rbm
+    >>> issubclass(rbm.SweepInterrupted, KeyboardInterrupt)  # raised by rbm.sweep(cfg, output=...)
+    True
+    """
 
     def __init__(self, folder: Path, n_kept: int, n_cells: int, resume_command: str):
         self.folder, self.n_kept, self.n_cells = folder, n_kept, n_cells

@@ -22,6 +22,7 @@ import numpy as np
 
 from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.motions import named, storable
 from rbm_cli.config.types import Config, hash_form
 from rbm_cli.study.cells import grid_points, key, max_drums
 from rbm_cli.study.domain import boundary_table, csv_text, domain_frame
@@ -319,8 +320,8 @@ def sweep_meta(
         where = Path(os.path.relpath(config.base_dir, Path(folder).resolve())).as_posix()
     return {
         "name": config.name,
-        "config": config.resolved(),
-        "config_written": config.written,
+        "config": named(config.resolved()),
+        "config_written": storable(config.written),  # a motion given as arrays: its identity
         "config_dir": where,
         "config_hash": digest,
         "solver_method": solver_methods(points),

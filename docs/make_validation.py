@@ -393,7 +393,7 @@ def section2(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         + ("next to the boundary at every alpha" if all_near else "mostly at the boundary")
         + ", i.e. the sensitivity of undamped (e = 1) harmonic "
         "rocking to small differences dominates the linearisation error at this resolution "
-        "(the time-history difference itself grows as alpha^2, README Validation)"
+        "(the time-history difference itself grows as alpha^2, the validation table of the docs)"
     )
     rep(
         f"**What it shows:** the cells that differ go from {pc[0]:.1f} % at alpha "

@@ -117,8 +117,9 @@ def cli_rst() -> str:
     """reStructuredText of every command: usage, help, and a table of its parameters."""
     group = cli_group()
     lines: list[str] = []
-    top = click.Context(group, info_name="rbm", terminal_width=88, max_content_width=88,
-                        **group.context_settings)
+    top = click.Context(
+        group, info_name="rbm", terminal_width=88, max_content_width=88, **group.context_settings
+    )
     lines += ["The ``rbm`` command", "-" * 19, "", "::", ""]
     lines += ["   " + line for line in group.get_help(top).splitlines()]
     lines.append("")
@@ -185,8 +186,7 @@ def _defaults() -> dict[str, str]:
             value = f.default
             if value is None or value == ():
                 continue
-            text = fmt(value) if isinstance(value, float) and not isinstance(value, bool) else (
-                f"{value:,}".replace(",", "_") if isinstance(value, int) else str(value))  # fmt: skip
+            text = fmt(value) if isinstance(value, float) else str(value)
             out[f"{prefix}.{f.name}" if prefix else f.name] = text
     return out
 
@@ -221,8 +221,7 @@ def _ranges() -> dict[str, str]:
     return {
         "model": one_of(t.MODELS),
         "column.height": f"[{fmt(HEIGHT_RANGE[0])}, {fmt(HEIGHT_RANGE[1])}]",
-        "column.base_width": f"> 0, <= height; in [{fmt(LENGTH_RANGE[0])}, "
-        f"{fmt(LENGTH_RANGE[1])}]",
+        "column.base_width": f"> 0, <= height; in [{fmt(LENGTH_RANGE[0])}, {fmt(LENGTH_RANGE[1])}]",
         "column.top_width": f"<= {fmt(MAX_TOP_TAPER)} x base_width and <= height; "
         f">= {fmt(LENGTH_RANGE[0])}",
         "column.section": one_of(t.SECTIONS),
@@ -242,10 +241,8 @@ def _ranges() -> dict[str, str]:
         "excitation.units": one_of(t.RECORD_UNITS),
         "excitation.scale": one_of(t.RECORD_SCALES),
         "excitation.free_time": f"[0, {fmt(MAX_DURATION)}]",
-        "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, "
-        "one per drum",
-        "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, "
-        "one per drum",
+        "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, one per drum",
+        "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, one per drum",
         "grid.amplitudes": f"[{fmt(AMPLITUDE_RANGE_G[0])}, {fmt(AMPLITUDE_RANGE_G[1])}]",
         "grid.frequencies": f"[{fmt(FREQUENCY_RANGE_HZ[0])}, {fmt(FREQUENCY_RANGE_HZ[1])}]",
         "grid.<key path>": f"at most {MAX_CELLS:,} cells in all",
@@ -262,97 +259,188 @@ def _ranges() -> dict[str, str]:
 #: An empty allowed text takes the one :func:`_ranges` writes from the code.
 KEY_DOCS: dict[str, tuple[str, str, str]] = {
     "name": ("", "letters, digits, ``_ - .`` (1-100)", "Required. The output folder's name."),
-    "model": ("", "", "``rbm`` the Rigid Beam Model; ``housner`` Housner's exact block (large "
-              "rotations, true geometry); ``housner-linear`` the piecewise-linear block of "
-              "Spanos and Koh; both monolithic only; ``bullet`` the rigid-body contact "
-              "engine (any drums; it ignores the joint law's stiffness, xi, restitution "
-              "and formulation)."),
+    "model": (
+        "",
+        "",
+        "``rbm`` the Rigid Beam Model; ``housner`` Housner's exact block (large "
+        "rotations, true geometry); ``housner-linear`` the piecewise-linear block of "
+        "Spanos and Koh; both monolithic only; ``bullet`` the rigid-body contact "
+        "engine (any drums; it ignores the joint law's stiffness, xi, restitution "
+        "and formulation).",
+    ),
     "column.height": ("m", "", "Required. Height H of the column."),
     "column.base_width": ("m", "", "Required. Width B_1 at the base."),
-    "column.top_width": ("m", "", "Width at the top; the width tapers linearly. Default: "
-                         "base_width."),
+    "column.top_width": (
+        "m",
+        "",
+        "Width at the top; the width tapers linearly. Default: base_width.",
+    ),
     "column.section": ("", "", "``circular``: the width is the diameter."),
     "column.depth": ("m", "", "Out-of-plane depth. Default: the local width (square drums)."),
     "column.density": ("kg/m^3", "", "Density of the stone."),
-    "column.drums": ("", "", "Count of equal drums, or the list of drum heights [m]. "
-                     "Default 1."),
+    "column.drums": ("", "", "Count of equal drums, or the list of drum heights [m]. Default 1."),
     "interface": ("", "", ""),
-    "interface.stiffness": ("", "``rigid``, ``{rotational: K_M}`` or ``{normal: k_n}``",
-                            "Joint stiffness. ``rigid`` (monolithic columns only) is the "
-                            "default. A bare number is refused: it does not say which of "
-                            "the two it is."),
-    "interface.stiffness.rotational": ("N m/rad", "", "K_M of every joint, or a list with "
-                                       "one per interface."),
-    "interface.stiffness.normal": ("Pa/m", "", "k_n; K_M,i = k_n depth_i B_i^3 / 12 "
-                                   "(rectangle), k_n pi B_i^4 / 64 (circle). ``rbm info`` "
-                                   "prints both."),
+    "interface.stiffness": (
+        "",
+        "``rigid``, ``{rotational: K_M}`` or ``{normal: k_n}``",
+        "Joint stiffness. ``rigid`` (monolithic columns only) is the "
+        "default. A bare number is refused: it does not say which of "
+        "the two it is.",
+    ),
+    "interface.stiffness.rotational": (
+        "N m/rad",
+        "",
+        "K_M of every joint, or a list with one per interface.",
+    ),
+    "interface.stiffness.normal": (
+        "Pa/m",
+        "",
+        "k_n; K_M,i = k_n depth_i B_i^3 / 12 "
+        "(rectangle), k_n pi B_i^4 / 64 (circle). ``rbm info`` "
+        "prints both.",
+    ),
     "interface.xi": ("", "(0, 1]", "1: bilinear law; < 1: tri-linear (a plateau at xi M_u)."),
-    "interface.restitution": ("", "(0, 1] or ``housner`` (monolithic only)",
-                              "Ratio of angular velocities after and before an impact."),
-    "interface.formulation": ("", "", "Which rotation the joint law reads: ``relative`` "
-                              "(theta_i - theta_(i-1)), ``absolute`` (theta_i, the paper's "
-                              "literal wording), ``geometric`` (the law without its "
-                              "rigid-stack P-Delta; gravity through the displaced drums)."),
-    "interface.friction": ("", "", "Coulomb coefficient of every joint and the base; "
-                           "``model: bullet`` only."),
-    "excitation.type": ("", "", "The ground motion: harmonic, half-sine, free motion, the "
-                        "near-fault pulses, or a record file."),
-    "excitation.duration": ("s", "", "Simulated time. Half-sine and pulses: the maximum "
-                            "(the whole pulse is always simulated). Not for ``record``."),
+    "interface.restitution": (
+        "",
+        "(0, 1] or ``housner`` (monolithic only)",
+        "Ratio of angular velocities after and before an impact.",
+    ),
+    "interface.formulation": (
+        "",
+        "",
+        "Which rotation the joint law reads: ``relative`` "
+        "(theta_i - theta_(i-1)), ``absolute`` (theta_i, the paper's "
+        "literal wording), ``geometric`` (the law without its "
+        "rigid-stack P-Delta; gravity through the displaced drums).",
+    ),
+    "interface.friction": (
+        "",
+        "",
+        "Coulomb coefficient of every joint and the base; ``model: bullet`` only.",
+    ),
+    "excitation.type": (
+        "",
+        "",
+        "The ground motion: harmonic, half-sine, free motion, the "
+        "near-fault pulses, or a record file.",
+    ),
+    "excitation.duration": (
+        "s",
+        "",
+        "Simulated time. Half-sine and pulses: the maximum "
+        "(the whole pulse is always simulated). Not for ``record``.",
+    ),
     "excitation.phase": ("rad", "", "Phase of a harmonic excitation."),
     "excitation.initial": ("", "", "Initial state of the drums."),
     "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),
     "excitation.initial.velocities": ("rad/s", "", "Angular velocity of each drum at t = 0."),
-    "excitation.file": ("", "a file, a list of files, a folder or a glob",
-                        "``record`` only: a PEER NGA ``.AT2`` or CSV (time [s], "
-                        "acceleration) file, relative to the config's folder. Several files "
-                        "are a suite: the grid axis ``excitation.file``."),
-    "excitation.units": ("", "", "``record`` only: the CSV's acceleration unit (an "
-                         "``.AT2`` is in g)."),
-    "excitation.free_time": ("s", "", "``record`` only: free motion simulated after the "
-                             "record's last sample."),
-    "excitation.scale": ("", "", "``record`` only: ``pga`` the grid amplitude is the scaled "
-                         "record's PGA [g]; ``factor`` a plain scale factor."),
-    "excitation.gamma": ("", "", "``mavroeidis-papageorgiou`` only: the pulse's gamma. "
-                         "Required there."),
-    "excitation.nu": ("rad", "", "``mavroeidis-papageorgiou`` only: the pulse's phase nu. "
-                      "Required there."),
-    "excitation.vertical": ("", "a file", "``record`` only: the ground's upward "
-                            "acceleration, scaled as the horizontal record; every weight "
-                            "then acts with g + a_v(t)."),
-    "grid.amplitudes": ("g", "", "A value, a list, or ``{start, stop, step}`` / "
-                        "``{start, stop, num}`` (stop included). Peak ground acceleration; "
-                        "a record's PGA (``scale: pga``)."),
+    "excitation.file": (
+        "",
+        "a file, a list of files, a folder or a glob",
+        "``record`` only: a PEER NGA ``.AT2`` or CSV (time [s], "
+        "acceleration) file, relative to the config's folder. Several files "
+        "are a suite: the grid axis ``excitation.file``.",
+    ),
+    "excitation.units": (
+        "",
+        "",
+        "``record`` only: the CSV's acceleration unit (an ``.AT2`` is in g).",
+    ),
+    "excitation.free_time": (
+        "s",
+        "",
+        "``record`` only: free motion simulated after the record's last sample.",
+    ),
+    "excitation.scale": (
+        "",
+        "",
+        "``record`` only: ``pga`` the grid amplitude is the scaled "
+        "record's PGA [g]; ``factor`` a plain scale factor.",
+    ),
+    "excitation.gamma": (
+        "",
+        "",
+        "``mavroeidis-papageorgiou`` only: the pulse's gamma. Required there.",
+    ),
+    "excitation.nu": (
+        "rad",
+        "",
+        "``mavroeidis-papageorgiou`` only: the pulse's phase nu. Required there.",
+    ),
+    "excitation.vertical": (
+        "",
+        "a file",
+        "``record`` only: the ground's upward "
+        "acceleration, scaled as the horizontal record; every weight "
+        "then acts with g + a_v(t).",
+    ),
+    "grid.amplitudes": (
+        "g",
+        "",
+        "A value, a list, or ``{start, stop, step}`` / "
+        "``{start, stop, num}`` (stop included). Peak ground acceleration; "
+        "a record's PGA (``scale: pga``).",
+    ),
     "grid.frequencies": ("Hz", "", "As amplitudes. Not needed for records or free motion."),
-    "grid.linked": ("", "a list of mappings of key paths to lists of one length",
-                    "Axes that vary together (e.g. ``column.height`` with "
-                    "``column.base_width``)."),
-    "grid.column.size": ("m", "> 0", "Virtual axis: the height of a geometrically similar "
-                         "column (every length scaled by size / height)."),
-    "grid.column.slenderness": ("", "> 0", "Virtual axis: H / B_1 (top width and depth "
-                                "scale with the base width)."),
-    "grid.<key path>": ("the key's", "", "An axis over any config key inside a section, "
-                        "named by its dotted path (``column.height``, "
-                        "``interface.restitution``, ``column.drums``, ``excitation.file`` "
-                        "...); values as amplitudes, a range may add ``spacing: log``. "
-                        "``name`` and ``model`` cannot vary."),
-    "collapse.ratio": ("", "(0, 1]", "Collapse when the quantity the law reads reaches "
-                       "ratio x its limit."),
-    "solver.method": ("", "", "``auto``: the rigid block's compiled closed form where it "
-                      "applies, DOP853 elsewhere; ``DOP853``, ``RK45``, ``RK23`` the step "
-                      "integrator; ``closed-form`` the rigid block; ``exact`` closed-form "
-                      "integration of the linear pieces (see the user guide)."),
+    "grid.linked": (
+        "",
+        "a list of mappings of key paths to lists of one length",
+        "Axes that vary together (e.g. ``column.height`` with ``column.base_width``).",
+    ),
+    "grid.column.size": (
+        "m",
+        "> 0",
+        "Virtual axis: the height of a geometrically similar "
+        "column (every length scaled by size / height).",
+    ),
+    "grid.column.slenderness": (
+        "",
+        "> 0",
+        "Virtual axis: H / B_1 (top width and depth scale with the base width).",
+    ),
+    "grid.<key path>": (
+        "the key's",
+        "",
+        "An axis over any config key inside a section, "
+        "named by its dotted path (``column.height``, "
+        "``interface.restitution``, ``column.drums``, ``excitation.file`` "
+        "...); values as amplitudes, a range may add ``spacing: log``. "
+        "``name`` and ``model`` cannot vary.",
+    ),
+    "collapse.ratio": (
+        "",
+        "(0, 1]",
+        "Collapse when the quantity the law reads reaches ratio x its limit.",
+    ),
+    "solver.method": (
+        "",
+        "",
+        "``auto``: the rigid block's compiled closed form where it "
+        "applies, DOP853 elsewhere; ``DOP853``, ``RK45``, ``RK23`` the step "
+        "integrator; ``closed-form`` the rigid block; ``exact`` closed-form "
+        "integration of the linear pieces (see the user guide).",
+    ),
     "solver.rtol": ("", "[1e-13, 1e-3]", "Relative tolerance of the step integrator."),
-    "solver.atol": ("", "(0, 1e-3]", "Absolute tolerance, relative to theta_u (rates: "
-                    "10 theta_u)."),
+    "solver.atol": (
+        "",
+        "(0, 1e-3]",
+        "Absolute tolerance, relative to theta_u (rates: 10 theta_u).",
+    ),
     "solver.max_steps": ("", "", "Step budget of one run: beyond it the run is ``failed``."),
-    "solver.max_events": ("", "", "Event budget of one run: beyond it the run is "
-                          "``failed``."),
+    "solver.max_events": ("", "", "Event budget of one run: beyond it the run is ``failed``."),
     "solver.time_step": ("s", "", "The contact engine's fixed step (``model: bullet``)."),
-    "solver.implementation": ("", "", "``python`` runs the compiled source uncompiled, for "
-                              "debugging (the same bits, 30-100x slower)."),
-    "solver.max_wall_time": ("s", "", "Wall-clock budget of one run; beyond it the run is "
-                             "``failed``. Not part of the config's hash."),
+    "solver.implementation": (
+        "",
+        "",
+        "``python`` runs the compiled source uncompiled, for "
+        "debugging (the same bits, 30-100x slower).",
+    ),
+    "solver.max_wall_time": (
+        "s",
+        "",
+        "Wall-clock budget of one run; beyond it the run is "
+        "``failed``. Not part of the config's hash.",
+    ),
 }
 #: Keys that are sections of their own (their sub-keys have rows).
 _SECTION_ROWS = {"interface"}

@@ -84,8 +84,9 @@ print(domain[columns].to_string(index=False))
 # ``robust`` (1 when all K agree and none failed). The robustness rule needs K >= 16.
 ensemble = rbm.sweep(cfg, jobs=2, ensemble=16)
 print(
-    ensemble[["amplitude_g", "frequency_hz", "status", "collapse_fraction", "robust"]]
-    .to_string(index=False)
+    ensemble[["amplitude_g", "frequency_hz", "status", "collapse_fraction", "robust"]].to_string(
+        index=False
+    )
 )
 print(f"sensitive cells: {int((ensemble['robust'] != 1).sum())} of {len(ensemble)}")
 

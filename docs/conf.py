@@ -76,6 +76,9 @@ sphinx_gallery_conf = {
     "matplotlib_animations": False,
     "show_memory": False,
     "write_computation_times": True,
+    # two examples at a time (2 cores): the multi-drum tutorial compiles the step
+    # integrator on a cold numba cache while the others run
+    "parallel": 2,
 }
 
 html_theme = "pydata_sphinx_theme"

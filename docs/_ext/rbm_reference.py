@@ -83,7 +83,8 @@ def _type_text(param: click.Parameter) -> str:
     if isinstance(t, click.Choice):
         return " | ".join(str(c) for c in t.choices)
     if isinstance(t, click.IntRange | click.FloatRange):
-        return str(t)
+        kind = "integer" if isinstance(t, click.IntRange) else "number"
+        return f"{kind} {t._describe_range()}"
     name = getattr(t, "name", str(t))
     return {"text": "text", "integer": "integer", "float": "number"}.get(name, name)
 
@@ -105,7 +106,8 @@ def _option_row(param: click.Parameter) -> list[str]:
     if param.multiple:
         flags += " (repeatable)"
     default = param.default
-    if param.is_flag or default is None or callable(default) or default == ():
+    unset = "sentinel" in type(default).__name__.lower()  # click's UNSET: no default
+    if unset or param.is_flag or default is None or callable(default) or default == ():
         default_text = "\\-"
     else:
         default_text = lit(default if not isinstance(default, tuple | list) else
@@ -118,21 +120,21 @@ def cli_rst() -> str:
     group = cli_group()
     lines: list[str] = []
     top = click.Context(
-        group, info_name="rbm", terminal_width=88, max_content_width=88, **group.context_settings
+        group, info_name="rbm", terminal_width=80, max_content_width=80, **group.context_settings
     )
-    lines += ["The ``rbm`` command", "-" * 19, "", "::", ""]
+    lines += ["The ``rbm`` command", "-" * 19, "", ".. code-block:: text", ""]
     lines += ["   " + line for line in group.get_help(top).splitlines()]
     lines.append("")
     for name, cmd in commands():
         ctx = click.Context(cmd, info_name=name, parent=top, **cmd.context_settings)
         title = f"rbm {name}"
         lines += [f".. _cli-{name}:", "", title, "-" * len(title), ""]
-        lines += [esc(cmd.get_short_help_str(limit=200)), "", "::", ""]
+        lines += [esc(cmd.get_short_help_str(limit=200)), "", ".. code-block:: text", ""]
         lines += ["   " + line for line in cmd.get_help(ctx).splitlines()]
         lines.append("")
         rows = [_option_row(p) for p in cmd.params]
         rows.append([lit("-h") + ", " + lit("--help"), "flag", "\\-", "Show the help and exit."])
-        lines += list_table(["option", "type", "default", "meaning"], rows, [28, 16, 12, 44])
+        lines += list_table(["option", "type", "default", "meaning"], rows, [30, 14, 10, 46])
     return "\n".join(lines) + "\n"
 
 

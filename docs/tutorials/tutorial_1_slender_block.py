@@ -36,9 +36,9 @@ print(cfg.excitation.type, cfg.excitation.duration, "s")
 # displacements, the drum's rotation).
 cell = rbm.run(cfg, amplitude_g=0.5, frequency_hz=1.0)
 print(f"{cell.status}, t_collapse = {cell.t_collapse_s:.3f} s")
-ax = rbm.plot_history(cell)
-ax.figure.set_size_inches(7, 3.5)
-ax.figure.tight_layout()
+fig, ax = plt.subplots(figsize=(7, 3.5))
+rbm.plot_history(cell, ax=ax)
+fig.tight_layout()
 plt.show()
 
 # %%
@@ -72,8 +72,9 @@ print(collapsed.groupby("frequency_hz")["amplitude_g"].min().to_string())
 # The figure
 # ----------
 # ``rbm.plot_domain`` draws safe (o) and unsafe (x) cells, the boundary and, given the
-# config, the static multiplier: the same figure as ``domain.png``.
-ax = rbm.plot_domain(domain, config=coarse)
-ax.figure.set_size_inches(7, 5)
-ax.figure.tight_layout()
+# config, the static multiplier: the same figure as ``domain.png``. It draws on an axes
+# of your own (without one it makes a new figure, not held by pyplot).
+fig, ax = plt.subplots(figsize=(7, 5))
+rbm.plot_domain(domain, ax=ax, config=coarse)
+fig.tight_layout()
 plt.show()

@@ -57,8 +57,10 @@ config_file.write_text(config_text)
 # starts to rock), the rocking parameter p and the elastic frequencies.
 info = subprocess.run(
     [sys.executable, "-m", "rbm_cli", "info", str(config_file)],
-    capture_output=True, text=True, check=True,
-)  # fmt: skip
+    capture_output=True,
+    text=True,
+    check=True,
+)
 print(info.stdout)
 
 # %%
@@ -92,7 +94,7 @@ print(f"sensitive cells: {int((ensemble['robust'] != 1).sum())} of {len(ensemble
 
 # %%
 # The figure colours each cell by its collapse fraction, so chaotic cells show.
-ax = rbm.plot_domain(ensemble, config=cfg)
-ax.figure.set_size_inches(7, 5)
-ax.figure.tight_layout()
+fig, ax = plt.subplots(figsize=(7, 5))
+rbm.plot_domain(ensemble, ax=ax, config=cfg)
+fig.tight_layout()
 plt.show()

@@ -70,8 +70,10 @@ result = fr.result
 print(result.table[["intensity_g", "n_records", "n_collapsed", "fraction"]].to_string(index=False))
 if result.fitted:
     lo, hi = result.median_ci_g
-    print(f"median PGA {result.fit.median_g:.2f} g (5-95 %: {lo:.2f}-{hi:.2f} g), "
-          f"dispersion beta {result.fit.beta:.2f}")  # fmt: skip
+    print(
+        f"median PGA {result.fit.median_g:.2f} g (5-95 %: {lo:.2f}-{hi:.2f} g), "
+        f"dispersion beta {result.fit.beta:.2f}"
+    )
 else:
     print("no fit:", result.note)
 print("files:", ", ".join(p.name for p in fr.paths))
@@ -85,8 +87,13 @@ print("files:", ", ".join(p.name for p in fr.paths))
 fig, (ax_ida, ax_fr) = plt.subplots(1, 2, figsize=(11, 4.2))
 for name, runs in domain.groupby("record"):
     runs = runs.sort_values("amplitude_g")
-    ax_ida.plot(runs["amplitude_g"], np.minimum(runs["max_rotation_ratio"], 1.0),
-                marker=".", lw=1, label=name)  # fmt: skip
+    ax_ida.plot(
+        runs["amplitude_g"],
+        np.minimum(runs["max_rotation_ratio"], 1.0),
+        marker=".",
+        lw=1,
+        label=name,
+    )
 ax_ida.set_xlabel("PGA [g]")
 ax_ida.set_ylabel("peak rotation / collapse limit")
 ax_ida.set_title("IDA, one line per record")
@@ -96,8 +103,14 @@ table, curve = result.table, result.curve
 ax_fr.plot(table["intensity_g"], table["fraction"], "o", color="k", label="fraction collapsed")
 if result.fitted:
     ax_fr.plot(curve["intensity_g"], curve["probability"], color="C3", label="lognormal fit")
-    ax_fr.fill_between(curve["intensity_g"], curve["lower"], curve["upper"], color="C3",
-                       alpha=0.2, label="5-95 % band over records")  # fmt: skip
+    ax_fr.fill_between(
+        curve["intensity_g"],
+        curve["lower"],
+        curve["upper"],
+        color="C3",
+        alpha=0.2,
+        label="5-95 % band over records",
+    )
 ax_fr.set_xlabel("PGA [g]")
 ax_fr.set_ylabel("P(collapse)")
 ax_fr.set_ylim(-0.02, 1.02)

@@ -2,7 +2,7 @@
 A multi-drum column of your own: its properties, a domain and its ensemble
 ==========================================================================
 
-A column of four equal marble drums, 3 m tall and tapering from 0.6 m to 0.48 m, with
+A column of four equal stone drums, 3 m tall and tapering from 0.6 m to 0.48 m, with
 elastic joints (normal stiffness k_n = 5e9 Pa/m). ``rbm info`` prints what the Rigid Beam
 Model derives from it; a small sweep gives its safe-unsafe domain, and the same sweep as an
 ensemble says which cells are robust and which are chaotic.
@@ -44,7 +44,7 @@ grid:
 """
 work = Path(tempfile.mkdtemp(prefix="rbm_tutorial_"))
 config_file = work / "four_drums.yaml"
-config_file.write_text(config_text)
+_ = config_file.write_text(config_text)
 
 # %%
 # What the model derives: ``rbm info``

@@ -61,6 +61,14 @@ RESULTS = ROOT / "results"
 # ----------------------------------------------------------------------------- helpers
 
 
+#: The line under every figure of the report: what made it, when, where.
+FIGURE_NOTE = (
+    f"*Made by `python docs/make_validation.py` on "
+    f"{_dt.datetime.now().astimezone().strftime('%Y-%m-%d')}, {platform.machine()}, "
+    f"{os.cpu_count()} cores.*"
+)
+
+
 class Report:
     """Markdown lines, printed as they are written."""
 
@@ -70,6 +78,9 @@ class Report:
     def __call__(self, text: str = "") -> None:
         print(text, flush=True)
         self.lines.append(text)
+        if text.startswith("!["):  # every figure names the script, date and machine
+            self("")
+            self(FIGURE_NOTE)
 
     def table(self, header: list[str], rows: list[list]) -> None:
         self("| " + " | ".join(header) + " |")
@@ -393,7 +404,7 @@ def section2(rep: Report, out: Path, tmp: Path, quick: bool, jobs: int) -> None:
         + ("next to the boundary at every alpha" if all_near else "mostly at the boundary")
         + ", i.e. the sensitivity of undamped (e = 1) harmonic "
         "rocking to small differences dominates the linearisation error at this resolution "
-        "(the time-history difference itself grows as alpha^2, README Validation)"
+        "(the time-history difference itself grows as alpha^2, the validation table of the docs)"
     )
     rep(
         f"**What it shows:** the cells that differ go from {pc[0]:.1f} % at alpha "

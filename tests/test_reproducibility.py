@@ -222,14 +222,14 @@ def test_meta_records_what_a_result_depends_on(tmp_path):
         assert prov["git_commit"] and len(prov["git_commit"].split("-")[0]) == 40
 
 
-# ---------------------------------------------------------------- the README's figures
-def test_readme_states_each_studys_sensitive_cells():
-    """The README's table of sensitive cells is the stored domains' (and lists every
-    regressed study): re-making a study without updating the README fails here."""
+# ---------------------------------------------------------------- the documented figures
+def test_docs_state_each_studys_sensitive_cells():
+    """docs/reproducibility.md's table of sensitive cells is the stored domains' (and lists
+    every regressed study): re-making a study without updating the page fails here."""
     from .test_regression import STUDIES
 
-    text = (ROOT / "README.md").read_text()
-    section = text.split("## The same answer on any machine", 1)[1].split("\n## ", 1)[0]
+    text = (ROOT / "docs" / "reproducibility.md").read_text()
+    section = text.split("## 7. Every stored study", 1)[1].split("\n## ", 1)[0]
     rows = {}
     for line in section.splitlines():
         cells = [c.strip(" `") for c in line.strip().strip("|").split("|")]

@@ -1,0 +1,516 @@
+"""The site's reference pages, generated from the code at build time so they cannot drift.
+
+Two directives:
+
+- ``.. rbm-cli::`` every command of the click group ``rbm_cli.cli.main:main``'s ``cli``
+  with its usage, its help text as ``rbm COMMAND --help`` prints it, and a table of its
+  arguments and options (flags, type, default, help);
+- ``.. rbm-config::`` every key of the config: the key paths are read from the loader's key
+  tuples (``rbm_cli.config.load.TOP_KEYS`` ...), the defaults from the config dataclasses
+  (``rbm_cli.config.types``), the choices and most ranges from the loader's constants; the
+  unit and the meaning of each key are written here, in :data:`KEY_DOCS`. A key the loader
+  accepts and this table lacks (or the reverse) stops the build.
+
+:func:`cli_rst` and :func:`config_rst` return the reStructuredText the directives parse;
+``tests/test_docs_reference.py`` checks that every option and every key appears in it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterator
+
+import click
+
+# ------------------------------------------------------------------------ text helpers
+_RST_SPECIAL = "\\`*_|[]<>"
+
+
+def esc(text: str) -> str:
+    """Plain text as reStructuredText inline text (nothing in it is markup)."""
+    out = []
+    for ch in str(text):
+        out.append("\\" + ch if ch in _RST_SPECIAL else ch)
+    return " ".join("".join(out).split())
+
+
+def lit(text: str) -> str:
+    """Inline literal (``text``), or plain escaped text when it holds backquotes."""
+    text = str(text)
+    if "`" in text or not text.strip():
+        return esc(text)
+    return f"``{text}``"
+
+
+def list_table(header: list[str], rows: list[list[str]], widths: list[int]) -> list[str]:
+    lines = [
+        ".. list-table::",
+        "   :header-rows: 1",
+        f"   :widths: {' '.join(str(w) for w in widths)}",
+        "   :class: rbm-reference",
+        "",
+    ]
+    for row in [header, *rows]:
+        for k, cell in enumerate(row):
+            lines.append(("   * - " if k == 0 else "     - ") + (cell if cell else "\\-"))
+    lines.append("")
+    return lines
+
+
+def fmt(x: float) -> str:
+    return f"{x:g}"
+
+
+# ------------------------------------------------------------------------- the CLI
+def cli_group() -> click.Group:
+    """The click group the ``rbm`` console script runs (``rbm_cli.cli.main:main``)."""
+    from rbm_cli.cli.main import cli
+
+    return cli
+
+
+def commands() -> Iterator[tuple[str, click.Command]]:
+    group = cli_group()
+    ctx = click.Context(group, info_name="rbm")
+    for name in group.list_commands(ctx):
+        yield name, group.get_command(ctx, name)
+
+
+def _type_text(param: click.Parameter) -> str:
+    if isinstance(param, click.Option) and param.is_flag:
+        return "flag"
+    t = param.type
+    if isinstance(t, click.Choice):
+        return " | ".join(str(c) for c in t.choices)
+    if isinstance(t, click.IntRange | click.FloatRange):
+        kind = "integer" if isinstance(t, click.IntRange) else "number"
+        return f"{kind} {t._describe_range()}"
+    name = getattr(t, "name", str(t))
+    return {"text": "text", "integer": "integer", "float": "number"}.get(name, name)
+
+
+def _option_row(param: click.Parameter) -> list[str]:
+    if isinstance(param, click.Argument):
+        flags = lit(param.make_metavar(click.Context(click.Command("x"))))
+        meaning = "argument" + (" (required)" if param.required else "")
+        return [flags, esc(_type_text(param)), "\\-", esc(meaning)]
+    assert isinstance(param, click.Option)
+    names = list(param.opts) + list(param.secondary_opts)
+    metavar = ""
+    if not param.is_flag:
+        metavar = " " + (param.metavar or param.type.get_metavar(param, click.Context(
+            click.Command("x"))) or param.name.upper())  # fmt: skip
+    flags = ", ".join(lit(n + metavar) for n in names)
+    if param.nargs and param.nargs > 1:
+        flags += f" (takes {param.nargs} values)"
+    if param.multiple:
+        flags += " (repeatable)"
+    default = param.default
+    unset = "sentinel" in type(default).__name__.lower()  # click's UNSET: no default
+    if unset or param.is_flag or default is None or callable(default) or default == ():
+        default_text = "\\-"
+    else:
+        default_text = lit(default if not isinstance(default, tuple | list) else
+                           " ".join(str(d) for d in default))  # fmt: skip
+    return [flags, esc(_type_text(param)), default_text, esc(param.help or "")]
+
+
+def cli_rst() -> str:
+    """reStructuredText of every command: usage, help, and a table of its parameters."""
+    group = cli_group()
+    lines: list[str] = []
+    top = click.Context(
+        group, info_name="rbm", terminal_width=80, max_content_width=80, **group.context_settings
+    )
+    lines += ["The ``rbm`` command", "-" * 19, "", ".. code-block:: text", ""]
+    lines += ["   " + line for line in group.get_help(top).splitlines()]
+    lines.append("")
+    for name, cmd in commands():
+        ctx = click.Context(cmd, info_name=name, parent=top, **cmd.context_settings)
+        title = f"rbm {name}"
+        lines += [f".. _cli-{name}:", "", title, "-" * len(title), ""]
+        lines += [esc(cmd.get_short_help_str(limit=200)), "", ".. code-block:: text", ""]
+        lines += ["   " + line for line in cmd.get_help(ctx).splitlines()]
+        lines.append("")
+        rows = [_option_row(p) for p in cmd.params]
+        rows.append([lit("-h") + ", " + lit("--help"), "flag", "\\-", "Show the help and exit."])
+        lines += list_table(["option", "type", "default", "meaning"], rows, [30, 14, 10, 46])
+    return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------------- the config
+def config_keys() -> list[str]:
+    """Every key path the config loader accepts, from its own key tuples."""
+    from rbm_cli.config.excitation import EXCITATION_KEYS, INITIAL_KEYS
+    from rbm_cli.config.grid import EXCITATION_AXES, LINKED, VIRTUAL_PATHS
+    from rbm_cli.config.interface import INTERFACE_KEYS, STIFFNESS_KEYS
+    from rbm_cli.config.load import COLLAPSE_KEYS, COLUMN_KEYS, SOLVER_KEYS, TOP_KEYS
+
+    nested = {
+        "column": COLUMN_KEYS,
+        "interface": INTERFACE_KEYS,
+        "excitation": EXCITATION_KEYS,
+        "collapse": COLLAPSE_KEYS,
+        "solver": SOLVER_KEYS,
+        "grid": (*EXCITATION_AXES, LINKED, *(p for p in VIRTUAL_PATHS), "<key path>"),
+    }
+    sub = {"interface.stiffness": STIFFNESS_KEYS, "excitation.initial": INITIAL_KEYS}
+    keys: list[str] = []
+    for top in TOP_KEYS:
+        if top not in nested:
+            keys.append(top)
+            continue
+        for key in nested[top]:
+            path = f"{top}.{key}"
+            keys.append(path)
+            keys += [f"{path}.{k}" for k in sub.get(path, ())]
+    return keys
+
+
+def _defaults() -> dict[str, str]:
+    """Defaults of the keys that have one, read from the config dataclasses."""
+    from rbm_cli.config import types as t
+
+    out: dict[str, str] = {}
+    sections = {
+        "": t.Config,
+        "column": t.ColumnConfig,
+        "interface": t.InterfaceConfig,
+        "excitation": t.ExcitationConfig,
+        "excitation.initial": t.InitialConfig,
+        "collapse": t.CollapseConfig,
+        "solver": t.SolverConfig,
+    }
+    for prefix, cls in sections.items():
+        for f in dataclasses.fields(cls):
+            if f.default is dataclasses.MISSING:
+                continue
+            value = f.default
+            if value is None or value == ():
+                continue
+            text = fmt(value) if isinstance(value, float) else str(value)
+            out[f"{prefix}.{f.name}" if prefix else f.name] = text
+    return out
+
+
+def _ranges() -> dict[str, str]:
+    """Allowed values written from the loader's constants."""
+    from rbm_cli.config import types as t
+    from rbm_cli.config.excitation import (
+        DEFAULT_DURATION,
+        GAMMA_MAX,
+        INITIAL_MAX,
+        MAX_DURATION,
+        PHASE_MAX,
+    )
+    from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, MAX_CELLS
+    from rbm_cli.config.interface import FRICTION_MAX, NORMAL_RANGE, ROTATIONAL_RANGE
+    from rbm_cli.config.load import (
+        DENSITY_RANGE,
+        HEIGHT_RANGE,
+        LENGTH_RANGE,
+        MAX_BUDGET,
+        MAX_DRUMS,
+        MAX_TOP_TAPER,
+        TIME_STEP_RANGE,
+        WALL_TIME_RANGE,
+    )
+
+    def one_of(values) -> str:
+        return ", ".join(f"``{v}``" for v in values)
+
+    durations = ", ".join(f"{fmt(v)} ({k})" for k, v in DEFAULT_DURATION.items())
+    return {
+        "model": one_of(t.MODELS),
+        "column.height": f"[{fmt(HEIGHT_RANGE[0])}, {fmt(HEIGHT_RANGE[1])}]",
+        "column.base_width": f"> 0, <= height; in [{fmt(LENGTH_RANGE[0])}, {fmt(LENGTH_RANGE[1])}]",
+        "column.top_width": f"<= {fmt(MAX_TOP_TAPER)} x base_width and <= height; "
+        f">= {fmt(LENGTH_RANGE[0])}",
+        "column.section": one_of(t.SECTIONS),
+        "column.depth": f"[{fmt(LENGTH_RANGE[0])}, {fmt(LENGTH_RANGE[1])}], rectangular only",
+        "column.density": f"[{fmt(DENSITY_RANGE[0])}, {fmt(DENSITY_RANGE[1])}]",
+        "column.drums": f"a count 1-{MAX_DRUMS}, or a list of drum heights summing to height",
+        "interface.stiffness.rotational": f"[{fmt(ROTATIONAL_RANGE[0])}, "
+        f"{fmt(ROTATIONAL_RANGE[1])}], one value or one per interface",
+        "interface.stiffness.normal": f"[{fmt(NORMAL_RANGE[0])}, {fmt(NORMAL_RANGE[1])}]",
+        "interface.formulation": one_of(t.FORMULATIONS),
+        "interface.friction": f"(0, {fmt(FRICTION_MAX)}]",
+        "excitation.type": one_of(t.EXCITATIONS),
+        "excitation.duration": f"(0, {fmt(MAX_DURATION)}]; default {durations}",
+        "excitation.phase": f"[-{fmt(PHASE_MAX)}, {fmt(PHASE_MAX)}]",
+        "excitation.gamma": f"(1, {fmt(GAMMA_MAX)}]",
+        "excitation.nu": "[-2 pi, 2 pi]",
+        "excitation.units": one_of(t.RECORD_UNITS),
+        "excitation.scale": one_of(t.RECORD_SCALES),
+        "excitation.free_time": f"[0, {fmt(MAX_DURATION)}]",
+        "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, one per drum",
+        "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, one per drum",
+        "grid.amplitudes": f"[{fmt(AMPLITUDE_RANGE_G[0])}, {fmt(AMPLITUDE_RANGE_G[1])}]",
+        "grid.frequencies": f"[{fmt(FREQUENCY_RANGE_HZ[0])}, {fmt(FREQUENCY_RANGE_HZ[1])}]",
+        "grid.<key path>": f"at most {MAX_CELLS:,} cells in all",
+        "solver.method": one_of(t.METHODS),
+        "solver.max_steps": f"at most {MAX_BUDGET:,}",
+        "solver.max_events": f"at most {MAX_BUDGET:,}",
+        "solver.time_step": f"[{fmt(TIME_STEP_RANGE[0])}, {fmt(TIME_STEP_RANGE[1])}]",
+        "solver.max_wall_time": f"({fmt(WALL_TIME_RANGE[0])}, {fmt(WALL_TIME_RANGE[1])}]",
+        "solver.implementation": one_of(t.IMPLEMENTATIONS),
+    }
+
+
+#: key path -> (unit, allowed values where no constant of the loader states them, meaning).
+#: An empty allowed text takes the one :func:`_ranges` writes from the code.
+KEY_DOCS: dict[str, tuple[str, str, str]] = {
+    "name": ("", "letters, digits, ``_ - .`` (1-100)", "Required. The output folder's name."),
+    "model": (
+        "",
+        "",
+        "``rbm`` the Rigid Beam Model; ``housner`` Housner's exact block (large "
+        "rotations, true geometry); ``housner-linear`` the piecewise-linear block of "
+        "Spanos and Koh; both monolithic only; ``bullet`` the rigid-body contact "
+        "engine (any drums; it ignores the joint law's stiffness, xi, restitution "
+        "and formulation).",
+    ),
+    "column.height": ("m", "", "Required. Height H of the column."),
+    "column.base_width": ("m", "", "Required. Width B_1 at the base."),
+    "column.top_width": (
+        "m",
+        "",
+        "Width at the top; the width tapers linearly. Default: base_width.",
+    ),
+    "column.section": ("", "", "``circular``: the width is the diameter."),
+    "column.depth": ("m", "", "Out-of-plane depth. Default: the local width (square drums)."),
+    "column.density": ("kg/m^3", "", "Density of the stone."),
+    "column.drums": ("", "", "Count of equal drums, or the list of drum heights [m]. Default 1."),
+    "interface": ("", "", ""),
+    "interface.stiffness": (
+        "",
+        "``rigid``, ``{rotational: K_M}`` or ``{normal: k_n}``",
+        "Joint stiffness. ``rigid`` (monolithic columns only) is the "
+        "default. A bare number is refused: it does not say which of "
+        "the two it is.",
+    ),
+    "interface.stiffness.rotational": (
+        "N m/rad",
+        "",
+        "K_M of every joint, or a list with one per interface.",
+    ),
+    "interface.stiffness.normal": (
+        "Pa/m",
+        "",
+        "k_n; K_M,i = k_n depth_i B_i^3 / 12 "
+        "(rectangle), k_n pi B_i^4 / 64 (circle). ``rbm info`` "
+        "prints both.",
+    ),
+    "interface.xi": ("", "(0, 1]", "1: bilinear law; < 1: tri-linear (a plateau at xi M_u)."),
+    "interface.restitution": (
+        "",
+        "(0, 1] or ``housner`` (monolithic only)",
+        "Ratio of angular velocities after and before an impact.",
+    ),
+    "interface.formulation": (
+        "",
+        "",
+        "Which rotation the joint law reads: ``relative`` "
+        "(theta_i - theta_(i-1)), ``absolute`` (theta_i, the paper's "
+        "literal wording), ``geometric`` (the law without its "
+        "rigid-stack P-Delta; gravity through the displaced drums).",
+    ),
+    "interface.friction": (
+        "",
+        "",
+        "Coulomb coefficient of every joint and the base; ``model: bullet`` only.",
+    ),
+    "excitation.type": (
+        "",
+        "",
+        "The ground motion: harmonic, half-sine, free motion, the "
+        "near-fault pulses, or a record file.",
+    ),
+    "excitation.duration": (
+        "s",
+        "",
+        "Simulated time. Half-sine and pulses: the maximum "
+        "(the whole pulse is always simulated). Not for ``record``.",
+    ),
+    "excitation.phase": ("rad", "", "Phase of a harmonic excitation."),
+    "excitation.initial": ("", "", "Initial state of the drums."),
+    "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),
+    "excitation.initial.velocities": ("rad/s", "", "Angular velocity of each drum at t = 0."),
+    "excitation.file": (
+        "",
+        "a file, a list of files, a folder or a glob",
+        "``record`` only: a PEER NGA ``.AT2`` or CSV (time [s], "
+        "acceleration) file, relative to the config's folder. Several files "
+        "are a suite: the grid axis ``excitation.file``.",
+    ),
+    "excitation.units": (
+        "",
+        "",
+        "``record`` only: the CSV's acceleration unit (an ``.AT2`` is in g).",
+    ),
+    "excitation.free_time": (
+        "s",
+        "",
+        "``record`` only: free motion simulated after the record's last sample.",
+    ),
+    "excitation.scale": (
+        "",
+        "",
+        "``record`` only: ``pga`` the grid amplitude is the scaled "
+        "record's PGA [g]; ``factor`` a plain scale factor.",
+    ),
+    "excitation.gamma": (
+        "",
+        "",
+        "``mavroeidis-papageorgiou`` only: the pulse's gamma. Required there.",
+    ),
+    "excitation.nu": (
+        "rad",
+        "",
+        "``mavroeidis-papageorgiou`` only: the pulse's phase nu. Required there.",
+    ),
+    "excitation.vertical": (
+        "",
+        "a file",
+        "``record`` only: the ground's upward "
+        "acceleration, scaled as the horizontal record; every weight "
+        "then acts with g + a_v(t).",
+    ),
+    "grid.amplitudes": (
+        "g",
+        "",
+        "A value, a list, or ``{start, stop, step}`` / "
+        "``{start, stop, num}`` (stop included). Peak ground acceleration; "
+        "a record's PGA (``scale: pga``).",
+    ),
+    "grid.frequencies": ("Hz", "", "As amplitudes. Not needed for records or free motion."),
+    "grid.linked": (
+        "",
+        "a list of mappings of key paths to lists of one length",
+        "Axes that vary together (e.g. ``column.height`` with ``column.base_width``).",
+    ),
+    "grid.column.size": (
+        "m",
+        "> 0",
+        "Virtual axis: the height of a geometrically similar "
+        "column (every length scaled by size / height).",
+    ),
+    "grid.column.slenderness": (
+        "",
+        "> 0",
+        "Virtual axis: H / B_1 (top width and depth scale with the base width).",
+    ),
+    "grid.<key path>": (
+        "the key's",
+        "",
+        "An axis over any config key inside a section, "
+        "named by its dotted path (``column.height``, "
+        "``interface.restitution``, ``column.drums``, ``excitation.file`` "
+        "...); values as amplitudes, a range may add ``spacing: log``. "
+        "``name`` and ``model`` cannot vary.",
+    ),
+    "collapse.ratio": (
+        "",
+        "(0, 1]",
+        "Collapse when the quantity the law reads reaches ratio x its limit.",
+    ),
+    "solver.method": (
+        "",
+        "",
+        "``auto``: the rigid block's compiled closed form where it "
+        "applies, DOP853 elsewhere; ``DOP853``, ``RK45``, ``RK23`` the step "
+        "integrator; ``closed-form`` the rigid block; ``exact`` closed-form "
+        "integration of the linear pieces (see the user guide).",
+    ),
+    "solver.rtol": ("", "[1e-13, 1e-3]", "Relative tolerance of the step integrator."),
+    "solver.atol": (
+        "",
+        "(0, 1e-3]",
+        "Absolute tolerance, relative to theta_u (rates: 10 theta_u).",
+    ),
+    "solver.max_steps": ("", "", "Step budget of one run: beyond it the run is ``failed``."),
+    "solver.max_events": ("", "", "Event budget of one run: beyond it the run is ``failed``."),
+    "solver.time_step": ("s", "", "The contact engine's fixed step (``model: bullet``)."),
+    "solver.implementation": (
+        "",
+        "",
+        "``python`` runs the compiled source uncompiled, for "
+        "debugging (the same bits, 30-100x slower).",
+    ),
+    "solver.max_wall_time": (
+        "s",
+        "",
+        "Wall-clock budget of one run; beyond it the run is "
+        "``failed``. Not part of the config's hash.",
+    ),
+}
+#: Keys that are sections of their own (their sub-keys have rows).
+_SECTION_ROWS = {"interface"}
+
+
+def config_rst() -> str:
+    """reStructuredText of every config key: a table per section."""
+    keys = config_keys()
+    missing = [k for k in keys if k not in KEY_DOCS]
+    extra = [k for k in KEY_DOCS if k not in keys and k not in _SECTION_ROWS]
+    if missing or extra:
+        raise ValueError(
+            "docs/_ext/rbm_reference.py KEY_DOCS is out of step with the config loader: "
+            f"keys without a description {missing}, described keys the loader lacks {extra}"
+        )
+    defaults, ranges = _defaults(), _ranges()
+    groups: dict[str, list[str]] = {}
+    for key in keys:
+        groups.setdefault(key.split(".")[0] if "." in key else "top level", []).append(key)
+    lines: list[str] = []
+    for section, section_keys in groups.items():
+        title = "Top-level keys" if section == "top level" else f"``{section}``"
+        lines += [f".. _config-{section.replace(' ', '-')}:", "", title, "-" * len(title), ""]
+        rows = []
+        for key in section_keys:
+            unit, allowed, meaning = KEY_DOCS[key]
+            allowed = allowed or ranges.get(key, "")
+            default = defaults.get(key, "")
+            rows.append([
+                f"``{key}``", esc(unit), f"``{default}``" if default else "\\-",
+                allowed, meaning,
+            ])  # fmt: skip
+        lines += list_table(["key", "unit", "default", "allowed", "meaning"], rows,
+                            [22, 8, 10, 22, 38])  # fmt: skip
+    return "\n".join(lines) + "\n"
+
+
+# --------------------------------------------------------------------- the directives
+def setup(app):  # pragma: no cover - exercised by the docs build
+    from docutils import nodes
+    from docutils.statemachine import StringList
+    from sphinx.util.docutils import SphinxDirective
+
+    class _Generated(SphinxDirective):
+        has_content = False
+        make = staticmethod(lambda: "")
+
+        def run(self):
+            text = self.make()
+            container = nodes.section()
+            container.document = self.state.document
+            self.state.nested_parse(
+                StringList(text.splitlines(), source="<rbm reference>"), 0, container,
+                match_titles=True,
+            )  # fmt: skip
+            return container.children
+
+    class CliDirective(_Generated):
+        make = staticmethod(cli_rst)
+
+    class ConfigDirective(_Generated):
+        make = staticmethod(config_rst)
+
+    app.add_directive("rbm-cli", CliDirective)
+    app.add_directive("rbm-config", ConfigDirective)
+    return {"parallel_read_safe": True, "version": "1"}
+
+
+if __name__ == "__main__":  # python docs/_ext/rbm_reference.py: print both
+    print(cli_rst())
+    print(config_rst())

@@ -1,0 +1,100 @@
+"""
+A multi-drum column of your own: its properties, a domain and its ensemble
+==========================================================================
+
+A column of four equal stone drums, 3 m tall and tapering from 0.6 m to 0.48 m, with
+elastic joints (normal stiffness k_n = 5e9 Pa/m). ``rbm info`` prints what the Rigid Beam
+Model derives from it; a small sweep gives its safe-unsafe domain, and the same sweep as an
+ensemble says which cells are robust and which are chaotic.
+"""
+
+# %%
+# The config, written as YAML
+# ---------------------------
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+
+import rbm
+
+config_text = """\
+name: four_drums
+model: rbm
+column:
+  height: 3.0              # m
+  base_width: 0.6          # m
+  top_width: 0.48          # m, linear taper
+  section: circular        # the width is the diameter
+  density: 2600            # kg/m^3
+  drums: 4                 # equal drums of 0.75 m
+interface:
+  stiffness: {normal: 5e9} # Pa/m: K_M,i = k_n pi B_i^4 / 64
+  xi: 1.0                  # bilinear law
+  restitution: 1.0
+  formulation: relative
+excitation:
+  type: harmonic
+  duration: 4.0            # s (10 s in the paper's studies; short here)
+grid:
+  amplitudes: [0.2, 0.3, 0.4, 0.5]   # g
+  frequencies: [1.0, 2.0, 3.0]       # Hz
+"""
+work = Path(tempfile.mkdtemp(prefix="rbm_tutorial_"))
+config_file = work / "four_drums.yaml"
+_ = config_file.write_text(config_text)
+
+# %%
+# What the model derives: ``rbm info``
+# ------------------------------------
+# Per interface i (1 at the ground): width B_i, drum height h_i, mass m_i and rotary
+# inertia I_Gi, normal force N_i (the weight above), the capacity M_u,i = (B_i / 2) N_i,
+# the zero-moment rotation theta_u,i, the joint's rotational stiffness K_M,i and the
+# normal stiffness k_n,i that gives it, and the rotation where the elastic branch ends.
+# Above the table: the static multiplier (the ground acceleration [g] at which the column
+# starts to rock), the rocking parameter p and the elastic frequencies.
+info = subprocess.run(
+    [sys.executable, "-m", "rbm_cli", "info", str(config_file)],
+    capture_output=True,
+    text=True,
+    check=True,
+)
+print(info.stdout)
+
+# %%
+# The domain
+# ----------
+# Twelve cells (4 amplitudes x 3 frequencies). The first run of an elastic column compiles
+# the step integrator once per installation (numba caches it on disk).
+cfg = rbm.load_config(config_file)
+domain = rbm.sweep(cfg, jobs=2)
+columns = ["amplitude_g", "frequency_hz", "status", "collapse_interface", "max_rotation_ratio"]
+print(domain[columns].to_string(index=False))
+
+# %%
+# ``collapse_interface`` says where the column broke (1 = at the base): a multi-drum
+# column can lose its upper drums before the whole of it overturns.
+
+# %%
+# The ensemble: robust and sensitive cells
+# ----------------------------------------
+# Rocking is chaotic near the boundary: a change of the excitation's phase or amplitude
+# by 1e-12 to 1e-6 can change the outcome. ``ensemble=K`` runs every cell K times (member
+# 0 is the cell itself; the others are perturbed) and adds ``collapse_fraction`` and
+# ``robust`` (1 when all K agree and none failed). The robustness rule needs K >= 16.
+ensemble = rbm.sweep(cfg, jobs=2, ensemble=16)
+print(
+    ensemble[["amplitude_g", "frequency_hz", "status", "collapse_fraction", "robust"]].to_string(
+        index=False
+    )
+)
+print(f"sensitive cells: {int((ensemble['robust'] != 1).sum())} of {len(ensemble)}")
+
+# %%
+# The figure colours each cell by its collapse fraction, so chaotic cells show.
+fig, ax = plt.subplots(figsize=(7, 5))
+rbm.plot_domain(ensemble, ax=ax, config=cfg)
+fig.tight_layout()
+plt.show()

@@ -44,7 +44,8 @@ def load_config(source: str | os.PathLike | Mapping[str, Any]) -> Config:
     ----------
     source : str, path-like or mapping  A YAML file or the mapping it holds (numbers may be
         numpy numbers, lists numpy arrays); lengths [m], stiffnesses [N m/rad] or [Pa/m],
-        grid amplitudes [g] and frequencies [Hz] (the README's Configuration section)
+        grid amplitudes [g] and frequencies [Hz] (the configuration reference,
+        docs/reference/config.md)
 
     Returns
     -------

@@ -4,10 +4,11 @@ Every user error raises :class:`rbm_cli.base.errors.ConfigError` with one line t
 the YAML key path and the allowed range or values, e.g.
 ``cfg.yaml: column.height must be a number > 0 [m], got -1``.
 
-The schema is the README's Configuration section: the column, interface, excitation (with
-``excitation.initial``), grid and ``solver`` (integrator settings) sections. Lengths are in m,
-stiffnesses in N m/rad (K_M) or Pa/m (k_n), times in s, angles in rad; the grid
-keeps amplitudes in g and frequencies in Hz, the edge units.
+The schema is the column, interface, excitation (with ``excitation.initial``), grid and
+``solver`` (integrator settings) sections; every key with its unit, default and range is in
+the site's configuration reference (docs/reference/config.md), generated from this module.
+Lengths are in m, stiffnesses in N m/rad (K_M) or Pa/m (k_n), times in s, angles in rad;
+the grid keeps amplitudes in g and frequencies in Hz, the edge units.
 """
 
 from __future__ import annotations
@@ -231,7 +232,8 @@ def parse_config(
 
     Parameters
     ----------
-    data : mapping  Parsed YAML or a dict (the README's config keys; numpy numbers allowed)
+    data : mapping  Parsed YAML or a dict (the configuration reference's keys; numpy numbers
+        allowed)
     source : str  Where ``data`` came from, prefixed to error messages
     base_dir : path or None  Folder that relative paths in the config (a record's
         ``excitation.file``) are taken from; None: the current directory.

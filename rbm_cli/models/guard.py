@@ -7,7 +7,7 @@ monotonic clock and a flag. Entering Python there also runs any pending signal h
 :func:`interruptible` installs, for the length of one kernel call in the main thread, a
 SIGINT handler that only sets that flag (an exception raised inside the object-mode
 block would not cross the compiled frames cleanly), and raises KeyboardInterrupt once the
-kernel has returned. The cost of the poll is measured in README (Speed and accuracy).
+kernel has returned. The cost of the poll is discussed in docs/guide/solving.md.
 """
 
 from __future__ import annotations

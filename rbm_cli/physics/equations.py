@@ -282,7 +282,7 @@ def build_model(
     column : Column  Derived properties (rbm_cli.physics.column.build_column)
     xi : float  Smoothing parameter of the law, 0 < xi <= 1
     restitution : float  e in (0, 1]
-    formulation : str  'relative', 'absolute' or 'geometric' (README, Assumptions)
+    formulation : str  'relative', 'absolute' or 'geometric' (docs/guide/assumptions.md)
     collapse_ratio : float  c in (0, 1]
     """
     n = column.n

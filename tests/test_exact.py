@@ -36,8 +36,7 @@ from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.models.rbm.exact.bounds import FULL, THIRD, empty_bounds, row_lower, track_upper
 from rbm_cli.models.rbm.exact.integrate import integrate_exact
 from rbm_cli.models.rbm.exact.modal import advance
-from rbm_cli.models.rbm.exact.model import new_cache
-from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, point_size, set_point
+from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, new_cache, point_size, set_point
 from rbm_cli.models.rbm.exact.search import bounds_of
 from rbm_cli.models.rbm.step import integrate
 from rbm_cli.models.registry import make_runner

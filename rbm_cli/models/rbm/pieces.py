@@ -2,7 +2,7 @@
 them: which piece of its moment-rotation law each interface is on, the piece's bounds and
 event rows, locating the pieces of a state and crossing to the next piece (uplift, kink,
 impact), the silent impacts, and what both integrators compute from the pieces (an impact's
-loss of rate, a law's potential, the friction demand).
+loss of rate, a law's potential and a state's energy, the friction demand).
 
 A law is odd and piecewise linear (rbm_cli.physics.law): on x >= 0 its piece k is
 f = a_k + b_k x on [x_k, x_{k+1}), the edges x_1 < x_2 < ... padded with inf
@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rbm_cli.base.detmath import dot, matvec
 from rbm_cli.base.jit import jit
 from rbm_cli.models.events import BIG, EVENT_EPS
 
@@ -164,6 +165,20 @@ def law_potential(i, x, edges, nedges, intercepts, slopes):
     return cum + intercepts[i, kk] * (ax - start) + 0.5 * slopes[i, kk] * (ax * ax - start * start)
 
 
+@jit
+def energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
+    """Energy [J] of one state (Model.energy): rotations theta [rad], rates rate [rad/s] (n,);
+    kinetic, the laws' potential and, for `geometric`, gravity's."""
+    n = theta.size
+    e = 0.5 * dot(rate, matvec(mass, rate, np.empty(n))) - 0.5 * dot(
+        theta, matvec(gravity, theta, np.empty(n))
+    )
+    x = matvec(argmap, theta, np.empty(n))
+    for i in range(n):
+        e += law_potential(i, x[i], edges, nedges, intercepts, slopes)
+    return e
+
+
 @jit(inline=True)
 def friction_demand(ag, gam, centre_map, acc, masses, normal_forces, out):
     """Raise out (n) to the friction demand |T_i| / (N_i gam) [-] of each interface: T_i the
@@ -188,6 +203,7 @@ __all__ = [
     "UPLIFT",
     "bound_rows",
     "cross",
+    "energy",
     "friction_demand",
     "law_potential",
     "locate",

@@ -28,12 +28,14 @@ cycloidal) and records, piecewise linear in time, which the closed form takes ex
 sample interval (a 'linear' forcing, forcing_arrays); motion says what is refused and why.
 
 The algorithm is written once, in the Python that numba compiles (run, piece, search,
-bounds, peaks, modal, model); integrate runs it compiled, or uncompiled with
+bounds, peaks, modal); integrate runs it compiled, or uncompiled with
 ``solver.implementation: python`` (rbm_cli.base.jit.plain: the same bits).
 
-Modules: integrate (the entry from Python), run (the run loop), piece (law pieces, modes,
-rows and points of a linear piece), search (certified intervals, event roots, peak
-refinement), bounds (bounds of the modes and rows over an interval), peaks (the deferred
-refinement of peaks), modal (the closed forms of one mode), model (the model's arrays,
-friction demand, energy) and motion (a ground motion's forcing segments).
+Modules: integrate (the entry from Python), run (the run loop), piece (law pieces, modes
+and their cache, rows and points of a linear piece), search (certified intervals, event
+roots, peak refinement), bounds (bounds of the modes and rows over an interval), peaks (the
+deferred refinement of peaks), modal (the closed forms of one mode) and motion (what it
+takes of a ground motion). The column's arrays are physics.arrays.ColumnArrays; the law
+pieces, the friction demand and a state's energy are the step integrator's too
+(rbm_cli.models.rbm.pieces).
 """

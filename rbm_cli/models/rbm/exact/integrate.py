@@ -18,8 +18,8 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
 from rbm_cli.models.guard import arm, disarm
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
-from rbm_cli.models.rbm.exact.model import new_cache
 from rbm_cli.models.rbm.exact.motion import check_exact
+from rbm_cli.models.rbm.exact.piece import new_cache
 from rbm_cli.models.rbm.exact.run import run_exact
 from rbm_cli.models.rbm.forcing_arrays import motion_arrays, run_settings
 from rbm_cli.models.status import (

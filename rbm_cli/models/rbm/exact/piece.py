@@ -6,8 +6,8 @@ The modes solve the symmetric pencil K phi = lam M phi (through the Cholesky fac
 M symmetric positive definite in the `relative` and `geometric` formulations, K symmetric,
 possibly indefinite or singular), M-orthonormal: Phi^T M Phi = I, so q = Phi^T M theta.
 They depend only on the slopes of the active pieces, so they are cached by the pieces'
-indices across the runs of one column (modes); the intercepts (which side) only move the
-constant load f.
+indices across the runs of one column (modes, in the cache new_cache makes); the intercepts
+(which side) only move the constant load f.
 
 Every event surface and every tracked peak quantity is linear in theta, so in modal
 coordinates a row is d(t) = G q(t) + h0 (event distances, >= 0 inside the piece) or
@@ -57,6 +57,19 @@ def _slot(keys, used, k):
             return i
         i = (i + 1) % cap
     return i
+
+
+def new_cache(n: int) -> tuple:
+    """An empty cache of modes for n interfaces (exact.piece.modes): a power-of-two
+    table of at most 2^22 / n^2 sets of pieces (64 MB of modes at most)."""
+    cap = 64
+    while cap * 2 <= min(8192, (1 << 22) // (n * n)):
+        cap *= 2
+    return (
+        np.zeros((cap, n), dtype=np.int64), np.zeros(cap, dtype=np.bool_), np.zeros((cap, n)),
+        np.zeros((cap, n, n)), np.zeros((cap, n, n)), np.zeros((cap, n)),
+        np.zeros(1, dtype=np.int64),
+    )  # fmt: skip
 
 
 @jit

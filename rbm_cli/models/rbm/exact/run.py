@@ -18,7 +18,6 @@ import numpy as np
 
 from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
-from rbm_cli.models.rbm.exact.model import energy1
 from rbm_cli.models.rbm.exact.peaks import NOTES, new_notes, note_interval, settle_peaks
 from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, row_at, set_point
 from rbm_cli.models.rbm.exact.search import SCRATCH, next_point
@@ -26,6 +25,7 @@ from rbm_cli.models.rbm.pieces import (
     IMPACT,
     UPLIFT,
     cross,
+    energy,
     friction_demand,
     locate,
     piece_bounds,
@@ -108,9 +108,12 @@ def _passed_peak(mdl, pc, pts):
         return False
     if not (pts[1, k] * pts[1, dk] <= 0.0 or pts[1, dk] * pts[0, dk] < 0.0):
         return False
-    theta = pc.phi[0, 0] * pts[1, 1]
-    rate = pc.phi[0, 0] * pts[1, 2]
-    return energy1(mdl, theta, rate) < mdl.barrier * (1.0 - 1e-9)
+    theta, rate = np.empty(1), np.empty(1)
+    theta[0] = pc.phi[0, 0] * pts[1, 1]
+    rate[0] = pc.phi[0, 0] * pts[1, 2]
+    en = energy(theta, rate, mdl.mass, mdl.argmap, mdl.gravity, mdl.edges, mdl.nedges,
+                mdl.intercepts, mdl.slopes)  # fmt: skip
+    return en < mdl.barrier * (1.0 - 1e-9)
 
 
 @jit

@@ -11,10 +11,8 @@ import math
 
 import numpy as np
 
-from rbm_cli.base.detmath import dot, matvec
 from rbm_cli.base.jit import jit
 from rbm_cli.models.brent import brent_step
-from rbm_cli.models.rbm.pieces import law_potential
 from rbm_cli.models.rbm.step.rk import TAB_NP
 from rbm_cli.models.rbm.step.vertical import add_moving, moving_rate, moving_value
 
@@ -308,16 +306,3 @@ def surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
     _event_rows(gx, gc, same, acc, 0, h0, False, d2)
     if mv_e.size > 0:
         add_moving(t, gr, mv_e, mv_w, d, dd, d2)
-
-
-@jit
-def energy1(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes):
-    """Model.energy [J] of one state: rotations theta [rad], rates rate [rad/s] (n,)."""
-    n = theta.size
-    e = 0.5 * dot(rate, matvec(mass, rate, np.empty(n))) - 0.5 * dot(
-        theta, matvec(gravity, theta, np.empty(n))
-    )
-    x = matvec(argmap, theta, np.empty(n))
-    for i in range(n):
-        e += law_potential(i, x[i], edges, nedges, intercepts, slopes)
-    return e

@@ -14,6 +14,7 @@ from rbm_cli.models.rbm.pieces import (
     IMPACT,
     UPLIFT,
     bound_rows,
+    energy,
     friction_demand,
     locate,
     settle,
@@ -22,7 +23,6 @@ from rbm_cli.models.rbm.step.events import (
     CHECK_INTERVALS,
     affine,
     brentq,
-    energy1,
     first_crossing,
     poly_val,
     row_poly,
@@ -352,7 +352,7 @@ def run_kernel(model, motion, solver, task):
                 if event:
                     break
                 if can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]:
-                    en = energy1(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
+                    en = energy(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
                                   intercepts, slopes)  # fmt: skip
                     if en < barrier * (1.0 - 1e-9):
                         return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction,

@@ -203,8 +203,8 @@ def remove_baseline(t: np.ndarray, a: np.ndarray, baseline: str) -> np.ndarray:
     if baseline not in BASELINES:
         raise RbmError(f"baseline must be one of {', '.join(BASELINES)}, got {baseline!r}")
     a = np.asarray(a, dtype=float)
-    degree = BASELINES.index(baseline) - 1
-    if degree < 0:
+    degree = BASELINES.index(baseline)  # none 0 (nothing removed), linear 1, quadratic 2
+    if degree == 0:
         return a.copy()
     return a - baseline_fit(t, a, degree)
 

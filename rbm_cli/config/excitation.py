@@ -425,11 +425,13 @@ def processing_section(raw: Any, records: list[tuple[str, RecordFile]]) -> Proce
     """The validated ``excitation.processing`` of the records ``records`` ((key, record
     file) pairs: the horizontal record, and the vertical one if any).
 
-    ``baseline`` (``none``, ``linear``, ``quadratic``): the polynomial in time removed
-    from the acceleration, fitted by least squares to the displacement;
-    ``filter: {low_hz, high_hz, order}``: a zero-phase Butterworth band-pass [Hz],
+    ``filter: {low_hz, high_hz, order}`` (applied first): a zero-phase Butterworth
+    band-pass [Hz],
     0 < low_hz < high_hz < each record's Nyquist frequency, order 1..FILTER_ORDER_MAX
-    (default 4) a side; it needs evenly sampled records. A processing that changes nothing
+    (default 4) a side; it needs evenly sampled records (one with uneven steps is refused,
+    not resampled). ``baseline`` (``none``, ``linear``, ``quadratic``; then): the polynomial
+    in time removed from the acceleration, fitted by least squares to the displacement; any
+    steps. A processing that changes nothing
     (``baseline: none`` and no filter) is None: the config is the record as read, with the
     same hash.
 

@@ -141,7 +141,12 @@ def cli_rst() -> str:
 # ------------------------------------------------------------------------- the config
 def config_keys() -> list[str]:
     """Every key path the config loader accepts, from its own key tuples."""
-    from rbm_cli.config.excitation import EXCITATION_KEYS, INITIAL_KEYS
+    from rbm_cli.config.excitation import (
+        EXCITATION_KEYS,
+        FILTER_KEYS,
+        INITIAL_KEYS,
+        PROCESSING_KEYS,
+    )
     from rbm_cli.config.grid import EXCITATION_AXES, LINKED, VIRTUAL_PATHS
     from rbm_cli.config.interface import INTERFACE_KEYS, STIFFNESS_KEYS
     from rbm_cli.config.load import COLLAPSE_KEYS, COLUMN_KEYS, SOLVER_KEYS, TOP_KEYS
@@ -154,16 +159,23 @@ def config_keys() -> list[str]:
         "solver": SOLVER_KEYS,
         "grid": (*EXCITATION_AXES, LINKED, *(p for p in VIRTUAL_PATHS), "<key path>"),
     }
-    sub = {"interface.stiffness": STIFFNESS_KEYS, "excitation.initial": INITIAL_KEYS}
+    sub = {
+        "interface.stiffness": STIFFNESS_KEYS,
+        "excitation.initial": INITIAL_KEYS,
+        "excitation.processing": PROCESSING_KEYS,
+        "excitation.processing.filter": FILTER_KEYS,
+    }
+
+    def with_sub(path: str) -> list[str]:
+        return [path] + [k for key in sub.get(path, ()) for k in with_sub(f"{path}.{key}")]
+
     keys: list[str] = []
     for top in TOP_KEYS:
         if top not in nested:
             keys.append(top)
             continue
         for key in nested[top]:
-            path = f"{top}.{key}"
-            keys.append(path)
-            keys += [f"{path}.{k}" for k in sub.get(path, ())]
+            keys += with_sub(f"{top}.{key}")
     return keys
 
 
@@ -178,6 +190,8 @@ def _defaults() -> dict[str, str]:
         "interface": t.InterfaceConfig,
         "excitation": t.ExcitationConfig,
         "excitation.initial": t.InitialConfig,
+        "excitation.processing": t.ProcessingConfig,
+        "excitation.processing.filter": t.FilterConfig,
         "collapse": t.CollapseConfig,
         "solver": t.SolverConfig,
     }
@@ -198,6 +212,7 @@ def _ranges() -> dict[str, str]:
     from rbm_cli.config import types as t
     from rbm_cli.config.excitation import (
         DEFAULT_DURATION,
+        FILTER_ORDER_MAX,
         GAMMA_MAX,
         INITIAL_MAX,
         MAX_DURATION,
@@ -243,6 +258,8 @@ def _ranges() -> dict[str, str]:
         "excitation.units": one_of(t.RECORD_UNITS),
         "excitation.scale": one_of(t.RECORD_SCALES),
         "excitation.free_time": f"[0, {fmt(MAX_DURATION)}]",
+        "excitation.processing.baseline": one_of(t.BASELINES),
+        "excitation.processing.filter.order": f"an integer 1-{FILTER_ORDER_MAX}",
         "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, one per drum",
         "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, one per drum",
         "grid.amplitudes": f"[{fmt(AMPLITUDE_RANGE_G[0])}, {fmt(AMPLITUDE_RANGE_G[1])}]",
@@ -375,6 +392,44 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "``record`` only: the ground's upward "
         "acceleration, scaled as the horizontal record; every weight "
         "then acts with g + a_v(t).",
+    ),
+    "excitation.processing": (
+        "",
+        "",
+        "``record`` only: how the record (and the vertical record) is "
+        "processed before it is scaled: band-passed, then its baseline "
+        "removed. With ``scale: pga`` the amplitude is the processed "
+        "record's PGA. Part of the config's hash.",
+    ),
+    "excitation.processing.baseline": (
+        "",
+        "",
+        "The polynomial in time removed from the acceleration: ``none``, "
+        "``linear`` (a0 + a1 t) or ``quadratic`` (+ a2 t^2), fitted by "
+        "least squares to the record's displacement (integrated from rest). "
+        "Any time steps.",
+    ),
+    "excitation.processing.filter": (
+        "",
+        "a mapping",
+        "A zero-phase Butterworth band-pass (a high-pass at ``low_hz``, a "
+        "low-pass at ``high_hz``, run forward and backward). It needs a "
+        "record at even time steps: one with uneven steps is refused.",
+    ),
+    "excitation.processing.filter.low_hz": (
+        "Hz",
+        "> 0, < high_hz",
+        "Corner of the high-pass side. Required.",
+    ),
+    "excitation.processing.filter.high_hz": (
+        "Hz",
+        "> low_hz, < the record's Nyquist frequency 1 / (2 dt)",
+        "Corner of the low-pass side. Required.",
+    ),
+    "excitation.processing.filter.order": (
+        "",
+        "",
+        "Order n of each side: gain 1 / (1 + (f / f_c)^(2n)) a side, squared by the backward pass.",
     ),
     "grid.amplitudes": (
         "g",

@@ -211,13 +211,16 @@ def run(
     return CellRun(config=cfg, result=CellResult(result))
 
 
-def plot_history(run: CellRun | RunResult, ax=None):
+def plot_history(run: CellRun | RunResult, ax=None, relative: bool | None = None):
     """Draw a run's base and top displacement [m] against time [s] on a matplotlib axes.
 
     Parameters
     ----------
     run : CellRun, CellResult or RunResult  A recorded run; its collapse time is marked
     ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
+    relative : bool or None  True: the top relative to the ground, the ground's
+        displacement on a right axis of its own; False: both on one scale; None (default):
+        relative when the ground's displacement dwarfs the column's (a record that drifts)
 
     Returns
     -------
@@ -238,7 +241,7 @@ def plot_history(run: CellRun | RunResult, ax=None):
         raise RbmError(f"plot_history takes a run, got a value of type {type(run).__name__}")
     if result.history is None:
         raise RbmError("this run kept no history: run it with record=True")
-    return _plot_history(result.history, ax=ax, t_collapse=result.t_collapse_s)
+    return _plot_history(result.history, ax=ax, t_collapse=result.t_collapse_s, relative=relative)
 
 
 # --------------------------------------------------------------------------- rbm run

@@ -16,7 +16,10 @@ Keys, by excitation type (a key of another type is refused, naming it):
   :data:`~rbm_cli.config.types.DEFAULT_FREE_TIME`, 5 s), ``scale`` (``pga``, default: the
   grid's amplitude [g] is the scaled record's PGA; ``factor``: a plain scale factor),
   ``vertical`` (a second file, same formats and units: the upward ground acceleration,
-  scaled by the same factor as the horizontal record; every model takes it).
+  scaled by the same factor as the horizontal record; every model takes it),
+  ``processing`` (``baseline``: ``none``, default, ``linear`` or ``quadratic``;
+  ``filter: {low_hz, high_hz, order}``: a zero-phase Butterworth band-pass [Hz], order
+  1-8, default 4; both records processed, before scaling: see :func:`processing_section`).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
   sets ``ExcitationConfig.duration`` to that. A mapping made in Python may give a motion
   (:class:`rbm_cli.config.motions.Motion`, arrays checked when it was made) in the place
@@ -45,22 +48,26 @@ import numpy as np
 
 from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.motions import Motion
-from rbm_cli.config.record_files import read_file
+from rbm_cli.config.record_files import read_file, uniform_step
 from rbm_cli.config.types import (
+    BASELINES,
     DEFAULT_FREE_TIME,
     EXCITATIONS,
     PULSES,
     RECORD_SCALES,
     RECORD_UNITS,
     ExcitationConfig,
+    FilterConfig,
     G,
     InitialConfig,
+    ProcessingConfig,
 )
 from rbm_cli.config.validate import (
     choice,
     describe,
     fmt,
     in_bounds,
+    integer,
     join,
     mapping,
     number,
@@ -71,6 +78,8 @@ from rbm_cli.config.validate import one_line as _one_line
 __all__ = [
     "RecordFile",
     "excitation_section",
+    "filter_padding",
+    "processing_section",
     "record_file",
     "resolve_record_path",
     "with_record",
@@ -88,7 +97,13 @@ EXCITATION_KEYS = (
     "gamma",
     "nu",
     "vertical",
+    "processing",
 )
+PROCESSING_KEYS = ("baseline", "filter")
+FILTER_KEYS = ("low_hz", "high_hz", "order")
+#: Largest order of each side of the band-pass [-]: the roll-off is 6 n dB an octave a
+#: side, doubled by the forward and backward pass; strong-motion practice uses 2-8.
+FILTER_ORDER_MAX = 8
 INITIAL_KEYS = ("rotations", "velocities")
 #: Default ``excitation.duration`` per type [s].
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
@@ -111,6 +126,7 @@ ONLY_FOR = {
     "gamma": ("mavroeidis-papageorgiou",),
     "nu": ("mavroeidis-papageorgiou",),
     "vertical": ("record",),
+    "processing": ("record",),
 }
 _DIGEST_CHUNK = 1 << 20
 
@@ -126,6 +142,9 @@ class RecordFile:
     pga : float  Its peak ground acceleration [m/s^2]
     motion : Motion or None  The motion given as arrays in place of a file (then
         ``written`` is its name, ``path`` names it in messages, ``sha256`` is its digest)
+    step : float or None  Its time step [s] when its samples are evenly spaced
+        (record_files.uniform_step), else None
+    samples : int  Its number of samples
     """
 
     written: str
@@ -134,6 +153,8 @@ class RecordFile:
     end: float
     pga: float
     motion: Motion | None = None
+    step: float | None = None
+    samples: int = 0
 
     @property
     def local_path(self) -> str | None:
@@ -175,7 +196,8 @@ def record_file(
     if isinstance(value, Motion):  # arrays given in memory: checked when made
         acc = value.acceleration_m_s2
         return RecordFile(value.name, f"motion {value.name!r}", value.sha256, value.duration_s,
-                          float(np.max(np.abs(acc))), motion=value)  # fmt: skip
+                          float(np.max(np.abs(acc))), motion=value,
+                          step=uniform_step(value.time_s), samples=int(acc.size))  # fmt: skip
     if not isinstance(value, str) or not value.strip():
         raise ConfigError(
             f"{key} must be one record file (a path to a PEER NGA .AT2 or a .csv, as a"
@@ -187,7 +209,8 @@ def record_file(
         found = _READ.get((signature, units))
         if found is None:
             t, acc, _ = read_file(path, units)
-            found = (_digest(path), float(t[-1]), float(np.max(np.abs(acc))))
+            found = (_digest(path), float(t[-1]), float(np.max(np.abs(acc))),
+                     uniform_step(t), int(t.size))  # fmt: skip
             if signature is not None:
                 if len(_READ) >= _READ_SIZE:
                     _READ.pop(next(iter(_READ)))
@@ -196,10 +219,12 @@ def record_file(
         raise ConfigError(f"{key}: {_one_line(str(exc))}") from None
     except OSError as exc:
         raise ConfigError(f"{key}: {value}: cannot read ({exc.strerror or exc})") from None
-    return RecordFile(value, str(path), *found)
+    sha256, end, pga, step, samples = found
+    return RecordFile(value, str(path), sha256, end, pga, step=step, samples=samples)
 
 
-#: Records read in this process, by file and units: (SHA-256, end [s], PGA [m/s^2]). The
+#: Records read in this process, by file and units: (SHA-256, end [s], PGA [m/s^2], even
+#: step [s] or None, number of samples). The
 #: points of a grid name the same file again and again; a file is read again when its
 #: size, modification time or inode changed.
 _READ: dict = {}
@@ -230,9 +255,14 @@ def with_record(
     rec = record_file(value, key, base_dir, excitation.units)
     _check_scalable(rec, excitation.scale, key)
     end = rec.end
+    records = [(key, rec)]
     if excitation.vertical is not None:
         ver = record_file(excitation.vertical, "excitation.vertical", base_dir, excitation.units)
         end = max(end, ver.end)
+        records.append(("excitation.vertical", ver))
+    if excitation.processing is not None and excitation.processing.filter is not None:
+        for where, each in records:
+            _check_filterable(each, where, excitation.processing.filter)
     duration = _record_duration(end, excitation.free_time, key)
     return dataclasses.replace(
         excitation,
@@ -344,6 +374,11 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
                               " arrays is horizontal")  # fmt: skip
         fields.update(vertical=ver.written, vertical_sha256=ver.sha256, vertical_path=ver.path)
         end = max(end, ver.end)
+    if "processing" in e:
+        records = [("excitation.file", rec)]
+        if "vertical" in e:
+            records.append(("excitation.vertical", ver))
+        fields["processing"] = processing_section(e["processing"], records)
     return dict(
         fields,
         units=units,
@@ -351,6 +386,80 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
         free_time=free_time,
         duration=_record_duration(end, free_time, "excitation.file"),
     )
+
+
+def filter_padding(order: int) -> int:
+    """Samples the band-pass of ``order`` (a side) extends a record by at each end before
+    its forward and backward pass (rbm_cli.physics.records.band_pass gives it to scipy's
+    sosfiltfilt as padlen): 3 (2 s + 1) with s = 2 ceil(order / 2), the number of its
+    second-order sections (a high-pass and a low-pass of that order), scipy's default for
+    sections of second order. A record needs more samples than this."""
+    return 3 * (2 * 2 * math.ceil(order / 2) + 1)
+
+
+def _check_filterable(rec: RecordFile, key: str, band: FilterConfig) -> None:
+    """A record the band-pass can run on: even steps, high_hz below its Nyquist frequency,
+    more samples than the filter's padding."""
+    where = "excitation.processing.filter"
+    if rec.step is None:
+        raise ConfigError(
+            f"{where}: {key} ({rec.path}) has uneven time steps, and a band-pass needs one"
+            " step: resample the record to an even step (baseline correction alone takes any"
+            " steps)"
+        )
+    nyquist = 0.5 / rec.step
+    if not band.high_hz < nyquist:
+        raise ConfigError(
+            f"{where}.high_hz must be below the Nyquist frequency of {key} ({rec.path}:"
+            f" {fmt(nyquist)} Hz, step {fmt(rec.step)} s), got {fmt(band.high_hz)}"
+        )
+    need = filter_padding(band.order) + 1
+    if rec.samples < need:
+        raise ConfigError(
+            f"{where}.order: {key} ({rec.path}) has {rec.samples} samples, and a band-pass of"
+            f" order {band.order} needs at least {need}: lower the order or drop the filter"
+        )
+
+
+def processing_section(raw: Any, records: list[tuple[str, RecordFile]]) -> ProcessingConfig | None:
+    """The validated ``excitation.processing`` of the records ``records`` ((key, record
+    file) pairs: the horizontal record, and the vertical one if any).
+
+    ``filter: {low_hz, high_hz, order}`` (applied first): a zero-phase Butterworth
+    band-pass [Hz],
+    0 < low_hz < high_hz < each record's Nyquist frequency, order 1..FILTER_ORDER_MAX
+    (default 4) a side; it needs evenly sampled records (one with uneven steps is refused,
+    not resampled). ``baseline`` (``none``, ``linear``, ``quadratic``; then): the polynomial
+    in time removed from the acceleration, fitted by least squares to the displacement; any
+    steps. A processing that changes nothing
+    (``baseline: none`` and no filter) is None: the config is the record as read, with the
+    same hash.
+
+    Raises
+    ------
+    ConfigError  One line naming the key, its allowed range, and the record at fault.
+    """
+    path = "excitation.processing"
+    p = mapping(raw, path, PROCESSING_KEYS)
+    baseline = choice(p.get("baseline", "none"), join(path, "baseline"), BASELINES)
+    band = None
+    if "filter" in p:
+        where = join(path, "filter")
+        f = mapping(p["filter"], where, FILTER_KEYS, required=("low_hz", "high_hz"))
+        order = integer(f.get("order", FilterConfig.order), join(where, "order"), 1,
+                        FILTER_ORDER_MAX, " (the order of each side of the band-pass)")  # fmt: skip
+        low = number(f["low_hz"], join(where, "low_hz"), "Hz", 0.0, None)
+        high = number(f["high_hz"], join(where, "high_hz"), "Hz", 0.0, None)
+        if not low < high:
+            raise ConfigError(
+                f"{where}.high_hz must be above {where}.low_hz ({fmt(low)} Hz), got {fmt(high)}"
+            )
+        band = FilterConfig(low, high, order)
+        for key, rec in records:
+            _check_filterable(rec, key, band)
+    if baseline == "none" and band is None:
+        return None
+    return ProcessingConfig(baseline, band)
 
 
 def _mp_fields(e: dict) -> dict:

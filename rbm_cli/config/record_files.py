@@ -81,6 +81,24 @@ def _check_peak(path, t: np.ndarray, values: np.ndarray, unit: float) -> None:
         )
 
 
+#: How far a record's time steps may stray from their mean, relative to it, for the record
+#: to count as evenly sampled (a CSV's times written in decimals differ from k dt by
+#: round-off, some 1e-12 relative; an uneven record differs by far more).
+EVEN_STEP_RTOL = 1e-6
+
+
+def uniform_step(t: np.ndarray) -> float | None:
+    """The time step [s] of samples at even steps (their mean step), or None when the
+    steps are uneven (one strays from the mean by more than EVEN_STEP_RTOL of it)."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 2:
+        return None
+    step = float(t[-1] - t[0]) / (t.size - 1)
+    if not step > 0.0 or np.max(np.abs(np.diff(t) - step)) > EVEN_STEP_RTOL * step:
+        return None
+    return step
+
+
 def check_samples(where: str, t: np.ndarray, values: np.ndarray, units: str,
                   at: Callable[[int], str]) -> None:  # fmt: skip
     """The rules every record's samples meet, whatever they came from (a CSV file, or

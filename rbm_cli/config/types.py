@@ -24,6 +24,9 @@ EXCITATIONS = ("harmonic", "half-sine", "free", *PULSES, "record")
 #: the grid's amplitude (excitation.scale: its PGA [g], or a plain factor).
 RECORD_UNITS = ("g", "m/s2")
 RECORD_SCALES = ("pga", "factor")
+#: Baseline corrections of a record (excitation.processing.baseline): the degree of the
+#: polynomial removed from its acceleration (none; linear: a0 + a1 t; quadratic: + a2 t^2).
+BASELINES = ("none", "linear", "quadratic")
 #: Default free motion after a record's last sample [s] (excitation.free_time)
 #: [assumption]: a few rocking half-periods of a stone column (0.5-2 s each), so a column
 #: still rocking when the shaking ends has time to collapse or settle; a monolithic
@@ -140,6 +143,34 @@ _LOCAL_FIELDS = ("file_path", "vertical_path", "motion")
 
 
 @dataclass(frozen=True)
+class FilterConfig:
+    """A record's zero-phase Butterworth band-pass (excitation.processing.filter).
+
+    low_hz, high_hz : float  Corner frequencies [Hz] of its high-pass and low-pass sides,
+        0 < low_hz < high_hz < the record's Nyquist frequency
+    order : int  Order n of each side (run forward and backward: the gain is squared)
+    """
+
+    low_hz: float
+    high_hz: float
+    order: int = 4
+
+
+@dataclass(frozen=True)
+class ProcessingConfig:
+    """How a record is processed before it is scaled (excitation.processing).
+
+    baseline : str  'none', 'linear' or 'quadratic': the polynomial in time removed from
+        the acceleration, fitted by least squares to the record's displacement
+        (rbm_cli.physics.records.remove_baseline)
+    filter : FilterConfig or None  The band-pass, applied before the baseline correction
+    """
+
+    baseline: str = "none"
+    filter: FilterConfig | None = None
+
+
+@dataclass(frozen=True)
 class ExcitationConfig:
     """Ground motion shape; amplitude and frequency come from the grid or the CLI.
 
@@ -168,6 +199,10 @@ class ExcitationConfig:
     motion : rbm_cli.config.motions.Motion or None  Record: the motion given as arrays in
         place of a file (then ``file`` is its name and ``file_sha256`` the digest of its
         samples, which identify it); not in :meth:`resolved`, not compared
+    processing : ProcessingConfig or None  Record: its baseline correction and band-pass,
+        applied to the record (and the vertical record) before scaling; None: the record
+        as read (also for a processing that changes nothing, so the config's hash is the
+        one it had before processing existed)
     """
 
     type: str = "harmonic"
@@ -186,6 +221,7 @@ class ExcitationConfig:
     file_path: str | None = field(default=None, compare=False)
     vertical_path: str | None = field(default=None, compare=False)
     motion: Any = field(default=None, compare=False)
+    processing: ProcessingConfig | None = None
 
     def resolved(self) -> dict:
         """The settings that define the motion, as plain data: the fields of other
@@ -199,6 +235,8 @@ class ExcitationConfig:
             drop += _VERTICAL_FIELDS
         if self.type != "mavroeidis-papageorgiou":
             drop += _MP_FIELDS
+        if self.processing is None:
+            drop.append("processing")
         for key in drop:
             out.pop(key)
         return out

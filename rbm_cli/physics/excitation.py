@@ -4,7 +4,8 @@
 [Hz] (the grid's, at this edge only) into the :class:`~rbm_cli.physics.motion.GroundMotion`
 every model integrates: a harmonic, a half-sine or near-fault pulse (physics/pulses.py),
 or a record read from its file (physics/records.py) or given as arrays
-(rbm_cli.config.motions.Motion), with its vertical record if any.
+(rbm_cli.config.motions.Motion), with its vertical record if any, both processed as
+``excitation.processing`` says before they are scaled.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import PULSES, ExcitationConfig, G
+from rbm_cli.config.types import PULSES, ExcitationConfig, G, ProcessingConfig
 from rbm_cli.physics.ground import mp_knots, ricker_knots
 from rbm_cli.physics.motion import PULSE_KINDS, SAMPLES_PER_PERIOD, GroundMotion
 from rbm_cli.physics.pulses import (
@@ -35,6 +36,7 @@ __all__ = [
     "load_record",
     "make_ground_motion",
     "merge_records",
+    "processed_record",
     "pulse_motion",
     "record_motion",
 ]
@@ -64,11 +66,23 @@ def load_record(path: str, units: str, sha256: str | None) -> Record:
     return record
 
 
+@lru_cache(maxsize=64)
+def processed_record(
+    path: str, units: str, sha256: str | None, processing: ProcessingConfig | None
+) -> Record:
+    """The record of a config's file (:func:`load_record`) processed as ``processing``
+    says (:meth:`~rbm_cli.physics.records.Record.processed`), once per process."""
+    return load_record(path, units, sha256).processed(processing)
+
+
 def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMotion:
     """The ground motion of a record excitation at amplitude [g] (its PGA after scaling
     with scale 'pga', a plain factor [-] with scale 'factor'): the scaled record (and its
     vertical record, scaled by the same factor), then free motion for
-    excitation.free_time [s]."""
+    excitation.free_time [s].
+
+    The records are processed (excitation.processing: baseline, band-pass) before they
+    are scaled, so with scale 'pga' the amplitude is the processed record's PGA."""
     path = excitation.file_path or excitation.file
     if path is None:
         raise RbmError("excitation.file is required for type record")
@@ -76,8 +90,10 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
         motion = excitation.motion
         path = f"motion {motion.name!r}"
         rec = Record(motion.time_s, motion.acceleration_m_s2, motion.name, "in memory")
+        rec = rec.processed(excitation.processing)
     else:
-        rec = load_record(str(path), excitation.units, excitation.file_sha256)
+        rec = processed_record(str(path), excitation.units, excitation.file_sha256,
+                               excitation.processing)  # fmt: skip
     with np.errstate(all="ignore"):  # checked below, with the file named
         if excitation.scale == "pga":
             factor = amplitude_g * G / rec.pga
@@ -87,7 +103,8 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
     end = rec.duration
     if excitation.vertical is not None:
         path = excitation.vertical_path or excitation.vertical
-        ver = load_record(str(path), excitation.units, excitation.vertical_sha256)
+        ver = processed_record(str(path), excitation.units, excitation.vertical_sha256,
+                               excitation.processing)  # fmt: skip
         knots, values, vertical = merge_records(rec.t, values, ver.t, _scaled(ver, factor, path))
         end = max(end, ver.duration)
         vertical.setflags(write=False)

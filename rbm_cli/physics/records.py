@@ -14,6 +14,10 @@ strictly increasing sample times t [s]. Its conventions, which the integrator re
 - **Duration.** :attr:`Record.duration` is the time of the last sample, measured from
   t = 0 (not from the first sample).
 
+Processing (``excitation.processing``) is a function of the samples (t, a):
+:func:`process` band-passes (:func:`band_pass`) and then removes a baseline
+(:func:`remove_baseline`); :meth:`Record.processed` gives the record it makes.
+
 Reading is strict: every malformed file is refused with an :class:`~rbm_cli.base.errors.RbmError`
 whose one-line message names the file and, where there is one, the line. Files are parsed
 in blocks of lines with numpy (:mod:`rbm_cli.config.record_files`), so memory stays bounded;
@@ -24,6 +28,11 @@ References
 .. [1] PEER NGA strong motion database: file format of the ``.AT2`` acceleration time
    series (four header lines, then the values in g). Pacific Earthquake Engineering
    Research Center, https://ngawest2.berkeley.edu.
+.. [2] Boore, D. M. and Bommer, J. J. (2005). Processing of strong-motion accelerograms:
+   needs, options and consequences. Soil Dynamics and Earthquake Engineering 25, 93-115
+   (baseline corrections fitted to the velocity or displacement; acausal, zero-phase
+   Butterworth filters); Ancheta, T. D. et al. (2014), NGA-West2 database, Earthquake
+   Spectra 30(3), 989-1005 (filtering, then a polynomial fitted to the displacement).
 """
 
 from __future__ import annotations
@@ -36,7 +45,8 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config import record_files as record_parsers
-from rbm_cli.config.types import G  # gravity [m/s^2], the one definition
+from rbm_cli.config.excitation import filter_padding
+from rbm_cli.config.types import BASELINES, G, ProcessingConfig  # G: the one definition
 
 _UNITS = record_parsers.UNITS
 
@@ -144,6 +154,122 @@ class Record:
         if not np.isfinite(factor):
             raise RbmError(f"record {self.name!r}: scale factor must be finite, got {factor!r}")
         return Record(self.t, self.acceleration * factor, self.name, self.source, self.title)
+
+    def processed(self, processing: ProcessingConfig | None) -> Record:
+        """The record processed as ``processing`` says (:func:`process`); itself for None."""
+        if processing is None:
+            return self
+        values = process(self.t, self.acceleration, processing, self.name)
+        return Record(self.t, values, self.name, self.source, self.title)
+
+
+# --------------------------------------------------------------------------- processing
+
+
+def displacement_at_samples(t: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Displacement [m] at the sample times of the acceleration a [m/s^2], linear between
+    its samples, integrated exactly from rest at the first sample (velocity by the
+    trapezoid rule, displacement cubic between samples)."""
+    t, a = np.asarray(t, dtype=float), np.asarray(a, dtype=float)
+    h = np.diff(t)
+    v = np.concatenate([[0.0], np.cumsum(h * (a[:-1] + a[1:]) / 2.0)])
+    return np.concatenate([[0.0], np.cumsum(v[:-1] * h + h * h * (2.0 * a[:-1] + a[1:]) / 6.0)])
+
+
+def baseline_fit(t: np.ndarray, a: np.ndarray, degree: int) -> np.ndarray:
+    """The polynomial in time of ``degree`` (its values at the samples [m/s^2]) whose
+    removal from the acceleration a [m/s^2] leaves the least displacement: least squares
+    on the displacement from rest (:func:`displacement_at_samples`), each sample weighted
+    by the time it stands for (trapezoid weights, so uneven steps are fitted as the time
+    integral of u^2). The displacement is linear in the acceleration, so the fit is that
+    of the displacement of each power of time to the record's: the corrected record's own
+    displacement is what is minimised. Time runs from the first sample, scaled by the
+    record's length (the powers stay of order 1)."""
+    t, a = np.asarray(t, dtype=float), np.asarray(a, dtype=float)
+    span = float(t[-1] - t[0])
+    tau = (t - t[0]) / span
+    powers = np.vstack([tau**j for j in range(degree + 1)]).T
+    basis = np.column_stack([displacement_at_samples(t, powers[:, j]) for j in range(degree + 1)])
+    h = np.diff(t)
+    weight = np.sqrt(np.concatenate([[h[0]], h[:-1] + h[1:], [h[-1]]]) / 2.0)
+    coef, *_ = np.linalg.lstsq(basis * weight[:, None], displacement_at_samples(t, a) * weight,
+                               rcond=None)  # fmt: skip
+    return powers @ coef
+
+
+def remove_baseline(t: np.ndarray, a: np.ndarray, baseline: str) -> np.ndarray:
+    """The acceleration a [m/s^2] less its baseline (:func:`baseline_fit`): ``none``
+    (a as given), ``linear`` (a0 + a1 t) or ``quadratic`` (a0 + a1 t + a2 t^2)."""
+    if baseline not in BASELINES:
+        raise RbmError(f"baseline must be one of {', '.join(BASELINES)}, got {baseline!r}")
+    a = np.asarray(a, dtype=float)
+    degree = BASELINES.index(baseline)  # none 0 (nothing removed), linear 1, quadratic 2
+    if degree == 0:
+        return a.copy()
+    return a - baseline_fit(t, a, degree)
+
+
+def band_pass_sections(low_hz: float, high_hz: float, order: int, fs: float) -> np.ndarray:
+    """Second-order sections of the band-pass: a Butterworth high-pass at low_hz and a
+    low-pass at high_hz [Hz], each of ``order``, for samples at fs [Hz] (scipy.signal.butter,
+    bilinear with the corners prewarped). One pass has the gain
+
+    .. math:: |H(f)|^2 = \\frac{1}{1 + (\\tan(\\pi f_l / f_s) / \\tan(\\pi f / f_s))^{2n}}
+              \\frac{1}{1 + (\\tan(\\pi f / f_s) / \\tan(\\pi f_h / f_s))^{2n}}
+
+    (the analogue Butterworth's 1 / (1 + (f / f_c)^(2n)) a side, for f well below f_s)."""
+    from scipy.signal import butter
+
+    high = butter(order, low_hz, btype="highpass", fs=fs, output="sos")
+    low = butter(order, high_hz, btype="lowpass", fs=fs, output="sos")
+    return np.vstack([high, low])
+
+
+def band_pass(t: np.ndarray, a: np.ndarray, low_hz: float, high_hz: float, order: int,
+              name: str = "record") -> np.ndarray:  # fmt: skip
+    """The acceleration a [m/s^2] band-passed between low_hz and high_hz [Hz], zero phase:
+    :func:`band_pass_sections` run forward and backward (scipy.signal.sosfiltfilt, the
+    record extended at each end by :func:`~rbm_cli.config.excitation.filter_padding`
+    samples, odd about its end values), so its gain is |H(f)|^2 and its phase 0.
+
+    Raises
+    ------
+    RbmError  Uneven time steps (a band-pass needs one step), 0 < low_hz < high_hz <
+        the Nyquist frequency not met, or too few samples for the filter's padding.
+    """
+    from scipy.signal import sosfiltfilt
+
+    where = f"record {name!r}"
+    step = record_parsers.uniform_step(t)
+    if step is None:
+        raise RbmError(f"{where}: a band-pass needs even time steps: resample the record")
+    fs = 1.0 / step
+    if not 0.0 < low_hz < high_hz < 0.5 * fs:
+        raise RbmError(
+            f"{where}: a band-pass needs 0 < low_hz < high_hz < the Nyquist frequency"
+            f" {0.5 * fs:g} Hz, got {low_hz:g} and {high_hz:g} Hz"
+        )
+    a = np.asarray(a, dtype=float)
+    padding = filter_padding(order)
+    if a.size <= padding:
+        raise RbmError(f"{where}: a band-pass of order {order} needs more than {padding} samples")
+    return sosfiltfilt(band_pass_sections(low_hz, high_hz, order, fs), a, padlen=padding)
+
+
+def process(t: np.ndarray, a: np.ndarray, processing: ProcessingConfig | None,
+            name: str = "record") -> np.ndarray:  # fmt: skip
+    """A record's acceleration [m/s^2] at its sample times t [s], processed: band-passed
+    (:func:`band_pass`) if ``processing.filter`` is given, then its baseline removed
+    (:func:`remove_baseline`). The baseline comes last, as in the PEER NGA processing [2]_:
+    fitted to the filtered record's displacement, it removes the drift a filter's ends can
+    leave as well as the record's own. None: a copy of ``a``."""
+    a = np.asarray(a, dtype=float)
+    if processing is None:
+        return a.copy()
+    band = processing.filter
+    if band is not None:
+        a = band_pass(t, a, band.low_hz, band.high_hz, band.order, name)
+    return remove_baseline(t, a, processing.baseline)
 
 
 # --------------------------------------------------------------------------- reading

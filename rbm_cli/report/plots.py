@@ -45,7 +45,28 @@ def top_relative_displacement(history: History) -> np.ndarray:
     return u[:, -1] - u[:, 0]
 
 
-def plot_history(history: History, ax=None, t_collapse: float | None = None):
+#: The ground's displacement is said to drift (and plot_history draws the column relative
+#: to it by default) when its range over the run is more than this many times the range of
+#: the top's displacement relative to the base: drawn together on one scale, the column's
+#: motion would be a flat line (a record that is not baseline-corrected can drift metres
+#: while a column rocks by centimetres).
+DRIFT_RATIO = 20.0
+
+
+def ground_drifts(history: History) -> bool:
+    """Whether the ground's displacement dwarfs the column's motion relative to it (its
+    range more than DRIFT_RATIO times the top's relative displacement's range)."""
+    ug = np.asarray(history.ground_displacement, dtype=float)
+    rel = top_relative_displacement(history)
+    if ug.size == 0 or not (np.all(np.isfinite(ug)) and np.all(np.isfinite(rel))):
+        return False
+    ground = float(np.ptp(ug))
+    return ground > 0.0 and ground > DRIFT_RATIO * float(np.ptp(rel))
+
+
+def plot_history(
+    history: History, ax=None, t_collapse: float | None = None, relative: bool | None = None
+):
     """Base and top horizontal displacement against time (paper fig. 4).
 
     Parameters
@@ -53,24 +74,46 @@ def plot_history(history: History, ax=None, t_collapse: float | None = None):
     history : History  Recorded run
     ax : matplotlib Axes, optional
     t_collapse : float, optional  Collapse time [s], drawn as a dashed line
+    relative : bool or None  True: the top drawn relative to the ground (the base at 0),
+        and the ground's displacement on a second axis on the right, with its own scale;
+        False: both absolute, on one scale; None (default): relative when the ground
+        drifts (:func:`ground_drifts`), else absolute
 
     Notes
     -----
     Base = ground displacement u_g; top = u_g + (u_{n+1} - u_1), the absolute
     displacement of the top node. Harmonic runs use the steady ground motion
-    u_g = -a_g / omega^2 (see :class:`rbm_cli.models.result.History`).
+    u_g = -a_g / omega^2; pulses and records the ground's displacement integrated from
+    rest (a record's after its processing, excitation.processing) (see
+    :class:`rbm_cli.models.result.History`).
     """
     ax = _new_axes(ax)
     t = np.asarray(history.t, dtype=float)
     ug = np.asarray(history.ground_displacement, dtype=float)
-    ax.plot(t, ug, color="0.4", linewidth=1.0, label="base (ground)")
-    ax.plot(
-        t, ug + top_relative_displacement(history), color="tab:blue", linewidth=1.2, label="top"
-    )
+    if relative is None:
+        relative = ground_drifts(history)
+    if relative:
+        ax.axhline(0.0, color="0.4", linewidth=1.0, label="base (ground)")
+        ax.plot(t, top_relative_displacement(history), color="tab:blue", linewidth=1.2,
+                label="top, relative to the ground")  # fmt: skip
+        right = ax.twinx()
+        right.plot(t, ug, color="0.55", linewidth=0.9, linestyle="--", gid="ground",
+                   label="ground (right axis)")  # fmt: skip
+        right.set_ylabel("ground displacement [m]", color="0.4")
+        # the ground's line in the left axis's legend
+        ax.plot([], [], color="0.55", linewidth=0.9, linestyle="--", label="ground (right axis)")
+        ax.set_ylabel("top - ground [m]")
+        ax.set_title(
+            f"Top relative to the ground; the ground, which moves {np.ptp(ug):.3g} m, on the right"
+        )
+    else:
+        ax.plot(t, ug, color="0.4", linewidth=1.0, label="base (ground)")
+        ax.plot(t, ug + top_relative_displacement(history), color="tab:blue", linewidth=1.2,
+                label="top")  # fmt: skip
+        ax.set_ylabel("displacement [m]")
+        ax.set_title("Base and top horizontal displacement")
     _mark_collapse(ax, t_collapse)
     ax.set_xlabel("time [s]")
-    ax.set_ylabel("displacement [m]")
-    ax.set_title("Base and top horizontal displacement")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize="small")
     return ax

@@ -78,17 +78,25 @@ def history_figure(
     title: str | None = None,
     joints: tuple | None = None,
 ):
-    """history.png: base and top displacement, top relative to base, and for more than
-    one drum each joint's rotation over its limit (``joints`` = (Column, formulation,
-    collapse ratio), see :func:`rbm_cli.report.plots.plot_joint_rotations`)."""
+    """history.png: base and top displacement (the top relative to the ground, and the
+    ground on a right axis, when the ground drifts: rbm_cli.report.plots.ground_drifts),
+    top relative to base, and for more than one drum each joint's rotation over its limit
+    (``joints`` = (Column, formulation, collapse ratio), see
+    :func:`rbm_cli.report.plots.plot_joint_rotations`)."""
     from matplotlib.figure import Figure
 
-    from rbm_cli.report.plots import plot_history, plot_joint_rotations, plot_top_relative
+    from rbm_cli.report.plots import (
+        ground_drifts,
+        plot_history,
+        plot_joint_rotations,
+        plot_top_relative,
+    )
 
     multi = joints is not None and joints[0].n > 1
     fig = Figure(figsize=(9.0, 8.5 if multi else 6.0))
     axes = fig.subplots(3 if multi else 2, 1, sharex=True)
-    plot_history(history, ax=axes[0], t_collapse=t_collapse)
+    relative = ground_drifts(history)  # the ground then on a right axis of the first panel
+    plot_history(history, ax=axes[0], t_collapse=t_collapse, relative=relative)
     plot_top_relative(history, ax=axes[1], t_collapse=t_collapse)
     if multi:
         column, formulation, ratio = joints
@@ -103,8 +111,9 @@ def history_figure(
         axes[2].set_title("joint rotations against their limits", fontsize="medium")
     for ax in axes[:-1]:
         ax.set_xlabel("")
-    for ax in axes:  # legends beside the axes, so every panel has the same width
-        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="x-small")
+    for k, ax in enumerate(axes):  # legends beside the axes (past a right axis, if any)
+        beside = 1.1 if relative and k == 0 else 1.01
+        ax.legend(loc="upper left", bbox_to_anchor=(beside, 1.0), fontsize="x-small")
     if title:
         fig.suptitle(title)
     fig.tight_layout()

@@ -230,7 +230,8 @@ def fragility(
         np.linspace(0.0, 1.1 * levels.max(), 201) if grid_g is None else np.asarray(grid_g, float)
     )
     n_records = int(rows["record"].nunique())
-    fit, note, n_resamples = _fit_table(rows, levels, n_records, n_resamples)
+    fit, note, n_resamples = _fit_table(rows, levels, n_records, n_resamples,
+                                        intensity_unit(column))  # fmt: skip
     band = _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, [lo_pct, hi_pct], progress)
     curve = _curve(grid, fit, band)
     _add_fitted(table, grid, fit, band)
@@ -324,7 +325,8 @@ def _shown(value) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _fit_table(rows: pd.DataFrame, levels: np.ndarray, n_records: int, n_resamples: int):
+def _fit_table(rows: pd.DataFrame, levels: np.ndarray, n_records: int, n_resamples: int,
+               unit: str = "g"):  # fmt: skip
     """(fit, note, resamples to draw): the lognormal fit of the per-level trials and
     collapses, or None and why there is none (one line); with a fit from fewer than
     MIN_BAND_RECORDS records, no resamples (each would be the one record: a band of zero
@@ -334,7 +336,7 @@ def _fit_table(rows: pd.DataFrame, levels: np.ndarray, n_records: int, n_resampl
     k = ok.groupby("x")["hits"].sum().reindex(levels, fill_value=0.0).to_numpy(float)
     used = n > 0
     try:
-        fit = fit_counts(np.log(levels[used]), n[used], k[used])
+        fit = fit_counts(np.log(levels[used]), n[used], k[used], unit=unit)
     except RbmError as exc:
         return None, str(exc).removeprefix("fragility: "), n_resamples
     if n_resamples > 0 and n_records < MIN_BAND_RECORDS:

@@ -450,7 +450,7 @@ def test_one_intensity_is_not_presented_as_a_fit(tmp_path):
     k, n = int(level["collapsed"].sum()), len(level)
     assert 0 < k < n  # mixed outcomes: the case a separated-outcomes message got wrong
     domain = write_domain(tmp_path / "level", level)
-    res = invoke("fragility", domain)
+    res = invoke("fragility", domain, "--ensemble-outcome", "member0")  # the rows' runs
     assert res.exit_code == 0, res.output
     assert f"no fit: all runs are at one intensity (0.5 g, {k} of {n} collapsed)" in res.output
     assert "two intensities or more" in res.output

@@ -214,8 +214,10 @@ def _ranges() -> dict[str, str]:
         DEFAULT_DURATION,
         FILTER_ORDER_MAX,
         GAMMA_MAX,
+        IM_PERIOD_RANGE_S,
         INITIAL_MAX,
         MAX_DURATION,
+        MAX_IM_PERIODS,
         PHASE_MAX,
     )
     from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, MAX_CELLS
@@ -260,6 +262,8 @@ def _ranges() -> dict[str, str]:
         "excitation.free_time": f"[0, {fmt(MAX_DURATION)}]",
         "excitation.processing.baseline": one_of(t.BASELINES),
         "excitation.processing.filter.order": f"an integer 1-{FILTER_ORDER_MAX}",
+        "excitation.im_periods": f"[{fmt(IM_PERIOD_RANGE_S[0])}, {fmt(IM_PERIOD_RANGE_S[1])}]"
+        f", distinct, at most {MAX_IM_PERIODS}",
         "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, one per drum",
         "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, one per drum",
         "grid.amplitudes": f"[{fmt(AMPLITUDE_RANGE_G[0])}, {fmt(AMPLITUDE_RANGE_G[1])}]",
@@ -369,6 +373,13 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "s",
         "",
         "``record`` only: free motion simulated after the record's last sample.",
+    ),
+    "excitation.im_periods": (
+        "s",
+        "",
+        "``record`` only: periods of the 5 %-damped spectral accelerations "
+        "``sa_<T>s_g`` a domain's rows report (beside ``sa_t1_g`` at the column's "
+        "first elastic period); no effect on a run. Default none.",
     ),
     "excitation.scale": (
         "",

@@ -35,6 +35,9 @@ def fragility(
     seed: int = 0,
     ci_percentiles: tuple[float, float] = (5.0, 95.0),
     intensity_column: str | None = None,
+    intensity: str | None = None,
+    ensemble_outcome: str = "members",
+    n_members: int | None = None,
 ) -> FragilityResult:
     """The lognormal fragility of a record-suite domain, as data (what ``rbm fragility``
     computes and writes to fragility.csv, fragility_curve.csv and fragility.json; no file
@@ -49,7 +52,18 @@ def fragility(
     n_resamples : int  Bootstrap resamples of the records (0: no band, no intervals)
     seed : int  Seed of the bootstrap (numpy PCG64), 0 to 2**64 - 1
     ci_percentiles : (float, float)  Percentiles bounding the intervals and the band [%]
-    intensity_column : str, optional  Default: intensity_g, amplitude_g or intensity
+    intensity : str, optional  The intensity measure fitted on: a column of the domain,
+        the amplitude by default (intensity_g, amplitude_g or intensity, the first
+        present), or a record's measure (pga_g, pgv_m_s, pgd_m, arias_m_s, cav_m_s,
+        sa_t1_g, sa_<T>s_g, pga_over_g_tan_alpha, pgv_p_over_g_tan_alpha); the median and
+        the tables' intensity_g are then in its unit (``result.intensity_unit``)
+    intensity_column : str, optional  The same as ``intensity`` (its older name)
+    ensemble_outcome : str  For an ensemble domain (a ``collapse_fraction`` column):
+        ``members`` (every member a trial, the default: all the runs the sweep made),
+        ``majority`` (a cell collapses when most members did) or ``member0`` (the row's
+        own run); ``result.outcome`` says which
+    n_members : int, optional  Members per cell of an ensemble domain given as a
+        DataFrame (a domain.csv's meta.json says it for a path)
 
     Returns
     -------
@@ -75,15 +89,28 @@ def fragility(
     """  # noqa: E501
     import pandas as pd
 
+    from rbm_cli.base.errors import RbmError
+    from rbm_cli.report.fragility_run import n_members as members_of
     from rbm_cli.study.fragility import check_options
     from rbm_cli.study.fragility import fragility as fit
     from rbm_cli.study.outcomes import prepare_outcomes, read_suite_domain
 
     check_options(n_resamples, seed, ci_percentiles)
+    if intensity is not None and intensity_column is not None and intensity != intensity_column:
+        raise RbmError(f"fragility: intensity {intensity!r} and intensity_column "
+                       f"{intensity_column!r} name two columns: give one")  # fmt: skip
+    column = intensity if intensity is not None else intensity_column
     if isinstance(domain, str | os.PathLike):
-        domain = read_suite_domain(domain)
+        path = domain
+        domain = read_suite_domain(path)
+        if n_members is None:
+            from pathlib import Path
+
+            n_members = members_of(Path(path), domain)
     elif isinstance(domain, pd.DataFrame):
         domain = domain.copy()
-    prepare_outcomes(domain, intensity_column)  # checked (one line) before the fit
+    # checked (one line) before the fit
+    prepare_outcomes(domain, column, ensemble_outcome, n_members)
     return fit(domain, n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
-               intensity_column=intensity_column)  # fmt: skip
+               intensity_column=column, ensemble_outcome=ensemble_outcome,
+               n_members=n_members)  # fmt: skip

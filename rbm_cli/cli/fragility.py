@@ -28,16 +28,24 @@ PROGRESS_AFTER_S = 2.0
               f"{MAX_RESAMPLES_SHOWN}, a few minutes).")  # fmt: skip
 @click.option("--seed", type=click.IntRange(min=0, max=2**64 - 1), default=0, show_default=True,
               help="Seed of the bootstrap (0 to 2^64 - 1).")  # fmt: skip
-@click.option("--intensity-column", default=None, metavar="NAME",
-              help="Column of the intensity  [default: intensity_g, amplitude_g or "
-              "intensity, the first present]")  # fmt: skip
+@click.option("--intensity", "--intensity-column", "intensity_column", default=None,
+              metavar="NAME",
+              help="The intensity measure to fit on, a column of the domain: a record's "
+              "pga_g, pgv_m_s, pgd_m, arias_m_s, cav_m_s, sa_t1_g, sa_<T>s_g, "
+              "pga_over_g_tan_alpha or pgv_p_over_g_tan_alpha  [default: the amplitude, "
+              "intensity_g, amplitude_g or intensity, the first present]")  # fmt: skip
+@click.option("--ensemble-outcome", type=click.Choice(["members", "majority", "member0"]),
+              default="members", show_default=True,
+              help="An ensemble domain's trials: every member of each cell (all the runs "
+              "the sweep made), each cell's majority, or its member 0's run.")  # fmt: skip
 @click.option("--ci", nargs=2, type=float, default=(5.0, 95.0), show_default=True,
               metavar="LOW HIGH",
               help="Percentiles of the bootstrap intervals and band.")  # fmt: skip
 @click.option("--compare", "others", multiple=True, metavar="OTHER.csv",
               help="Another record-suite domain whose fragility is drawn in fragility.png "
               "beside this one (repeatable; its own files are not written).")  # fmt: skip
-def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> None:
+def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcome, ci,
+              others) -> None:  # fmt: skip
     """Fit a lognormal fragility curve to a record-suite domain and draw its IDA.
 
     DOMAIN.csv is the domain.csv of a sweep over records x intensities (one row
@@ -46,7 +54,11 @@ def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> 
     fitted by maximum likelihood on the per-record outcomes (Baker 2015), with a
     bootstrap over records for the intervals and the band (it needs 2 records or
     more; progress on stderr when it takes more than a few seconds). Failed runs
-    are left out and counted. A curve needs runs at 2 intensities or more.
+    are left out and counted, per intensity in fragility.json, with a warning
+    when they gather at the high intensities. A curve needs runs at 2
+    intensities or more. --intensity fits on a record's intensity measure
+    instead of the amplitude. An ensemble domain (rbm sweep --ensemble) counts
+    every member of a cell as a trial, or its majority (--ensemble-outcome).
 
     Writes fragility.csv, fragility_curve.csv, fragility.json, fragility.png and
     ida.png (peak rotation ratio against intensity, a line per record), all
@@ -70,7 +82,8 @@ def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> 
     try:
         made = run_fragility(domain, output, n_resamples=resamples, seed=seed,
                              intensity_column=intensity_column, ci_percentiles=tuple(ci),
-                             compare=others, progress=progress)  # fmt: skip
+                             compare=others, progress=progress,
+                             ensemble_outcome=ensemble_outcome)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except KeyboardInterrupt:
@@ -83,11 +96,15 @@ def fragility(domain, output, resamples, seed, intensity_column, ci, others) -> 
     res = made.result
     click.echo(f"records: {res.n_records}, runs: {res.n_runs} (failed, left out: "
                f"{res.n_failed}), intensities: {len(res.table)}")  # fmt: skip
+    click.echo(f"intensity: {res.intensity_column} [{res.intensity_unit}]; trials: {res.outcome}")
+    if res.warning:
+        click.echo(f"warning: {res.warning}")
     if res.fit is None:
         click.echo(f"no fit: {res.note}")
     else:
         lo, hi = res.ci_percentiles
-        median = f"{res.fit.median_g:.4g} g" + _interval(res.median_ci_g, lo, hi, " g")
+        unit = f" {res.intensity_unit}"
+        median = f"{res.fit.median_g:.4g}{unit}" + _interval(res.median_ci_g, lo, hi, unit)
         beta = f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
         click.echo(f"median {median}, dispersion beta {beta}")
         if res.note:

@@ -19,7 +19,10 @@ Keys, by excitation type (a key of another type is refused, naming it):
   scaled by the same factor as the horizontal record; every model takes it),
   ``processing`` (``baseline``: ``none``, default, ``linear`` or ``quadratic``;
   ``filter: {low_hz, high_hz, order}``: a zero-phase Butterworth band-pass [Hz], order
-  1-8, default 4; both records processed, before scaling: see :func:`processing_section`).
+  1-8, default 4; both records processed, before scaling: see :func:`processing_section`),
+  ``im_periods`` (periods [s] of the 5 %-damped spectral accelerations a domain's rows
+  report among the record's intensity measures, rbm_cli.physics.intensity; no effect on
+  a run).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
   sets ``ExcitationConfig.duration`` to that. A mapping made in Python may give a motion
   (:class:`rbm_cli.config.motions.Motion`, arrays checked when it was made) in the place
@@ -98,6 +101,7 @@ EXCITATION_KEYS = (
     "nu",
     "vertical",
     "processing",
+    "im_periods",
 )
 PROCESSING_KEYS = ("baseline", "filter")
 FILTER_KEYS = ("low_hz", "high_hz", "order")
@@ -127,7 +131,12 @@ ONLY_FOR = {
     "nu": ("mavroeidis-papageorgiou",),
     "vertical": ("record",),
     "processing": ("record",),
+    "im_periods": ("record",),
 }
+#: Periods of the spectral accelerations a record's rows report (excitation.im_periods)
+#: [s], and how many a config may list.
+IM_PERIOD_RANGE_S = (0.01, 20.0)
+MAX_IM_PERIODS = 20
 _DIGEST_CHUNK = 1 << 20
 
 
@@ -381,6 +390,7 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
         fields["processing"] = processing_section(e["processing"], records)
     return dict(
         fields,
+        im_periods=_im_periods(e.get("im_periods", [])),
         units=units,
         scale=scale,
         free_time=free_time,
@@ -460,6 +470,23 @@ def processing_section(raw: Any, records: list[tuple[str, RecordFile]]) -> Proce
     if baseline == "none" and band is None:
         return None
     return ProcessingConfig(baseline, band)
+
+
+def _im_periods(raw: Any) -> tuple[float, ...]:
+    """excitation.im_periods: distinct periods [s] in IM_PERIOD_RANGE_S, at most
+    MAX_IM_PERIODS, as given (an empty list is none)."""
+    path = "excitation.im_periods"
+    lo, hi = IM_PERIOD_RANGE_S
+    if isinstance(raw, list | tuple) and not raw:
+        return ()
+    periods = number_list(raw, path, "s", 0.0)
+    if len(periods) > MAX_IM_PERIODS:
+        raise ConfigError(f"{path}: at most {MAX_IM_PERIODS} periods, got {len(periods)}")
+    for i, period in enumerate(periods):
+        in_bounds(period, join(path, i), "s", (lo, hi), "the spectra of records are reported")
+    if len(set(periods)) != len(periods):
+        raise ConfigError(f"{path}: each period once, got {', '.join(map(fmt, periods))} [s]")
+    return tuple(float(p) for p in periods)
 
 
 def _mp_fields(e: dict) -> dict:

@@ -192,6 +192,9 @@ class ExcitationConfig:
     vertical : str or None  Record: a second file, the upward ground acceleration, as
         written (scaled by the same factor as the horizontal record)
     vertical_sha256 : str or None  Its SHA-256
+    im_periods : tuple of float  Record: periods [s] of the spectral accelerations a
+        domain's rows report beside the column's first elastic period (no effect on a
+        run; left out of :meth:`resolved` when empty, as before the key existed)
     gamma : float or None  Mavroeidis-Papageorgiou: oscillatory character, > 1 [-]
     nu : float or None  Mavroeidis-Papageorgiou: phase of the harmonic [rad]
     file_path, vertical_path : str or None  Record: the files' absolute paths (resolved
@@ -218,6 +221,7 @@ class ExcitationConfig:
     nu: float | None = None
     vertical: str | None = None
     vertical_sha256: str | None = None
+    im_periods: tuple[float, ...] = ()
     file_path: str | None = field(default=None, compare=False)
     vertical_path: str | None = field(default=None, compare=False)
     motion: Any = field(default=None, compare=False)
@@ -237,6 +241,8 @@ class ExcitationConfig:
             drop += _MP_FIELDS
         if self.processing is None:
             drop.append("processing")
+        if not self.im_periods:
+            drop.append("im_periods")
         for key in drop:
             out.pop(key)
         return out

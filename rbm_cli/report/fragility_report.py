@@ -50,6 +50,14 @@ def fragility_summary(result: FragilityResult) -> dict:
         "n_resamples_used": result.n_resamples_used,
         "seed": result.seed,
         "intensity_column": result.intensity_column,
+        "intensity_unit": result.intensity_unit,
+        "outcome": result.outcome,
+        "ensemble_outcome": result.ensemble_outcome,
+        "failed_by_intensity": [
+            {"intensity": float(x), "n_failed": int(n)}
+            for x, n in zip(result.table["intensity_g"], result.table["n_failed"], strict=True)
+        ],
+        "warning": result.warning,
     }
 
 
@@ -214,7 +222,7 @@ def _plot_fit(ax, result: FragilityResult, prefix: str, color) -> None:
         curve["probability"],
         "-",
         color=color,
-        label=f"{prefix}lognormal MLE: median {result.fit.median_g:.3g} g, "
+        label=f"{prefix}lognormal MLE: median {result.fit.median_g:.3g} {result.intensity_unit}, "
         f"beta {result.fit.beta:.2f}",
     )
     fitted.set_gid("fitted")

@@ -32,7 +32,13 @@ from rbm_cli.base.files import check_writable_dir
 from rbm_cli.report.fragility_report import fragility_texts, plot_fragility, plot_ida
 from rbm_cli.report.fragility_store import FILES, FragilityFolder
 from rbm_cli.study.fragility import FragilityResult, check_options, fragility
-from rbm_cli.study.outcomes import prepare_outcomes, read_suite_domain_hashed
+from rbm_cli.study.intensities import label as measure_label
+from rbm_cli.study.outcomes import (
+    ENSEMBLE_OUTCOMES,
+    is_ensemble,
+    prepare_outcomes,
+    read_suite_domain_hashed,
+)
 
 #: Bootstrap resamples of the records by default.
 DEFAULT_RESAMPLES = 500
@@ -64,6 +70,7 @@ def run_fragility(
     ci_percentiles: tuple[float, float] = (5.0, 95.0),
     compare: tuple[str | os.PathLike, ...] = (),
     progress: Callable[[int, int], None] | None = None,
+    ensemble_outcome: str = ENSEMBLE_OUTCOMES[0],
 ) -> FragilityRun:
     """Fragility of a record-suite domain: fit, files and figures.
 
@@ -81,7 +88,9 @@ def run_fragility(
     seed : int
         Seed of the bootstrap (numpy PCG64), 0 to 2**64 - 1
     intensity_column : str, optional
-        Column of the intensity (default: the first of intensity_g, amplitude_g, intensity)
+        Column of the intensity (default: the first of intensity_g, amplitude_g,
+        intensity): the amplitude, or a record's intensity measure (pgv_m_s, sa_t1_g, ...:
+        rbm_cli.study.intensities), labelled with its unit in the figures
     ci_percentiles : (float, float)
         Percentiles of the bootstrap that bound the intervals and the band [%]
     compare : sequence of paths
@@ -91,6 +100,10 @@ def run_fragility(
     progress : callable, optional
         ``progress(done, total)`` after each bootstrap resample, of this domain and of the
         compared ones together
+    ensemble_outcome : str
+        How an ensemble domain's cells count: ``members`` (every member a trial; their
+        number per cell from meta.json beside the domain), ``majority`` or ``member0``
+        (rbm_cli.study.outcomes)
 
     Returns
     -------
@@ -108,22 +121,26 @@ def run_fragility(
     check_options(n_resamples, seed, ci_percentiles)
     domain = Path(domain_csv)
     df, digest = read_suite_domain_hashed(domain)
-    prepare_outcomes(df, intensity_column)  # its rows, checked before anything is made
+    members = n_members(domain, df)
+    # its rows, checked before anything is made
+    prepare_outcomes(df, intensity_column, ensemble_outcome, members)
     if isinstance(compare, str | os.PathLike):
         compare = (compare,)
     frames = [(Path(p), read_suite_domain_hashed(Path(p))[0]) for p in compare]
-    for _, frame in frames:
-        prepare_outcomes(frame, intensity_column)
+    frames = [(p, frame, n_members(p, frame)) for p, frame in frames]
+    for _, frame, m in frames:
+        prepare_outcomes(frame, intensity_column, ensemble_outcome, m)
     folder = Path(output) if output is not None else domain.parent
     check_writable_dir(folder)
     options = dict(n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
-                   intensity_column=intensity_column)  # fmt: skip
+                   intensity_column=intensity_column,
+                   ensemble_outcome=ensemble_outcome)  # fmt: skip
     parts = len(frames) + 1
     with FragilityFolder(folder) as store:
-        result = fragility(df, **options, progress=_part(progress, 0, parts))
+        result = fragility(df, **options, n_members=members, progress=_part(progress, 0, parts))
         others = []
-        for k, (path, frame) in enumerate(frames, start=1):
-            others.append((_name(path), fragility(frame, **options,
+        for k, (path, frame, m) in enumerate(frames, start=1):
+            others.append((_name(path), fragility(frame, **options, n_members=m,
                                                   progress=_part(progress, k, parts))))  # fmt: skip
         source = {
             "domain": os.path.relpath(domain.resolve(), folder.resolve()),
@@ -132,6 +149,16 @@ def run_fragility(
         label, contents = _contents(domain, df, result, others, source)
         paths = store.publish({name: contents[name] for name in FILES})
     return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label)
+
+
+def n_members(domain: Path, df: pd.DataFrame) -> int | None:
+    """The ensemble's members per cell of an ensemble domain (meta.json beside it says),
+    None for a plain domain or when meta.json does not say."""
+    if not is_ensemble(df):
+        return None
+    members = _meta(domain).get("ensemble", {})
+    members = members.get("members") if isinstance(members, dict) else None
+    return members if isinstance(members, int) and not isinstance(members, bool) else None
 
 
 def _part(progress, k: int, parts: int):
@@ -147,7 +174,8 @@ def _contents(domain: Path, df, result, others, source: dict) -> tuple[str, dict
     meta = _meta(domain)
     label = intensity_label(result.intensity_column, meta)
     title = f"{meta.get('name') or domain.parent.name or domain.stem}: " \
-        f"{result.n_records} records, {len(result.table)} intensities"  # fmt: skip
+        f"{result.n_records} records, {len(result.table)} intensities" \
+        + (f"\n{result.outcome}" if result.ensemble_outcome else "")  # fmt: skip
     names = ", ".join([_name(domain)] + [n for n, _ in others])
     frag_title = f"fragility under one suite: {names}" if others else title
     contents = {
@@ -160,14 +188,16 @@ def _contents(domain: Path, df, result, others, source: dict) -> tuple[str, dict
 
 def intensity_label(column: str, meta: dict | None = None) -> str:
     """Axis label of the intensity column: PGA [g], or the records' scale factor [-] when
-    the sweep's config says ``excitation.scale: factor``, or the column's name."""
+    the sweep's config says ``excitation.scale: factor``, a record's intensity measure
+    with its unit (rbm_cli.study.intensities), or the column's name."""
     written = (meta or {}).get("config_written")
     excitation = written.get("excitation") if isinstance(written, dict) else None
     if column in ("amplitude_g", "intensity_g"):
         if isinstance(excitation, dict) and excitation.get("scale") == "factor":
             return "intensity: scale factor of the records [-]"
         return "intensity: peak ground acceleration [g]"
-    return f"intensity: {column}"
+    measure = measure_label(column)
+    return f"intensity: {measure}" if measure else f"intensity: {column}"
 
 
 def _name(domain: Path) -> str:

@@ -5,7 +5,8 @@ point (rbm_cli.config.points), empty for a plain amplitude x frequency grid; fre
 is None for an excitation without one (a record). Cells are listed point-major, then
 frequency-major, so a plain grid lists its cells as it always did. A domain.csv row
 carries its point as one column per path, named by the path (the dots tell them from the
-result's columns), and the scales of its column (rbm_cli.physics.similarity).
+result's columns), the scales of its column (rbm_cli.physics.similarity) and, for a
+record, the record's intensity measures (rbm_cli.study.intensities).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from rbm_cli.config.points import GridPoint, expand
 from rbm_cli.config.types import Config
 from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
 from rbm_cli.study.domain import cell_key, row_key
+from rbm_cli.study.intensities import column_period, measure_fields, measure_values
 
 Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
 
@@ -70,9 +72,10 @@ def record_name(config: Config) -> str:
 
 def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
     """domain.csv's columns: the axis paths, ``record`` (the record's name, for record
-    excitations), the result's ``fields``, the scales."""
+    excitations), the result's ``fields``, the scales, the record's intensity measures
+    (record excitations only)."""
     record = ("record",) if has_records(config) else ()
-    return config.grid.axis_paths + record + tuple(fields) + SCALE_FIELDS
+    return config.grid.axis_paths + record + tuple(fields) + SCALE_FIELDS + measure_fields(config)
 
 
 def tasks(
@@ -96,14 +99,23 @@ def max_drums(points: list[GridPoint]) -> int:
     return max(p.config.column.n_drums for p in points)
 
 
-def add_point(row: dict, config: Config, cell: Cell, scales=None) -> dict:
-    """The row with its point's values and its column's scales."""
+#: add_point's period not given: computed from the config.
+_FROM_CONFIG = object()
+
+
+def add_point(row: dict, config: Config, cell: Cell, scales=None, period=_FROM_CONFIG) -> dict:
+    """The row with its point's values, its column's scales and, for a record, the
+    record's intensity measures (``period``: the column's first elastic period [s], None
+    for a rigid column; computed when not given)."""
     a, f, values = cell
     row.update({p: str(v) if isinstance(v, Motion) else v for p, v in values})
     if has_records(config):
         row["record"] = record_name(config)
     scales = scales or rocking_scales(config)
     row.update(scale_fields(scales, a, f))
+    if has_records(config):
+        t1 = column_period(config) if period is _FROM_CONFIG else period
+        row.update(measure_values(config, a, scales, t1))
     return row
 
 
@@ -115,6 +127,7 @@ __all__ = [
     "frequencies",
     "grid_cells",
     "grid_points",
+    "has_records",
     "key",
     "max_drums",
     "record_name",

@@ -138,7 +138,9 @@ INTEGER_COLUMNS = ("collapsed", "collapse_interface", "n_uplifts", "n_impacts", 
                    "n_rhs", "robust")  # fmt: skip
 FLOAT_COLUMNS = ("t_collapse_s", "max_rotation_ratio", "max_top_displacement_m",
                  "collapse_fraction", "alpha_rad", "p_rad_s", "static_multiplier",
-                 "a_over_g_alpha", "omega_over_p")  # fmt: skip
+                 "a_over_g_alpha", "omega_over_p", "pga_g", "pgv_m_s", "pgd_m", "arias_m_s",
+                 "cav_m_s", "d5_95_s", "t1_s", "sa_t1_g", "pga_over_g_tan_alpha",
+                 "pgv_p_over_g_tan_alpha")  # fmt: skip
 
 
 def _set_types(df: pd.DataFrame) -> None:

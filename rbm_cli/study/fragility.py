@@ -48,7 +48,13 @@ from rbm_cli.study.fragility_fit import (
     fit_counts,
     fit_lognormal,
 )
-from rbm_cli.study.outcomes import level_table, prepare_outcomes
+from rbm_cli.study.outcomes import (
+    ENSEMBLE_OUTCOMES,
+    intensity_unit,
+    is_ensemble,
+    level_table,
+    prepare_outcomes,
+)
 
 METHOD = (
     "lognormal fragility, maximum likelihood on per-record outcomes "
@@ -61,6 +67,10 @@ MAX_RESAMPLES = 100_000
 MAX_SEED = 2**64 - 1
 #: Fewest records a bootstrap over records can resample.
 MIN_BAND_RECORDS = 2
+#: Failed runs are said to concentrate at the high intensities when at least this share
+#: of them (and 2 or more) is in the upper third of the intensity levels: left out, they
+#: would most likely have been collapses, so the fitted median is biased upwards.
+FAILED_HIGH_SHARE = 2.0 / 3.0
 
 
 @dataclass(frozen=True)
@@ -74,6 +84,11 @@ class FragilityResult:
     note : why there is no fit, or, with a fit, why it has no band (one record), one
         line; "" when there is nothing to say
     median_ci_g, beta_ci : bootstrap percentile intervals (nan without a band)
+    intensity_column : the intensity's column; ``intensity_g`` in the tables and
+        ``median_g`` are in its unit (:attr:`intensity_unit`)
+    outcome : what a trial is, one line (each run; an ensemble's members or majority)
+    ensemble_outcome : members, majority or member0 for an ensemble domain, else None
+    warning : one line when failed runs concentrate at the high intensities, else ""
     """
 
     table: pd.DataFrame
@@ -90,6 +105,14 @@ class FragilityResult:
     n_resamples_used: int
     seed: int
     intensity_column: str
+    outcome: str = "each run a trial"
+    ensemble_outcome: str | None = None
+    warning: str = ""
+
+    @property
+    def intensity_unit(self) -> str:
+        """The unit of the intensity (of the median): g, m/s, m, s or - (dimensionless)."""
+        return intensity_unit(self.intensity_column)
 
     @property
     def fitted(self) -> bool:
@@ -100,15 +123,16 @@ class FragilityResult:
 
 
 def _record_matrices(rows: pd.DataFrame, levels: np.ndarray):
-    """Per record and level: runs (0/1) and collapses (0/1) of the non-failed rows."""
+    """Per record and level: trials and collapses of the non-failed rows (0/1 each, or an
+    ensemble cell's member counts)."""
     ok = rows[~rows["failed"]]
     records = np.unique(rows["record"].to_numpy())
     r_index = pd.Index(records).get_indexer(ok["record"])
     l_index = np.searchsorted(levels, ok["x"].to_numpy())
     runs = np.zeros((records.size, levels.size))
     hits = np.zeros((records.size, levels.size))
-    np.add.at(runs, (r_index, l_index), 1.0)
-    np.add.at(hits, (r_index, l_index), ok["collapsed"].to_numpy())
+    np.add.at(runs, (r_index, l_index), ok["trials"].to_numpy())
+    np.add.at(hits, (r_index, l_index), ok["hits"].to_numpy())
     return records, runs, hits
 
 
@@ -147,6 +171,8 @@ def fragility(
     grid_g=None,
     intensity_column: str | None = None,
     progress: Callable[[int, int], None] | None = None,
+    ensemble_outcome: str = ENSEMBLE_OUTCOMES[0],
+    n_members: int | None = None,
 ) -> FragilityResult:
     """Per-intensity counts, lognormal MLE and bootstrap band from per-record outcomes.
 
@@ -172,9 +198,14 @@ def fragility(
     grid_g : array_like, optional
         Intensities of the fitted curve and band [g]; default 201 points from 0 to 1.1 x
         the largest intensity
-    intensity_column : str, optional  Name of the intensity column
+    intensity_column : str, optional  Name of the intensity column: the amplitude (by
+        default) or a record's intensity measure (rbm_cli.study.intensities), in its unit
     progress : callable, optional
         ``progress(done, total)``, called after each bootstrap resample
+    ensemble_outcome : str
+        For an ensemble domain (a ``collapse_fraction`` column): ``members`` (every
+        member a trial, the default), ``majority`` or ``member0`` (rbm_cli.study.outcomes)
+    n_members : int, optional  The ensemble's members per cell (``members`` needs it)
 
     Returns
     -------
@@ -191,14 +222,16 @@ def fragility(
         nothing but failed runs), or options out of range (:func:`check_options`).
     """
     lo_pct, hi_pct = check_options(n_resamples, seed, ci_percentiles)
-    rows, column = prepare_outcomes(df, intensity_column)
-    table = level_table(rows)
+    rows, column = prepare_outcomes(df, intensity_column, ensemble_outcome, n_members)
+    ensemble = is_ensemble(df)
+    table = level_table(rows, trials=ensemble and ensemble_outcome == "members")
     levels = table["intensity_g"].to_numpy()
     grid = (
         np.linspace(0.0, 1.1 * levels.max(), 201) if grid_g is None else np.asarray(grid_g, float)
     )
     n_records = int(rows["record"].nunique())
-    fit, note, n_resamples = _fit_table(table, n_records, n_resamples)
+    fit, note, n_resamples = _fit_table(rows, levels, n_records, n_resamples,
+                                        intensity_unit(column))  # fmt: skip
     band = _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, [lo_pct, hi_pct], progress)
     curve = _curve(grid, fit, band)
     _add_fitted(table, grid, fit, band)
@@ -217,6 +250,41 @@ def fragility(
         n_resamples_used=band.n_used,
         seed=int(seed),
         intensity_column=column,
+        outcome=_outcome(ensemble, ensemble_outcome, n_members),
+        ensemble_outcome=ensemble_outcome if ensemble else None,
+        warning=failed_warning(table),
+    )
+
+
+def _outcome(ensemble: bool, how: str, n_members) -> str:
+    """What a trial is, one line."""
+    if not ensemble:
+        return "each run a trial"
+    return {
+        "members": f"every ensemble member a trial ({n_members} per cell)"
+        if n_members
+        else "every ensemble member a trial (members per cell unknown: each cell weighs 1, "
+        "its collapses the fraction of its members)",
+        "majority": "each cell a trial, collapsed when most of its ensemble members did",
+        "member0": "each cell a trial, its member 0's run",
+    }[how]
+
+
+def failed_warning(table: pd.DataFrame) -> str:
+    """One line when the failed runs concentrate at the high intensities (at least
+    FAILED_HIGH_SHARE of them, 2 or more, in the upper third of the levels), else ""."""
+    failed = table["n_failed"].to_numpy()
+    total = int(failed.sum())
+    if total < 2:
+        return ""
+    top = int(failed[len(failed) - math.ceil(len(failed) / 3) :].sum())
+    if top < FAILED_HIGH_SHARE * total:
+        return ""
+    low = table["intensity_g"].to_numpy()[len(failed) - math.ceil(len(failed) / 3)]
+    return (
+        f"{top} of the {total} failed runs are at the upper third of the intensities "
+        f"(from {low:.4g}): left out of the fit, they may hide collapses, so the median may "
+        "be too high"
     )
 
 
@@ -257,19 +325,18 @@ def _shown(value) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _fit_table(table: pd.DataFrame, n_records: int, n_resamples: int):
-    """(fit, note, resamples to draw): the lognormal fit of the per-level counts, or None
-    and why there is none (one line); with a fit from fewer than MIN_BAND_RECORDS
-    records, no resamples (each would be the one record: a band of zero width, as if the
-    fit were certain) and a note that says so."""
-    levels = table["intensity_g"].to_numpy()
-    used = table["n_records"].to_numpy() > 0
+def _fit_table(rows: pd.DataFrame, levels: np.ndarray, n_records: int, n_resamples: int,
+               unit: str = "g"):  # fmt: skip
+    """(fit, note, resamples to draw): the lognormal fit of the per-level trials and
+    collapses, or None and why there is none (one line); with a fit from fewer than
+    MIN_BAND_RECORDS records, no resamples (each would be the one record: a band of zero
+    width, as if the fit were certain) and a note that says so."""
+    ok = rows[~rows["failed"]]
+    n = ok.groupby("x")["trials"].sum().reindex(levels, fill_value=0.0).to_numpy(float)
+    k = ok.groupby("x")["hits"].sum().reindex(levels, fill_value=0.0).to_numpy(float)
+    used = n > 0
     try:
-        fit = fit_counts(
-            np.log(levels[used]),
-            table["n_records"].to_numpy(float)[used],
-            table["n_collapsed"].to_numpy(float)[used],
-        )
+        fit = fit_counts(np.log(levels[used]), n[used], k[used], unit=unit)
     except RbmError as exc:
         return None, str(exc).removeprefix("fragility: "), n_resamples
     if n_resamples > 0 and n_records < MIN_BAND_RECORDS:
@@ -339,10 +406,12 @@ __all__ = [
     "MAX_RESAMPLES",
     "MAX_SEED",
     "METHOD",
+    "ENSEMBLE_OUTCOMES",
     "FragilityResult",
     "LognormalFit",
     "check_options",
     "collapse_probability",
+    "failed_warning",
     "fit_lognormal",
     "fragility",
 ]

@@ -77,10 +77,11 @@ def _start(log_x, n, k) -> np.ndarray:
     return np.array([mx - mz / slope, -math.log(slope)])
 
 
-def fit_counts(log_x, n, k, start=None) -> LognormalFit:
+def fit_counts(log_x, n, k, start=None, unit: str = "g") -> LognormalFit:
     """MLE from counts per level: ln of each intensity [ln g], runs and collapses there
-    (``start``: the (ln theta, ln beta) to start from); RbmError, one line, when no finite,
-    increasing fit exists (no collapse, only collapses, one intensity, separated outcomes)."""
+    (``start``: the (ln theta, ln beta) to start from; ``unit``: the intensity's, for the
+    messages); RbmError, one line, when no finite, increasing fit exists (no collapse, only
+    collapses, one intensity, separated outcomes)."""
     total_k, total_n = float(np.sum(k)), float(np.sum(n))
     if total_n == 0:
         raise RbmError("fragility: no runs to fit")
@@ -95,15 +96,16 @@ def fit_counts(log_x, n, k, start=None) -> LognormalFit:
     if np.unique(log_x[n > 0]).size < 2:
         x = math.exp(float(np.max(log_x[n > 0])))
         raise RbmError(
-            f"fragility: all runs are at one intensity ({x:.6g} g, {total_k:.0f} of "
-            f"{total_n:.0f} collapsed): a lognormal curve needs runs at two intensities or more"
+            f"fragility: all runs are at one intensity ({x:.6g} {unit}, {total_k:.6g} of "
+            f"{total_n:.6g} collapsed): a lognormal curve needs runs at two intensities or more"
         )
     survived, collapsed = n - k > 0, k > 0
     if np.max(log_x[survived]) <= np.min(log_x[collapsed]):
         raise RbmError(
             f"fragility: outcomes are separated (all runs survive up to "
-            f"{math.exp(np.max(log_x[survived])):.6g} g and collapse from "
-            f"{math.exp(np.min(log_x[collapsed])):.6g} g): the dispersion has no finite estimate"
+            f"{math.exp(np.max(log_x[survived])):.6g} {unit} and collapse from "
+            f"{math.exp(np.min(log_x[collapsed])):.6g} {unit}): the dispersion has no finite "
+            "estimate"
         )
     x0 = _start(log_x, n, k) if start is None else np.asarray(start, dtype=float)
     res = minimize(

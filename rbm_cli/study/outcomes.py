@@ -5,6 +5,28 @@ to an intensity [g]. ``failed`` runs (the integrator gave up) are neither collap
 survivals: they are left out and counted (their ``collapsed`` is 0, as on every row whose
 status is not ``collapsed``: the rule `rbm compare` applies, :func:`rbm_cli.study.domain.
 check_collapsed`).
+
+The intensity may be any positive column: the amplitude (the scaled PGA [g], the default)
+or a record's intensity measure (rbm_cli.study.intensities: pgv_m_s, arias_m_s, sa_t1_g,
+...), its unit read from its name.
+
+An ensemble domain (a ``collapse_fraction`` column: each cell run by MEMBERS perturbed
+members, rbm_cli.study.robustness; its row is member 0's) is counted by
+:data:`ENSEMBLE_OUTCOMES`:
+
+- ``members`` (the default): every member is a trial, so a cell is n = MEMBERS trials of
+  which n x collapse_fraction collapsed. The domain stores the fraction over the members
+  that did not fail, not their count: a cell where some failed is taken as MEMBERS
+  trials at that fraction (its collapses need not then be a whole number). Without the
+  number of members (a domain without its meta.json), each cell weighs 1 with the
+  fraction as its collapses: the same fit, since the likelihood of MEMBERS equal trials
+  per cell is that of one such cell to the power MEMBERS;
+- ``majority``: the cell is one trial, collapsed when collapse_fraction >= 0.5 (the
+  majority's boundary of the domain figure);
+- ``member0``: the cell is its row, member 0's run, one trial.
+
+A cell whose members all failed (collapse_fraction empty) is a failed run under
+``members`` and ``majority``.
 """
 
 from __future__ import annotations
@@ -24,6 +46,25 @@ INTENSITY_COLUMNS = ("intensity_g", "amplitude_g", "intensity")
 
 #: Statuses a row may have; ``failed`` rows are left out of the fit and counted.
 STATUSES = ("collapsed", "survived", "failed")
+#: How the runs of an ensemble domain's cells count (module docstring); the first is the
+#: default.
+ENSEMBLE_OUTCOMES = ("members", "majority", "member0")
+#: Unit of an intensity column, by the end of its name (the longest that matches).
+UNITS = (("_m_s", "m/s"), ("_g", "g"), ("_m", "m"), ("_s", "s"), ("intensity", "g"))
+
+
+def intensity_unit(column: str) -> str:
+    """The unit of an intensity column by its name (``pgv_m_s``: m/s, ``amplitude_g``: g,
+    ``pga_over_g_tan_alpha``: -)."""
+    for end, unit in UNITS:
+        if column.endswith(end):
+            return unit
+    return "-"
+
+
+def is_ensemble(df: pd.DataFrame) -> bool:
+    """Whether a domain is an ensemble's (it has a collapse_fraction column)."""
+    return "collapse_fraction" in df.columns
 
 
 def intensity_column(df: pd.DataFrame, name: str | None = None) -> str | None:
@@ -31,16 +72,30 @@ def intensity_column(df: pd.DataFrame, name: str | None = None) -> str | None:
     return name or next((c for c in INTENSITY_COLUMNS if c in df.columns), None)
 
 
-def prepare_outcomes(df: pd.DataFrame, name: str | None = None) -> tuple[pd.DataFrame, str]:
+def prepare_outcomes(
+    df: pd.DataFrame,
+    name: str | None = None,
+    ensemble_outcome: str = ENSEMBLE_OUTCOMES[0],
+    n_members: int | None = None,
+) -> tuple[pd.DataFrame, str]:
     """Validated runs and the name of the intensity column.
 
-    Returns a table with columns record (str), x (intensity [g]), collapsed (0/1; 0 for
-    failed runs) and failed (bool), one row per input row in order. Raises RbmError, one
-    line naming the row, on: a missing column, an intensity that is not a number > 0,
-    collapsed not 0/1, an unknown status, status and collapsed disagreeing (collapsed is 1
-    exactly when status is collapsed: a failed run is not a collapse), two runs of one
-    record at one intensity, no rows, only failed runs.
+    Returns a table with columns record (str), x (the intensity, in its column's unit),
+    collapsed (0/1; 0 for failed runs), failed (bool), trials and hits (the Bernoulli
+    trials the row stands for and how many collapsed: 1 and collapsed, or for an ensemble
+    domain as ``ensemble_outcome`` says, module docstring; 0 and 0 for a failed row), one
+    row per input row in order. ``n_members``: the ensemble's members per cell (None:
+    unknown, module docstring). Raises RbmError, one line naming the row, on: a missing
+    column, an intensity that is not a number > 0, collapsed not 0/1, an unknown status,
+    status and collapsed disagreeing (collapsed is 1 exactly when status is collapsed: a
+    failed run is not a collapse), two runs of one record at one intensity, no rows, only failed
+    runs, an unknown ``ensemble_outcome``.
     """
+    if ensemble_outcome not in ENSEMBLE_OUTCOMES:
+        raise RbmError(
+            f"fragility: ensemble_outcome must be one of {', '.join(ENSEMBLE_OUTCOMES)}, "
+            f"got {str(ensemble_outcome)[:40]!r}"
+        )
     if not isinstance(df, pd.DataFrame):
         raise RbmError("fragility: the input must be a table (pandas DataFrame)")
     column = intensity_column(df, name)
@@ -61,7 +116,10 @@ def prepare_outcomes(df: pd.DataFrame, name: str | None = None) -> tuple[pd.Data
     for i in range(len(df)):
         where = f"fragility: row {i + 1} (record {rows['record'].iat[i]!r})"
         if not (np.isfinite(x[i]) and x[i] > 0.0):
-            raise RbmError(f"{where}: {column} must be a number > 0 [g], got {df[column].iat[i]!r}")
+            raise RbmError(
+                f"{where}: {column} must be a number > 0 [{intensity_unit(column)}], got "
+                f"{df[column].iat[i]!r}"
+            )
         if status is not None and status[i] not in STATUSES:
             raise RbmError(
                 f"{where}: status must be one of {', '.join(STATUSES)}, got {status[i]!r}"
@@ -71,36 +129,69 @@ def prepare_outcomes(df: pd.DataFrame, name: str | None = None) -> tuple[pd.Data
         if status is not None and (status[i] == "collapsed") != (collapsed[i] == 1.0):
             raise RbmError(f"{where}: status {status[i]!r} but collapsed = {int(collapsed[i])}")
     rows["x"], rows["collapsed"], rows["failed"] = x, collapsed, failed
+    rows["trials"], rows["hits"] = np.where(failed, 0.0, 1.0), np.where(failed, 0.0, collapsed)
+    if is_ensemble(df) and ensemble_outcome != "member0":
+        _ensemble_trials(rows, df, ensemble_outcome, n_members)
+        failed = rows["failed"].to_numpy()
     dup = rows.duplicated(["record", "x"])
     if dup.any():
         i = int(np.argmax(dup.to_numpy()))
         raise RbmError(
             f"fragility: row {i + 1}: a second run of record {rows['record'].iat[i]!r} at "
-            f"{x[i]:.6g} g (one run per record and intensity)"
+            f"{x[i]:.6g} {intensity_unit(column)} (one run per record and intensity: "
+            f"{column} must grow with the record's scale)"
         )
     if failed.all():
         raise RbmError(f"fragility: all {len(df)} runs failed; nothing to fit")
     return rows, column
 
 
-def level_table(rows: pd.DataFrame) -> pd.DataFrame:
-    """Per intensity: intensity_g, n_records (non-failed), n_failed, n_collapsed, fraction."""
+def _ensemble_trials(rows: pd.DataFrame, df: pd.DataFrame, outcome: str, n_members) -> None:
+    """The trials and hits of an ensemble domain's rows, in place (module docstring); a
+    cell whose members all failed (no fraction) is a failed row."""
+    fraction = pd.to_numeric(df["collapse_fraction"], errors="coerce").to_numpy(dtype=float)
+    bad = ~np.isnan(fraction) & ((fraction < 0.0) | (fraction > 1.0))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RbmError(f"fragility: row {i + 1}: collapse_fraction must be in [0, 1], "
+                       f"got {df['collapse_fraction'].iat[i]!r}")  # fmt: skip
+    failed = np.isnan(fraction)
+    if outcome == "majority":
+        trials, hits = np.ones(len(df)), (fraction >= 0.5).astype(float)
+    else:
+        if not (isinstance(n_members, int | np.integer) and n_members >= 1):
+            n_members = 1  # the same fit: every cell has the same weight (module docstring)
+        trials, hits = np.full(len(df), float(n_members)), fraction * n_members
+    rows["failed"] = failed
+    rows["collapsed"] = np.where(failed, 0.0, (fraction >= 0.5).astype(float))
+    rows["trials"] = np.where(failed, 0.0, trials)
+    rows["hits"] = np.where(failed, 0.0, hits)
+
+
+def level_table(rows: pd.DataFrame, trials: bool = False) -> pd.DataFrame:
+    """Per intensity: intensity_g (the intensity, in its column's unit), n_records
+    (non-failed), n_failed, n_collapsed, fraction; with ``trials`` (an ensemble counted
+    by its members) also n_trials, and n_collapsed and fraction count the trials."""
     ok = rows[~rows["failed"]]
     levels = np.unique(rows["x"].to_numpy())
     n = ok.groupby("x")["collapsed"].size().reindex(levels, fill_value=0).to_numpy()
-    k = ok.groupby("x")["collapsed"].sum().reindex(levels, fill_value=0).to_numpy()
+    column = "hits" if trials else "collapsed"
+    k = ok.groupby("x")[column].sum().reindex(levels, fill_value=0).to_numpy()
+    nt = ok.groupby("x")["trials"].sum().reindex(levels, fill_value=0).to_numpy()
     nf = rows[rows["failed"]].groupby("x").size().reindex(levels, fill_value=0).to_numpy()
     with np.errstate(invalid="ignore", divide="ignore"):
-        fraction = np.where(n > 0, k / np.maximum(n, 1), np.nan)
-    return pd.DataFrame(
-        {
-            "intensity_g": levels,
-            "n_records": n.astype(int),
-            "n_failed": nf.astype(int),
-            "n_collapsed": k.astype(int),
-            "fraction": fraction,
-        }
-    )
+        fraction = np.where(nt > 0, k / np.maximum(nt, 1), np.nan)
+    whole = np.allclose(k, np.round(k), rtol=0.0, atol=1e-9)
+    table = {
+        "intensity_g": levels,
+        "n_records": n.astype(int),
+        "n_failed": nf.astype(int),
+        "n_collapsed": np.round(k).astype(int) if whole else k,
+        "fraction": fraction,
+    }
+    if trials:
+        table["n_trials"] = np.round(nt).astype(int)
+    return pd.DataFrame(table)
 
 
 def read_suite_domain(path: str | Path) -> pd.DataFrame:

@@ -37,12 +37,14 @@ from rbm_cli.study.cells import (
     domain_fields,
     grid_cells,
     grid_points,
+    has_records,
     key,
     max_drums,
     row_key,
     tasks,
 )
 from rbm_cli.study.domain import csv_text, parse_domain
+from rbm_cli.study.intensities import column_period
 from rbm_cli.study.parallel import run_chunks
 from rbm_cli.study.robustness import member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
@@ -117,11 +119,12 @@ def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict
 
     runner = make_runner(config)  # the column assembled once for every cell and member
     scales = rocking_scales(config)
+    period = column_period(config) if has_records(config) else None
     rows = []
     others = members(ensemble)[1:]
     for cell in cells:
         a, f, _ = cell
-        row = add_point(_run_cell(config, a, f, runner), config, cell, scales)
+        row = add_point(_run_cell(config, a, f, runner), config, cell, scales, period)
         if ensemble > 1:
             runs = [row] + [_run_cell(*member_config(config, a, m), f, runner) for m in others]
             flags = [r["collapsed"] for r in runs if r["status"] != "failed"]

@@ -22,7 +22,8 @@ class Column:
 
     heights : (n,) Drum heights h_i [m]
     bottoms : (n,) Drum bottom elevations z_i [m]
-    widths : (n+1,) Column width at the interfaces and at the top [m]
+    widths : (n+1,) Column width at the interfaces and at the top [m] (with a capital,
+        the last is the capital's own width; its interface's is the shaft's top width)
     depths : (n+1,) Out-of-plane depth (rectangular) or diameter (circular) there [m]
     masses : (n,) Drum masses m_i [kg] (the top drum's with the top mass)
     inertias : (n,) Centroidal rotary inertias I_Gi [kg m^2], about the drum's centre

@@ -187,3 +187,29 @@ def test_top_mass_uplift_level_in_a_run():
     above = rbm.run(cfg, amplitude_g=1.05 * a, frequency_hz=1.0, record=False)
     assert np.isclose(below.result.max_rotation_ratio, 0.0)
     assert above.result.max_rotation_ratio > 0.0
+
+
+def test_rbm_info_prints_them_and_refuses_a_flat_capital_in_one_line(tmp_path):
+    import yaml
+    from click.testing import CliRunner
+
+    from rbm_cli.cli.main import cli
+
+    column = {"height": H, "base_width": B, "capital": {"height": 0.4, "width": 0.6},
+              "top_mass": {"mass": 250.0, "height_of_centre": 0.1}}  # fmt: skip
+    good = tmp_path / "good.yaml"
+    good.write_text(yaml.safe_dump({"name": "c", "column": column,
+                                    "interface": {"stiffness": {"normal": 5e9}}}))  # fmt: skip
+    res = CliRunner().invoke(cli, ["info", str(good)])
+    assert res.exit_code == 0, res.output
+    assert "capital:             0.4 m high, 0.6 x 0.6 m" in res.output
+    # the top mass's centre: 2 m shaft + 0.4 m capital + 0.1 m above it
+    assert "top mass:            250 kg, centre at 2.5 m" in res.output
+    bad = tmp_path / "bad.yaml"
+    column["capital"]["height"] = 0
+    bad.write_text(yaml.safe_dump({"name": "c", "column": column,
+                                   "interface": {"stiffness": {"normal": 5e9}}}))  # fmt: skip
+    res = CliRunner().invoke(cli, ["info", str(bad)])
+    assert res.exit_code != 0
+    assert len(res.output.strip().splitlines()) == 1
+    assert "column.capital.height" in res.output and "Traceback" not in res.output

@@ -45,6 +45,7 @@ STUDIES = {
     "spanos_koh_thick_linear": CONFIGS / "spanos_koh_thick_linear.yaml",
     "spanos_koh_thick_housner_e": CONFIGS / "spanos_koh_thick_housner_e.yaml",
     "harmonic_monolithic": CONFIGS / "harmonic_monolithic.yaml",
+    "harmonic_monolithic_capital": CONFIGS / "harmonic_monolithic_capital.yaml",
     "harmonic_multidrum": CONFIGS / "harmonic_multidrum.yaml",
     "harmonic_multidrum_ci": CONFIGS / "ci" / "harmonic_multidrum_ci.yaml",
     # the exact block (housner) of each monolithic rigid RBM study (tests/test_model_error.py)

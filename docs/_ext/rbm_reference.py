@@ -149,7 +149,14 @@ def config_keys() -> list[str]:
     )
     from rbm_cli.config.grid import EXCITATION_AXES, LINKED, VIRTUAL_PATHS
     from rbm_cli.config.interface import INTERFACE_KEYS, STIFFNESS_KEYS
-    from rbm_cli.config.load import COLLAPSE_KEYS, COLUMN_KEYS, SOLVER_KEYS, TOP_KEYS
+    from rbm_cli.config.load import (
+        CAPITAL_KEYS,
+        COLLAPSE_KEYS,
+        COLUMN_KEYS,
+        SOLVER_KEYS,
+        TOP_KEYS,
+        TOP_MASS_KEYS,
+    )
 
     nested = {
         "column": COLUMN_KEYS,
@@ -164,6 +171,8 @@ def config_keys() -> list[str]:
         "excitation.initial": INITIAL_KEYS,
         "excitation.processing": PROCESSING_KEYS,
         "excitation.processing.filter": FILTER_KEYS,
+        "column.capital": CAPITAL_KEYS,
+        "column.top_mass": TOP_MASS_KEYS,
     }
 
     def with_sub(path: str) -> list[str]:
@@ -187,6 +196,8 @@ def _defaults() -> dict[str, str]:
     sections = {
         "": t.Config,
         "column": t.ColumnConfig,
+        "column.capital": t.CapitalConfig,
+        "column.top_mass": t.TopMassConfig,
         "interface": t.InterfaceConfig,
         "excitation": t.ExcitationConfig,
         "excitation.initial": t.InitialConfig,
@@ -230,6 +241,7 @@ def _ranges() -> dict[str, str]:
         MAX_DRUMS,
         MAX_TOP_TAPER,
         TIME_STEP_RANGE,
+        TOP_MASS_RANGE,
         WALL_TIME_RANGE,
     )
 
@@ -247,6 +259,12 @@ def _ranges() -> dict[str, str]:
         "column.depth": f"[{fmt(LENGTH_RANGE[0])}, {fmt(LENGTH_RANGE[1])}], rectangular only",
         "column.density": f"[{fmt(DENSITY_RANGE[0])}, {fmt(DENSITY_RANGE[1])}]",
         "column.drums": f"a count 1-{MAX_DRUMS}, or a list of drum heights summing to height",
+        "column.capital.height": f"[{fmt(LENGTH_RANGE[0])}, {fmt(LENGTH_RANGE[1])}]",
+        "column.capital.width": f"[{fmt(LENGTH_RANGE[0])}, {fmt(LENGTH_RANGE[1])}]",
+        "column.capital.depth": f"[{fmt(LENGTH_RANGE[0])}, {fmt(LENGTH_RANGE[1])}], "
+        "rectangular only",
+        "column.top_mass.mass": f"[{fmt(TOP_MASS_RANGE[0])}, {fmt(TOP_MASS_RANGE[1])}]",
+        "column.top_mass.height_of_centre": f"[0, {fmt(LENGTH_RANGE[1])}]",
         "interface.stiffness.rotational": f"[{fmt(ROTATIONAL_RANGE[0])}, "
         f"{fmt(ROTATIONAL_RANGE[1])}], one value or one per interface",
         "interface.stiffness.normal": f"[{fmt(NORMAL_RANGE[0])}, {fmt(NORMAL_RANGE[1])}]",
@@ -302,6 +320,33 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
     "column.depth": ("m", "", "Out-of-plane depth. Default: the local width (square drums)."),
     "column.density": ("kg/m^3", "", "Density of the stone."),
     "column.drums": ("", "", "Count of equal drums, or the list of drum heights [m]. Default 1."),
+    "column.capital": (
+        "",
+        "a mapping; model ``rbm`` only",
+        "A capital on top of the shaft: a drum of its own (one more interface, initial "
+        "rotation and K_M) above column.height, rocking on the shaft's top section. Its "
+        "mass is its volume times column.density. Default: none.",
+    ),
+    "column.capital.height": ("m", "", "Required. The capital's own height (0 is refused)."),
+    "column.capital.width": ("m", "", "Required. Its width (diameter for a circular column)."),
+    "column.capital.depth": (
+        "m",
+        "",
+        "Its out-of-plane depth, rectangular only. Default: its width (square).",
+    ),
+    "column.top_mass": (
+        "",
+        "a mapping; model ``rbm`` only",
+        "A rigid point mass on the axis carried by the top drum (an architrave's share): "
+        "part of that drum's mass, centre and inertia (parallel axis, no rotary inertia of "
+        "its own), and of the normal force of every joint. Default: none.",
+    ),
+    "column.top_mass.mass": ("kg", "", "Required. Its mass."),
+    "column.top_mass.height_of_centre": (
+        "m",
+        "",
+        "Height of its centre above the top drum's top face.",
+    ),
     "interface": ("", "", ""),
     "interface.stiffness": (
         "",

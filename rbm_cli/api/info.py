@@ -38,7 +38,10 @@ def info(
     Returns
     -------
     dict or pandas.DataFrame  For one config a dict, units in the key names: name,
-        n_drums, total_mass_kg [kg], height_m [m], static_multiplier_g [g] (B/H for a
+        n_drums (the capital included), capital_height_m, capital_width_m,
+        capital_depth_m [m] (None without a capital), top_mass_kg [kg] and
+        top_mass_centre_height_m [m above the ground] (None without a top mass),
+        total_mass_kg [kg] (the top mass included), height_m [m] (the capital included), static_multiplier_g [g] (B/H for a
         rigid monolith), uplift_acceleration_g [g] (None for elastic interfaces),
         rocking_p_rad_s [rad/s], rocking_frequency_hz [Hz], elastic_frequencies_hz [Hz]
         (a list; empty when rigid), formulation, restitution [-], and ``interfaces``, a

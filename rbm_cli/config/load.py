@@ -37,10 +37,12 @@ from rbm_cli.config.types import (
     METHODS,
     MODELS,
     SECTIONS,
+    CapitalConfig,
     CollapseConfig,
     ColumnConfig,
     Config,
     SolverConfig,
+    TopMassConfig,
 )
 from rbm_cli.config.validate import (
     choice,
@@ -67,7 +69,22 @@ __all__ = [
 ]
 
 TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
-COLUMN_KEYS = ("height", "base_width", "top_width", "section", "depth", "density", "drums")
+COLUMN_KEYS = (
+    "height",
+    "base_width",
+    "top_width",
+    "section",
+    "depth",
+    "density",
+    "drums",
+    "capital",
+    "top_mass",
+)
+CAPITAL_KEYS = ("height", "width", "depth")
+TOP_MASS_KEYS = ("mass", "height_of_centre")
+#: Masses of a top mass the tool accepts [kg] [assumption]: a laboratory weight to the
+#: share of a heavy stone entablature many times a column's own mass.
+TOP_MASS_RANGE = (1e-3, 1e9)
 COLLAPSE_KEYS = ("ratio",)
 SOLVER_KEYS = (
     "method",
@@ -294,8 +311,23 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
     model = choice(model, "model", MODELS)
     column = _column(top["column"])
     n = column.n_drums
+    for key in ("capital", "top_mass"):
+        if model != "rbm" and getattr(column, key) is not None:
+            raise ConfigError(
+                f"column.{key} is taken by model rbm only (model {model} has no such body):"
+                " delete it or use model: rbm"
+            )
     if model not in MULTI_DRUM_MODELS and n != 1:
         raise ConfigError(f"model {model!r} needs a monolithic column (drums: 1), got {n} drums")
+    raw_interface = top.get("interface")
+    stiffness = (
+        raw_interface.get("stiffness", "rigid") if isinstance(raw_interface, Mapping) else "rigid"
+    )
+    if column.capital is not None and isinstance(stiffness, str) and stiffness == "rigid":
+        raise ConfigError(
+            "interface.stiffness: rigid needs a monolithic column, and column.capital is a drum"
+            f" of its own ({n} drums): give {{rotational: K_M}} or {{normal: k_n}}"
+        )
     interface = interface_section(top.get("interface"), n, model)
     excitation = excitation_section(top.get("excitation"), n, base_dir)
     return Config(
@@ -377,7 +409,46 @@ def _column(raw: Any) -> ColumnConfig:
             DENSITY_RANGE,
         ),
         drum_heights=_drums(c.get("drums", 1), height),
+        capital=_capital(c.get("capital"), section),
+        top_mass=_top_mass(c.get("top_mass")),
     )
+
+
+def _capital(raw: Any, section: str) -> CapitalConfig | None:
+    """column.capital: {height, width, depth} [m], or None when not given."""
+    if raw is None:
+        return None
+    path = "column.capital"
+    c = mapping(raw, path, CAPITAL_KEYS)
+    for key in ("height", "width"):
+        if key not in c:
+            raise ConfigError(f"{path}.{key} is required (a number > 0 [m])")
+    height = _bounded(number(c["height"], f"{path}.height", "m", 0.0), f"{path}.height")
+    width = _bounded(number(c["width"], f"{path}.width", "m", 0.0), f"{path}.width")
+    depth = None
+    if "depth" in c:
+        if section != "rectangular":
+            raise ConfigError(
+                f"{path}.depth applies only to section: rectangular (section is {section};"
+                " the capital's width is its diameter): delete it"
+            )
+        depth = _bounded(number(c["depth"], f"{path}.depth", "m", 0.0), f"{path}.depth")
+    return CapitalConfig(height=height, width=width, depth=depth)
+
+
+def _top_mass(raw: Any) -> TopMassConfig | None:
+    """column.top_mass: {mass [kg], height_of_centre [m]}, or None when not given."""
+    if raw is None:
+        return None
+    path = "column.top_mass"
+    t = mapping(raw, path, TOP_MASS_KEYS)
+    if "mass" not in t:
+        raise ConfigError(f"{path}.mass is required (a number > 0 [kg])")
+    mass = _bounded(number(t["mass"], f"{path}.mass", "kg", 0.0), f"{path}.mass", "kg",
+                    TOP_MASS_RANGE)  # fmt: skip
+    centre = number(t.get("height_of_centre", 0.0), f"{path}.height_of_centre", "m", 0.0,
+                    LENGTH_RANGE[1], lo_open=False)  # fmt: skip
+    return TopMassConfig(mass=mass, height_of_centre=centre)
 
 
 def _bounded(

@@ -115,7 +115,8 @@ def _column(data: dict, path: str, value: Any) -> dict | None:
 
 
 def _scale_column(data: dict, size: Any) -> None:
-    """Scale every length of the column so that its height is ``size`` [m]."""
+    """Scale every length of the column so that its height is ``size`` [m] (a capital's
+    too, a top mass's height with them and its mass with the volume)."""
     column = _column(data, "column.size", size)
     if column is None:
         return
@@ -127,10 +128,25 @@ def _scale_column(data: dict, size: Any) -> None:
     drums = column.get("drums")
     if isinstance(drums, list) and all(is_number(h) for h in drums):
         column["drums"] = [h * ratio for h in drums]
+    _scale_keys(column, "capital", ("height", "width", "depth"), ratio)
+    # a similar top mass: its lever scales with the lengths, its mass as the volume
+    _scale_keys(column, "top_mass", ("height_of_centre",), ratio)
+    _scale_keys(column, "top_mass", ("mass",), ratio**3)
+
+
+def _scale_keys(column: dict, key: str, names: tuple[str, ...], ratio: float) -> None:
+    """Scale the numbers ``names`` of the mapping column[key] (a capital, a top mass)."""
+    if not isinstance(column.get(key), Mapping):
+        return
+    sub = column[key] = dict(column[key])
+    for name in names:
+        if is_number(sub.get(name)):
+            sub[name] = sub[name] * ratio
 
 
 def _set_slenderness(data: dict, slenderness: Any) -> None:
-    """Base width = height / slenderness; top width and depth scale with it."""
+    """Base width = height / slenderness; top width and depth (and a capital's width and
+    depth) scale with it."""
     column = _column(data, "column.slenderness", slenderness)
     if column is None or not is_number(column.get("base_width")):
         return
@@ -140,6 +156,7 @@ def _set_slenderness(data: dict, slenderness: Any) -> None:
         if is_number(column.get(key)):
             column[key] = column[key] * ratio
     column["base_width"] = base
+    _scale_keys(column, "capital", ("width", "depth"), ratio)
 
 
 __all__ = ["GridPoint", "expand", "point_values", "point_written"]

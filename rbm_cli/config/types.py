@@ -67,6 +67,35 @@ MODELS = {
 
 
 @dataclass(frozen=True)
+class CapitalConfig:
+    """A capital: a drum of its own on top of the shaft (the column's height does not
+    include it). It rocks on the shaft's top section (its joint is the shaft's top width
+    wide); its mass is its own volume times the column's density.
+
+    height : float  Its height [m]
+    width : float  Its width, or diameter for a circular column [m]
+    depth : float or None  Out-of-plane depth [m] (rectangular only); None = its width
+    """
+
+    height: float
+    width: float
+    depth: float | None = None
+
+
+@dataclass(frozen=True)
+class TopMassConfig:
+    """A rigid point mass carried by the top drum (an architrave's share), on the column's
+    axis.
+
+    mass : float  Its mass [kg]
+    height_of_centre : float  Height of its centre above the top drum's top face [m]
+    """
+
+    mass: float
+    height_of_centre: float = 0.0
+
+
+@dataclass(frozen=True)
 class ColumnConfig:
     """Geometry and material of the column.
 
@@ -76,7 +105,9 @@ class ColumnConfig:
     section : str  'rectangular' or 'circular'
     depth : float or None  Out-of-plane depth [m] (rectangular only); None = local width
     density : float  Mass density [kg/m^3]
-    drum_heights : tuple of float  Heights h_i of the drums, bottom first [m]
+    drum_heights : tuple of float  Heights h_i of the shaft's drums, bottom first [m]
+    capital : CapitalConfig or None  A capital on top of the shaft: one more drum
+    top_mass : TopMassConfig or None  A point mass carried by the top drum
     """
 
     height: float
@@ -86,10 +117,14 @@ class ColumnConfig:
     depth: float | None = None
     density: float = 2700.0
     drum_heights: tuple[float, ...] = ()
+    capital: CapitalConfig | None = None
+    top_mass: TopMassConfig | None = None
 
     @property
     def n_drums(self) -> int:
-        return len(self.drum_heights)
+        """Drums of the model: the shaft's, and the capital if there is one (so also the
+        number of interfaces, of initial rotations and of per-interface stiffnesses)."""
+        return len(self.drum_heights) + (self.capital is not None)
 
 
 @dataclass(frozen=True)
@@ -365,6 +400,9 @@ class Config:
         out.pop("written", None)
         out.pop("base_dir", None)
         out["excitation"] = self.excitation.resolved()
+        for key in ("capital", "top_mass"):  # a column without them hashes as it always did
+            if out["column"][key] is None:
+                del out["column"][key]
         for key in ("axes", "records"):  # a plain grid resolves (and hashes) as it always did
             if not out["grid"][key]:
                 del out["grid"][key]

@@ -245,6 +245,9 @@ def linear_rocking_parameters(column: Column) -> tuple[float, float]:
 
     .. math:: \\alpha = B_1 / H, \\qquad p^2 = \\frac{m g (H/2)}{I_G + m H^2 / 4}
 
+    With a top mass, m and I_G are those of the drum with the mass and H/2 is the height c
+    of their common centre: p^2 = m g c / (I_G + m c^2) (and alpha = (B_1 / 2) / c).
+
     This is not Housner's p^2 = W R / I_O of the same block: the RBM puts the
     weight on the axis (lever arm H/2, no B/2 term in the inertia about the
     base), so for a rectangle p^2 = 6 g H / (4 H^2 + B^2) against
@@ -259,7 +262,7 @@ def linear_rocking_parameters(column: Column) -> tuple[float, float]:
             f"linear_rocking_parameters needs a monolithic column (n = 1), got n = {column.n}"
         )
     m = float(column.masses[0])
-    h = float(column.heights[0])
+    h = 2.0 * float(column.centres[0])  # twice the centre's height: H without a top mass
     i_g = float(column.inertias[0])
     alpha = float(column.rotation_capacity[0])
     p = math.sqrt(m * G * (h / 2.0) / (i_g + m * h * h / 4.0))

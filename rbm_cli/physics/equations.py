@@ -7,8 +7,9 @@ these coordinates the paper's system (5) reads
     M theta'' = D^T m(x) + K_g theta - r a_g(t)
 
 with M = L^T diag(m) L + diag(I_G) the (constant, symmetric) mass matrix,
-L the map from theta to the drums' centre displacements (weight at mid-height:
-L_ij = h_j for j < i, h_i / 2 for j = i), r = L^T m the ground load vector,
+L the map from theta to the drums' centre displacements (weight at the drum's centre,
+mid-height but for the drum carrying a top mass: L_ij = h_j for j < i, c_i for j = i),
+r = L^T m the ground load vector,
 D the difference matrix (D^T M gives M_i - M_{i+1}: interface moments acting
 on the drums above and below), m(x) = -f(x) the interface moments, x the
 argument the law reads (phi = D theta, or theta for `absolute`), and K_g the
@@ -288,7 +289,7 @@ def build_model(
     n = column.n
     h = column.heights
     lower = np.tril(np.ones((n, n)), -1) * h[None, :]
-    centre = lower + np.diag(h / 2.0)
+    centre = lower + np.diag(column.centres)
     mass = product(centre.T, column.masses[:, None] * centre) + np.diag(column.inertias)
     node = np.vstack([np.zeros(n), np.tril(np.ones((n, n))) * h[None, :]])
     diff = np.eye(n) - np.eye(n, k=-1)
@@ -297,7 +298,11 @@ def build_model(
     mu, tu = column.moment_capacity, column.rotation_capacity
     if formulation == "geometric":
         n_above = np.concatenate([column.normal_forces[1:], [0.0]])
-        gravity = np.diag((column.normal_forces + n_above) * h / 2.0)
+        # P_i c_i + N_{i+1} h_i: written as (N_i + N_{i+1}) h_i / 2 + P_i (c_i - h_i / 2),
+        # whose last term is 0 for a drum with its centre at mid-height
+        gravity = np.diag(
+            (column.normal_forces + n_above) * h / 2.0 + column.weights * (column.centres - h / 2.0)
+        )
         extra = mu / tu
         # overturning moment of the drums above joint i about the joint:
         # sum_{j>=i} P_j (x_j - u_i), x_j the centre, u_i the joint's node

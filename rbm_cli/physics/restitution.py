@@ -39,14 +39,14 @@ def block_restitution(geometry: BlockGeometry) -> float:
 
 
 def column_restitution(column: Column) -> float:
-    """Housner's e of a monolithic RBM column, with the RBM's centre (mid-height) and
-    inertia: I_O = I_G + m (H^2 + B^2) / 4, lever B / 2 [-].
+    """Housner's e of a monolithic RBM column, with the RBM's centre (mid-height, or the
+    centre c with a top mass) and inertia: I_O = I_G + m (c^2 + B^2 / 4), lever B / 2 [-].
 
     For a rectangle of uniform width this is Housner's 1 - 1.5 sin^2(alpha).
     """
     m = column.total_mass
     half_b = column.widths[0] / 2.0
-    half_h = column.height / 2.0
+    half_h = float(column.centres[0]) if column.n == 1 else column.height / 2.0
     i_o = float(column.inertias[0]) + m * (half_h**2 + half_b**2)
     return housner_coefficient(m, half_b, i_o)
 

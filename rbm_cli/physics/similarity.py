@@ -13,7 +13,9 @@ The scales are those of the column taken as one rigid body (its drums glued), th
 column's own first scales however many drums it has:
 
 - ``rbm``: the RBM's rigid monolith (rbm_cli.physics.closed_forms.linear_rocking_parameters:
-  tan alpha = theta_u,1, p^2 = m g (H / 2) / (I_G + m H^2 / 4));
+  tan alpha = theta_u,1, p^2 = m g (H / 2) / (I_G + m H^2 / 4)); with a capital, the shaft
+  and the capital as one rigid stack: tan alpha = theta_u,1, p^2 = N_1 zbar_1 / (1^T M 1)
+  (rbm_cli.physics.equations.Model.rocking_p);
 - ``housner``, ``housner-linear``, ``bullet`` (true geometry, rigid blocks): the block's
   tan alpha = b / z_c and p^2 = m g R / I_O (rbm_cli.physics.block.block_geometry).
 
@@ -60,6 +62,13 @@ def rocking_scales(config: Config) -> RockingScales:
     rigid = InterfaceConfig(stiffness=StiffnessConfig("rigid", ()))
     column = build_column(config.column, rigid)
     glued = dataclasses.replace(config.column, drum_heights=(config.column.height,))
+    if config.model == "rbm" and config.column.capital is not None:
+        # shaft and capital glued into one rigid stack: its base's theta_u and its p
+        from rbm_cli.physics.equations import build_model
+
+        p = build_model(build_column(glued, rigid)).rocking_p
+        tan_alpha = float(column.rotation_capacity[0])
+        return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)
     if config.model == "rbm":
         tan_alpha, p = linear_rocking_parameters(build_column(glued, rigid))
         return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)

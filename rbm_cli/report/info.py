@@ -23,9 +23,10 @@ def describe(config: Config) -> dict:
     """Masses, capacities, stiffnesses and frequencies of a configured column.
 
     The rocking p is that of the rigid stack, p^2 = N_1 zbar_1 / (1^T M 1)
-    (for n = 1: m g (H/2) / (I_G + m H^2 / 4)). Elastic frequencies are those
-    of the elastic branches of the laws in the chosen formulation. For
-    `model: bullet` the figures are the RBM's, plus the engine's own uplift
+    (for n = 1: m g (H/2) / (I_G + m H^2 / 4)); a capital is one of the drums, a top
+    mass part of the top drum's mass and inertia (height_m: the shaft and the capital).
+    Elastic frequencies are those of the elastic branches of the laws in the chosen
+    formulation. For `model: bullet` the figures are the RBM's, plus the engine's own uplift
     level (true solids, min(tan alpha_i, friction) g).
     """
     model = model_from_config(config)
@@ -56,9 +57,19 @@ def describe(config: Config) -> dict:
         from rbm_cli.models.bullet.run import engine_uplift_g
 
         engine = {"engine_uplift_g": engine_uplift_g(config), "friction": config.interface.friction}
+    geometry = config.column
+    capital = geometry.capital
+    top = geometry.top_mass
     return {
         "name": config.name,
         "n_drums": n,
+        "capital_height_m": None if capital is None else capital.height,
+        "capital_width_m": None if capital is None else capital.width,
+        "capital_depth_m": None
+        if capital is None
+        else (capital.width if capital.depth is None else capital.depth),
+        "top_mass_kg": None if top is None else top.mass,
+        "top_mass_centre_height_m": None if top is None else col.height + top.height_of_centre,
         "total_mass_kg": col.total_mass,
         "height_m": col.height,
         "static_multiplier_g": col.static_multiplier,
@@ -123,6 +134,14 @@ def format_info(info: dict) -> str:
             (", ".join(_fmt(f) for f in freqs) + " Hz") if freqs else "- (rigid)",
         ),
     ]
+    if info.get("capital_height_m") is not None:
+        size = f"{_fmt(info['capital_width_m'])} x {_fmt(info['capital_depth_m'])} m"
+        rows.insert(2, ("capital", f"{_fmt(info['capital_height_m'])} m high, {size} (the top"
+                                   " drum)"))  # fmt: skip
+    if info.get("top_mass_kg") is not None:
+        rows.insert(2, ("top mass", f"{_fmt(info['top_mass_kg'])} kg, centre at "
+                                    f"{_fmt(info['top_mass_centre_height_m'])} m above the"
+                                    " ground (in the top drum's m_i and I_Gi)"))  # fmt: skip
     if info.get("engine_uplift_g") is not None:
         rows.append(
             (

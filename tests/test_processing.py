@@ -334,8 +334,10 @@ def _run(folder, method, processing, name):
     excitation = {"type": "record", "file": "r.AT2"}
     if processing is not None:
         excitation["processing"] = processing
-    data = {"name": name, "column": COLUMN, "excitation": excitation,
-            "solver": {"method": method}}  # fmt: skip
+    solver = {"method": method}
+    if method == "exact":  # its own source uncompiled (the same bits): no compile here
+        solver["implementation"] = "python"
+    data = {"name": name, "column": COLUMN, "excitation": excitation, "solver": solver}
     (folder / f"{name}.yaml").write_text(json.dumps(data))
     out = folder / "out"
     res = CliRunner().invoke(

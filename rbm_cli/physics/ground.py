@@ -269,16 +269,15 @@ def next_uplift(t0, level, peak, gr, knots, values, vertical, last):
     return _exceedance_pieces(t0, level, last, gr, knots, values, vertical)
 
 
-def form_function(form, gain, omega, phase, center, gamma, knots, values):
-    """a_g(t) [m/s^2] of a form as a function of a float t [s], for the Python integrators:
-    the compiled :func:`ground_at` (no support window: they call it only inside the forced
-    segments of the motion)."""
+def form_function(gr, knots, values):
+    """a_g(t) [m/s^2] of a motion's ground tuple gr (its form, gain, omega, phase, center,
+    gamma) and samples (float64 arrays, empty for none) as a function of a float t [s], for
+    the Python integrators: the compiled :func:`ground_at` (no support window: they call it
+    only inside the forced segments of the motion)."""
+    gain = gr[1]
     if gain == 0.0:
         return lambda tt: 0.0
-    gr = (int(form), float(gain), float(omega), float(phase), float(center), float(gamma),
-          0.0, 0.0, 0.0)  # fmt: skip
-    knots, values = as_samples(knots), as_samples(values)
-    if form == SAMPLED and gain != 1.0:
+    if gr[0] == SAMPLED and gain != 1.0:
         return lambda tt: gain * ground_at(tt, gr, knots, values)
     return lambda tt: ground_at(tt, gr, knots, values)
 

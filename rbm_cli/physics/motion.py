@@ -104,16 +104,8 @@ class GroundMotion:
 
     @cached_property
     def _scalar(self):
-        return form_function(
-            self.form,
-            self.shape_gain,
-            self.omega,
-            self.phase,
-            self.center,
-            self.gamma,
-            self.knots,
-            self.values,
-        )
+        knots, values, _ = self._samples
+        return form_function(self._ground, knots, values)
 
     @property
     def has_vertical(self) -> bool:

@@ -26,7 +26,6 @@ vertical record, if any, is not measured: these are the horizontal record's.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 
 import numpy as np
 
@@ -78,14 +77,11 @@ def column_period(config: Config) -> float | None:
     """The column's first elastic period [s], None for a rigid one (module docstring)."""
     if config.model != "rbm":
         return None
-    from rbm_cli.physics.column import build_column
-    from rbm_cli.physics.equations import build_model
+    from rbm_cli.physics.assembly import model_from_config
 
-    column = build_column(config.column, config.interface)
-    if not np.all(np.isfinite(column.stiffness)):
+    model = model_from_config(config)
+    if model.rigid:
         return None
-    model = build_model(column, config.interface.xi, config.interface.restitution,
-                        config.interface.formulation)  # fmt: skip
     slopes = np.array([law.slopes[0] for law in model.laws])
     stiffness = model.arg_map.T @ np.diag(slopes) @ model.arg_map - model.gravity
     return first_elastic_period(model.mass, stiffness)
@@ -110,24 +106,8 @@ def _record(config: Config):
     return t, np.asarray(process(t, a, exc.processing, name), float)
 
 
-@lru_cache(maxsize=64)
-def _unit_measures(identity: tuple, periods: tuple[float, ...], config_ref) -> RecordMeasures:
-    t, a = _record(config_ref.config)
-    return record_measures(t, a, periods)
-
-
-class _Ref:
-    """A config carried into the cache without being part of its key (the key is the
-    record's identity and the periods)."""
-
-    def __init__(self, config: Config):
-        self.config = config
-
-    def __hash__(self) -> int:
-        return 0
-
-    def __eq__(self, other) -> bool:
-        return isinstance(other, _Ref)
+#: The measures of each record met in this process, by (record identity, periods).
+_MEASURED: dict = {}
 
 
 def record_measures_of(config: Config, t1: float | None) -> RecordMeasures:
@@ -136,7 +116,10 @@ def record_measures_of(config: Config, t1: float | None) -> RecordMeasures:
     exc = config.excitation
     identity = (str(exc.file_path or exc.file), exc.units, exc.file_sha256, exc.processing)
     periods = ((t1,) if t1 is not None else ()) + tuple(exc.im_periods)
-    return _unit_measures(identity, periods, _Ref(config))
+    key = (identity, periods)
+    if key not in _MEASURED:
+        _MEASURED[key] = record_measures(*_record(config), periods)
+    return _MEASURED[key]
 
 
 def scale_factor(config: Config, amplitude_g: float, pga: float) -> float:

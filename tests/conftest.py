@@ -8,6 +8,13 @@ tests that fork run in a fresh interpreter; on Linux a skipped test is a failed 
   they skipped, and the forked child was never exercised. The marked tests of one module
   run together in one such process when the first of them is reached (its duration is
   theirs); each reports its own outcome, a failure with the fresh interpreter's report.
+- A run of many tests (:data:`WARM_UP_ITEMS` or more: the whole suite) first compiles the
+  package's compiled code (the step kernel, the exact integrator, the rigid block's closed
+  form) into numba's cache, each once: every worker takes them in its own order through
+  rbm_cli.models.compile_ahead.compile_once, whose lock makes a worker that needs a target
+  another one compiles wait for it and load it. Without it each worker compiled what its
+  first tests needed, the same kernel in both at once (tests call the integrators directly,
+  not through the lock), and a test's duration held a compile.
 - On Linux, where CI runs, a skipped test fails: a test that skips where it must run tests
   nothing. A test that may skip there says why, ``@pytest.mark.may_skip(reason="...")``
   (an opt-in environment variable not set, a test that cannot work as root, ...).
@@ -38,6 +45,25 @@ FRESH_ENV = "RBM_TESTS_FRESH_INTERPRETER"
 _OUTCOMES = pytest.StashKey[dict]()
 #: The end of the fresh interpreter's output quoted when a test has no result from it.
 _TAIL = 6000
+#: A run of at least this many tests compiles every target first (see the module).
+WARM_UP_ITEMS = 200
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _compiled_once(request):
+    """Every compiled target in numba's cache before the first test of a large run, each
+    compiled once across the workers (see the module)."""
+    if len(request.session.items) < WARM_UP_ITEMS or os.environ.get(FRESH_ENV) == "1":
+        return
+    from rbm_cli.models.compile_ahead import TARGETS, compile_once
+
+    # worker k starts k targets from the end (the second on the exact integrator, the
+    # longest compile, while the first compiles the kernel and the closed form)
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw")
+    order = list(TARGETS)
+    start = -int(worker) % len(order) if worker.isdigit() else 0
+    for target in order[start:] + order[:start]:
+        compile_once(target)
 
 
 def pytest_configure(config):

@@ -13,14 +13,19 @@ subprocesses (the copy first on PYTHONPATH, numba's cache in a fresh folder):
    from the cache) writes the same run folder as the first. The first run once answered
    from the Python integrator while the kernel compiled in the background: collapse at
    3.41 s at interface 8 the first time, 2.28 s at interface 7 every time after;
-2. that compile is the cache a run now loads (needs_compile False); then a callee's constant
-   is changed in the copy: the change must show (another step count, needs_compile True
-   before the run); and an unchanged copy must load its cache again (needs_compile False,
-   the same step count).
+2. that compile is the cache a run now loads (needs_compile False); then a constant of a
+   compiled callee in another module is changed in the copy (the rigid block's closed form,
+   run_block in block/closed_form.py, and its scan step in block/piece.py): the change must
+   show (another count of closed-form evaluations, needs_compile True before the run, for the
+   closed form and for the kernel alike: the key covers every compiled source at once); and
+   an unchanged copy must load its cache again (needs_compile False, the same count).
 
-Two compiles of the kernel (the first run's and the one after the change): about 40 s at
-low load, 60-120 s under load. (The first-use flow shares this test's first compile
-instead of making its own: one compile fewer in CI.)
+One compile of the kernel (the first run's: about 40 s at low load, 60-120 s under load) and
+two of the closed form (6-10 s each). The first-use flow shares this test's compile of the
+kernel instead of making its own, and the change is made to the closed form's callee, whose
+compile is the cheapest: one kernel compile in CI instead of three. The kernel's own stamp
+is the same key (test_every_compiled_function_carries_the_key); before the key, a change to
+step/rk.py left the cached run_kernel in use.
 
 The other tests are quick: which files key the cache (found here by parsing every module
 for compiled functions, independently of the glob and text scan of
@@ -49,21 +54,27 @@ from .test_first_use import same_run_folders
 
 PACKAGE = Path(__file__).resolve().parents[1] / "rbm_cli"
 
-#: One run of a rigid block under a harmonic pulse train through the compiled kernel:
-#: enough adaptive steps that the step-size controller's safety factor changes their count.
+#: One run of a rigid block under a harmonic pulse train, through the compiled kernel
+#: (DOP853) or the compiled closed form ("closed-form"): whether each needed a compile
+#: before and after, and the run's counts (steps; for the closed form, pieces, and its
+#: evaluations, which the scan step changes).
 DRIVER = """
 import json, sys
 import rbm_cli
-from rbm_cli.models.rbm.step import needs_compile
-before = needs_compile()
+from rbm_cli.models.rbm.step import needs_compile as kernel_stale
+from rbm_cli.models.block.closed_form import needs_compile as closed_stale
+method = sys.argv[1]
+stale = kernel_stale if method == "DOP853" else closed_stale
+before, kernel_before = stale(), kernel_stale()
 from rbm_cli.api import run
 cfg = {"name": "block", "column": {"height": 2.0, "base_width": 0.5},
        "excitation": {"type": "harmonic", "duration": 4.0},
-       "solver": {"method": "DOP853", "implementation": "compiled", "rtol": 1e-9,
+       "solver": {"method": method, "implementation": "compiled", "rtol": 1e-9,
                   "atol": 1e-11}}
 cell = run(cfg, amplitude_g=0.4, frequency_hz=2.0, record=False)
-print(json.dumps({"file": rbm_cli.__file__, "before": before, "after": needs_compile(),
-                  "n_steps": int(cell.result.n_steps), "status": cell.status}))
+print(json.dumps({"file": rbm_cli.__file__, "before": before, "after": stale(),
+                  "kernel_before": kernel_before, "n_steps": int(cell.result.n_steps),
+                  "n_rhs": int(cell.result.n_rhs), "status": cell.status}))
 """
 
 
@@ -86,8 +97,8 @@ def _env(copy: Path, cache: Path) -> dict:
     return dict(env, PYTHONPATH=str(copy), NUMBA_CACHE_DIR=str(cache), MPLBACKEND="Agg")
 
 
-def _run(copy: Path, cache: Path, cwd: Path) -> dict:
-    res = subprocess.run([sys.executable, "-c", DRIVER], env=_env(copy, cache), cwd=cwd,
+def _run(copy: Path, cache: Path, cwd: Path, method: str = "DOP853") -> dict:
+    res = subprocess.run([sys.executable, "-c", DRIVER, method], env=_env(copy, cache), cwd=cwd,
                          capture_output=True, text=True, timeout=900)  # fmt: skip
     assert res.returncode == 0, res.stderr[-3000:]
     out = json.loads(res.stdout.strip().splitlines()[-1])
@@ -100,11 +111,11 @@ def _rbm(*args: str) -> list[str]:
     return [sys.executable, "-m", "rbm_cli", *args]
 
 
-def _edit_safety(path: Path, new: str) -> None:
-    """The step-size controller's safety factor (0.9, scipy's) of the Runge-Kutta module."""
+def _edit_scan_step(path: Path, new: str) -> None:
+    """The closed form's longest scanning interval (SCAN_STEP = 1.0) of block/piece.py."""
     text = path.read_text()
-    edited, n = re.subn(r"^(SAFETY\b[^=\n]*=\s*)0\.9\b", rf"\g<1>{new}", text, flags=re.M)
-    assert n == 1, f"no 'SAFETY ... = 0.9' in {path}"
+    edited, n = re.subn(r"^(SCAN_STEP\b[^=\n]*=\s*)1\.0\b", rf"\g<1>{new}", text, flags=re.M)
+    assert n == 1, f"no 'SCAN_STEP ... = 1.0' in {path}"
     path.write_text(edited)
 
 
@@ -155,19 +166,24 @@ def test_first_use_then_a_change_to_a_compiled_callee_invalidates_the_cache(tmp_
 
     first = _run(copy, cache, tmp_path)
     assert first["before"] is False and first["after"] is False  # the first run's compile
+    closed = _run(copy, cache, tmp_path, "closed-form")  # its first use: a compile
+    assert closed["before"] is True and closed["after"] is False
+    assert closed["kernel_before"] is False
     indexes = sorted(p.name for p in cache.rglob("*.nbi"))
 
     # same length, same size on disk: only the contents differ
-    _edit_safety(copy / "rbm_cli" / "models" / "rbm" / "step" / "rk.py", "0.8")
-    edited = _run(copy, cache, tmp_path)
-    assert edited["before"] is True, "needs_compile() missed a change to step/rk.py"
-    assert edited["n_steps"] != first["n_steps"], "the stale cached kernel ran"
+    _edit_scan_step(copy / "rbm_cli" / "models" / "block" / "piece.py", "0.5")
+    edited = _run(copy, cache, tmp_path, "closed-form")
+    assert edited["before"] is True, "needs_compile() missed a change to block/piece.py"
+    assert edited["kernel_before"] is True, "the kernel's key missed a change to a compiled source"
+    assert edited["n_rhs"] != closed["n_rhs"], "the stale cached closed form ran"
+    assert edited["status"] == closed["status"]  # the same answer, found with more evaluations
     assert edited["after"] is False
     assert sorted(p.name for p in cache.rglob("*.nbi")) == indexes  # rewritten, not added
 
-    again = _run(copy, cache, tmp_path)  # nothing changed: the cache is used as it is
+    again = _run(copy, cache, tmp_path, "closed-form")  # nothing changed: the cache as it is
     assert again["before"] is False
-    assert again["n_steps"] == edited["n_steps"]
+    assert again["n_rhs"] == edited["n_rhs"]
 
 
 # --------------------------------------------------------------------------- quick checks

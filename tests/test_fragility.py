@@ -288,22 +288,29 @@ def test_plot_fragility_artists_carry_the_data():
 
 
 def test_plot_ida_one_line_per_record():
+    """A curve per record, intensity up and response across, up to the first collapse
+    (each record of _ida collapses at every level from its capacity on), then flat."""
     df = _ida(6, 0.4, 0.3, seed=5, column="amplitude_g")
     df.loc[3, "status"] = "failed"  # record rec0000 at its 4th level: left out
     df = df.sample(frac=1.0, random_state=1)  # unsorted rows: the plot sorts by intensity
     ax = plot_ida(df)
+    right = ax.get_xlim()[1]
     lines = {ln.get_gid(): ln for ln in ax.get_lines() if ln.get_gid()}
     for name, group in df[df["status"] != "failed"].groupby("record"):
         group = group.sort_values("amplitude_g")
         x, y = lines[f"record:{name}"].get_data()
-        np.testing.assert_array_equal(x, group["amplitude_g"])
-        np.testing.assert_array_equal(y, group["max_rotation_ratio"])
         hit = group[group["collapsed"] == 1]
+        kept = group[group["amplitude_g"] <= (hit["amplitude_g"].min() if len(hit) else 9)]
         if len(hit):
+            np.testing.assert_array_equal(y, [*kept["amplitude_g"], kept["amplitude_g"].max()])
+            np.testing.assert_array_equal(x, [*kept["max_rotation_ratio"], right])
             mx, my = lines[f"collapse:{name}"].get_data()
-            np.testing.assert_array_equal(mx, hit["amplitude_g"])
-            np.testing.assert_array_equal(my, hit["max_rotation_ratio"])
+            np.testing.assert_array_equal(mx, hit["max_rotation_ratio"][:1])
+            np.testing.assert_array_equal(my, hit["amplitude_g"][:1])
+        else:
+            np.testing.assert_array_equal(y, group["amplitude_g"])
+            np.testing.assert_array_equal(x, group["max_rotation_ratio"])
     assert len([g for g in lines if g.startswith("record:")]) == 6
-    assert len(lines["record:rec0000"].get_xdata()) == len(LEVELS) - 1
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [f"rec{k:04d}" for k in range(6)]
     with pytest.raises(RbmError, match="max_rotation_ratio"):
         plot_ida(df.drop(columns="max_rotation_ratio"))

@@ -173,10 +173,16 @@ def check_ida_axes(ax, df, capacity):
     ok = df[df["status"] != "failed"]
     for r in (0, 57, 199):
         name = f"rec{r:03d}"
-        x, y = records[f"record:{name}"].get_data()
-        mine = ok[ok["record"] == name].sort_values("amplitude_g")
-        np.testing.assert_allclose(x, mine["amplitude_g"])
-        np.testing.assert_allclose(y, np.where(x >= capacity[r], 1.0, x / capacity[r]))
+        x, y = records[f"record:{name}"].get_data()  # response across, intensity up
+        level = ok[ok["record"] == name].sort_values("amplitude_g")["amplitude_g"].to_numpy()
+        ratio = np.where(level >= capacity[r], 1.0, level / capacity[r])
+        if level.max() < capacity[r]:  # never collapsed: its runs
+            np.testing.assert_allclose(y, level)
+            np.testing.assert_allclose(x, ratio)
+            continue
+        k = int(np.argmax(level >= capacity[r]))  # its first collapse, then flat
+        np.testing.assert_allclose(y, [*level[: k + 1], level[k]])
+        np.testing.assert_allclose(x, [*ratio[: k + 1], ax.get_xlim()[1]])
     marks = [ln for ln in ax.get_lines() if str(ln.get_gid()).startswith("collapse:")]
     assert len(marks) == int((capacity <= LEVELS.max()).sum())
 
@@ -207,8 +213,9 @@ def test_scale_factor_axis_label(tmp_path, figures):
     (tmp_path / "suite" / "meta.json").write_text(json.dumps(meta))
     res = invoke("fragility", domain, "--resamples", 0)
     assert res.exit_code == 0, res.output
+    frag, ida = (fig.axes[0] for fig in figures)  # the IDA's intensity on its y axis
+    assert frag.get_xlabel() == ida.get_ylabel() == "intensity: scale factor of the records [-]"
     for fig in figures:
-        assert fig.axes[0].get_xlabel() == "intensity: scale factor of the records [-]"
         assert fig.axes[0].get_title().startswith(("suite: 20 records", "IDA, suite: 20"))
 
 

@@ -4,7 +4,7 @@ A record suite: incremental dynamic analysis and fragility curves
 
 A suite of ground-motion records, each scaled to a range of peak ground accelerations
 (PGA), is one sweep: records x intensities. Its outcomes give the incremental dynamic
-analysis (IDA: a line per record, the peak rotation against the intensity) and a
+analysis (IDA: a curve per record, the intensity against its peak rotation) and a
 lognormal fragility curve, fitted by maximum likelihood (Baker 2015) with a bootstrap band
 over the records.
 
@@ -81,22 +81,24 @@ print("files:", ", ".join(p.name for p in fr.paths))
 # %%
 # IDA and the fragility curve, drawn here
 # ---------------------------------------
-# Left: each record's peak rotation ratio (1 = collapse) against its PGA. Right: the
-# fraction of records that topple the column at each intensity, and the fitted lognormal
-# curve with its band.
+# Left: the IDA in the field's convention, the intensity (PGA) up and each record's peak
+# rotation ratio (1 = collapse) across, its curve flat from its first collapse on (`rbm
+# fragility`'s ida.png draws it so). Right: the fraction of records that topple the column
+# at each intensity, and the fitted lognormal curve with its band.
 fig, (ax_ida, ax_fr) = plt.subplots(1, 2, figsize=(11, 4.2))
 for name, runs in domain.groupby("record"):
     runs = runs.sort_values("amplitude_g")
-    ax_ida.plot(
-        runs["amplitude_g"],
-        np.minimum(runs["max_rotation_ratio"], 1.0),
-        marker=".",
-        lw=1,
-        label=name,
-    )
-ax_ida.set_xlabel("PGA [g]")
-ax_ida.set_ylabel("peak rotation / collapse limit")
-ax_ida.set_title("IDA, one line per record")
+    pga, ratio = runs["amplitude_g"].to_numpy(), runs["max_rotation_ratio"].to_numpy()
+    hit = np.flatnonzero(runs["collapsed"].to_numpy() == 1)
+    if hit.size:  # up to the first collapse, then flat at its PGA
+        k = hit[0]
+        pga, ratio = np.append(pga[: k + 1], pga[k]), np.append(ratio[: k + 1], 1.5)
+    ax_ida.plot(ratio, pga, marker=".", lw=1, label=name)
+ax_ida.set_xlim(0.0, 1.5)
+ax_ida.axvline(1.0, color="k", ls="--", lw=0.8)
+ax_ida.set_xlabel("peak rotation / collapse limit")
+ax_ida.set_ylabel("PGA [g]")
+ax_ida.set_title("IDA, one curve per record")
 ax_ida.legend(fontsize=7, ncol=2)
 
 table, curve = result.table, result.curve

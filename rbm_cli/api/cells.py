@@ -16,7 +16,7 @@ from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.models.result import CSV_FIELDS, RunResult
 from rbm_cli.report.plots import plot_history as _plot_history
-from rbm_cli.report.run_folder import history_frame
+from rbm_cli.report.run_folder import history_frame, vertical_history
 from rbm_cli.study.simulate import simulate
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` never does
@@ -146,9 +146,14 @@ class CellRun:
 
     @cached_property
     def history(self) -> pd.DataFrame | None:
-        """history.csv's table (None unless recorded): t_s [s], ag_m_s2 [m/s^2] and ug_m [m]
+        """history.csv's table (None unless recorded): t_s [s], ag_m_s2 [m/s^2], av_m_s2
+        [m/s^2] (the upward ground acceleration, with a vertical record only) and ug_m [m]
         (ground), u1_m..u{n+1}_m (nodes, relative to the ground) [m], theta1_rad.. [rad]."""
-        return None if self.result.history is None else history_frame(self.result.history)
+        history = self.result.history
+        if history is None:
+            return None
+        vertical = vertical_history(self.config, self.result.run_result.amplitude_g, history.t)
+        return history_frame(history, vertical)
 
 
 def run(
@@ -287,12 +292,18 @@ def write_run_folder(config: Config, column, result: RunResult | CellResult,
     shapes.png, summary.json: rbm_cli.report.run_folder.write_run); returns the folder.
     figure_process: the rbm_cli.report.figure_process.FigureProcess that draws the
     figures, or None to draw them here."""
-    from rbm_cli.report.run_folder import run_folder_name, run_summary, write_run
+    from rbm_cli.report.run_folder import (
+        run_folder_name,
+        run_summary,
+        write_run,
+    )
 
     if isinstance(result, CellResult):
         result = result.run_result
     summary = run_summary(result, config, config_path=config_path, amplitude_g=amplitude_g,
                           frequency_hz=frequency_hz, output_dt=output_dt)  # fmt: skip
+    vertical = vertical_history(config, amplitude_g, result.history.t) \
+        if result.history is not None else None  # fmt: skip
     return write_run(
         output,
         config.name,
@@ -302,4 +313,5 @@ def write_run_folder(config: Config, column, result: RunResult | CellResult,
         widths=column.widths,
         elevations=list(column.bottoms) + [column.height],
         figure_process=figure_process,
+        vertical=vertical,
     )

@@ -43,7 +43,11 @@ def info(
         top_mass_centre_height_m [m above the ground] (None without a top mass),
         total_mass_kg [kg] (the top mass included), height_m [m] (the capital included), static_multiplier_g [g] (B/H for a
         rigid monolith), uplift_acceleration_g [g] (None for elastic interfaces),
-        rocking_p_rad_s [rad/s], rocking_frequency_hz [Hz], elastic_frequencies_hz [Hz]
+        rocking_p_rad_s [rad/s] (the RBM's column rocking as one rigid stack on its base),
+        rocking_frequency_hz [Hz], domain_p_rad_s [rad/s] and domain_alpha_rad [rad] (the
+        scales a sweep writes in domain.csv's p_rad_s and alpha_rad: the model's monolith,
+        the true solid's for housner and bullet), rocking_p_is and domain_p_is (what each
+        p is, one line each), elastic_frequencies_hz [Hz]
         (a list; empty when rigid), formulation, restitution [-], and ``interfaces``, a
         DataFrame with one row per interface (1 at the ground): width_m [m],
         drum_height_m [m], drum_mass_kg [kg], drum_inertia_kgm2 [kg m^2],

@@ -61,9 +61,10 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
     every member of a cell as a trial, or its majority (--ensemble-outcome).
 
     Writes fragility.csv, fragility_curve.csv, fragility.json, fragility.png and
-    ida.png (peak rotation ratio against intensity, a line per record), all
-    moved into place together at the end: a Ctrl-C or a kill leaves the old set
-    or the new one, never a mix. One run writes a folder at a time.
+    ida.png (intensity against peak rotation ratio, a curve per record, flat from
+    its first collapse, the records named), all moved into place together at the
+    end: a Ctrl-C or a kill leaves the old set or the new one, never a mix. One
+    run writes a folder at a time.
 
     \b
     Example:

@@ -14,11 +14,12 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.report.fragility_store import FragilityFolder
-from rbm_cli.study.fragility import METHOD, FragilityResult
+from rbm_cli.study.fragility import METHOD, MIN_BAND_RECORDS, FragilityResult
 from rbm_cli.study.outcomes import intensity_column as find_intensity_column
 
 #: Float format of the CSV files (12 significant digits, as domain.csv).
@@ -149,23 +150,29 @@ def plot_fragility(
     color = _plot_observed(ax, result.table, prefix, color, counts)
     if result.fit is not None:
         _plot_fit(ax, result, prefix, color)
-    if result.fit is None or result.note:
-        ax.text(
-            0.02,
-            0.95,
-            f"{prefix}{'no fit: ' if result.fit is None else ''}{result.note}",
-            transform=ax.transAxes,
-            fontsize=7,
-            va="top",
-            wrap=True,
-        )
+    if result.n_records < MIN_BAND_RECORDS:
+        n = result.n_records
+        _note(ax, f"{prefix}too few records: a fit from {n} record{'s' * (n != 1)}, below the "
+                  f"{MIN_BAND_RECORDS} a bootstrap over records needs (no band, no intervals)",
+              "few-records", "tab:red")  # fmt: skip
+    if result.fit is None:
+        _note(ax, f"{prefix}no fit: {result.note}", "note")
+    elif result.note and result.n_records >= MIN_BAND_RECORDS:
+        _note(ax, f"{prefix}{result.note}", "note")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("probability of collapse [-]")
     ax.set_ylim(-0.03, 1.03)
     ax.set_xlim(left=0.0)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     return ax
+
+
+def _note(ax, text: str, gid: str, color: str = "black") -> None:
+    """A note under the axes (off the points and the legend), one line below the last."""
+    below = sum(t.get_gid() in ("note", "few-records") for t in ax.texts)
+    ax.text(0.0, -0.14 - 0.06 * below, text, transform=ax.transAxes, fontsize=7, va="top",
+            color=color, gid=gid)  # fmt: skip
 
 
 def _plot_observed(ax, table: pd.DataFrame, prefix: str, color, counts: bool):
@@ -228,8 +235,44 @@ def _plot_fit(ax, result: FragilityResult, prefix: str, color) -> None:
     fitted.set_gid("fitted")
 
 
+#: Colours of the records in ida.png (a record k gets colour k mod 20 and line style
+#: k // 20 mod 4, so 80 records are told apart before a pair repeats).
+IDA_COLOURS = "tab20"
+IDA_STYLES = ("-", "--", "-.", ":")
+#: Records per column of the IDA's legend (beside the axes: 25 names fit its height).
+IDA_LEGEND_ROWS = 25
+
+
+def ida_curve(x: np.ndarray, y: np.ndarray, collapsed: np.ndarray, right: float):
+    """The IDA curve of one record in the field's convention (Vamvatsikos and Cornell
+    2002): its runs sorted by intensity ``x``, peak response ``y``, up to its first
+    collapse, then a flat line at that collapse intensity out to the response ``right``.
+
+    Returns (response, intensity, first collapse index or None): the curve's points, the
+    response on the horizontal axis. Runs above the first collapse are not on the curve.
+    """
+    hit = np.flatnonzero(collapsed)
+    if hit.size == 0:
+        return y.copy(), x.copy(), None
+    k = int(hit[0])
+    response = np.append(y[: k + 1], max(right, float(y[k])))
+    intensity = np.append(x[: k + 1], x[k])
+    return response, intensity, k
+
+
+def ida_style(k: int) -> dict:
+    """Colour and line style of the k-th record (by name) in ida.png."""
+    from matplotlib import colormaps
+
+    colours = colormaps[IDA_COLOURS].colors
+    return {"color": colours[k % len(colours)],
+            "linestyle": IDA_STYLES[(k // len(colours)) % len(IDA_STYLES)]}  # fmt: skip
+
+
 def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):
-    """Incremental dynamic analysis: peak rotation ratio against intensity, a line per record.
+    """Incremental dynamic analysis: intensity against peak rotation ratio, a curve per
+    record, flat from its first collapse on (the field's convention: intensity on the
+    vertical axis, the response on the horizontal).
 
     Parameters
     ----------
@@ -245,10 +288,17 @@ def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):
     Returns
     -------
     matplotlib.axes.Axes
-        One line per record (gid ``record:<name>``, points sorted by intensity), collapsed
-        runs marked "x" in the record's colour (gid ``collapse:<name>``), the collapse
-        limit (ratio 1) dashed
+        One curve per record (gid ``record:<name>``, label the record's name): its runs
+        sorted by intensity, response on x, intensity on y, up to the first collapse
+        (marked "x", gid ``collapse:<name>``), then horizontal at that intensity to the
+        right edge (:func:`ida_curve`); runs of a record that survive above its first
+        collapse intensity are hollow circles off the curve (gid ``above:<name>``). The
+        collapse limit (ratio 1) is a dashed vertical line (gid ``limit``). The legend,
+        beside the axes, names every record (colour k mod 20, line style k // 20:
+        :func:`ida_style`), in columns of :data:`IDA_LEGEND_ROWS`.
     """
+    from matplotlib.lines import Line2D
+
     column = find_intensity_column(df, intensity_column)
     needed = ["record", column or "intensity_g", "max_rotation_ratio", "collapsed"]
     missing = [c for c in needed if c not in df.columns]
@@ -256,32 +306,52 @@ def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):
         raise RbmError(f"IDA plot: missing column {missing[0]!r}")
     rows = df if "status" not in df.columns else df[df["status"].astype(str) != "failed"]
     ax = ax if ax is not None else _new_axes()
-    first = True
-    for name, group in sorted(rows.groupby(rows["record"].astype(str)), key=lambda g: g[0]):
+    ratios = rows["max_rotation_ratio"].to_numpy(float)
+    finite = ratios[np.isfinite(ratios)]
+    right = 1.5 * max(1.0, float(finite.max()) if finite.size else 1.0)
+    handles, above_any, collapse_any = [], False, False
+    groups = sorted(rows.groupby(rows["record"].astype(str)), key=lambda g: g[0])
+    for k, (name, group) in enumerate(groups):
         group = group.sort_values(column)
         x = group[column].to_numpy(float)
         y = group["max_rotation_ratio"].to_numpy(float)
-        (line,) = ax.plot(
-            x, y, "-", lw=1.0, alpha=0.8, label="a record (one line each)" if first else None
-        )
-        line.set_gid(f"record:{name}")
         hit = group["collapsed"].to_numpy(float) == 1.0
-        if hit.any():
-            (marks,) = ax.plot(
-                x[hit],
-                y[hit],
-                "x",
-                color=line.get_color(),
-                ms=6,
-                label="collapsed run" if first else None,
-            )
-            marks.set_gid(f"collapse:{name}")
-        first = False
-    ax.axhline(1.0, color="k", ls="--", lw=0.8, label="collapse limit (ratio 1)")
-    ax.set_xlabel("intensity: peak ground acceleration [g]")
-    ax.set_ylabel("peak rotation ratio (collapse quantity / limit) [-]")
-    ax.set_xlim(left=0.0)
+        response, intensity, first = ida_curve(x, y, hit, right)
+        style = ida_style(k)
+        (line,) = ax.plot(response, intensity, lw=1.0, alpha=0.85, label=name, **style)
+        line.set_gid(f"record:{name}")
+        handles.append(line)
+        if first is None:
+            continue
+        collapse_any = True
+        (mark,) = ax.plot([y[first]], [x[first]], "x", color=style["color"], ms=6)
+        mark.set_gid(f"collapse:{name}")
+        later = ~hit[first + 1 :]
+        if later.any():
+            above_any = True
+            (up,) = ax.plot(y[first + 1 :][later], x[first + 1 :][later], "o", ms=4,
+                            mfc="none", color=style["color"])  # fmt: skip
+            up.set_gid(f"above:{name}")
+    limit = ax.axvline(1.0, color="k", ls="--", lw=0.8, label="collapse limit (ratio 1)")
+    limit.set_gid("limit")
+    keys = [limit]
+    if collapse_any:
+        keys.append(Line2D([], [], color="0.3", marker="x", lw=1.0,
+                           label="first collapse, then flat at its intensity"))  # fmt: skip
+    if above_any:
+        keys.append(Line2D([], [], color="0.3", marker="o", mfc="none", ls="none",
+                           label="survived above its first collapse"))  # fmt: skip
+    ax.set_ylabel("intensity: peak ground acceleration [g]")
+    ax.set_xlabel("peak rotation ratio (collapse quantity / limit) [-]")
+    ax.set_xlim(0.0, right)
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="upper left")
+    columns = max(1, math.ceil(len(handles) / IDA_LEGEND_ROWS))
+    key = ax.legend(handles=keys, fontsize=7, loc="lower right")
+    ax.add_artist(key)
+    names = ax.legend(handles=handles, title=f"{len(handles)} records", fontsize=6,
+                      title_fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                      borderaxespad=0.0, ncols=columns)  # fmt: skip
+    names.set_gid("records")
+    key.set_gid("key")
     return ax

@@ -140,8 +140,8 @@ def run_fragility(
         result = fragility(df, **options, n_members=members, progress=_part(progress, 0, parts))
         others = []
         for k, (path, frame, m) in enumerate(frames, start=1):
-            others.append((_name(path), fragility(frame, **options, n_members=m,
-                                                  progress=_part(progress, k, parts))))  # fmt: skip
+            fit = fragility(frame, **options, n_members=m, progress=_part(progress, k, parts))
+            others.append((path, _name(path), fit))
         source = {
             "domain": os.path.relpath(domain.resolve(), folder.resolve()),
             "domain_sha256": digest,  # of the bytes fitted: which domain.csv these are of
@@ -173,13 +173,20 @@ def _contents(domain: Path, df, result, others, source: dict) -> tuple[str, dict
     ``source``: fragility.json's entries naming the domain)."""
     meta = _meta(domain)
     label = intensity_label(result.intensity_column, meta)
+    suite = suite_name(meta)
     title = f"{meta.get('name') or domain.parent.name or domain.stem}: " \
-        f"{result.n_records} records, {len(result.table)} intensities" \
+        f"{result.n_records} records{f' ({suite})' if suite else ''}, " \
+        f"{len(result.table)} intensities" \
         + (f"\n{result.outcome}" if result.ensemble_outcome else "")  # fmt: skip
-    names = ", ".join([_name(domain)] + [n for n, _ in others])
-    frag_title = f"fragility under one suite: {names}" if others else title
+    frag_title = compare_title([(_name(domain), suite_name(meta))]
+                               + [(n, suite_name(_meta(p))) for p, n, _ in others]) \
+        if others else title  # fmt: skip
     contents = {
-        "fragility.png": _png(fragility_figure(result, label, frag_title, _name(domain), others)),
+        "fragility.png": _png(
+            fragility_figure(
+                result, label, frag_title, _name(domain), [(n, r) for _, n, r in others]
+            )
+        ),
         "ida.png": _png(ida_figure(df, result.intensity_column, label, title)),
     }
     contents.update(fragility_texts(result, extra=source))
@@ -198,6 +205,32 @@ def intensity_label(column: str, meta: dict | None = None) -> str:
         return "intensity: peak ground acceleration [g]"
     measure = measure_label(column)
     return f"intensity: {measure}" if measure else f"intensity: {column}"
+
+
+def compare_title(suites: list[tuple[str, str]]) -> str:
+    """Title of a fragility.png that compares domains: their names, and the suite of
+    records they ran (one line when they share it, else each domain's own)."""
+    names = ", ".join(name for name, _ in suites)
+    kinds = {suite for _, suite in suites}
+    if len(kinds) == 1:
+        (suite,) = kinds
+        return f"fragility of {names}\nunder the suite {suite or '(not named in meta.json)'}"
+    each = "; ".join(f"{name}: {suite or '(not named)'}" for name, suite in suites)
+    return f"fragility of {names}\nunder different suites: {each}"
+
+
+def suite_name(meta: dict) -> str:
+    """The suite of records a sweep ran, as its config writes it (excitation.file: a
+    pattern such as records/rdk_*.AT2, or a list of files), from its meta.json; "" when
+    the meta.json does not say."""
+    written = meta.get("config_written")
+    excitation = written.get("excitation") if isinstance(written, dict) else None
+    files = excitation.get("file") if isinstance(excitation, dict) else None
+    if isinstance(files, str):
+        return files
+    if isinstance(files, list) and files and all(isinstance(f, str) for f in files):
+        return files[0] if len(files) == 1 else f"{files[0]} ... ({len(files)} files)"
+    return ""
 
 
 def _name(domain: Path) -> str:
@@ -221,7 +254,8 @@ def fragility_figure(
         plot_fragility(result, ax, xlabel=label)
     else:
         for k, (who, res) in enumerate([(name, result), *others]):
-            plot_fragility(res, ax, xlabel=label, label=who, color=COLOURS[k % len(COLOURS)],
+            plot_fragility(res, ax, xlabel=label, label=f"{who} ({res.n_records} records)",
+                           color=COLOURS[k % len(COLOURS)],
                            counts=False)  # fmt: skip
     ax.set_title(title, fontsize=9)
     return ax.figure
@@ -233,7 +267,7 @@ def ida_figure(df: pd.DataFrame, column: str, label: str, title: str = ""):
 
     ax = Figure(figsize=(7, 5)).subplots()
     plot_ida(df, ax, intensity_column=column)
-    ax.set_xlabel(label)
+    ax.set_ylabel(label)
     ax.set_title(f"IDA, {title}" if title else "IDA", fontsize=9)
     return ax.figure
 

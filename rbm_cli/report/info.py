@@ -8,6 +8,7 @@ import math
 from rbm_cli.config.grid import VIRTUAL_PATHS
 from rbm_cli.config.types import Config, G
 from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.physics.similarity import rocking_scales
 
 
 def normal_stiffness(col, i: int) -> float:
@@ -25,6 +26,10 @@ def describe(config: Config) -> dict:
     The rocking p is that of the rigid stack, p^2 = N_1 zbar_1 / (1^T M 1)
     (for n = 1: m g (H/2) / (I_G + m H^2 / 4)); a capital is one of the drums, a top
     mass part of the top drum's mass and inertia (height_m: the shaft and the capital).
+    domain_p_rad_s and domain_alpha_rad are the scales a sweep writes in domain.csv's
+    p_rad_s and alpha_rad (rbm_cli.physics.similarity: the model's monolith, the true
+    solid's for housner and bullet); rocking_p_is and domain_p_is say what each p is
+    (:func:`p_meaning`), as `rbm info` prints them.
     Elastic frequencies are those of the elastic branches of the laws in the chosen
     formulation. For `model: bullet` the figures are the RBM's, plus the engine's own uplift
     level (true solids, min(tan alpha_i, friction) g).
@@ -57,6 +62,7 @@ def describe(config: Config) -> dict:
         from rbm_cli.models.bullet.run import engine_uplift_g
 
         engine = {"engine_uplift_g": engine_uplift_g(config), "friction": config.interface.friction}
+    scales = rocking_scales(config)
     geometry = config.column
     capital = geometry.capital
     top = geometry.top_mass
@@ -76,12 +82,42 @@ def describe(config: Config) -> dict:
         "uplift_acceleration_g": uplift,
         "rocking_p_rad_s": p,
         "rocking_frequency_hz": p / (2 * math.pi),
+        "domain_p_rad_s": scales.p,
+        "domain_alpha_rad": scales.alpha,
+        **p_meaning(config, col.n, float(col.lever_arms[0])),
         "elastic_frequencies_hz": freqs,
         "formulation": model.formulation,
         "restitution": model.restitution,
         "interfaces": interfaces,
         **engine,
     }
+
+
+def p_meaning(config: Config, n: int, lever: float) -> dict[str, str]:
+    """What each of the two p's is, by name: ``rocking_p_is`` (`rbm info`'s: the RBM's column
+    as configured, its n drums rocking as one rigid stack on the base, p^2 = N_1 zbar_1 /
+    (1^T M 1)) and ``domain_p_is`` (domain.csv's p_rad_s and alpha_rad: the similarity scales
+    of rbm_cli.physics.similarity, the model's own monolith); one line each. ``lever``:
+    zbar_1, the height of the weight's resultant above the base [m]."""
+    stack = (f"the RBM's {n} drums rocking as one rigid stack on the base (centre of mass at "
+             f"zbar_1 = {lever:.4g} m, tan alpha = theta_u,1)" if n > 1 else
+             f"the RBM's monolith on its base (its weight at zbar_1 = {lever:.4g} m over the "
+             "base's centre: tan alpha = theta_u,1 = (B_1/2)/zbar_1, p^2 = m g zbar_1 / "
+             "(I_G + m zbar_1^2))")  # fmt: skip
+    if config.model == "rbm" and config.column.capital is not None:
+        domain = "the RBM's shaft and capital glued into one rigid stack: the rocking p"
+    elif config.model == "rbm" and n > 1:
+        domain = (
+            "the RBM's one-drum monolith (the drums glued into one drum of height H: "
+            "its weight at H/2, tan alpha = B_1/H), not the stack of the rocking p"
+        )
+    elif config.model == "rbm":
+        domain = "the RBM's monolith: the rocking p"
+    else:
+        domain = (f"the true solid's ({config.model}: a rigid block, tan alpha = b/z_c with "
+                  "z_c its true centre of mass, p^2 = m g R / I_O about the base corner), "
+                  "not the RBM's approximation of the rocking p")  # fmt: skip
+    return {"rocking_p_is": stack, "domain_p_is": domain}
 
 
 def _fmt(value, spec: str = ".4g") -> str:
@@ -134,6 +170,11 @@ def format_info(info: dict) -> str:
             (", ".join(_fmt(f) for f in freqs) + " Hz") if freqs else "- (rigid)",
         ),
     ]
+    if info.get("domain_p_rad_s") is not None:
+        rows.append(("rocking p is", info.get("rocking_p_is") or "-"))
+        values = (f"{_fmt(info['domain_p_rad_s'])} rad/s, alpha_rad "
+                  f"{_fmt(info.get('domain_alpha_rad'))} rad (domain.csv's scales): ")  # fmt: skip
+        rows.append(("domain p_rad_s", values + (info.get("domain_p_is") or "-")))
     if info.get("capital_height_m") is not None:
         size = f"{_fmt(info['capital_width_m'])} x {_fmt(info['capital_depth_m'])} m"
         rows.insert(2, ("capital", f"{_fmt(info['capital_height_m'])} m high, {size} (the top"

@@ -43,19 +43,59 @@ def shape_instants(t: Sequence[float], count: int = N_SHAPES) -> list[int]:
 
 
 def run_title(summary: dict) -> str | None:
-    """'<config name>: A = <a> g, f = <f> Hz' (or ': free motion') from a summary.json
-    made by :func:`run_summary`; None if the summary does not hold them."""
+    """'<config name> (<type>): A = <a> g, f = <f> Hz' (or ': free motion'; a record run:
+    '<config name>: record <name> scaled to PGA <pga> g', and its vertical record if any)
+    from a summary.json made by :func:`run_summary`; None if the summary does not hold
+    them."""
     try:
         name = summary["config_written"]["name"]
         inputs = summary["inputs"]
         kind = summary["config_written"].get("excitation", {}).get("type", "harmonic")
         if kind == "free":
             return f"{name}: free motion"
+        if kind == "record":
+            return record_title(name, summary["record"], float(inputs["amplitude_g"]))
         amplitude, frequency = float(inputs["amplitude_g"]), float(inputs["frequency_hz"])
         cell = f"A = {amplitude:.4g} g, f = {frequency:.4g} Hz"
     except (KeyError, TypeError, ValueError, AttributeError):
         return None
     return f"{name} ({kind}): {cell}"
+
+
+def record_title(name: str, record: dict, amplitude: float) -> str:
+    """Title of a record run: the config's name, the record's, its scaled PGA [g] (and the
+    scale factor with ``scale: factor``), the vertical record's name and scaled peak."""
+    title = f"{name}: record {record['record']} scaled to PGA {float(record['pga_g']):.4g} g"
+    if record.get("scale") == "factor":
+        title += f" (factor {amplitude:.4g})"
+    if record.get("vertical"):
+        title += (f", with vertical record {record['vertical']} "
+                  f"(peak {float(record['vertical_peak_g']):.4g} g)")  # fmt: skip
+    return title
+
+
+def plot_ground(history: History, ax, vertical=None, t_collapse: float | None = None):
+    """The ground's acceleration against time [g]: a_g (gid 'a_g') and, with a vertical
+    record, the upward a_v (gid 'a_v', ``vertical`` [m/s^2] at the history's times)."""
+    from rbm_cli.config.types import G
+
+    t = np.asarray(history.t, dtype=float)
+    ag = np.asarray(history.ground_acceleration, dtype=float) / G
+    ax.plot(t, ag, color="0.35", linewidth=0.8, label="$a_g$ (horizontal)", gid="a_g")
+    if vertical is not None:
+        av = np.asarray(vertical, dtype=float) / G
+        ax.plot(t, av, color="tab:green", linewidth=0.8, label="$a_v$ (vertical, upward)",
+                gid="a_v")  # fmt: skip
+    if t_collapse is not None and np.isfinite(t_collapse):
+        ax.axvline(t_collapse, color="tab:red", linestyle="--", linewidth=1.0,
+                   label=f"collapse, t = {t_collapse:.3g} s")  # fmt: skip
+    ax.axhline(0.0, color="0.6", linewidth=0.6)
+    ax.set_ylabel("ground acc. [g]")
+    ax.set_xlabel("time [s]")
+    ax.grid(True, alpha=0.3)
+    ax.set_title("ground acceleration" + (" (horizontal and vertical)" if vertical is not None
+                                          else ""), fontsize="medium")  # fmt: skip
+    return ax
 
 
 def run_column(summary: dict):
@@ -65,7 +105,11 @@ def run_column(summary: dict):
     from rbm_cli.physics.column import build_column
 
     try:
-        config = parse_config(summary["config_written"])
+        # the column alone: the excitation's files (and a grid over them) are the run's
+        # business, and may be relative to a folder the summary does not name
+        written = {key: value for key, value in summary["config_written"].items()
+                   if key not in ("excitation", "grid")}  # fmt: skip
+        config = parse_config(written)
         column = build_column(config.column, config.interface)
     except (KeyError, TypeError, ValueError, RbmError):
         return None
@@ -77,12 +121,15 @@ def history_figure(
     t_collapse: float | None,
     title: str | None = None,
     joints: tuple | None = None,
+    ground: bool = False,
+    vertical=None,
 ):
-    """history.png: base and top displacement (the top relative to the ground, and the
-    ground on a right axis, when the ground drifts: rbm_cli.report.plots.ground_drifts),
-    top relative to base, and for more than one drum each joint's rotation over its limit
-    (``joints`` = (Column, formulation, collapse ratio), see
-    :func:`rbm_cli.report.plots.plot_joint_rotations`)."""
+    """history.png: with ``ground`` (a record run) first the ground's acceleration (a_g,
+    and a_v when ``vertical`` [m/s^2] is given: :func:`plot_ground`); base and top
+    displacement (the top relative to the ground, and the ground on a right axis, when the
+    ground drifts: rbm_cli.report.plots.ground_drifts), top relative to base, and for more
+    than one drum each joint's rotation over its limit (``joints`` = (Column, formulation,
+    collapse ratio), see :func:`rbm_cli.report.plots.plot_joint_rotations`)."""
     from matplotlib.figure import Figure
 
     from rbm_cli.report.plots import (
@@ -93,8 +140,12 @@ def history_figure(
     )
 
     multi = joints is not None and joints[0].n > 1
-    fig = Figure(figsize=(9.0, 8.5 if multi else 6.0))
-    axes = fig.subplots(3 if multi else 2, 1, sharex=True)
+    ground = bool(ground or vertical is not None)
+    count = 2 + int(multi) + int(ground)
+    fig = Figure(figsize=(9.0, 2.0 + 2.2 * count if count > 2 else 6.0))
+    axes = list(fig.subplots(count, 1, sharex=True))
+    if ground:
+        plot_ground(history, axes.pop(0), vertical, t_collapse)
     relative = ground_drifts(history)  # the ground then on a right axis of the first panel
     plot_history(history, ax=axes[0], t_collapse=t_collapse, relative=relative)
     plot_top_relative(history, ax=axes[1], t_collapse=t_collapse)
@@ -109,10 +160,12 @@ def history_figure(
             t_collapse=t_collapse,
         )
         axes[2].set_title("joint rotations against their limits", fontsize="medium")
+    axes = fig.axes[:count]  # the panels, top to bottom (a right axis comes after them)
     for ax in axes[:-1]:
         ax.set_xlabel("")
+    first = int(ground)  # the panel of plot_history
     for k, ax in enumerate(axes):  # legends beside the axes (past a right axis, if any)
-        beside = 1.1 if relative and k == 0 else 1.01
+        beside = 1.1 if relative and k == first else 1.01
         ax.legend(loc="upper left", bbox_to_anchor=(beside, 1.0), fontsize="x-small")
     if title:
         fig.suptitle(title)
@@ -153,9 +206,12 @@ def png_bytes(fig) -> bytes:
     return buffer.getvalue()
 
 
-def history_png(history: History, t_collapse: float | None, summary: dict) -> bytes:
-    """history.png of one run (see :func:`run_pngs` for the arguments)."""
-    figure = history_figure(history, t_collapse, run_title(summary), run_column(summary))
+def history_png(history: History, t_collapse: float | None, summary: dict,
+                vertical=None) -> bytes:  # fmt: skip
+    """history.png of one run (see :func:`run_pngs` for the arguments); a record run's
+    (its summary has ``record``) starts with the ground's acceleration."""
+    figure = history_figure(history, t_collapse, run_title(summary), run_column(summary),
+                            ground="record" in summary, vertical=vertical)  # fmt: skip
     return png_bytes(figure)
 
 
@@ -165,7 +221,8 @@ def shapes_png(history: History, t_collapse: float | None, summary: dict, widths
     return png_bytes(figure)
 
 
-def run_pngs(history: History, t_collapse: float | None, summary: dict, widths, elevations):
+def run_pngs(history: History, t_collapse: float | None, summary: dict, widths, elevations,
+             vertical=None):  # fmt: skip
     """{'history.png': bytes, 'shapes.png': bytes} of one run.
 
     Parameters
@@ -176,15 +233,18 @@ def run_pngs(history: History, t_collapse: float | None, summary: dict, widths, 
         and cell) and the column's rotation limits come from it
     widths : (n+1,) Column widths at the nodes [m]
     elevations : (n+1,) Node elevations [m]
+    vertical : (k,) or None  a_v [m/s^2] at the history's times, with a vertical record
+        (rbm_cli.report.run_folder.vertical_history)
     """
-    calls = run_png_calls(history, t_collapse, summary, widths, elevations)
+    calls = run_png_calls(history, t_collapse, summary, widths, elevations, vertical)
     return {name: function(*args) for name, (function, args) in zip(RUN_PNGS, calls, strict=True)}
 
 
-def run_png_calls(history: History, t_collapse, summary: dict, widths, elevations) -> list:
+def run_png_calls(history: History, t_collapse, summary: dict, widths, elevations,
+                  vertical=None) -> list:  # fmt: skip
     """The (function, args) pairs that draw :data:`RUN_PNGS` (see :func:`run_pngs`): for
     rbm_cli.report.figure_process.FigureProcess.submit_all, which draws them side by side."""
     return [
-        (history_png, (history, t_collapse, summary)),
+        (history_png, (history, t_collapse, summary, vertical)),
         (shapes_png, (history, t_collapse, summary, widths, elevations)),
     ]

@@ -63,17 +63,24 @@ def run_folder_name(amplitude_g: float, frequency_hz: float | None, excitation_t
 # --------------------------------------------------------------------------- one run
 
 
-def history_columns(history: History) -> dict[str, np.ndarray]:
-    """The columns of history.csv: t_s [s], ag_m_s2 [m/s2], ug_m [m], u1_m..u{n+1}_m [m]
-    (node displacements relative to the ground), theta1_rad..thetan_rad [rad] (absolute
-    drum rotations); -0.0 made 0.0, so the file never shows "-0"."""
+def history_columns(history: History, vertical=None) -> dict[str, np.ndarray]:
+    """The columns of history.csv: t_s [s], ag_m_s2 [m/s2], av_m_s2 [m/s2] (the upward
+    ground acceleration, only when a vertical record is given: ``vertical``, a_v at the
+    history's times, :func:`vertical_history`), ug_m [m], u1_m..u{n+1}_m [m] (node
+    displacements relative to the ground), theta1_rad..thetan_rad [rad] (absolute drum
+    rotations); -0.0 made 0.0, so the file never shows "-0"."""
     u = np.atleast_2d(np.asarray(history.node_displacements, dtype=float))
     theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
     data: dict[str, np.ndarray] = {
         "t_s": np.asarray(history.t, dtype=float),
         "ag_m_s2": np.asarray(history.ground_acceleration, dtype=float),
-        "ug_m": np.asarray(history.ground_displacement, dtype=float),
     }
+    if vertical is not None:
+        av = np.asarray(vertical, dtype=float)
+        if av.shape != data["t_s"].shape:
+            raise ValueError(f"vertical has {av.size} samples, the history {data['t_s'].size}")
+        data["av_m_s2"] = av
+    data["ug_m"] = np.asarray(history.ground_displacement, dtype=float)
     for i in range(u.shape[1]):
         data[f"u{i + 1}_m"] = u[:, i]
     for i in range(theta.shape[1]):
@@ -81,19 +88,20 @@ def history_columns(history: History) -> dict[str, np.ndarray]:
     return {k: v + 0.0 for k, v in data.items()}
 
 
-def history_frame(history: History) -> pd.DataFrame:
+def history_frame(history: History, vertical=None) -> pd.DataFrame:
     """history.csv as a table (the columns of :func:`history_columns`; pandas is imported
     here, not with the module)."""
     import pandas as pd
 
-    return pd.DataFrame(history_columns(history))
+    return pd.DataFrame(history_columns(history, vertical))
 
 
-def history_csv(history: History, rows_per_chunk: int = 4096) -> Iterator[str]:
+def history_csv(history: History, rows_per_chunk: int = 4096, vertical=None) -> Iterator[str]:
     """The text of history.csv in pieces, without pandas: the file
     ``history_frame(history).to_csv(index=False, float_format="%.12g", lineterminator="\\n")``
-    writes (base.files.write_csv_atomic), floats with 12 significant digits, empty for NaN."""
-    columns = history_columns(history)
+    writes (base.files.write_csv_atomic), floats with 12 significant digits, empty for NaN
+    (``vertical``: a_v at the history's times, see :func:`history_columns`)."""
+    columns = history_columns(history, vertical)
     yield ",".join(columns) + "\n"
     table = np.column_stack(list(columns.values())) if columns else np.empty((0, 0))
     line = ",".join([FLOAT_FORMAT] * table.shape[1]) + "\n"
@@ -110,6 +118,46 @@ def _csv_line(row: list[float]) -> str:
     return ",".join("" if math.isnan(v) else FLOAT_FORMAT % v for v in row) + "\n"
 
 
+def record_of_run(config, amplitude_g: float) -> dict | None:
+    """What a record run ran, for its summary.json and its figures' titles: the record's
+    name, its peak acceleration as scaled [g] (the amplitude with ``scale: pga``; the
+    factor times the processed record's PGA with ``scale: factor``), and the vertical
+    record's name and scaled peak [g] (None without one); None for another excitation."""
+    from rbm_cli.config.types import G
+    from rbm_cli.physics.excitation import make_ground_motion
+
+    excitation = config.excitation
+    if excitation.type != "record":
+        return None
+    motion = make_ground_motion(excitation, amplitude_g)
+    info = {"record": motion.name, "pga_g": float(np.max(np.abs(motion.values))) / G,
+            "scale": excitation.scale, "vertical": None, "vertical_peak_g": None}  # fmt: skip
+    if motion.vertical is not None:
+        info["vertical"] = Path(str(excitation.vertical)).stem
+        info["vertical_peak_g"] = float(np.max(np.abs(motion.vertical))) / G
+    return info
+
+
+def vertical_history(config, amplitude_g: float, t) -> np.ndarray | None:
+    """a_v [m/s^2], the upward ground acceleration of a record run with a vertical record
+    (excitation.vertical, scaled as the run scales it), at the times ``t`` [s]: as the
+    run's ground motion gives it (rbm_cli.physics.motion.GroundMotion, 0 outside the
+    record); None without a vertical record."""
+    from rbm_cli.base.jit import plain
+    from rbm_cli.config.types import G
+    from rbm_cli.physics.excitation import make_ground_motion
+    from rbm_cli.physics.ground import as_samples, vertical_factor
+
+    excitation = config.excitation
+    if excitation.type != "record" or excitation.vertical is None:
+        return None
+    motion = make_ground_motion(excitation, amplitude_g)
+    knots, vertical = as_samples(motion.knots), as_samples(motion.vertical)
+    factor = plain(vertical_factor)  # the run's own statements, not compiled once more
+    times = np.asarray(t, dtype=float)
+    return np.array([(factor(float(x), knots, vertical) - 1.0) * G for x in times])
+
+
 def run_summary(
     result: RunResult,
     config,
@@ -119,7 +167,8 @@ def run_summary(
     frequency_hz: float,
     output_dt: float | None,
 ) -> dict:
-    """summary.json: RunResult.summary() plus the resolved inputs and the version."""
+    """summary.json: RunResult.summary() plus the resolved inputs, the version and, for a
+    record run, what it ran (``record``: :func:`record_of_run`)."""
     summary = dict(result.summary())
     summary["inputs"] = {
         "config_file": os.fspath(config_path) if config_path is not None else None,
@@ -127,6 +176,9 @@ def run_summary(
         "frequency_hz": frequency_hz,
         "output_dt_s": output_dt,
     }
+    record = record_of_run(config, amplitude_g)
+    if record is not None:
+        summary["record"] = record
     summary["config"] = json_ready(config.resolved())
     summary["config_written"] = json_ready(config.written)
     summary["rbm_version"] = __version__
@@ -151,6 +203,7 @@ def write_run(
     widths,
     elevations,
     figure_process=None,
+    vertical=None,
 ) -> Path:
     """Write history.csv, history.png, shapes.png and summary.json of one run.
 
@@ -174,6 +227,8 @@ def write_run(
     elevations : (n+1,) Node elevations [m]
     figure_process : FigureProcess or None  The child that draws the figures; None: drawn
         in this process
+    vertical : (k,) or None  a_v [m/s^2] at the history's times, with a vertical record
+        (:func:`vertical_history`): history.csv's av_m_s2 and the figures' a_v
 
     Returns
     -------
@@ -200,10 +255,11 @@ def write_run(
     except OSError as exc:
         raise OutputError(f"cannot write in output folder {parent}: {exc.strerror}") from None
     try:
-        figures = (result.history, t_collapse, summary, widths, elevations)
+        figures = (result.history, t_collapse, summary, widths, elevations, vertical)
         if figure_process is not None:  # drawn by the child while history.csv is written
             figure_process.submit_all(run_png_calls(*figures))
-        write_chunks_atomic(staging / "history.csv", history_csv(result.history))
+        rows = history_csv(result.history, vertical=vertical)
+        write_chunks_atomic(staging / "history.csv", rows)
         for png, data in _pngs(figure_process, figures).items():
             write_chunks_atomic(staging / png, [data])
         write_json_atomic(staging / "summary.json", summary)

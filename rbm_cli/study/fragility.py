@@ -406,6 +406,7 @@ __all__ = [
     "MAX_RESAMPLES",
     "MAX_SEED",
     "METHOD",
+    "MIN_BAND_RECORDS",
     "ENSEMBLE_OUTCOMES",
     "FragilityResult",
     "LognormalFit",

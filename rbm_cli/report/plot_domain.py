@@ -345,7 +345,7 @@ def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
         where = pd.to_numeric(df["collapse_interface"], errors="coerce").to_numpy(float)
         upper = unsafe & (where > 1)
         if upper.any():
-            ax.plot(f[upper], a[upper], marker="^", color="tab:red", markersize=1.9 * size,
+            ax.plot(f[upper], a[upper], marker="^", color="tab:red", markersize=1.5 * size,
                     label=UPPER_JOINT_LABEL, gid="upper-joint", **style)  # fmt: skip
             ax.plot([], [], marker="x", linestyle="none", color="tab:red",
                     label=BASE_JOINT_LABEL, gid="base-joint")  # fmt: skip
@@ -353,7 +353,7 @@ def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
         slides = _flag(df, SLIDES)
         if slides.any():
             ax.plot(f[slides], a[slides], marker="D", color="tab:orange",
-                    markersize=1.7 * size, markeredgewidth=1.1, label=SLIDES_LABEL,
+                    markersize=1.5 * size, markeredgewidth=1.1, label=SLIDES_LABEL,
                     gid="slides", **style)  # fmt: skip
 
 

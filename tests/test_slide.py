@@ -12,6 +12,7 @@ from its geometry (tan alpha = B / H of a rectangular monolith).
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import math
@@ -138,6 +139,17 @@ def test_models_that_compute_no_demand_leave_the_column_empty():
                            "column": {"height": H, "base_width": B}})  # fmt: skip
     row = simulate(cfg, 0.5, FREQ).row()
     assert math.isnan(row["friction_demand"]) and "slides" not in row
+
+
+def test_a_bullet_domain_keeps_no_demand_and_no_slides():
+    """The engine's contacts slide: their |T/N| (capped by Coulomb) is no demand."""
+    cfg = rbm.load_config({"name": "x", "model": "bullet", "column": {"height": H,
+                           "base_width": B}, "interface": {"friction": 0.4}})  # fmt: skip
+    assert cfg.interface.friction == 0.4 and cfg.interface.friction_limit is None
+    assert "slides" not in sweep_fields(cfg)
+    engine = dataclasses.replace(simulate(block(), 0.1, FREQ), model="bullet")
+    assert engine.max_friction_demand == pytest.approx(0.1)
+    assert math.isnan(engine.row()["friction_demand"]) and engine.slides is None
 
 
 def test_run_summary_says_where_the_demand_first_exceeded_mu(tmp_path):

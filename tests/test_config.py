@@ -290,7 +290,11 @@ BAD = [
 BAD_EXTRA = [
     ("colum:\n  height: 4\n", ["unknown key 'colum' at top level", "allowed: name, model"]),
     ("model: bullet\ninterface:\n  friction: 0\n", ["interface.friction must be a number > 0"]),
-    ("interface:\n  friction: 0.6\n", ["interface.friction applies only to model bullet"]),
+    (
+        "model: housner\ninterface:\n  friction: 0.6\n",
+        ["interface.friction applies only to models bullet", "model housner"],
+    ),
+    ("interface:\n  friction: 200\n", ["interface.friction must be at most 100"]),
     ("solver:\n  time_step: 0.1\n", ["solver.time_step must be a number in", "[s]"]),
     ("model: fem\n", ["model must be one of rbm", "'fem'"]),
     ("interface:\n  stiffness: soft\n", ["interface.stiffness must be rigid"]),

@@ -215,7 +215,9 @@ def test_panels_one_axes_per_point_titled_by_it(size_csv):
                                    rtol=1e-12)  # fmt: skip
     assert axes[0].get_shared_x_axes().joined(axes[0], axes[2])
     assert axes[0].get_shared_y_axes().joined(axes[0], axes[1])
-    assert fig._suptitle.get_text() == "size_effect: safe-unsafe domain (half-sine)"
+    title, note = fig._suptitle.get_text().split("\n")
+    assert title == "size_effect: safe-unsafe domain (half-sine)"
+    assert note.startswith("column: H = over the grid, B = over the grid")
 
 
 def test_overlay_one_boundary_line_per_point_with_its_label(size_csv):
@@ -227,7 +229,9 @@ def test_overlay_one_boundary_line_per_point_with_its_label(size_csv):
     texts = [t.get_text() for t in ax.get_legend().get_texts()]
     for k, size in enumerate(SIZES):
         line = one(ax, f"boundary-{k}")
-        assert line.get_label() == f"column.size = {size:.3g} m" and line.get_label() in texts
+        # each point's label names its static multiplier: tan alpha = B / H of every size
+        assert line.get_label() == f"column.size = {size:.3g} m, static multiplier {B / H:.3g} g"
+        assert line.get_label() in texts
         want = bnd[np.isclose(bnd["column.size"], size)]["lowest_unsafe_g"]
         np.testing.assert_array_equal(line.get_ydata(), want)
     # the cells are there, faint, under the lines: once per place and status (the sizes
@@ -244,7 +248,7 @@ def test_one_frequency_puts_the_size_on_a_log_x_axis(one_frequency_csv):
     fig = domain_figure(df, cfg)
     (ax,) = fig.axes
     assert ax.get_xscale() == "log" and ax.get_xlabel() == "column.size [m]"
-    assert ax.get_ylabel() == "amplitude [g]" and ax.get_title().endswith("at 2 Hz")
+    assert ax.get_ylabel() == "amplitude [g]" and ax.get_title().split("\n")[0].endswith("at 2 Hz")
     rows = df[df["status"] == "collapsed"]
     want = rows[["column.size", "amplitude_g"]].to_numpy(float)
     np.testing.assert_array_equal(sorted_rows(xy(one(ax, "unsafe"))), sorted_rows(want))

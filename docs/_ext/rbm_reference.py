@@ -384,7 +384,11 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
     "interface.friction": (
         "",
         "",
-        "Coulomb coefficient of every joint and the base; ``model: bullet`` only.",
+        "Coulomb coefficient of every joint and the base. ``model: bullet``: its "
+        "contacts' friction (default 1). ``model: rbm`` (which cannot slide): the "
+        "coefficient its friction demand ``max |T_i/N_i|`` is checked against; a run "
+        "reports where the demand first exceeded it and domain.csv gains ``slides`` "
+        "(0/1; no key: not checked, no column). Refused for the other models.",
     ),
     "excitation.type": (
         "",

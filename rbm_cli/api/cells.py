@@ -43,8 +43,10 @@ class CellResult(Mapping):
     ``max_rotation_ratio`` [-] (the largest rotation over its collapse limit),
     ``max_top_displacement_m`` [m], ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs``
     (int), ``message``, then ``friction_demand`` (per interface, max |T/N| [-]),
-    ``wall_time_s`` [s] and ``method``
-    (the method that ran). Whole numbers are ints, real numbers floats.
+    ``wall_time_s`` [s], ``method`` (the method that ran), ``friction_limit`` (model
+    rbm's interface.friction, the coefficient the demand is checked against; None: not
+    checked) and ``slip`` ((t [s], interface) where the demand first exceeded it; None:
+    it did not, or no check). Whole numbers are ints, real numbers floats.
 
     Examples
     --------
@@ -102,10 +104,12 @@ class CellResult(Mapping):
 
 #: CellResult's keys, in order: domain.csv's columns of a run (the collapsed flag is
 #: status == 'collapsed'), then figures a domain does not keep.
-FIELDS = tuple(k for k in CSV_FIELDS if k != "collapsed") + (
+FIELDS = tuple(k for k in CSV_FIELDS if k not in ("collapsed", "friction_demand")) + (
     "friction_demand",
     "wall_time_s",
     "method",
+    "friction_limit",
+    "slip",
 )
 
 

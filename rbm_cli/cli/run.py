@@ -36,6 +36,18 @@ def _check_excitation(cfg, amplitude: float | None, frequency: float | None):
         raise UserError(one_line(exc)) from None
 
 
+def _slide_lines(result) -> list[tuple[str, str]]:
+    """Where model rbm's friction demand first exceeded interface.friction (given)."""
+    mu = result.friction_limit
+    if mu is None:
+        return []
+    if result.slip is None:
+        return [("slides", f"no: |T/N| stays <= interface.friction {mu:.4g}")]
+    t, where = result.slip
+    return [("slides", f"|T/N| > interface.friction {mu:.4g} first at t = {t:.6g} s, interface"
+                       f" {where}")]  # fmt: skip
+
+
 def _print_summary(result, folder: Path) -> None:
     lines = [("status", result.status), ("method", result.method or "-")]
     if result.collapsed:
@@ -50,6 +62,7 @@ def _print_summary(result, folder: Path) -> None:
             if math.isfinite(result.max_friction_demand)
             else "- (not computed by this model)",
         ),
+        *_slide_lines(result),
         ("uplifts / impacts", f"{result.n_uplifts} / {result.n_impacts}"),
         ("steps / rhs", f"{result.n_steps} / {result.n_rhs}"),
         ("wall time", f"{result.wall_time_s:.3g} s"),

@@ -39,10 +39,11 @@ BOTH_FORMS = "{rotational: K_M} [N m/rad] or {normal: k_n} [Pa/m]"
 def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
     """Validate the ``interface`` mapping of a column of n drums for a model."""
     i = mapping(raw, "interface", INTERFACE_KEYS)
-    if "friction" in i and model != "bullet":
+    if "friction" in i and model not in ("bullet", "rbm"):
         raise ConfigError(
-            f"interface.friction applies only to model bullet (model is {model}, which does"
-            " not slide): delete it"
+            f"interface.friction applies only to models bullet (its contacts) and rbm (its"
+            f" friction demand is checked against it); model {model} computes no friction"
+            " demand: delete it"
         )
     friction = number(i.get("friction", 1.0), "interface.friction", "", 0.0)
     if friction > FRICTION_MAX:
@@ -72,6 +73,7 @@ def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
         restitution=restitution,
         formulation=choice(i.get("formulation", "relative"), "interface.formulation", FORMULATIONS),
         friction=friction,
+        friction_limit=friction if model == "rbm" and "friction" in i else None,
     )
 
 

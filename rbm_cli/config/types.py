@@ -147,7 +147,11 @@ class InterfaceConfig:
 
     restitution : float or str  Angular-velocity ratio in (0, 1], or 'housner'
     friction : float  Coulomb friction coefficient of the joints and the base
-        (model bullet only; the RBM and the reference models do not slide) [-]
+        (model bullet's contacts; the RBM and the reference models do not slide) [-]
+    friction_limit : float or None  The friction coefficient the RBM's friction demand
+        max |T_i / N_i| is checked against (interface.friction given for model rbm): a run
+        says where the demand first exceeds it and a domain marks the cells it does
+        (``slides``); None: not checked [-]
     """
 
     stiffness: StiffnessConfig = field(default_factory=StiffnessConfig)
@@ -155,6 +159,7 @@ class InterfaceConfig:
     restitution: float | str = 1.0
     formulation: str = "relative"
     friction: float = 1.0
+    friction_limit: float | None = None
 
 
 @dataclass(frozen=True)
@@ -403,6 +408,8 @@ class Config:
         for key in ("capital", "top_mass"):  # a column without them hashes as it always did
             if out["column"][key] is None:
                 del out["column"][key]
+        if out["interface"]["friction_limit"] is None:  # not checked: hashes as it always did
+            del out["interface"]["friction_limit"]
         for key in ("axes", "records"):  # a plain grid resolves (and hashes) as it always did
             if not out["grid"][key]:
                 del out["grid"][key]
@@ -427,7 +434,7 @@ class Config:
 def hash_form(config: Config) -> dict:
     """What a config's hash is taken of (rbm_cli.study.sweep.config_hash): its resolved
     form, without solver.max_wall_time (a guard against a run that would not end, not a
-    setting of the domain; hashes of domains made before it existed stay valid), and with
+    setting of the domain; hashes of domains made before it existed stay valid),  and with
     solver.method auto written as STEP_DEFAULT, the default before auto existed (so stored
     domains and journals keep their hashes; where auto runs the closed form instead, the two
     agree on every robust cell: tests/test_closed_form_jit.py, tests/test_regression.py)."""

@@ -39,7 +39,9 @@ from rbm_cli.physics.excitation import GroundMotion
 
 class Integrator(Protocol):
     """What a method prepares for one RBM column: one run from an initial state [rad,
-    rad/s] under a motion, with a run's solver settings, to an Outcome."""
+    rad/s] under a motion, with a run's solver settings, to an Outcome (with
+    friction_limit [-], inf for none: where the friction demand first exceeded it,
+    Outcome.slip)."""
 
     def __call__(
         self,
@@ -52,6 +54,7 @@ class Integrator(Protocol):
         record: bool,
         output_dt: float,
         early_stop: bool,
+        friction_limit: float = ...,
     ) -> Outcome: ...
 
 

@@ -27,6 +27,9 @@ class Outcome:
     max_ratio: np.ndarray | None = None
     max_top: float = 0.0
     friction: np.ndarray | None = None
+    #: where the friction demand first exceeded the run's friction limit: (t [s], interface
+    #: from 1); None: it did not, or no limit was given
+    slip: tuple[float, int] | None = None
     n_uplifts: int = 0
     n_impacts: int = 0
     n_steps: int = 0

@@ -22,8 +22,12 @@ CSV_FIELDS = (
     "n_impacts",
     "n_steps",
     "n_rhs",
+    "friction_demand",
     "message",
 )
+#: The column a domain of model rbm with interface.friction given adds after
+#: friction_demand: 1 where the demand exceeds the coefficient, else 0.
+SLIDES_FIELD = "slides"
 
 
 @dataclass(frozen=True)
@@ -63,9 +67,16 @@ class RunResult:
     n_impacts : int  Zero crossings of a law argument after an excursion
         beyond its elastic branch (every crossing for a rigid law)
     n_steps, n_rhs : int  Accepted integrator steps, right-hand-side evaluations
-    friction_demand : tuple of float  max over time of |T_i / N_i| per interface
+    friction_demand : tuple of float  max over time of |T_i / N_i| per interface (domain.csv
+        keeps their largest, for model rbm; empty for the models that do not compute it or,
+        as bullet's contacts, slide for real: their |T / N| is capped by Coulomb)
     wall_time_s : float  Wall time of the run [s]
     method : str  The method that ran (solver.method, `auto` resolved; not in domain.csv)
+    model : str  The model that ran (config.model)
+    friction_limit : float or None  The friction coefficient the demand was checked
+        against (interface.friction of model rbm), None: not checked
+    slip : (t [s], interface) or None  Where the demand first exceeded friction_limit
+        (interface from 1, at the ground); None: it did not, or no check
     """
 
     status: str
@@ -84,6 +95,9 @@ class RunResult:
     wall_time_s: float
     history: History | None = None
     method: str = ""
+    model: str = "rbm"
+    friction_limit: float | None = None
+    slip: tuple[float, int] | None = None
 
     @property
     def collapsed(self) -> bool:
@@ -94,17 +108,41 @@ class RunResult:
         finite = [v for v in self.friction_demand if np.isfinite(v)]
         return max(finite) if finite else float("nan")
 
+    @property
+    def domain_friction_demand(self) -> float:
+        """domain.csv's friction_demand: max_friction_demand for model rbm, else NaN (not
+        computed, or a contact engine's friction, capped by Coulomb, not a demand)."""
+        return self.max_friction_demand if self.model == "rbm" else float("nan")
+
+    @property
+    def slides(self) -> int | None:
+        """1 where the friction demand exceeds friction_limit, 0 where not, None without a
+        limit or a demand (a failed run)."""
+        demand = self.domain_friction_demand
+        if self.friction_limit is None or not np.isfinite(demand):
+            return None
+        return int(demand > self.friction_limit)
+
     def row(self) -> dict:
-        """The domain.csv fields, in CSV_FIELDS order (collapsed as 0/1)."""
+        """The domain.csv fields, in CSV_FIELDS order (collapsed as 0/1), and ``slides``
+        when the demand was checked against a friction coefficient."""
         out = {k: getattr(self, k) for k in CSV_FIELDS}
         out["collapsed"] = int(self.collapsed)
+        out["friction_demand"] = self.domain_friction_demand
+        if self.friction_limit is not None:
+            out[SLIDES_FIELD] = self.slides
         return out
 
     def summary(self) -> dict:
-        """The domain.csv fields plus friction demand and wall time (JSON-ready)."""
+        """The domain.csv fields plus friction demand per interface, the first exceedance
+        of the friction coefficient (when checked) and wall time (JSON-ready)."""
         out = self.row()
         out["friction_demand"] = [v if np.isfinite(v) else None for v in self.friction_demand]
         out["max_friction_demand"] = self.max_friction_demand
+        if self.friction_limit is not None:
+            out["friction_limit"] = self.friction_limit
+            out["slip_interface"] = None if self.slip is None else self.slip[1]
+            out["t_slip_s"] = None if self.slip is None else self.slip[0]
         out["wall_time_s"] = self.wall_time_s
         out["method"] = self.method
         for k, v in out.items():

@@ -204,6 +204,45 @@ def sine_exceedance(t0, level, amp, om, ph, last):
 
 
 @jit
+def sine_peak(t0, t1, amp, om, ph):
+    """max over [t0, t1] of |amp sin(om t + ph)| [its unit]: |amp| when a crest (om t + ph =
+    pi/2 + k pi) lies in the interval, else the larger of its ends (the sine is monotone
+    between crests)."""
+    if t1 < t0 or amp == 0.0:
+        return 0.0
+    psi0 = om * t0 + ph
+    kk = math.ceil((psi0 - _HALF_PI) / math.pi)
+    crest = _HALF_PI + kk * math.pi
+    if om > 0.0 and (crest - ph) / om <= t1:
+        return abs(amp)
+    return max(abs(amp * dsin(psi0)), abs(amp * dsin(om * t1 + ph)))
+
+
+@jit
+def rest_demand(t0, t1, gr, knots, values, vertical):
+    """The friction demand max |T / N| = max |a_g| / (g + a_v) [-] of a column at rest on
+    the ground over [t0, t1] [s] (T = m a_g, N = m (g + a_v)): a sine's crest or ends
+    (sine_peak); for the other forms the ends and the knots between them, where a_g is
+    monotone between knots (a record's samples, a pulse's extrema), and so is a_g / (g + a_v)
+    under a vertical record (both straight between samples, g + a_v > 0)."""
+    if gr[1] == 0.0 or t1 < t0:
+        return 0.0
+    if gr[0] == SINE:
+        return sine_peak(t0, t1, gr[1], gr[2], gr[3]) / G
+    best = 0.0
+    k = _first_after(knots, t0)
+    tt = t0
+    while True:
+        d = abs(ground_at(tt, gr, knots, values)) / (G * vertical_factor(tt, knots, vertical))
+        if d > best:
+            best = d
+        if tt >= t1:
+            return best
+        tt = min(knots[k], t1) if k < knots.size else t1
+        k += 1
+
+
+@jit
 def _solve_piece(gr, tl, tr, target):
     """Bisection for a_g = target on [tl, tr], a_g monotone with s (a_g(tl) - target) <= 0 <
     s (a_g(tr) - target), s = sign(target): the earliest float past the crossing."""

@@ -19,11 +19,53 @@ from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, upli
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.study.domain import axis_columns
 
-__all__ = ["domain_figure", "draw_domain_on", "uplift_level"]
+__all__ = ["column_note", "domain_figure", "draw_domain_on", "uplift_level"]
 
 if TYPE_CHECKING:  # matplotlib is imported when a figure is drawn, not with this module
     import pandas as pd
     from matplotlib.figure import Figure
+
+
+def _metres(value: float) -> str:
+    return f"{value:.4g} m"
+
+
+def column_note(config: Config) -> str:
+    """The column a domain was swept with, in one line under its title: H, B (base and
+    top width where they differ), drums, the joint stiffness (k_n, K_M or rigid), the
+    restitution e, and interface.friction where model rbm's demand is checked against it.
+    A grid over one of these says so ("over the grid") instead of one value."""
+    col, itf = config.column, config.interface
+    axes = set(config.grid.axis_paths)
+
+    def value(path: str, text: str) -> str:
+        sized = "column.size" in axes and path in ("column.height", "column.base_width")
+        return "over the grid" if path in axes or sized else text
+
+    width = _metres(col.base_width)
+    if col.top_width is not None and col.top_width != col.base_width:
+        width = f"{_metres(col.base_width)} (top {_metres(col.top_width)})"
+    stiffness = itf.stiffness
+    if stiffness.kind == "normal":
+        joint = f"k_n = {value('interface.stiffness.normal', f'{stiffness.values[0]:.3g} Pa/m')}"
+    elif stiffness.kind == "moment":
+        k_m = ", ".join(f"{v:.3g}" for v in stiffness.values)
+        joint = f"K_M = {value('interface.stiffness.rotational', k_m + ' N m/rad')}"
+    else:
+        joint = "rigid joints"
+    restitution = itf.restitution
+    e = restitution if isinstance(restitution, str) else f"{restitution:.3g}"
+    parts = [
+        f"H = {value('column.height', _metres(col.height))}",
+        f"B = {value('column.base_width', width)}",
+        f"drums = {value('column.drums', str(col.n_drums))}",
+        joint,
+        f"e = {value('interface.restitution', e)}",
+        f"model {config.model}",
+    ]
+    if config.model == "rbm" and itf.friction_limit is not None:
+        parts.append(f"interface.friction = {itf.friction_limit:.3g}")
+    return "column: " + ", ".join(parts)
 
 
 def _plain(df: pd.DataFrame, dimensionless: bool, layout: str) -> bool:
@@ -174,6 +216,8 @@ def domain_figure(
     freqs = df["frequency_hz"].dropna().unique()
     if view.line != "frequency_hz" and len(freqs) == 1:
         title += f", at {freqs[0]:g} Hz"
+    if config is not None:
+        title += "\n" + column_note(config)
     if isinstance(drawn, list):
         fig.suptitle(title)
     else:
@@ -214,6 +258,7 @@ def _plain_figure(df, config, compare, labels) -> Figure:
         fig.tight_layout()
         return fig
     plot_domain(df, ax=ax, compare=compare, labels=labels, **_config_options(config))
-    ax.set_title(f"{config.name}: safe-unsafe domain ({config.excitation.type})")
+    ax.set_title(f"{config.name}: safe-unsafe domain ({config.excitation.type})\n"
+                 f"{column_note(config)}")  # fmt: skip
     fig.tight_layout()
     return fig

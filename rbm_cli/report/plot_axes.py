@@ -255,6 +255,7 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
     if view.dimensionless and all(t[1] for t in tops):
         draw_dimensionless_curves(ax, _x_range(plane))
     _overlay_static(ax, view, [t[0] for t in tops])
+    label_static_levels(ax, view, [t[0] for t in tops])
     levels = [lv for t in tops for lv in t[0][1]]
     finish_axes(ax, [plane], max(levels) if levels else None, [], view.labels, legend=False)
     _finish_x(ax, view)
@@ -305,6 +306,23 @@ def _overlay_static(ax, view: DomainView, levels: list) -> None:
         gid = "static" if len(values) == 1 else f"static-{j}"
         ax.axhline(value, label=f"{name} {value:.3g}{unit}" if j == 0 or len(values) < 4
                    else "_", gid=gid, **STATIC)  # fmt: skip
+
+
+def label_static_levels(ax, view: DomainView, levels: list) -> None:
+    """Each overlaid point's uplift level in its line's legend label: '<point>, static
+    multiplier <level> g' (the engine's uplift level for bullet). Physical axes with
+    frequency on x only (a level is one value per point there); an overlay in
+    dimensionless axes or over another x keeps its labels."""
+    if view.dimensionless or view.line != "frequency_hz":
+        return
+    lines = {line.get_gid(): line for line in ax.lines}
+    for k, (point, (_, ys)) in enumerate(zip(view.points, levels, strict=True)):
+        line = lines.get(f"boundary-{k}")
+        if line is None or len(ys) != 1 or not math.isfinite(float(ys[0])):
+            continue
+        cfg = _single_config(point)
+        name = uplift_level(cfg)[1] if cfg is not None else "static multiplier"
+        line.set_label(f"{point.label}, {name} {float(ys[0]):.3g} g")
 
 
 def draw_panels(fig, view: DomainView, spec=None, compare=(), labels=None, colorbar=True) -> list:

@@ -2,8 +2,9 @@
 
 A pure plot function: it takes ``ax=None`` (a new figure is made if omitted)
 and returns the axes; it never saves or shows (the CLI and the sweep do).
-Every artist it draws carries a ``gid`` ('safe', 'unsafe', 'failed',
-'boundary', 'boundary-member0', 'compare-<k>', 'static', 'housner', 'linear'), so
+Every artist it draws carries a ``gid`` ('safe', 'unsafe', 'failed', 'upper-joint',
+'base-joint', 'slides', 'boundary', 'boundary-member0', 'compare-<k>', 'static',
+'housner', 'linear'), so
 callers and tests can find them. In an ensemble domain (a collapse_fraction column)
 'boundary' is the majority's and 'boundary-member0' member 0's
 (:func:`rbm_cli.study.domain.boundary`).
@@ -30,6 +31,7 @@ __all__ = [
     "fraction_colorbar",
     "is_ensemble",
     "legend_beside",
+    "mark_cells",
     "plot_domain",
     "plot_levels",
 ]
@@ -50,6 +52,12 @@ MAJORITY_LABEL = f"boundary of the majority (collapse fraction >= {MAJORITY:g})"
 MEMBER0_LABEL = "member 0's boundary (its own outcome)"
 #: Style of member 0's boundary line (the majority's is solid).
 MEMBER0_STYLE = dict(linestyle=":", linewidth=1.6)
+#: The column of domain.csv marking cells whose friction demand exceeds interface.friction.
+SLIDES = "slides"
+#: Legend labels of the marks over the cells (mark_cells).
+UPPER_JOINT_LABEL = "collapsed at an upper joint (cross in a triangle)"
+BASE_JOINT_LABEL = "collapsed at the base joint (cross alone)"
+SLIDES_LABEL = "slides: max |T/N| > interface.friction"
 #: Marker size range [points] and its share of the grid spacing on screen.
 MARKER_MAX, MARKER_MIN, MARKER_SHARE = 5.0, 1.5, 0.75
 #: z-order of the cells: above the boundary and level lines.
@@ -306,11 +314,47 @@ def plot_levels(ax, domains, column, excitation_type, static_multiplier, static_
 
 def draw_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None) -> list:
     """The cells of ``df`` (see :func:`plot_domain`) at its frequency_hz (x) and
-    amplitude_g (y); returns the ensemble's legend proxies ([] for a plain domain)."""
+    amplitude_g (y), with the marks of :func:`mark_cells`; returns the ensemble's legend
+    proxies ([] for a plain domain)."""
+    size = marker_size(ax, df) if size is None else size
     if "collapse_fraction" in df.columns:
-        return _plot_fraction_cells(ax, df, colorbar, size)
-    _plot_cells(ax, df, size)
-    return []
+        proxies = _plot_fraction_cells(ax, df, colorbar, size)
+    else:
+        _plot_cells(ax, df, size)
+        proxies = []
+    mark_cells(ax, df, size)
+    return proxies
+
+
+def _flag(df: pd.DataFrame, column: str) -> np.ndarray:
+    """A 0/1 (or empty) column of df as a boolean array (empty: False)."""
+    return pd.to_numeric(df[column], errors="coerce").fillna(0).to_numpy(float) == 1.0
+
+
+def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
+    """Marks over the cells: the mechanism of a collapse, where the domain says which
+    interface collapsed (collapse_interface, 1 at the ground: a cross alone is a collapse
+    at the base joint, a cross in a triangle at an upper joint; gid 'upper-joint'), and
+    the cells whose friction demand exceeds interface.friction (slides = 1: an open
+    diamond around the cell; gid 'slides')."""
+    f = df["frequency_hz"].to_numpy(float)
+    a = df["amplitude_g"].to_numpy(float)
+    _, unsafe, _ = _masks(df)
+    style = dict(linestyle="none", markerfacecolor="none", zorder=CELL_Z + 1)
+    if "collapse_interface" in df.columns and unsafe.any():
+        where = pd.to_numeric(df["collapse_interface"], errors="coerce").to_numpy(float)
+        upper = unsafe & (where > 1)
+        if upper.any():
+            ax.plot(f[upper], a[upper], marker="^", color="tab:red", markersize=1.5 * size,
+                    label=UPPER_JOINT_LABEL, gid="upper-joint", **style)  # fmt: skip
+            ax.plot([], [], marker="x", linestyle="none", color="tab:red",
+                    label=BASE_JOINT_LABEL, gid="base-joint")  # fmt: skip
+    if SLIDES in df.columns:
+        slides = _flag(df, SLIDES)
+        if slides.any():
+            ax.plot(f[slides], a[slides], marker="D", color="tab:orange",
+                    markersize=1.5 * size, markeredgewidth=1.1, label=SLIDES_LABEL,
+                    gid="slides", **style)  # fmt: skip
 
 
 def draw_domain(
@@ -373,7 +417,10 @@ def plot_domain(
     -----
     Safe cells are open circles, unsafe (collapsed) cells crosses, failed runs
     grey squares (in the legend only if there are any), drawn above the lines and
-    sized to the grid's spacing on screen (:func:`marker_size`). In an ensemble
+    sized to the grid's spacing on screen (:func:`marker_size`). A collapse at an upper
+    joint (collapse_interface > 1) has a triangle around its cross, and a cell whose
+    friction demand exceeds interface.friction (slides = 1) an orange diamond
+    (:func:`mark_cells`; each in the legend where the domain has one). In an ensemble
     domain the marker is member 0's outcome (the row's status) and the colour the
     fraction of members that collapsed (a colour map without a light end, so
     every mark shows on white), as the legend's title and the colour bar say.

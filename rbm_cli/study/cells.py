@@ -19,6 +19,7 @@ from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import Motion
 from rbm_cli.config.points import GridPoint, expand
 from rbm_cli.config.types import Config
+from rbm_cli.models.result import SLIDES_FIELD
 from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
 from rbm_cli.study.domain import cell_key, row_key
 from rbm_cli.study.intensities import column_period, measure_fields, measure_values
@@ -72,10 +73,15 @@ def record_name(config: Config) -> str:
 
 def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
     """domain.csv's columns: the axis paths, ``record`` (the record's name, for record
-    excitations), the result's ``fields``, the scales, the record's intensity measures
-    (record excitations only)."""
+    excitations), the result's ``fields`` (with ``slides`` after friction_demand when
+    model rbm's demand is checked against interface.friction), the scales, the record's
+    intensity measures (record excitations only)."""
     record = ("record",) if has_records(config) else ()
-    return config.grid.axis_paths + record + tuple(fields) + SCALE_FIELDS + measure_fields(config)
+    fields = tuple(fields)
+    if config.model == "rbm" and config.interface.friction_limit is not None:
+        at = fields.index("friction_demand") + 1 if "friction_demand" in fields else len(fields)
+        fields = fields[:at] + (SLIDES_FIELD,) + fields[at:]
+    return config.grid.axis_paths + record + fields + SCALE_FIELDS + measure_fields(config)
 
 
 def tasks(

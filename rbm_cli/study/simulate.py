@@ -96,4 +96,7 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         wall_time_s=wall,
         history=history,
         method=out.method,
+        model=config.model,
+        friction_limit=config.interface.friction_limit if config.model == "rbm" else None,
+        slip=out.slip,
     )

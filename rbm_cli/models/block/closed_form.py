@@ -45,6 +45,7 @@ from rbm_cli.models.block.run import (
     LOG_REST,
     LOG_UPLIFT,
     N_LOG,
+    T_SLIP,
     run_block,
 )
 from rbm_cli.models.events import EVENT_EPS
@@ -74,7 +75,18 @@ def _params(p, alpha, e, limit, restitution, rest_rate, uplift, barrier, eps, fa
 
 
 def rbm_block(model: Model) -> Block:
-    """The Block of a rigid RBM monolith (RbmError in one line if it is not one)."""
+    """The Block of a rigid RBM monolith (RbmError in one line if it is not one).
+
+    Its friction demand T / N [-]: the ground joint carries the shear T = m (a_g + c
+    theta'') of the drum's centre, c = centre_map[0, 0] [m] (its horizontal acceleration
+    over theta'', H/2 for the RBM's small rotations), against the normal force at rest
+    N = m g (normal_forces[0]). On a piece theta'' = p^2 (theta - s alpha) + e a_g, so
+    T / N = (1 + c e) a_g / g + (c p^2 / g)(theta - s alpha) = fa a_g + fb (theta - s
+    alpha) with fa = (m / N)(1 + c e) [s^2/m] and fb = (m / N) c p^2 [1/rad] (block.piece's
+    demand, linear in a_g and theta: exact on every piece). At rest theta'' = 0 and
+    T / N = a_g / g (block.run._rest_friction), up to the uplift level alpha; at uplift
+    theta'' starts from 0 (p^2 s alpha = e a_g there), so the two meet.
+    """
     reason = model_why_not(model)
     if reason is not None:
         raise RbmError(f"solver.method closed-form: {reason}; use DOP853 (or auto)")
@@ -171,8 +183,12 @@ def run_closed_form(
     early_stop: bool = True,
     seg: tuple | None = None,
     events: list | None = None,
+    friction_limit: float = math.inf,
 ) -> Outcome:
     """One run of a block (Block) from (theta0 [rad], rate0 [rad/s]).
+
+    friction_limit : float  A friction coefficient [-]: the outcome says where the RBM
+        block's |T / N| first exceeded it (Outcome.slip; exact); inf: none.
 
     seg : (seg_t, seg_fc, seg_v), optional  The motion's forcing segments
         (block_segments); made here from the motion when None (a vertical record taken
@@ -186,7 +202,7 @@ def run_closed_form(
     (t, [theta], [rate]) every output_dt [s] when record.
     """
     seg_t, seg_fc, seg_v = seg if seg is not None else block_segments(motion, not block.rbm)
-    mo, se = run_settings(motion, solver, early_stop, record, output_dt)
+    mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit)
     samples = sample_buffer(motion.t_end, output_dt, record, 1)
     run = run_block if solver.implementation == "compiled" else plain(run_block)
     rows = 0 if events is None else LOG_ROWS
@@ -206,6 +222,8 @@ def run_closed_form(
     out = Outcome(t_end=float(st[0]), t_collapse=float(st[9]), max_top=block.height * st[5])
     out.max_ratio = np.array([st[5] / block.ratio_scale])
     out.friction = np.array([st[6] if block.rbm else math.nan])
+    if block.rbm and not math.isnan(st[T_SLIP]):
+        out.slip = (float(st[T_SLIP]), 1)
     out.n_uplifts, out.n_impacts, out.n_steps, out.n_rhs = (int(x) for x in cnt[:4])
     out.n_events = int(cnt[4]) if block.rbm else out.n_uplifts + out.n_impacts
     _messages(block, code, out, solver)
@@ -301,12 +319,14 @@ def integrate_closed_form(
     output_dt: float = 0.002,
     early_stop: bool = True,
     block: Block | None = None,
+    friction_limit: float = math.inf,
 ) -> Outcome:
     """The RBM integrators' signature (rbm.kernel.integrate) for a rigid monolith:
     block is rbm_block(model), made once by a caller that runs one model many times."""
     block = rbm_block(model) if block is None else block
     return run_closed_form(block, motion, float(theta0[0]), float(rate0[0]), solver,
-                           record=record, output_dt=output_dt, early_stop=early_stop)  # fmt: skip
+                           record=record, output_dt=output_dt, early_stop=early_stop,
+                           friction_limit=friction_limit)  # fmt: skip
 
 
 def prepare(model: Model):

@@ -55,8 +55,11 @@ PIECE_SIZE = 16
  B_FB, B_AT_ZERO) = range(12)  # fmt: skip
 BLOCK_SIZE = 12
 #: What the scan of a piece keeps: the largest s theta [rad], the time of the interior
-#: maximum holding it [s] (-1: none), the evaluations made, the friction demand [-].
-A_PEAK, A_TAU_PEAK, A_EVALS, A_FRICTION = range(4)
+#: maximum holding it [s] (-1: none), the evaluations made, the friction demand [-]; and,
+#: for a friction limit mu [-] (inf: none) it is given, the first time in the piece its
+#: |demand| exceeds mu [s] (-1: none).
+A_PEAK, A_TAU_PEAK, A_EVALS, A_FRICTION, A_MU, A_SLIP = range(6)
+ACC_SIZE = 6
 #: Events of a piece.
 NONE, IMPACT, COLLAPSE = 0, 1, 2
 #: Longest scanning interval, in units of the shorter of 1/p and 1/omega [-] (the bound
@@ -120,11 +123,13 @@ def point(pc, tau):
 
 @jit
 def _value(pc, which, shift, tau):
-    """s theta + shift (which 0), s theta' (which 1) or the friction demand's rate
-    (which 2) at t0 + tau."""
-    f, g, _, _, _, dr, _ = point(pc, tau)
+    """s theta + shift (which 0), s theta' (which 1), the friction demand's rate
+    (which 2) or the friction demand + shift (which 3) at t0 + tau."""
+    f, g, _, _, d, dr, _ = point(pc, tau)
     if which == 0:
         return f + shift
+    if which == 3:
+        return d + shift
     return g if which == 1 else dr
 
 
@@ -208,15 +213,33 @@ def _interval(pc, blk, a, b, fa, ga, fb, gb, acc):
 
 
 @jit
+def _first_over(pc, a, b, da, db, tm, dm, mu, acc):
+    """The first time in [a, b] where |demand| exceeds mu, the demand being monotone on
+    [a, tm] and [tm, b] (tm < 0: on [a, b]) with its ends da, dm, db: Brent on
+    demand = +-mu on the first monotone part whose end is past it."""
+    if abs(da) > mu:
+        return a
+    lo = a
+    if tm >= 0.0:
+        if abs(dm) > mu:
+            return brent(pc, 3, -mu if dm > 0.0 else mu, a, tm, acc)
+        lo = tm
+    return brent(pc, 3, -mu if db > 0.0 else mu, lo, b, acc)
+
+
+@jit
 def _friction(pc, a, b, da, db, dra, drb, acc):
     """Raise acc's friction demand to the largest |demand| on [a, b]: its ends' (da, db)
     and, where its rate (dra, drb) changes sign, the extremum's (Brent on the rate)."""
     best = max(abs(da), abs(db))
+    tm, dm = -1.0, 0.0
     if dra * drb < 0.0:
         tm = brent(pc, 2, 0.0, a, b, acc)
         _, _, _, _, dm, _, _ = point(pc, tm)
         acc[A_EVALS] += 1
         best = max(best, abs(dm))
+    if best > acc[A_MU] and acc[A_SLIP] < 0.0:
+        acc[A_SLIP] = _first_over(pc, a, b, da, db, tm, dm, acc[A_MU], acc)
     if best > acc[A_FRICTION]:
         acc[A_FRICTION] = best
 

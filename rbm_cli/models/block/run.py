@@ -3,13 +3,21 @@ rest, uplift, pieces of closed-form motion (block.piece), impacts, collapse and 
 stop of free motion, in one call per run.
 
 Mutable scalars live in small arrays: st = [t, theta, rate, side, at rest, peak,
-friction, next output time, samples written, t_collapse, events logged] (floats) and
+friction, next output time, samples written, t_collapse, events logged, t_slip] (floats;
+t_slip: where the friction demand first exceeded the limit se[6], nan if not) and
 cnt = [uplifts, impacts, pieces, evaluations, events] (ints). A motion is mo = [pulse or
 record (0/1), amplitude, omega, phase, pulse_end, t_end] with its segments (start, end),
 their forcings (exact.modal) and, under a vertical record, the upward acceleration
 on each segment, seg_v = [a_v at the forcing's t0 [m/s^2], its slope [m/s^3]] (no rows:
 no vertical motion); settings are se = [max_steps (pieces), max_events, deadline
-(time.monotonic) [s], early_stop, record, output_dt [s]] (as exact.run's).
+(time.monotonic) [s], early_stop, record, output_dt [s], friction limit [-] (inf: none)]
+(as exact.run's).
+
+The friction demand |T / N| of the RBM block (block.closed_form.rbm_block derives it) is
+exact: at rest |a_g| / (g + a_v) over the rest (T = m a_g, N = m (g + a_v); a harmonic's
+crest or a line's ends), in motion the piece's largest |demand| (block.piece._friction),
+and so is its first exceedance of the limit (the exceedance of |a_g| at rest, Brent on the
+piece's demand in motion).
 
 A vertical record makes the weights act as under g + a_v: on a piece the block obeys
 theta'' = p^2 gam (theta - s alpha) + e a_g with gam = (g + a_v) / g taken at the middle
@@ -29,10 +37,14 @@ from rbm_cli.config.types import G
 from rbm_cli.models.block.piece import (
     A_EVALS,
     A_FRICTION,
+    A_MU,
     A_PEAK,
+    A_SLIP,
     A_TAU_PEAK,
+    ACC_SIZE,
     B_ALPHA,
     B_BARRIER,
+    B_FA,
     B_LIMIT,
     B_P,
     B_REST,
@@ -47,7 +59,14 @@ from rbm_cli.models.block.piece import (
     start_piece,
 )
 from rbm_cli.models.events import STOP_MARGIN
-from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
+from rbm_cli.models.rbm.exact.modal import (
+    LINEAR,
+    ZERO,
+    f_accel,
+    f_exceedance,
+    f_peak_on,
+    linear_exceedance,
+)
 from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
@@ -61,7 +80,9 @@ from rbm_cli.models.status import (
 )
 from rbm_cli.physics.ground import sine_exceedance
 
-T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG = range(11)
+T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG, T_SLIP = range(
+    12
+)
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)
 #: The kinds of the event log's rows (t [s], kind).
 LOG_UPLIFT, LOG_IMPACT, LOG_REST, LOG_COLLAPSE = 1, 2, 3, 4
@@ -125,7 +146,26 @@ def _emit(pc, st, samples, t_stop, dt, rest):
 
 
 @jit
-def _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, dt, log):
+def _rest_friction(st, fc, fv, t0, t1, mu):
+    """The friction demand of the block at rest on [t0, t1] [s], |a_g| / (g + a_v) (a_g
+    and a_v straight on a record's piece: their ratio is monotone, its ends hold the
+    largest), and where it first exceeds mu: the time |a_g| reaches mu (g + a_v)."""
+    if fv.size > 0:
+        d = max(abs(f_accel(fc, t0)) / gravity_factor(fc, fv, t0),
+                abs(f_accel(fc, t1)) / gravity_factor(fc, fv, t1)) / G  # fmt: skip
+    else:
+        d = f_peak_on(fc, t0, t1) / G
+    if d > st[FRICTION]:
+        st[FRICTION] = d
+    if math.isnan(st[T_SLIP]) and d > mu:
+        if fv.size > 0:
+            st[T_SLIP] = vertical_exceedance(fc, fv, t0, mu * G, t1)
+        else:
+            st[T_SLIP] = f_exceedance(fc, t0, mu * G, t1)
+
+
+@jit
+def _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, dt, log, mu):
     """The block at rest: 0 no ground motion left (rests to the end), 1 the segment ends
     first, 2 it lifts (a harmonic's exceedance from its formula, a line's from the line,
     under a vertical record (fv: its line, else empty) against the level times
@@ -148,6 +188,8 @@ def _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, dt, log):
             kind, t_stop = 1, seg_end
         else:
             kind, t_stop = 2, t_up
+    if not math.isnan(blk[B_FA]) and kind_fc != ZERO:
+        _rest_friction(st, fc, fv, t, t_stop, mu)
     _emit(pc, st, samples, t_stop - (1e-15 if kind == 2 else 0.0), dt, True)
     st[T] = t_stop
     if kind != 2:
@@ -191,6 +233,8 @@ def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log):
     start_piece(blk, t, st[THETA], st[RATE], st[SIDE], fc, gam, pc)
     cnt[PIECES] += 1
     acc[A_PEAK], acc[A_TAU_PEAK], acc[A_EVALS], acc[A_FRICTION] = 0.0, -1.0, 0.0, st[FRICTION]
+    acc[A_MU] = se[6] if math.isnan(st[T_SLIP]) else math.inf
+    acc[A_SLIP] = -1.0
     kind, tau = scan_piece(pc, blk, seg_end - t, acc)
     cnt[EVALS] += int(acc[A_EVALS])
     stop_here = (
@@ -205,6 +249,8 @@ def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log):
     f, g, _, _, _, _, _ = point(pc, tau_end)
     st[THETA], st[RATE], st[T] = pc[1] * f, pc[1] * g, t_new
     st[PEAK], st[FRICTION] = max(st[PEAK], acc[A_PEAK]), acc[A_FRICTION]
+    if acc[A_SLIP] >= 0.0:
+        st[T_SLIP] = t + acc[A_SLIP]
     if stop_here:
         return STOPPED_EARLY
     if kind == IMPACT or kind == COLLAPSE:
@@ -218,7 +264,8 @@ def _segment(blk, st, cnt, mo, se, fc, fv, seg_end, can_stop, samples, pc, acc, 
     code."""
     while st[T] < seg_end:
         if st[AT_REST] != 0.0:
-            kind = _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, se[5], log)
+            kind = _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, se[5], log,
+                               se[6])  # fmt: skip
             if kind == 0:
                 return AT_REST_END
             if kind == 1:
@@ -243,10 +290,10 @@ def run_block(blk, seg_t, seg_fc, seg_v, mo, se, theta0, rate0, samples, log):
     side = 1.0 if theta0 > 0.0 else -1.0 if theta0 < 0.0 else (-1.0 if rate0 < 0.0 else 1.0)
     at_rest = 1.0 if theta0 == 0.0 and rate0 == 0.0 else 0.0
     st = np.array([0.0, theta0, rate0, side, at_rest, abs(theta0), 0.0, 0.0, 0.0, math.nan,
-                   0.0])  # fmt: skip
+                   0.0, math.nan])  # fmt: skip
     no_v = np.zeros(0)
     cnt = np.zeros(5, dtype=np.int64)
-    pc, acc = np.zeros(PIECE_SIZE), np.zeros(4)
+    pc, acc = np.zeros(PIECE_SIZE), np.zeros(ACC_SIZE)
     if abs(theta0) >= blk[B_LIMIT]:
         st[T_COLLAPSE] = 0.0
         return COLLAPSED, st, cnt

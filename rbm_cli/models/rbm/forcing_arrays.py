@@ -7,6 +7,7 @@ FORCING_SIZE): its forcing (exact.modal: zero, harmonic or linear).
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -66,15 +67,20 @@ def motion_arrays(model: Model, motion: GroundMotion) -> tuple[np.ndarray, np.nd
 
 
 def run_settings(
-    motion: GroundMotion, solver, early_stop: bool, record: bool, output_dt: float
+    motion: GroundMotion,
+    solver,
+    early_stop: bool,
+    record: bool,
+    output_dt: float,
+    friction_limit: float = math.inf,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(mo, se) of one run of a compiled closed-form loop: the motion
     mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and the settings
     se = [max_steps, max_events, deadline (monotonic clock, from solver.max_wall_time),
-    early_stop, record, output_dt]."""
+    early_stop, record, output_dt, friction limit [-] (inf: none)]."""
     mo = np.array([1.0 if motion.is_pulse else 0.0, motion.amplitude, motion.omega,
                    motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
     deadline = time.monotonic() + float(solver.max_wall_time)
     se = np.array([solver.max_steps, solver.max_events, deadline, float(early_stop),
-                   float(record), output_dt], dtype=float)  # fmt: skip
+                   float(record), output_dt, friction_limit], dtype=float)  # fmt: skip
     return mo, se

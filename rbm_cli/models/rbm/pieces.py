@@ -197,6 +197,17 @@ def friction_demand(ag, gam, centre_map, acc, masses, normal_forces, out):
             out[i] = fr
 
 
+@jit(inline=True)
+def first_over(friction, mu, t, slip):
+    """Note (t [s], interface from 1) in slip where a friction demand first exceeds mu [-]
+    (the largest of those over it)."""
+    best = mu
+    for i in range(friction.size):
+        if friction[i] > best:
+            best = friction[i]
+            slip[0], slip[1] = t, i + 1.0
+
+
 __all__ = [
     "IMPACT",
     "KINK",
@@ -204,6 +215,7 @@ __all__ = [
     "bound_rows",
     "cross",
     "energy",
+    "first_over",
     "friction_demand",
     "law_potential",
     "locate",

@@ -9,6 +9,7 @@ monolith runs in the block's closed form (rbm_cli.models.block.closed_form) unde
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -42,6 +43,8 @@ class RbmRunner:
         n = self.model.n
         self.theta0 = np.zeros(n) if not init.rotations else np.asarray(init.rotations, float)
         self.rate0 = np.zeros(n) if not init.velocities else np.asarray(init.velocities, float)
+        limit = config.interface.friction_limit  # interface.friction: checked against
+        self.friction_limit = math.inf if limit is None else float(limit)
         self._integrators: dict = {}  # (method, implementation) -> integrator, on first use
         resolve(config, model=self.model)  # an explicit method that does not apply: refused
 
@@ -80,6 +83,7 @@ class RbmRunner:
                 record=record,
                 output_dt=output_dt,
                 early_stop=early_stop,
+                friction_limit=self.friction_limit,
             )
             out.lifted_off(t_lift)
             if t_shape is not None and out.status == "survived":

@@ -57,6 +57,8 @@ def _outcome(code, st, cnt, maxima, fric, solver, n: int) -> Outcome:
     out.max_ratio = maxima[:n].copy()
     out.max_top = float(maxima[n])
     out.friction = fric.copy()
+    if st[7] > 0.0:  # run.SLIP_IF
+        out.slip = (float(st[6]), int(st[7]))
     out.n_uplifts, out.n_impacts, out.n_steps, out.n_rhs, out.n_events = (int(x) for x in cnt[:5])
     t = out.t_end
     if code == COLLAPSED:
@@ -80,6 +82,7 @@ def integrate_exact(
     output_dt: float = 0.002,
     early_stop: bool = True,
     prepared: PreparedExact | None = None,
+    friction_limit: float = math.inf,
 ) -> Outcome:
     """Integrate one motion of a model from the initial state (theta0 [rad], rate0
     [rad/s]) exactly, piece by piece (rbm_cli.models.rbm.exact): compiled, or its
@@ -97,12 +100,14 @@ def integrate_exact(
     early_stop : bool  Stop free motion once its outcome cannot change
     prepared : PreparedExact, optional  prepare_exact(model), made once by a caller that
         runs one model many times (a sweep); made here when None.
+    friction_limit : float  A friction coefficient [-]: the outcome says where |T / N|
+        first exceeded it (Outcome.slip); inf: none.
     """
     seg_t, seg_fc = motion_arrays(model, motion)
     if prepared is None:
         prepared = prepare_exact(model)
     n = model.n
-    mo, se = run_settings(motion, solver, early_stop, record, output_dt)
+    mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.models.guard)
     try:

@@ -44,6 +44,7 @@ import math
 import numpy as np
 
 from rbm_cli.base.jit import jit
+from rbm_cli.physics.ground import sine_exceedance, sine_peak
 
 #: Terms of the power series of C, S, S2, S3 tabulated (used for |lam| tau^2 < 1: the
 #: last term is below 1e-26 of the first; _terms takes as many as a given |z| needs).
@@ -80,6 +81,29 @@ def linear_exceedance(fc, t0, level, t_stop):
     target = level if slope > 0.0 else -level
     t = t0 + (target - a) / slope
     return t if t < t_stop else -1.0
+
+
+@jit
+def f_peak_on(fc, t0, t1):
+    """max over [t0, t1] of |a_g| [m/s^2]: a harmonic's crest or ends (sine_peak), a line's
+    ends."""
+    kind = int(fc[0])
+    if kind == HARMONIC:
+        return sine_peak(t0, t1, fc[1], fc[2], fc[3])
+    if kind == LINEAR:
+        return max(abs(f_accel(fc, t0)), abs(f_accel(fc, t1)))
+    return 0.0
+
+
+@jit
+def f_exceedance(fc, t0, level, t_stop):
+    """First t in [t0, t_stop) with |a_g(t)| > level [m/s^2] (-1: none)."""
+    kind = int(fc[0])
+    if kind == HARMONIC:
+        return sine_exceedance(t0, level, fc[1], fc[2], fc[3], t_stop)
+    if kind == LINEAR:
+        return linear_exceedance(fc, t0, level, t_stop)
+    return -1.0
 
 
 @jit

@@ -1,12 +1,18 @@
 """The run loop of the exact integrator (numba): one call per run, from piece to piece
 (rbm_cli.models.rbm.exact, the package docstring, says what it does).
 
-Mutable scalars live in small arrays: st = [t, h, next_out, t_collapse, at_rest, n_out]
-(floats) and cnt = [n_uplifts, n_impacts, n_steps, n_rhs, n_events, collapse interface,
-the part of n_rhs spent on peaks, the current segment] (ints). A motion is
-mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
+Mutable scalars live in small arrays: st = [t, h, next_out, t_collapse, at_rest, n_out,
+t_slip, slip interface] (floats; the slip: where the friction demand first exceeded the
+limit se[6], nan and 0 if not) and cnt = [n_uplifts, n_impacts, n_steps, n_rhs, n_events,
+collapse interface, the part of n_rhs spent on peaks, the current segment] (ints). A motion
+is mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
 (start, end) with their forcings (exact.modal); settings are
-se = [max_steps, max_events, deadline, early_stop, record, output_dt].
+se = [max_steps, max_events, deadline, early_stop, record, output_dt, friction limit].
+
+The friction demand is the largest |T_i / N_i| at the points of the march (the step
+integrators' step ends) and, at rest, over the rest (exact: the forcing's crest or ends,
+T = m a_g, N = m g); its first exceedance of the limit is the point where the running
+maximum first passes it, at rest the time |a_g| reaches limit g.
 """
 
 from __future__ import annotations
@@ -17,7 +23,15 @@ from collections import namedtuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.exact.modal import LINEAR, ZERO, f_accel, linear_exceedance
+from rbm_cli.config.types import G
+from rbm_cli.models.rbm.exact.modal import (
+    LINEAR,
+    ZERO,
+    f_accel,
+    f_exceedance,
+    f_peak_on,
+    linear_exceedance,
+)
 from rbm_cli.models.rbm.exact.peaks import NOTES, new_notes, note_interval, settle_peaks
 from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, row_at, set_point
 from rbm_cli.models.rbm.exact.search import SCRATCH, next_point
@@ -26,6 +40,7 @@ from rbm_cli.models.rbm.pieces import (
     UPLIFT,
     cross,
     energy,
+    first_over,
     friction_demand,
     locate,
     piece_bounds,
@@ -45,7 +60,7 @@ from rbm_cli.models.status import (
 )
 from rbm_cli.physics.ground import sine_exceedance
 
-T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT = range(6)
+T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT, T_SLIP, SLIP_IF = range(8)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)
 
 #: First interval tried at the start of a run and of a segment [s].
@@ -154,6 +169,8 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
         if se[4] != 0.0:
             _emit(pc, pts, s, samples, pts[1, 0], se[5])
         _accel_and_friction(mdl, pc, pts, 1, s.fric)
+        if s.st[SLIP_IF] == 0.0:
+            first_over(s.fric, se[6], pts[1, 0], s.st[T_SLIP : SLIP_IF + 1])
         if can_stop and _passed_peak(mdl, pc, pts):
             s.st[T] = pts[1, 0]
             return -STOPPED_EARLY
@@ -203,7 +220,19 @@ def _handle(mdl, pc, row, s, se):
 
 
 @jit
-def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
+def _rest_friction(s, fc, t0, t1, mu):
+    """The friction demand of a monolith at rest on [t0, t1] [s]: |a_g| / g (T = m a_g,
+    N = m g); where it first exceeds mu, the time |a_g| reaches mu g."""
+    d = f_peak_on(fc, t0, t1) / G
+    if d > s.fric[0]:
+        s.fric[0] = d
+    if s.st[SLIP_IF] == 0.0 and d > mu:
+        s.st[T_SLIP] = f_exceedance(fc, t0, mu * G, t1)
+        s.st[SLIP_IF] = 1.0
+
+
+@jit
+def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt, mu):
     """A rigid monolith at rest: 0 no ground motion left (rests to
     the end), 1 the segment ends first, 2 it lifts (a harmonic's exceedance from its
     formula, a linear piece's from its line)."""
@@ -223,6 +252,7 @@ def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt):
             kind, t_stop = 1, seg_end
         else:
             kind, t_stop = 2, t_up
+    _rest_friction(s, fc, t, t_stop, mu)
     _emit_rest(s, samples, t_stop - (1e-15 if kind == 2 else 0.0), dt)
     s.st[T] = t_stop
     if kind != 2:
@@ -241,7 +271,7 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
     """Run up to seg_end [s] under the forcing fc. Returns a code."""
     while s.st[T] < seg_end:
         if s.st[AT_REST] != 0.0:
-            kind = _leave_rest(mdl, s, mo, seg_end, fc, samples, se[5])
+            kind = _leave_rest(mdl, s, mo, seg_end, fc, samples, se[5], se[6])
             if kind == 0:
                 return AT_REST_END
             if kind == 1:
@@ -269,7 +299,7 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     theta, rate = theta0.copy(), rate0.copy()
     locate(mdl.argmap @ theta, mdl.argmap @ rate, side, k, pending, mdl.rigid, mdl.edges,
            mdl.nedges)  # fmt: skip
-    st = np.array([0.0, FIRST_STEP, 0.0, math.nan, 0.0, 0.0])
+    st = np.array([0.0, FIRST_STEP, 0.0, math.nan, 0.0, 0.0, math.nan, 0.0])
     if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
         st[AT_REST] = 1.0
     s = State(theta, rate, side, k, pending, awaiting, np.zeros(n + 1), np.zeros(n), st,

@@ -72,6 +72,7 @@ def integrate(
     output_dt: float = 0.002,
     early_stop: bool = True,
     prepared: PreparedModel | None = None,
+    friction_limit: float = math.inf,
 ) -> Outcome:
     """Integrate one motion of a model from the initial state (theta0 [rad], rate0
     [rad/s]) with the step kernel: compiled, or its uncompiled version (the same source,
@@ -87,6 +88,8 @@ def integrate(
     early_stop : bool  Stop free motion once its outcome cannot change
     prepared : PreparedModel, optional  prepare_kernel(model), made once by a caller
         that runs one model many times (a sweep); made here when None.
+    friction_limit : float  A friction coefficient [-]: the outcome says where |T / N|
+        first exceeded it (Outcome.slip); inf: none.
     """
     if prepared is None:
         prepared = prepare_kernel(model)
@@ -96,7 +99,7 @@ def integrate(
     settings = solver_settings(solver, prepared.atol_scale, deadline)
     # a RunTask, as a plain tuple (step.inputs)
     task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), bool(early_stop),
-            bool(record), float(output_dt), samples)  # fmt: skip
+            bool(record), float(output_dt), samples, float(friction_limit))  # fmt: skip
     armed = arm()  # Ctrl-C reaches the kernel through poll (rbm_cli.models.guard)
     try:
         kernel = run_kernel if solver.implementation == "compiled" else plain(run_kernel)
@@ -114,12 +117,12 @@ def prepare(model: Model):
 
 def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> Outcome:
     """The Outcome of what run_kernel returned (samples: its output rows)."""
-    (code, t_end, t_col, c_if, max_ratio, max_top, friction,
+    (code, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
      n_upl, n_imp, n_steps, n_rhs, n_ev, n_out) = res  # fmt: skip
     out = Outcome(
         t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=friction,
         n_uplifts=int(n_upl), n_impacts=int(n_imp), n_steps=int(n_steps), n_rhs=int(n_rhs),
-        n_events=int(n_ev),
+        n_events=int(n_ev), slip=(float(slip[0]), int(slip[1])) if slip[1] > 0 else None,
     )  # fmt: skip
     if record:
         out.samples = sample_rows(samples, n_out, n)

@@ -82,6 +82,7 @@ class RunTask(NamedTuple):
     record: bool  #: write samples
     output_dt: float  #: sampling interval [s]
     samples: np.ndarray  #: output rows (t, theta, rate) (n_max, 1 + 2n), written in place
+    friction_limit: float  #: a friction coefficient [-]: where |T / N| first exceeds it (inf: none)
 
 
 @dataclass(frozen=True)

@@ -9,12 +9,14 @@ import numpy as np
 
 from rbm_cli.base.detmath import matvec, pow_pos
 from rbm_cli.base.jit import jit
+from rbm_cli.config.types import G
 from rbm_cli.models.guard import POLL_STEPS
 from rbm_cli.models.rbm.pieces import (
     IMPACT,
     UPLIFT,
     bound_rows,
     energy,
+    first_over,
     friction_demand,
     locate,
     settle,
@@ -62,7 +64,7 @@ from rbm_cli.models.status import (
     guard_code,
 )
 from rbm_cli.physics.arrays import ColumnArrays
-from rbm_cli.physics.ground import ground_at, next_uplift, record_piece
+from rbm_cli.physics.ground import ground_at, next_uplift, record_piece, rest_demand
 
 
 @jit
@@ -83,8 +85,12 @@ def run_kernel(model, motion, solver, task):
     Returns
     -------
     tuple  (status code (rbm_cli.models.status), t_end [s], t_collapse [s], collapsed interface,
-        max_ratio (n,), max_top, friction (n,), n_uplifts, n_impacts, n_steps, n_rhs,
-        n_events, n_samples).
+        max_ratio (n,), max_top, friction (n,), slip (2,), n_uplifts, n_impacts, n_steps,
+        n_rhs, n_events, n_samples). friction: the largest |T_i / N_i| of each interface [-],
+        at rest (physics.ground.rest_demand, exact) and at step ends in motion; slip: where
+        it first exceeded task.friction_limit, (t [s], interface from 1), (nan, 0) if not:
+        at rest the exceedance time itself (physics.ground.next_uplift at the limit), in
+        motion the end of the first step whose demand exceeds it.
     """
     model, motion = ColumnArrays(*model), Excitation(*motion)
     solver, task = SolverSettings(*solver), RunTask(*task)
@@ -107,6 +113,7 @@ def run_kernel(model, motion, solver, task):
     max_steps, max_events = solver.max_steps, solver.max_events
     theta0, rate0, early_stop = task.theta0, task.rate0, task.early_stop
     record, output_dt, samples = task.record, task.output_dt, task.samples
+    mu = task.friction_limit
 
     n = theta0.size
     n_out = 0
@@ -114,6 +121,7 @@ def run_kernel(model, motion, solver, task):
     m = 2 * n
     max_ratio = np.zeros(n)
     friction = np.zeros(n)
+    slip = np.array([np.nan, 0.0])
     max_top = 0.0
     n_upl, n_imp, n_steps, n_rhs, n_ev = 0, 0, 0, 0, 0
     status = SURVIVED
@@ -189,11 +197,19 @@ def run_kernel(model, motion, solver, task):
                 if free_seg:
                     if record:
                         n_out, next_out = emit_rest(t_end, samples, n_out, next_out, output_dt)
-                    return (status, t_end, t_col, c_if, max_ratio, max_top, friction,
+                    return (status, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 last = min(pulse_end, t_end)
                 t_up = next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical,
                                     last)  # fmt: skip
+                t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
+                d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
+                if d_rest > friction[0]:
+                    friction[0] = d_rest
+                if slip[1] == 0.0 and d_rest > mu:
+                    slip[0] = next_uplift(t, mu * G, amplitude, gr_full, knots, values,
+                                          vertical, t_rest)  # fmt: skip
+                    slip[1] = 1.0
                 if t_up < 0.0 or t_up >= seg_end:
                     if record:
                         n_out, next_out = emit_rest(seg_end, samples, n_out, next_out, output_dt)
@@ -246,7 +262,7 @@ def run_kernel(model, motion, solver, task):
                     if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
                         t_fail = t
                         return (FAILED_STEP, t_fail, t_col, c_if, max_ratio, max_top, friction,
-                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                     t_new = t + h_abs
                     if t_new - bound > 0:
                         t_new = bound
@@ -257,7 +273,7 @@ def run_kernel(model, motion, solver, task):
                     err = error_norm(mc, K, h, y, ynew, atol, rtol, scale)
                     if not (err == err and abs(err) < math.inf):  # NaN or inf state
                         return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top, friction,
-                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                     if err < 1.0:
                         if err == 0.0:
                             factor = MAX_FACTOR
@@ -271,12 +287,12 @@ def run_kernel(model, motion, solver, task):
                     rejected = True
                 n_steps += 1
                 if n_steps > max_steps:
-                    return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction,
+                    return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 if n_steps % POLL_STEPS == 0:  # the wall-clock budget and Ctrl-C
                     code = guard_code(deadline)
                     if code != GOING:
-                        return (code, t, t_col, c_if, max_ratio, max_top, friction,
+                        return (code, t, t_col, c_if, max_ratio, max_top, friction, slip,
                                 n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
                 if t_new - seg_end >= 0:
                     running = False
@@ -341,6 +357,8 @@ def run_kernel(model, motion, solver, task):
                 if peaks[n] > max_top:
                     max_top = peaks[n]
                 friction_demand(g_new, gam_new, centre_map, acc, masses, normal_forces, friction)
+                if slip[1] == 0.0:
+                    first_over(friction, mu, t_new, slip)
                 z_prev, z_old, z_new = z_old, z_new, z_prev
                 dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
                 d_old, d_new = d_new, d_old
@@ -356,7 +374,7 @@ def run_kernel(model, motion, solver, task):
                                   intercepts, slopes)  # fmt: skip
                     if en < barrier * (1.0 - 1e-9):
                         return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction,
-                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
             if not event:
                 t = seg_end if not running else t
                 continue
@@ -365,14 +383,14 @@ def run_kernel(model, motion, solver, task):
             h_carry = h_abs
             n_ev += 1
             if n_ev > max_events:
-                return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction,
+                return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction, slip,
                         n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
             which, i = event_row // n, event_row % n
             if which >= 2:
                 t_col, c_if = t, i + 1
                 if c_ratio > max_ratio[i]:
                     max_ratio[i] = c_ratio
-                return (COLLAPSED, t, t_col, c_if, max_ratio, max_top, friction,
+                return (COLLAPSED, t, t_col, c_if, max_ratio, max_top, friction, slip,
                         n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
             going_up = which == 1
             bound = bound_now(i, going_up, n, lo, hi, tu, t, gr, mv_e, mv_w) if vert else (
@@ -383,5 +401,5 @@ def run_kernel(model, motion, solver, task):
             elif what >= IMPACT:
                 n_imp += 1
                 at_rest = what == REST
-    return (status, t, t_col, c_if, max_ratio, max_top, friction,
+    return (status, t, t_col, c_if, max_ratio, max_top, friction, slip,
             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip

@@ -43,8 +43,10 @@ class CellResult(Mapping):
     ``max_rotation_ratio`` [-] (the largest rotation over its collapse limit),
     ``max_top_displacement_m`` [m], ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs``
     (int), ``message``, then ``friction_demand`` (per interface, max |T/N| [-]),
-    ``wall_time_s`` [s] and ``method``
-    (the method that ran). Whole numbers are ints, real numbers floats.
+    ``wall_time_s`` [s], ``method`` (the method that ran) and ``energy`` (a recorded run's
+    energy account [J] where its method keeps one: ``initial_J``, ``final_J``,
+    ``ground_work_J``, ``damping_J``, ``impacts_J``, ``residual_J``; else None). Whole
+    numbers are ints, real numbers floats.
 
     Examples
     --------
@@ -106,6 +108,7 @@ FIELDS = tuple(k for k in CSV_FIELDS if k != "collapsed") + (
     "friction_demand",
     "wall_time_s",
     "method",
+    "energy",
 )
 
 

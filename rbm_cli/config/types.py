@@ -148,6 +148,9 @@ class InterfaceConfig:
     restitution : float or str  Angular-velocity ratio in (0, 1], or 'housner'
     friction : float  Coulomb friction coefficient of the joints and the base
         (model bullet only; the RBM and the reference models do not slide) [-]
+    damping : float  Ratio zeta of critical damping of the column's first elastic mode,
+        in [0, 1): viscous damping of the joints on their elastic branch, proportional to
+        their stiffness (model rbm with a finite interface.stiffness; 0: undamped) [-]
     """
 
     stiffness: StiffnessConfig = field(default_factory=StiffnessConfig)
@@ -155,6 +158,7 @@ class InterfaceConfig:
     restitution: float | str = 1.0
     formulation: str = "relative"
     friction: float = 1.0
+    damping: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -403,6 +407,8 @@ class Config:
         for key in ("capital", "top_mass"):  # a column without them hashes as it always did
             if out["column"][key] is None:
                 del out["column"][key]
+        if out["interface"]["damping"] == 0.0:  # an undamped column hashes as it always did
+            del out["interface"]["damping"]
         for key in ("axes", "records"):  # a plain grid resolves (and hashes) as it always did
             if not out["grid"][key]:
                 del out["grid"][key]

@@ -66,6 +66,9 @@ class RunResult:
     friction_demand : tuple of float  max over time of |T_i / N_i| per interface
     wall_time_s : float  Wall time of the run [s]
     method : str  The method that ran (solver.method, `auto` resolved; not in domain.csv)
+    energy : dict or None  A recorded run's energy account [J] (models.outcome.EnergyAccount
+        as_dict: start, end, the ground's work, what damping and impacts took, the residual
+        of the balance); None where the method keeps none (not in domain.csv)
     """
 
     status: str
@@ -84,6 +87,7 @@ class RunResult:
     wall_time_s: float
     history: History | None = None
     method: str = ""
+    energy: dict | None = None
 
     @property
     def collapsed(self) -> bool:
@@ -107,6 +111,8 @@ class RunResult:
         out["max_friction_demand"] = self.max_friction_demand
         out["wall_time_s"] = self.wall_time_s
         out["method"] = self.method
+        if self.energy is not None:
+            out["energy"] = dict(self.energy)
         for k, v in out.items():
             if isinstance(v, float) and not np.isfinite(v):
                 out[k] = None

@@ -96,4 +96,5 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         wall_time_s=wall,
         history=history,
         method=out.method,
+        energy=None if out.energy is None else out.energy.as_dict(),
     )

@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-
 from typing import NamedTuple
 
 import numpy as np

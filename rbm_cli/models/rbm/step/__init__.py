@@ -112,8 +112,9 @@ def prepare(model: Model):
     return partial(integrate, prepared=prepare_kernel(model))
 
 
-def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver,
-             account: bool) -> Outcome:
+def _outcome(
+    res: tuple, samples: np.ndarray, n: int, record: bool, solver, account: bool
+) -> Outcome:
     """The Outcome of what run_kernel returned (samples: its output rows; account: its
     energy account is kept, a recorded run without a vertical record)."""
     (code, t_end, t_col, c_if, max_ratio, max_top, friction,

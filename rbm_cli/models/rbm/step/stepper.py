@@ -64,7 +64,6 @@ from rbm_cli.models.status import (
 from rbm_cli.physics.arrays import ColumnArrays
 from rbm_cli.physics.ground import ground, ground_at, next_uplift, record_piece
 
-
 #: Gauss-Legendre nodes on [0, 1] and weights (5 points: exact for polynomials of degree 9).
 GL_NODES = np.array([0.04691007703066802, 0.23076534494715845, 0.5, 0.7692346550528415,
                      0.9530899229693319])  # fmt: skip

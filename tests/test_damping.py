@@ -23,10 +23,14 @@ import numpy as np
 import pytest
 from scipy.linalg import eig
 
-from rbm_cli.api import load_config, run
+from rbm_cli.api import load_config, run, run_sweep
+from rbm_cli.api.configs import with_values
 from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.models.methods import resolve_method
 from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.study.domain import read_domain
+
+from .paths import CONFIGS, RESULTS
 
 TWO_DRUMS = {"height": 2.0, "base_width": 0.5, "drums": 2}
 SOFT = {"normal": 5e8}  # first elastic frequency 5.7 Hz
@@ -180,3 +184,21 @@ def test_the_exact_method_refuses_damping_in_one_line():
     cfg = _config(0.05, method="exact", implementation="compiled", type="harmonic", duration=1.0)
     with pytest.raises(RbmError, match="solver.method exact does not take interface.damping"):
         run(cfg, amplitude_g=0.1, frequency_hz=2.0)
+
+
+def test_the_stored_damped_study_is_reproduced(tmp_path):
+    """The stored damped 8-drum study (results/harmonic_multidrum_damped, an ensemble of 16)
+    on a sub-grid of 6 cells across its boundary: the same outcome on its robust cells, the
+    same peak to the digit on every cell (one member, the stored member 0)."""
+    name = "harmonic_multidrum_damped"
+    stored = read_domain(RESULTS / name / "domain.csv")
+    cfg = load_config(CONFIGS / f"{name}.yaml")
+    assert cfg.interface.damping == 0.05
+    sub = with_values(cfg, {"grid.amplitudes": [0.35, 0.55, 0.7], "grid.frequencies": [1.5, 2.0]})
+    fresh = read_domain(run_sweep(sub, tmp_path, jobs=2).folder / "domain.csv")
+    merged = fresh.merge(stored, on=["amplitude_g", "frequency_hz"], suffixes=("", "_stored"))
+    assert len(merged) == 6 and merged["collapsed"].nunique() == 2  # both sides of it
+    robust = merged["robust"] == 1
+    assert robust.sum() >= 4
+    assert (merged.loc[robust, "collapsed"] == merged.loc[robust, "collapsed_stored"]).all()
+    assert (merged["max_rotation_ratio"] == merged["max_rotation_ratio_stored"]).all()

@@ -270,6 +270,7 @@ def _ranges() -> dict[str, str]:
         "interface.stiffness.normal": f"[{fmt(NORMAL_RANGE[0])}, {fmt(NORMAL_RANGE[1])}]",
         "interface.formulation": one_of(t.FORMULATIONS),
         "interface.friction": f"(0, {fmt(FRICTION_MAX)}]",
+        "interface.damping": "[0, 1); default 0 (undamped)",
         "excitation.type": one_of(t.EXCITATIONS),
         "excitation.duration": f"(0, {fmt(MAX_DURATION)}]; default {durations}",
         "excitation.phase": f"[-{fmt(PHASE_MAX)}, {fmt(PHASE_MAX)}]",
@@ -389,6 +390,14 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "coefficient its friction demand ``max |T_i/N_i|`` is checked against; a run "
         "reports where the demand first exceeded it and domain.csv gains ``slides`` "
         "(0/1; no key: not checked, no column). Refused for the other models.",
+    ),
+    "interface.damping": (
+        "",
+        "",
+        "Ratio zeta of critical damping of the column's first elastic mode: viscous "
+        "damping of each joint while it is on its elastic branch, proportional to its "
+        "stiffness (none once it lifts). ``model: rbm`` with a finite "
+        "``interface.stiffness``; the Runge-Kutta methods (``auto`` takes DOP853).",
     ),
     "excitation.type": (
         "",

@@ -45,8 +45,10 @@ class CellResult(Mapping):
     (int), ``message``, then ``friction_demand`` (per interface, max |T/N| [-]),
     ``wall_time_s`` [s], ``method`` (the method that ran), ``friction_limit`` (model
     rbm's interface.friction, the coefficient the demand is checked against; None: not
-    checked) and ``slip`` ((t [s], interface) where the demand first exceeded it; None:
-    it did not, or no check). Whole numbers are ints, real numbers floats.
+    checked), ``slip`` ((t [s], interface) where the demand first exceeded it; None:
+    it did not, or no check) and ``energy`` (a recorded run's energy account [J] where its
+    method keeps one: ``initial_J``, ``final_J``, ``ground_work_J``, ``damping_J``,
+    ``impacts_J``, ``residual_J``; else None). Whole numbers are ints, real numbers floats.
 
     Examples
     --------
@@ -110,6 +112,7 @@ FIELDS = tuple(k for k in CSV_FIELDS if k not in ("collapsed", "friction_demand"
     "method",
     "friction_limit",
     "slip",
+    "energy",
 )
 
 

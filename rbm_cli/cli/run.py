@@ -64,6 +64,16 @@ def _print_summary(result, folder: Path) -> None:
         ),
         *_slide_lines(result),
         ("uplifts / impacts", f"{result.n_uplifts} / {result.n_impacts}"),
+    ]
+    if result.energy is not None:
+        e = result.energy
+        lines.append((
+            "energy",
+            f"ground work {e['ground_work_J']:.4g} J, taken by damping {e['damping_J']:.4g} J"
+            f" and impacts {e['impacts_J']:.4g} J, kept {e['final_J'] - e['initial_J']:.4g} J"
+            f" (balance residual {e['residual_J']:.2g} J)",
+        ))  # fmt: skip
+    lines += [
         ("steps / rhs", f"{result.n_steps} / {result.n_rhs}"),
         ("wall time", f"{result.wall_time_s:.3g} s"),
     ]

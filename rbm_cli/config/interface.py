@@ -26,7 +26,7 @@ from rbm_cli.config.validate import (
     number_list,
 )
 
-INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation", "friction")
+INTERFACE_KEYS = ("stiffness", "xi", "restitution", "formulation", "friction", "damping")
 STIFFNESS_KEYS = ("rotational", "normal")
 #: Stiffnesses the tool accepts [assumption]: far beyond any stone joint on either side,
 #: and inside the range where K_M theta^2, K_M / I and their products stay finite.
@@ -50,6 +50,7 @@ def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
         raise ConfigError(
             f"interface.friction must be at most {fmt(FRICTION_MAX)}, got {fmt(friction)}"
         )
+    damping = damping_value(i, model)
     stiffness = i.get("stiffness", "rigid")
     if model == "bullet" and isinstance(stiffness, str) and stiffness == "rigid":
         n = 1  # the engine's drums are rigid; the RBM's joint law is not used
@@ -67,14 +68,34 @@ def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
             f"interface.restitution must be a number in (0, 1] or housner, got"
             f" {describe(restitution)}"
         )
+    stiffness = stiffness_value(i.get("stiffness", "rigid"), n, given="stiffness" in i)
+    if damping > 0.0 and stiffness.kind == "rigid":
+        raise ConfigError(
+            "interface.damping damps the joints' elastic branch, which a rigid interface does"
+            f" not have: give {BOTH_FORMS} as interface.stiffness, or delete interface.damping"
+        )
     return InterfaceConfig(
-        stiffness=stiffness_value(i.get("stiffness", "rigid"), n, given="stiffness" in i),
+        stiffness=stiffness,
         xi=number(i.get("xi", 1.0), "interface.xi", "", 0.0, 1.0),
         restitution=restitution,
         formulation=choice(i.get("formulation", "relative"), "interface.formulation", FORMULATIONS),
         friction=friction,
         friction_limit=friction if model == "rbm" and "friction" in i else None,
+        damping=damping,
     )
+
+
+def damping_value(i: Mapping, model: str) -> float:
+    """``interface.damping``: the ratio zeta of critical damping of the first elastic mode,
+    a number in [0, 1) (model rbm only; 0 when not given)."""
+    if "damping" not in i:
+        return 0.0
+    if model != "rbm":
+        raise ConfigError(
+            f"interface.damping applies only to model rbm (model is {model}, which has no"
+            " elastic joints to damp): delete it"
+        )
+    return number(i["damping"], "interface.damping", "", 0.0, 1.0, lo_open=False, hi_open=True)
 
 
 def stiffness_value(value: Any, n: int, *, given: bool = True) -> StiffnessConfig:

@@ -152,6 +152,9 @@ class InterfaceConfig:
         max |T_i / N_i| is checked against (interface.friction given for model rbm): a run
         says where the demand first exceeds it and a domain marks the cells it does
         (``slides``); None: not checked [-]
+    damping : float  Ratio zeta of critical damping of the column's first elastic mode,
+        in [0, 1): viscous damping of the joints on their elastic branch, proportional to
+        their stiffness (model rbm with a finite interface.stiffness; 0: undamped) [-]
     """
 
     stiffness: StiffnessConfig = field(default_factory=StiffnessConfig)
@@ -160,6 +163,7 @@ class InterfaceConfig:
     formulation: str = "relative"
     friction: float = 1.0
     friction_limit: float | None = None
+    damping: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -410,6 +414,8 @@ class Config:
                 del out["column"][key]
         if out["interface"]["friction_limit"] is None:  # not checked: hashes as it always did
             del out["interface"]["friction_limit"]
+        if out["interface"]["damping"] == 0.0:  # an undamped column hashes as it always did
+            del out["interface"]["damping"]
         for key in ("axes", "records"):  # a plain grid resolves (and hashes) as it always did
             if not out["grid"][key]:
                 del out["grid"][key]

@@ -105,7 +105,10 @@ def _exact_why_not(config: Config, model: Model | None) -> str | None:
 
     excitation = config.excitation
     return exact_why_not(
-        config.interface.formulation, excitation.type, excitation.vertical is not None
+        config.interface.formulation,
+        excitation.type,
+        excitation.vertical is not None,
+        config.interface.damping if model is None else model.damping,
     )
 
 

@@ -9,10 +9,36 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
 from rbm_cli.models.result import History
+
+
+class EnergyAccount(NamedTuple):
+    """The energy account of a run [J], relative to the ground (Model.energy: kinetic, the
+    joints' potential and, for `geometric`, gravity's): at the start and at the end, the work
+    the ground did, and the energy the joints' damping and the impacts took."""
+
+    initial: float
+    final: float
+    ground_work: float
+    damping: float
+    impacts: float
+
+    @property
+    def residual(self) -> float:
+        """final - initial - (ground_work - damping - impacts) [J]: zero for an exact
+        balance (the integration's error otherwise; the `absolute` formulation's joint
+        moments are not conservative, so its balance does not close)."""
+        return self.final - self.initial - (self.ground_work - self.damping - self.impacts)
+
+    def as_dict(self) -> dict:
+        """JSON-ready, the residual included [J]."""
+        return {"initial_J": self.initial, "final_J": self.final,
+                "ground_work_J": self.ground_work, "damping_J": self.damping,
+                "impacts_J": self.impacts, "residual_J": self.residual}  # fmt: skip
 
 
 @dataclass
@@ -38,6 +64,7 @@ class Outcome:
     samples: list = field(default_factory=list)  # (t, theta, rate) when recording
     history: History | None = None  # the sampled history, made by the runner when recording
     method: str = ""  # the method that ran (solver.method, `auto` resolved), set by the runner
+    energy: EnergyAccount | None = None  # a recorded run's energy account, where kept
 
     def stop(self, status: str, message: str, t: float) -> Outcome:
         """End the run at time t with a status and a reason."""

@@ -77,6 +77,9 @@ class RunResult:
         against (interface.friction of model rbm), None: not checked
     slip : (t [s], interface) or None  Where the demand first exceeded friction_limit
         (interface from 1, at the ground); None: it did not, or no check
+    energy : dict or None  A recorded run's energy account [J] (models.outcome.EnergyAccount
+        as_dict: start, end, the ground's work, what damping and impacts took, the residual
+        of the balance); None where the method keeps none (not in domain.csv)
     """
 
     status: str
@@ -98,6 +101,7 @@ class RunResult:
     model: str = "rbm"
     friction_limit: float | None = None
     slip: tuple[float, int] | None = None
+    energy: dict | None = None
 
     @property
     def collapsed(self) -> bool:
@@ -145,6 +149,8 @@ class RunResult:
             out["t_slip_s"] = None if self.slip is None else self.slip[0]
         out["wall_time_s"] = self.wall_time_s
         out["method"] = self.method
+        if self.energy is not None:
+            out["energy"] = dict(self.energy)
         for k, v in out.items():
             if isinstance(v, float) and not np.isfinite(v):
                 out[k] = None

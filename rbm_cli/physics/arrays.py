@@ -69,6 +69,8 @@ class ColumnArrays(NamedTuple):
     es: np.ndarray  #: -minv @ ground_load (n,)
     slope_parts: np.ndarray  #: weight and elastic parts of the slopes (2, n, max edges + 1)
     edge_w: np.ndarray  #: weight share of each kink, 1: fixed (n, max edges), padded with 1
+    damp: np.ndarray  #: viscous coefficient of each joint's elastic branch [N m s/rad] (n,)
+    damped: bool  #: any joint damped
 
 
 def rest_levels(model: Model) -> tuple[float | None, float, float]:
@@ -145,7 +147,8 @@ def column_arrays(model: Model) -> ColumnArrays:
         barrier=float(barrier), families=np.vstack([args, cmap, top[None, :]]),
         event_rows=event_rows, gx=event_rows[:n], gc=event_rows[3 * n :], same=bool(same),
         md=md, mg=mg, track=track, es=es, slope_parts=np.stack(model.slope_parts),
-        edge_w=model.edge_weight_shares,
+        edge_w=model.edge_weight_shares, damp=model.joint_damping.copy(),
+        damped=bool(model.joint_damping.any()),
     )  # fmt: skip
 
 

@@ -61,6 +61,7 @@ def model_from_config(config: Config, column: Column | None = None) -> Model:
                 restitution=float(e),
                 formulation=config.interface.formulation,
                 collapse_ratio=config.collapse.ratio,
+                damping=config.interface.damping,
             )
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
             raise RbmError(

@@ -4,7 +4,7 @@ Generalised coordinates are the absolute drum rotations theta_i; the nodal
 displacements relative to the ground are u_{k+1} = sum_{j<=k} h_j theta_j. In
 these coordinates the paper's system (5) reads
 
-    M theta'' = D^T m(x) + K_g theta - r a_g(t)
+    M theta'' = D^T m(x) + K_g theta - r a_g(t)  (- D^T C x' with damping)
 
 with M = L^T diag(m) L + diag(I_G) the (constant, symmetric) mass matrix,
 L the map from theta to the drums' centre displacements (weight at the drum's centre,
@@ -54,6 +54,8 @@ class Model:
     restitution : float  e, angular-velocity ratio at an impact
     formulation : str
     xi : float  Smoothing parameter of the laws [-]
+    damping : float  zeta, the ratio of critical damping of the first elastic mode [-]
+        (:attr:`joint_damping`)
     """
 
     column: Column
@@ -72,6 +74,7 @@ class Model:
     restitution: float
     formulation: str
     xi: float = 1.0
+    damping: float = 0.0
 
     @property
     def n(self) -> int:
@@ -147,6 +150,24 @@ class Model:
 
         w2 = np.real(eig(self.stiffness(slopes), self.mass, right=False))
         return sorted(float(math.sqrt(v) / (2 * math.pi)) for v in w2 if v > 0)
+
+    @cached_property
+    def joint_damping(self) -> np.ndarray:
+        """(n,) viscous coefficients c_i [N m s/rad] of the joints on their elastic branch:
+        c_i = beta K_M,i with beta = 2 zeta / omega_1, omega_1 the first elastic circular
+        frequency. The damping moment c_i x_i' acts while interface i is on the first piece
+        of its law (elastic), not once it has lifted off: stiffness-proportional (Rayleigh
+        beta) damping of the elastic column, which gives its first mode the ratio zeta
+        exactly (C = beta K for `relative` and `absolute`; for `geometric` K also holds
+        gravity's softening, and zeta is then the first mode's ratio to first order) and
+        leaves rigid-body rocking undamped (impacts dissipate it, as for an undamped
+        column). Zero without damping or for a rigid law."""
+        out = np.zeros(self.n)
+        if self.damping == 0.0 or self.rigid:
+            return out
+        omega_1 = 2.0 * math.pi * self.elastic_frequencies_hz()[0]
+        beta = 2.0 * self.damping / omega_1
+        return beta * np.asarray(self.column.stiffness, dtype=float)
 
     @cached_property
     def impulse_directions(self) -> tuple[np.ndarray, np.ndarray]:
@@ -275,6 +296,7 @@ def build_model(
     restitution: float = 1.0,
     formulation: str = "relative",
     collapse_ratio: float = 1.0,
+    damping: float = 0.0,
 ) -> Model:
     """Assemble the equations of a column.
 
@@ -285,6 +307,7 @@ def build_model(
     restitution : float  e in (0, 1]
     formulation : str  'relative', 'absolute' or 'geometric' (docs/guide/assumptions.md)
     collapse_ratio : float  c in (0, 1]
+    damping : float  zeta in [0, 1): damping of the first elastic mode (Model.joint_damping)
     """
     n = column.n
     h = column.heights
@@ -337,6 +360,7 @@ def build_model(
         restitution=float(restitution),
         formulation=formulation,
         xi=float(xi),
+        damping=float(damping),
     )
 
 

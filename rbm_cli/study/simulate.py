@@ -99,4 +99,5 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         model=config.model,
         friction_limit=config.interface.friction_limit if config.model == "rbm" else None,
         slip=out.slip,
+        energy=None if out.energy is None else out.energy.as_dict(),
     )

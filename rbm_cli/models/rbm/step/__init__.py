@@ -43,7 +43,7 @@ import numpy as np
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
 from rbm_cli.models.guard import arm, disarm, poll
-from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
+from rbm_cli.models.outcome import EnergyAccount, Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.step.inputs import (
     PreparedModel,
     excitation,
@@ -106,7 +106,7 @@ def integrate(
         res = kernel(prepared.packed, excitation(motion), settings, task)
     finally:
         disarm(armed)
-    return _outcome(res, samples, n, record, solver)
+    return _outcome(res, samples, n, record, solver, account=motion.vertical is None)
 
 
 def prepare(model: Model):
@@ -115,10 +115,13 @@ def prepare(model: Model):
     return partial(integrate, prepared=prepare_kernel(model))
 
 
-def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> Outcome:
-    """The Outcome of what run_kernel returned (samples: its output rows)."""
+def _outcome(
+    res: tuple, samples: np.ndarray, n: int, record: bool, solver, account: bool
+) -> Outcome:
+    """The Outcome of what run_kernel returned (samples: its output rows; account: its
+    energy account is kept, a recorded run without a vertical record)."""
     (code, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
-     n_upl, n_imp, n_steps, n_rhs, n_ev, n_out) = res  # fmt: skip
+     n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger) = res  # fmt: skip
     out = Outcome(
         t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=friction,
         n_uplifts=int(n_upl), n_impacts=int(n_imp), n_steps=int(n_steps), n_rhs=int(n_rhs),
@@ -126,6 +129,8 @@ def _outcome(res: tuple, samples: np.ndarray, n: int, record: bool, solver) -> O
     )  # fmt: skip
     if record:
         out.samples = sample_rows(samples, n_out, n)
+        if account:
+            out.energy = EnergyAccount(*(float(v) for v in ledger))
     if code == COLLAPSED:
         out.collapse(float(t_col), int(c_if))
     elif code == STOPPED_EARLY:

@@ -244,23 +244,30 @@ def first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, 
 
 # ---------------------------------------------------------------- the equations, the rows
 @jit
-def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
+def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, cs):
     """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place into
     As[:, :n] and cs: A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :],
     c = -(M^-1 D^T) a, with md = M^-1 D^T and mg = M^-1 K_g assembled once
     (Model.linear_system). With a vertical record (vert), b is the slopes' weight part
-    parts[0] and As[:, n:] gets the elastic part parts[1] (Model.vertical_system):
-    theta'' = gam (As[:, :n] theta + c) + As[:, n:] theta + e a_g."""
+    parts[0] and As[:, n:2n] gets the elastic part parts[1] (Model.vertical_system):
+    theta'' = gam (As[:, :n] theta + c) + As[:, n:2n] theta + e a_g. A damped column (As
+    with 3n columns) gets -sum_i c_i (M^-1 D^T)[:, i] argmap[i, :] in As[:, 2n:], over the
+    interfaces on their elastic piece (k_i = 0; Model.joint_damping c), read on the rates:
+    theta'' += As[:, 2n:] theta'."""
     n = side.size
+    damped = As.shape[1] > 2 * n
     for p in range(n):
         cs[p] = 0.0
         for q in range(n):
             As[p, q] = mg[p, q]
             As[p, n + q] = 0.0
+            if damped:
+                As[p, 2 * n + q] = 0.0
     for i in range(n):
         a = side[i] * intercepts[i, k[i]]
         b = parts[0, i, k[i]] if vert else slopes[i, k[i]]
         be = parts[1, i, k[i]] if vert else 0.0
+        ci = damp[i] if damped and k[i] == 0 else 0.0
         for p in range(n):
             w = md[p, i]
             if w == 0.0:
@@ -271,6 +278,8 @@ def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs):
                     As[p, q] -= w * b * argmap[i, q]
                     if be != 0.0:
                         As[p, n + q] -= w * be * argmap[i, q]
+                    if ci != 0.0:
+                        As[p, 2 * n + q] -= w * ci * argmap[i, q]
 
 
 @jit

@@ -83,18 +83,31 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
 # ---------------------------------------------------------------- small pieces
 @jit(inline=True)
+def _damping(i, y, n, As):
+    """The damping term of theta''_i, As[i, 2n:] theta' (a damped column's As has 3n
+    columns, step.events.system; callers add it only then, so an undamped run's arithmetic
+    is the same to the bit)."""
+    s = 0.0
+    for j in range(n):
+        s += As[i, 2 * n + j] * y[n + j]
+    return s
+
+
+@jit(inline=True)
 def rhs(t, y, n, As, cs, es, gr, out):
     g = ground(t, gr)
+    damped = As.shape[1] > 2 * n
     if gr[6] == 0.0:
         for i in range(n):
             out[i] = y[n + i]
             s = cs[i] + es[i] * g
             for j in range(n):
                 s += As[i, j] * y[j]
-            out[n + i] = s
+            out[n + i] = s + _damping(i, y, n, As) if damped else s
         return
     # a vertical record: every weight (the law's weight part and gravity, As[:, :n] and cs)
-    # times (g + a_v) / g; the joints' stiffness (As[:, n:], step.events.system) not
+    # times (g + a_v) / g; the joints' stiffness (As[:, n:2n], step.events.system) and
+    # damping not
     gam = gravity_factor(t, gr)
     for i in range(n):
         out[i] = y[n + i]
@@ -104,16 +117,19 @@ def rhs(t, y, n, As, cs, es, gr, out):
             s += As[i, j] * y[j]
             el += As[i, n + j] * y[j]
         out[n + i] = gam * s + el + es[i] * g
+        if damped:
+            out[n + i] += _damping(i, y, n, As)
 
 
 @jit(inline=True)
 def acc_of(t, y, n, As, cs, es, gr, acc):
     """Angular accelerations theta'' at (t, y) into acc [rad/s^2]; returns a_g(t) [m/s^2]
     and (g + a_v(t)) / g [-]. (gam * x + e g is x + e g to the bit when gam = 1; the
-    elastic part As[:, n:] is read with a vertical record only, as rhs reads it.)"""
+    elastic part As[:, n:2n] is read with a vertical record only, as rhs reads it.)"""
     g = ground(t, gr)
     gam = gravity_factor(t, gr)
     vert = gr[6] != 0.0
+    damped = As.shape[1] > 2 * n
     for i in range(n):
         d = cs[i]
         el = 0.0
@@ -122,6 +138,8 @@ def acc_of(t, y, n, As, cs, es, gr, acc):
             if vert:
                 el += As[i, n + j] * y[j]
         acc[i] = (gam * d + el + es[i] * g) if vert else (gam * d + es[i] * g)
+        if damped:
+            acc[i] += _damping(i, y, n, As)
     return g, gam
 
 

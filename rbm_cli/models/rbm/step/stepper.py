@@ -64,7 +64,39 @@ from rbm_cli.models.status import (
     guard_code,
 )
 from rbm_cli.physics.arrays import ColumnArrays
-from rbm_cli.physics.ground import ground_at, next_uplift, record_piece, rest_demand
+from rbm_cli.physics.ground import ground, ground_at, next_uplift, record_piece, rest_demand
+
+#: Gauss-Legendre nodes on [0, 1] and weights (5 points: exact for polynomials of degree 9).
+GL_NODES = np.array([0.04691007703066802, 0.23076534494715845, 0.5, 0.7692346550528415,
+                     0.9530899229693319])  # fmt: skip
+GL_WEIGHTS = np.array([0.11846344252809454, 0.23931433524968324, 0.28444444444444444,
+                       0.23931433524968324, 0.11846344252809454])  # fmt: skip
+
+
+@jit
+def account_step(mc, t_old, t_new, h, y_old, F, gr, ground_load, argmap, damp, k, yq, ledger):
+    """Add one step's work of the ground and the energy its damping took to ledger[2] and
+    ledger[3] [J]: over [t_old, t_new] on the step's dense output (F, from y_old; its
+    interpolant over h), the powers -a_g r . theta' (r the ground load) and
+    sum_i c_i x_i'^2 (the joints on their elastic piece, k_i = 0) by Gauss-Legendre."""
+    n = damp.size
+    dt = t_new - t_old
+    for q in range(GL_NODES.size):
+        tq = t_old + GL_NODES[q] * dt
+        dense_eval(mc, tq, t_old, h, y_old, F, yq)
+        ag = ground(tq, gr)
+        p_in = 0.0
+        for j in range(n):
+            p_in -= ag * ground_load[j] * yq[n + j]
+        p_d = 0.0
+        for i in range(n):
+            if damp[i] != 0.0 and k[i] == 0:
+                xd = 0.0
+                for j in range(n):
+                    xd += argmap[i, j] * yq[n + j]
+                p_d += damp[i] * xd * xd
+        ledger[2] += GL_WEIGHTS[q] * dt * p_in
+        ledger[3] += GL_WEIGHTS[q] * dt * p_d
 
 
 @jit
@@ -86,17 +118,24 @@ def run_kernel(model, motion, solver, task):
     -------
     tuple  (status code (rbm_cli.models.status), t_end [s], t_collapse [s], collapsed interface,
         max_ratio (n,), max_top, friction (n,), slip (2,), n_uplifts, n_impacts, n_steps,
-        n_rhs, n_events, n_samples). friction: the largest |T_i / N_i| of each interface [-],
-        at rest (physics.ground.rest_demand, exact) and at step ends in motion; slip: where
-        it first exceeded task.friction_limit, (t [s], interface from 1), (nan, 0) if not:
-        at rest the exceedance time itself (physics.ground.next_uplift at the limit), in
-        motion the end of the first step whose demand exceeds it.
+        n_rhs, n_events, n_samples, ledger). friction: the largest |T_i / N_i| of each
+        interface [-], at rest (physics.ground.rest_demand, exact) and at step ends in
+        motion; slip: where it first exceeded task.friction_limit, (t [s], interface from 1),
+        (nan, 0) if not: at rest the exceedance time itself (physics.ground.next_uplift at the
+        limit), in motion the end of the first step whose demand exceeds it. ledger: the
+        energy account of a recorded run without a vertical record [J] (zeros otherwise): the
+        energy at the start and at the end (pieces.energy), the ground's work, the energy the
+        joints' damping and the impacts took. Their balance: end - start = work - damping -
+        impacts, to the integration's accuracy (the work and the damping are integrated over
+        each step's dense output by Gauss-Legendre quadrature, the impacts counted exactly at
+        each one).
     """
     model, motion = ColumnArrays(*model), Excitation(*motion)
     solver, task = SolverSettings(*solver), RunTask(*task)
     mass, argmap, gravity = model.mass, model.argmap, model.gravity
     edges, nedges, intercepts, slopes = model.edges, model.nedges, model.intercepts, model.slopes
     parts, edge_w = model.slope_parts, model.edge_w
+    damp, ground_load = model.damp, model.ground_load
     rigid, silent, tu, c_ratio = model.rigid, model.silent, model.tu, model.c_ratio
     centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
     uplift_level, barrier = model.uplift_level, model.barrier
@@ -138,8 +177,13 @@ def run_kernel(model, motion, solver, task):
     event_rows, gx, gc, same = model.event_rows, model.gx, model.gc, model.same
     md, mg, track, es = model.md, model.mg, model.track, model.es
     peaks = np.zeros(nt)
-    As, cs = np.empty((n, 2 * n)), np.empty(n)  # As[:, n:]: the joints' (step.events.system)
+    # As[:, n:2n]: the joints' stiffness, As[:, 2n:]: their damping (step.events.system)
+    As, cs = np.empty((n, 3 * n if model.damped else 2 * n)), np.empty(n)
     vert = vertical.size > 0  # a vertical record: kinks that move with it (step.vertical)
+    # the energy account of a recorded run (see Returns): start, end, work, damping, impacts
+    account = record and not vert
+    ledger = np.zeros(5)
+    yq = np.empty(2 * n)
     mv_e, mv_w = np.zeros(2 * n if vert else 0), np.ones(2 * n if vert else 0)
     h0 = np.empty(4 * n)
     K = np.empty((NS_MAX, m))
@@ -182,6 +226,10 @@ def run_kernel(model, motion, solver, task):
     x0 = matvec(argmap, y[:n], np.empty(n))
     r0 = matvec(argmap, y[n:], np.empty(n))
     locate(x0, r0, side, k, pending, rigid, edges, nedges)
+    if account:
+        ledger[0] = energy(y[:n], y[n:], mass, argmap, gravity, edges, nedges, intercepts,
+                           slopes)  # fmt: skip
+        ledger[1] = ledger[0]
 
     for seg in range(bounds.size - 1):
         seg_end = bounds[seg + 1]
@@ -198,7 +246,7 @@ def run_kernel(model, motion, solver, task):
                     if record:
                         n_out, next_out = emit_rest(t_end, samples, n_out, next_out, output_dt)
                     return (status, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
                 last = min(pulse_end, t_end)
                 t_up = next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical,
                                     last)  # fmt: skip
@@ -226,7 +274,7 @@ def run_kernel(model, motion, solver, task):
                 n_upl += 1
                 h_carry = -1.0
 
-            system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, As, cs)
+            system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, cs)
             bound_rows(side, k, pending, rigid, edges, nedges, tu, c_ratio, lo, hi, h0)
             if vert:
                 moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv_w)
@@ -262,7 +310,8 @@ def run_kernel(model, motion, solver, task):
                     if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
                         t_fail = t
                         return (FAILED_STEP, t_fail, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
+                                ledger)  # fmt: skip
                     t_new = t + h_abs
                     if t_new - bound > 0:
                         t_new = bound
@@ -273,7 +322,8 @@ def run_kernel(model, motion, solver, task):
                     err = error_norm(mc, K, h, y, ynew, atol, rtol, scale)
                     if not (err == err and abs(err) < math.inf):  # NaN or inf state
                         return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
+                                ledger)  # fmt: skip
                     if err < 1.0:
                         if err == 0.0:
                             factor = MAX_FACTOR
@@ -288,12 +338,12 @@ def run_kernel(model, motion, solver, task):
                 n_steps += 1
                 if n_steps > max_steps:
                     return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
                 if n_steps % POLL_STEPS == 0:  # the wall-clock budget and Ctrl-C
                     code = guard_code(deadline)
                     if code != GOING:
                         return (code, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
                 if t_new - seg_end >= 0:
                     running = False
                 t_old = t
@@ -327,6 +377,11 @@ def run_kernel(model, motion, solver, task):
                         dense_ready = True
                     n_out, next_out = emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
                                             next_out, output_dt)  # fmt: skip
+                if account:  # the step's dense output is ready (recorded runs always are)
+                    account_step(mc, t_old, t_new, h, y_old, F, gr, ground_load, argmap, damp,
+                                 k, yq, ledger)  # fmt: skip
+                    ledger[1] = energy(y_new[:n], y_new[n:], mass, argmap, gravity, edges,
+                                       nedges, intercepts, slopes)  # fmt: skip
                 if any_silent:
                     n_imp += settle(awaiting, argmap, y_new, side)
                 # peaks and friction demand over [t_old, t_new]
@@ -374,7 +429,8 @@ def run_kernel(model, motion, solver, task):
                                   intercepts, slopes)  # fmt: skip
                     if en < barrier * (1.0 - 1e-9):
                         return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
+                                ledger)  # fmt: skip
             if not event:
                 t = seg_end if not running else t
                 continue
@@ -384,22 +440,28 @@ def run_kernel(model, motion, solver, task):
             n_ev += 1
             if n_ev > max_events:
                 return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
             which, i = event_row // n, event_row % n
             if which >= 2:
                 t_col, c_if = t, i + 1
                 if c_ratio > max_ratio[i]:
                     max_ratio[i] = c_ratio
                 return (COLLAPSED, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
             going_up = which == 1
             bound = bound_now(i, going_up, n, lo, hi, tu, t, gr, mv_e, mv_w) if vert else (
                 hi[i] if going_up else lo[i])  # fmt: skip
             what = switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
+            if account:
+                after = energy(y[:n], y[n:], mass, argmap, gravity, edges, nedges, intercepts,
+                               slopes)  # fmt: skip
+                if what >= IMPACT:
+                    ledger[4] += ledger[1] - after
+                ledger[1] = after
             if what == UPLIFT:
                 n_upl += 1
             elif what >= IMPACT:
                 n_imp += 1
                 at_rest = what == REST
     return (status, t, t_col, c_if, max_ratio, max_top, friction, slip,
-            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out)  # fmt: skip
+            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip

@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from scipy.linalg import eig
 
+from rbm_cli.api import info as rbm_info
 from rbm_cli.api import load_config, run, run_sweep
 from rbm_cli.api.configs import with_values
 from rbm_cli.base.errors import ConfigError, RbmError
@@ -48,13 +49,14 @@ def _config(zeta, method="DOP853", implementation="python", **excitation):
     }  # fmt: skip
 
 
-def _first_mode(cfg: dict) -> tuple[np.ndarray, float]:
-    """The first elastic mode's drum rotations [rad] at half the elastic limit of the
-    joint nearest to it, and its frequency [Hz], from scipy's eigenproblem K v = w^2 M v."""
+def _first_mode(cfg: dict, which: int = 0) -> tuple[np.ndarray, float]:
+    """The first (or which-th) elastic mode's drum rotations [rad] at half the elastic limit
+    of the joint nearest to it, and its frequency [Hz], from scipy's eigenproblem
+    K v = w^2 M v."""
     model = model_from_config(load_config(cfg))
     slopes = np.array([law.slopes[0] for law in model.laws])
     w2, vecs = eig(model.stiffness(slopes), model.mass)
-    first = int(np.argmin(w2.real))
+    first = int(np.argsort(w2.real)[which])
     phi = vecs[:, first].real
     elastic_end = model.column.moment_capacity / model.column.stiffness  # xi = 1
     phi *= 0.5 * np.min(elastic_end / np.abs(model.arg_map @ phi))
@@ -89,6 +91,26 @@ def test_first_mode_decays_with_the_logarithmic_decrement_of_zeta(zeta, method, 
     assert np.all(np.abs(measured - zeta) < zeta / 10), measured
     # closer than the tenth asked of it: one mode alone, integrated at rtol 1e-10 (1e-8)
     assert np.all(np.abs(measured - zeta) < 1e-3 * zeta), measured
+
+
+def test_the_second_mode_has_the_ratio_rbm_info_states():
+    """Stiffness-proportional damping gives mode k the ratio zeta w_k / w_1: the second mode,
+    started alone, decays with that logarithmic decrement, and `rbm info` says so."""
+    zeta = 0.02
+    cfg = _config(zeta, implementation="compiled")
+    phi, f2 = _first_mode(cfg, which=1)
+    _, f1 = _first_mode(cfg)
+    cfg["excitation"] = {"type": "free", "duration": 5.0 / f2,
+                         "initial": {"rotations": [float(v) for v in phi]}}  # fmt: skip
+    cell = run(cfg, amplitude_g=0.0, frequency_hz=1.0, record=True, output_dt=1e-3 / f2)
+    h = cell.history
+    peaks = _peaks(h["u2_m"].to_numpy() - h["u1_m"].to_numpy())
+    delta = np.log(peaks[:-1] / peaks[1:])
+    measured = delta / np.sqrt(4 * math.pi**2 + delta**2)
+    assert np.all(np.abs(measured - zeta * f2 / f1) < 1e-3 * zeta * f2 / f1), measured
+    stated = rbm_info(load_config(cfg))["damping_ratios"]
+    assert stated[1] == pytest.approx(zeta * f2 / f1, rel=1e-9)
+    assert stated[0] == pytest.approx(zeta, rel=1e-12)
 
 
 @pytest.mark.parametrize("zeta, restitution", [(0.05, 0.9), (0.0, 0.9), (0.1, 1.0)])

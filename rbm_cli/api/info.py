@@ -48,7 +48,9 @@ def info(
         scales a sweep writes in domain.csv's p_rad_s and alpha_rad: the model's monolith,
         the true solid's for housner and bullet), rocking_p_is and domain_p_is (what each
         p is, one line each), elastic_frequencies_hz [Hz]
-        (a list; empty when rigid), formulation, restitution [-], and ``interfaces``, a
+        (a list; empty when rigid), formulation, restitution [-], damping (interface.damping
+        zeta [-]) and damping_ratios (each elastic mode's, zeta f_k / f_1; empty undamped),
+        and ``interfaces``, a
         DataFrame with one row per interface (1 at the ground): width_m [m],
         drum_height_m [m], drum_mass_kg [kg], drum_inertia_kgm2 [kg m^2],
         normal_force_N [N], moment_capacity_Nm [N m], rotation_capacity_rad [rad],

@@ -88,6 +88,8 @@ def describe(config: Config) -> dict:
         "elastic_frequencies_hz": freqs,
         "formulation": model.formulation,
         "restitution": model.restitution,
+        "damping": model.damping,
+        "damping_ratios": [model.damping * f / freqs[0] for f in freqs] if model.damping else [],
         "interfaces": interfaces,
         **engine,
     }
@@ -170,6 +172,11 @@ def format_info(info: dict) -> str:
             (", ".join(_fmt(f) for f in freqs) + " Hz") if freqs else "- (rigid)",
         ),
     ]
+    if info.get("damping"):
+        ratios = ", ".join(_fmt(z, ".3g") for z in info.get("damping_ratios") or [])
+        text = (f"zeta {_fmt(info['damping'])} of the first elastic mode, stiffness-"
+                f"proportional: the modes' ratios {ratios}")  # fmt: skip
+        rows.append(("damping", text))
     if info.get("domain_p_rad_s") is not None:
         rows.append(("rocking p is", info.get("rocking_p_is") or "-"))
         values = (f"{_fmt(info['domain_p_rad_s'])} rad/s, alpha_rad "

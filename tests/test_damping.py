@@ -224,3 +224,11 @@ def test_the_stored_damped_study_is_reproduced(tmp_path):
     assert robust.sum() >= 4
     assert (merged.loc[robust, "collapsed"] == merged.loc[robust, "collapsed_stored"]).all()
     assert (merged["max_rotation_ratio"] == merged["max_rotation_ratio_stored"]).all()
+
+
+def test_the_domain_figure_states_the_damping():
+    from rbm_cli.report.domain_figure import column_note
+
+    damped = column_note(load_config(CONFIGS / "harmonic_multidrum_damped.yaml"))
+    assert "damping zeta = 0.05" in damped and "e = 1" in damped
+    assert "damping" not in column_note(load_config(CONFIGS / "harmonic_multidrum.yaml"))

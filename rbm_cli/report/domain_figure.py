@@ -33,7 +33,8 @@ def _metres(value: float) -> str:
 def column_note(config: Config) -> str:
     """The column a domain was swept with, in one line under its title: H, B (base and
     top width where they differ), drums, the joint stiffness (k_n, K_M or rigid), the
-    restitution e, and interface.friction where model rbm's demand is checked against it.
+    restitution e, the joints' damping zeta where there is some, and interface.friction where
+    model rbm's demand is checked against it.
     A grid over one of these says so ("over the grid") instead of one value."""
     col, itf = config.column, config.interface
     axes = set(config.grid.axis_paths)
@@ -63,6 +64,8 @@ def column_note(config: Config) -> str:
         f"e = {value('interface.restitution', e)}",
         f"model {config.model}",
     ]
+    if itf.damping > 0 or "interface.damping" in axes:
+        parts.insert(5, f"damping zeta = {value('interface.damping', f'{itf.damping:.3g}')}")
     if config.model == "rbm" and itf.friction_limit is not None:
         parts.append(f"interface.friction = {itf.friction_limit:.3g}")
     return "column: " + ", ".join(parts)

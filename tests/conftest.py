@@ -21,6 +21,7 @@ tests that fork run in a fresh interpreter; on Linux a skipped test is a failed 
 """
 
 import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -67,6 +68,11 @@ def _compiled_once(request):
 
 
 def pytest_configure(config):
+    # A shell starts a background job with SIGINT ignored, and children inherit that: the
+    # tests that press Ctrl-C on a run they start would see it ignored. Python's own handler
+    # here, so every child starts as it would from a terminal.
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     config.addinivalue_line(
         "markers",
         "fresh_interpreter: run in a pytest process of its own (the test forks; see conftest)",

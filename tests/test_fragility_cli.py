@@ -554,3 +554,20 @@ def test_api_progress_and_ctrl_c_during_the_bootstrap(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         fragility_run.run_fragility(domain, n_resamples=25, seed=1, progress=interrupt)
     assert {p.name: p.read_bytes() for p in (tmp_path / "s").iterdir()} == before
+
+
+def test_a_stored_suite_is_fitted_on_its_pgv(tmp_path):
+    """The stored monolith suite (results/suite_monolithic) keeps each record cell's
+    intensity measures: `rbm fragility --intensity pgv_m_s` fits on them, and the points it
+    fits are the stored PGVs (each record's PGV is proportional to its scaling, so the
+    ratio PGV / PGA is the same at every level of a record)."""
+    stored = pd.read_csv(RESULTS / "suite_monolithic" / "domain.csv", dtype={"record": str})
+    ratio = stored["pgv_m_s"] / stored["pga_g"]
+    assert (ratio.groupby(stored["record"]).std() <= 1e-9 * ratio.mean()).all()
+    res = CliRunner().invoke(cli, ["fragility", str(RESULTS / "suite_monolithic" / "domain.csv"),
+                                   "--intensity", "pgv_m_s", "-o", str(tmp_path)])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert "intensity: pgv_m_s [m/s]" in res.output and "median" in res.output
+    table = pd.read_csv(tmp_path / "fragility.csv")
+    np.testing.assert_allclose(np.sort(table["intensity_g"]),
+                               np.sort(stored["pgv_m_s"].unique()), rtol=1e-11)  # fmt: skip

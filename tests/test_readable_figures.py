@@ -320,3 +320,29 @@ def test_info_says_the_multidrum_domain_p_is_the_glued_monolith():
     text = format_info(info)
     assert re.search(r"rocking p is:\s+the RBM's 4 drums rocking as one rigid stack", text)
     assert "drums glued into one drum of height H" in text
+
+
+def test_counts_are_of_trials_and_left_out_where_they_would_cover_each_other():
+    """Beside each point the collapses over the trials that made it: every ensemble member
+    of a record where members count; with one point per record and level (an intensity
+    measure of each record's own) the labels would cover each other, and are left out."""
+    from matplotlib.figure import Figure
+
+    from rbm_cli.report.fragility_report import MAX_COUNT_LABELS, _plot_observed
+
+    few = pd.DataFrame({"intensity_g": [0.1, 0.2, 0.3], "fraction": [0.0, 0.5, 1.0],
+                        "n_collapsed": [0, 8, 32], "n_records": [2, 1, 2],
+                        "n_trials": [32, 16, 32]})  # fmt: skip
+    fig = Figure()
+    ax = fig.add_subplot()
+    _plot_observed(ax, few, "", None, True)
+    assert [t.get_text() for t in ax.texts] == ["0/32", "8/16", "32/32"]
+    assert ax.get_lines()[0].get_label().endswith("(collapsed/trials)")
+    n = MAX_COUNT_LABELS + 1
+    many = pd.DataFrame({"intensity_g": np.linspace(0.1, 1, n), "fraction": np.zeros(n),
+                         "n_collapsed": np.zeros(n, int), "n_records": np.ones(n, int),
+                         "n_trials": np.ones(n, int)})  # fmt: skip
+    fig = Figure()
+    ax = fig.add_subplot()
+    _plot_observed(ax, many, "", None, True)
+    assert not ax.texts and ax.get_lines()[0].get_label() == "observed fraction collapsed"

@@ -135,7 +135,7 @@ def plot_fragility(
     color : str, optional
         Colour of all three marks
     counts : bool
-        Write "collapsed/records" beside each point
+        Write "collapsed/trials" beside each point (at most MAX_COUNT_LABELS points)
     xlabel : str
         Label of the intensity axis
 
@@ -175,25 +175,32 @@ def _note(ax, text: str, gid: str, color: str = "black") -> None:
             color=color, gid=gid)  # fmt: skip
 
 
+#: Most points labelled with their counts: beyond, the labels cover each other (a suite
+#: scaled to each record's own intensity measure has one point per record and level).
+MAX_COUNT_LABELS = 40
+
+
 def _plot_observed(ax, table: pd.DataFrame, prefix: str, color, counts: bool):
-    """The observed fractions (gid "observed"), with "collapsed/records" beside each point
-    when `counts`; returns the colour used."""
+    """The observed fractions (gid "observed"), with "collapsed/trials" beside each point
+    when `counts` and there are at most MAX_COUNT_LABELS points (trials are the records, or
+    every ensemble member of each record where members count as trials); returns the colour
+    used."""
+    trials = table["n_trials"] if "n_trials" in table.columns else table["n_records"]
+    per_member = bool((trials != table["n_records"]).any())
+    what = "collapsed/trials" if per_member else "collapsed/records"
+    shown = counts and len(table) <= MAX_COUNT_LABELS
     (points,) = ax.plot(
         table["intensity_g"],
         table["fraction"],
         "o",
         color=color,
-        label=f"{prefix}observed fraction collapsed (collapsed/records)",
+        label=f"{prefix}observed fraction collapsed" + (f" ({what})" if shown else ""),
     )
     points.set_gid("observed")
     color = points.get_color()
-    if counts:
+    if shown:
         for x, y, k, n in zip(
-            table["intensity_g"],
-            table["fraction"],
-            table["n_collapsed"],
-            table["n_records"],
-            strict=True,
+            table["intensity_g"], table["fraction"], table["n_collapsed"], trials, strict=True
         ):
             if n > 0:
                 ax.annotate(

@@ -10,6 +10,7 @@ and solver settings were lost.
 from __future__ import annotations
 
 import json
+import os
 
 import pandas as pd
 import pytest
@@ -104,8 +105,15 @@ def test_every_stored_result_keeps_its_config_as_written():
 
     metas = sorted((Path(__file__).resolve().parents[1] / "results").rglob("meta.json"))
     assert metas
+    root = Path(__file__).resolve().parents[1]
     for path in metas:
         meta = json.loads(path.read_text())
+        # the config's folder, relative to the domain's, inside this checkout (a domain made
+        # elsewhere and copied in names a folder that only its maker's machine has)
+        if "config_dir" in meta:
+            inside = os.path.normpath(path.parent.relative_to(root) / meta["config_dir"])
+            assert inside.split(os.sep)[0] == "configs", (path, meta["config_dir"])
+            assert (root / inside).is_dir(), (path, inside)
         cfg = domain_config(path.with_name("domain.csv"))
         assert cfg is not None, path
         assert config_hash(cfg) == meta["config_hash"].split("-")[0], path

@@ -28,7 +28,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import rbm
-from rbm_cli.api.fragility import run_fragility
+from rbm_cli.api.fragility_curves import run_fragility
 
 # the repository's root: the folder above that holds configs/ (run from the root or docs/)
 ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "configs").is_dir())

@@ -1,5 +1,5 @@
 """`rbm fragility`: fragility curve and IDA of a record-suite domain (thin, over
-rbm_cli.api.fragility)."""
+rbm_cli.api.fragility_curves)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from rbm_cli.api.errors import RbmError
 from rbm_cli.cli.common import Interrupted, UserError, check_output, cli, one_line
 from rbm_cli.cli.progress import Progress, duration
 
-#: Most --resamples (rbm_cli.api.fragility.MAX_RESAMPLES, which refuses more; written
+#: Most --resamples (rbm_cli.api.fragility_curves.MAX_RESAMPLES, which refuses more; written
 #: here so that `rbm --help` does not import the fit).
 MAX_RESAMPLES_SHOWN = "100,000"
 #: Seconds of bootstrap before its progress is shown (a short one says nothing).
@@ -73,7 +73,7 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         rbm fragility results/suite_multidrum/domain.csv \
             --compare results/suite_monolithic/domain.csv -o docs/figures/suite
     """
-    from rbm_cli.api.fragility import MAX_RESAMPLES, run_fragility
+    from rbm_cli.api.fragility_curves import MAX_RESAMPLES, run_fragility
 
     if resamples > MAX_RESAMPLES:
         raise UserError(

@@ -169,7 +169,7 @@ def _check_output_dt(cfg, output_dt: float | None) -> None:
 def _say_which_point(cfg) -> None:
     """A note when the config's grid has axes over config keys (a suite of records, a
     column.height axis...): one run is the config's own point, named here."""
-    from rbm_cli.api.info import own_point_note
+    from rbm_cli.api.column_info import own_point_note
 
     note = own_point_note(cfg)
     if note is not None:
@@ -217,7 +217,7 @@ def info(config: str, as_json: bool) -> None:
         rbm info configs/harmonic_multidrum.yaml
         rbm info configs/spanos_koh_thick.yaml --json
     """
-    from rbm_cli.api.info import describe, format_info, info_json
+    from rbm_cli.api.column_info import describe, format_info, info_json
 
     cfg = load(config)
     try:

@@ -223,7 +223,7 @@ def test_a_worker_does_not_import_plotting(workers):
 
 
 def test_a_worker_imports_no_scipy_solver(workers):
-    """The compiled path's tableaux are written out (models/rbm/step/tableaux.py) and
+    """The compiled path's tableaux are written out (base/rk_tableaux.py) and
     Brent's method is imported where the Python paths call it: a worker never imports
     scipy.integrate or scipy.optimize (numba itself imports scipy.linalg for its BLAS)."""
     modules = _worker_modules(rigid(), workers)

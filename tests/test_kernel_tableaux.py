@@ -1,4 +1,4 @@
-"""The kernel's Runge-Kutta tableaux (written out in models/rbm/step/tableaux.py so the
+"""The kernel's Runge-Kutta tableaux (written out in base/rk_tableaux.py so the
 compiled path does not import scipy.integrate) are scipy's, bit for bit: the
 kernel's step sequence is scipy's only if every coefficient is."""
 
@@ -10,7 +10,7 @@ from scipy.integrate._ivp import dop853_coefficients as dop
 from scipy.integrate._ivp.rk import RK23, RK45
 
 from rbm_cli.models.rbm.step import rk
-from rbm_cli.models.rbm.step import tableaux as tb
+from rbm_cli.base import rk_tableaux as tb
 
 
 def padded(rows, shape) -> np.ndarray:

@@ -49,7 +49,7 @@ from rbm_cli.models.block.run import (
     run_block,
 )
 from rbm_cli.models.events import EVENT_EPS
-from rbm_cli.models.guard import arm, disarm
+from rbm_cli.base.guard import arm, disarm
 from rbm_cli.models.methods import model_why_not
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.modal import LINEAR
@@ -208,7 +208,7 @@ def run_closed_form(
     rows = 0 if events is None else LOG_ROWS
     while True:
         log = np.zeros((rows, 2))
-        armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.models.guard)
+        armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
         try:
             code, st, cnt = run(block.params, seg_t, seg_fc, seg_v, mo, se, float(theta0),
                                 float(rate0), samples, log)  # fmt: skip

@@ -9,7 +9,7 @@ a base corner (not the RBM's mid-height lumping). Integrated by scipy's DOP853
 driven step by step, restarted at every impact and at the end of a pulse;
 impacts (theta = 0), collapse (|theta| = c alpha) and peaks (theta' = 0) are
 located by root finding on the step's dense output. Under a record every step ends at
-a sample (rbm_cli.models.knots), where the acceleration has a kink.
+a sample (rbm_cli.base.knots), where the acceleration has a kink.
 
 References
 ----------
@@ -40,7 +40,7 @@ from rbm_cli.models.housner.steps import (
     HousnerStep,
     peak_in_step,
 )
-from rbm_cli.models.knots import clip_at_knots
+from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.arrays import REST_RATE

@@ -16,7 +16,7 @@ import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
-from rbm_cli.models.guard import arm, disarm
+from rbm_cli.base.guard import arm, disarm
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.rbm.exact.piece import new_cache
@@ -109,7 +109,7 @@ def integrate_exact(
     n = model.n
     mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
-    armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.models.guard)
+    armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
     try:
         run = run_exact if solver.implementation == "compiled" else plain(run_exact)
         code, st, cnt, maxima, fric = run(

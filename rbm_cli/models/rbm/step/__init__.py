@@ -42,7 +42,7 @@ import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.jit import plain
-from rbm_cli.models.guard import arm, disarm, poll
+from rbm_cli.base.guard import arm, disarm, poll
 from rbm_cli.models.outcome import EnergyAccount, Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.step.inputs import (
     PreparedModel,
@@ -100,7 +100,7 @@ def integrate(
     # a RunTask, as a plain tuple (step.inputs)
     task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), bool(early_stop),
             bool(record), float(output_dt), samples, float(friction_limit))  # fmt: skip
-    armed = arm()  # Ctrl-C reaches the kernel through poll (rbm_cli.models.guard)
+    armed = arm()  # Ctrl-C reaches the kernel through poll (rbm_cli.base.guard)
     try:
         kernel = run_kernel if solver.implementation == "compiled" else plain(run_kernel)
         res = kernel(prepared.packed, excitation(motion), settings, task)

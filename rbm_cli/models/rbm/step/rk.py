@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-import rbm_cli.models.rbm.step.tableaux as _tb
+import rbm_cli.base.rk_tableaux as _tb
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.base.jit import jit
 from rbm_cli.physics.ground import gravity_factor, ground
@@ -16,7 +16,7 @@ from rbm_cli.physics.ground import gravity_factor, ground
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
 
-# ---- Butcher tableaux (scipy's, written out in step.tableaux), padded to one shape:
+# ---- Butcher tableaux (scipy's, written out in rbm_cli.base.rk_tableaux), padded to one shape:
 # (A, B, C, E, P, n_stages, est_order)
 NS_MAX = _tb.DOP853_N_STAGES_EXTENDED
 

@@ -1,7 +1,8 @@
 """Every registered model keeps the one Runner contract (rbm_cli.models.contract) and answers
 the same case alike.
 
-The case is a rigid monolithic rectangle (H 4 m, B 1 m) under a half-sine pulse, where the
+The case is a rigid monolithic rectangle (H 4 m, B 1 m; a cylinder 1 m across for a model in
+three dimensions, with the same alpha) under a half-sine pulse, where the
 physics leaves no doubt: at 0.1 g, below every model's uplift level (B/H = 0.25 g for the
 RBM and housner-linear, tan(alpha) = 0.25 g for Housner's block, min(tan alpha, friction)
 for the engine) nothing moves; at 3 g and 1 Hz, twelve times the uplift level over a
@@ -30,10 +31,13 @@ from rbm_cli.study.simulate import simulate
 def _block_dict(model: str) -> dict:
     interface = {"stiffness": "rigid", "restitution": 0.9}
     solver = {"time_step": 2e-4} if model == "bullet" else {}
+    column = {"height": 4.0, "base_width": 1.0, "density": 2700}
+    if MODELS[model].three_d:  # a cylinder: its uplift level is tan(alpha) = 0.25 g too
+        column["section"] = "circular"
     return {
         "name": f"contract_{model}",
         "model": model,
-        "column": {"height": 4.0, "base_width": 1.0, "density": 2700},
+        "column": column,
         "interface": interface,
         "excitation": {"type": "half-sine", "duration": 3.0},
         "solver": solver,

@@ -222,6 +222,7 @@ def _ranges() -> dict[str, str]:
     """Allowed values written from the loader's constants."""
     from rbm_cli.config import types as t
     from rbm_cli.config.excitation import (
+        ANGLE_RANGE_DEG,
         DEFAULT_DURATION,
         FILTER_ORDER_MAX,
         GAMMA_MAX,
@@ -274,6 +275,7 @@ def _ranges() -> dict[str, str]:
         "excitation.type": one_of(t.EXCITATIONS),
         "excitation.duration": f"(0, {fmt(MAX_DURATION)}]; default {durations}",
         "excitation.phase": f"[-{fmt(PHASE_MAX)}, {fmt(PHASE_MAX)}]",
+        "excitation.angle": f"[{fmt(ANGLE_RANGE_DEG[0])}, {fmt(ANGLE_RANGE_DEG[1])}]",
         "excitation.gamma": f"(1, {fmt(GAMMA_MAX)}]",
         "excitation.nu": "[-2 pi, 2 pi]",
         "excitation.units": one_of(t.RECORD_UNITS),
@@ -308,7 +310,8 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "rotations, true geometry); ``housner-linear`` the piecewise-linear block of "
         "Spanos and Koh; both monolithic only; ``bullet`` the rigid-body contact "
         "engine (any drums; it ignores the joint law's stiffness, xi, restitution "
-        "and formulation).",
+        "and formulation); ``housner-3d`` the rigid cylinder rocking and rolling on "
+        "its rim in three dimensions (monolithic, ``column.section: circular``).",
     ),
     "column.height": ("m", "", "Required. Height H of the column."),
     "column.base_width": ("m", "", "Required. Width B_1 at the base."),
@@ -412,6 +415,13 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "(the whole pulse is always simulated). Not for ``record``.",
     ),
     "excitation.phase": ("rad", "", "Phase of a harmonic excitation."),
+    "excitation.angle": (
+        "deg",
+        "",
+        "Azimuth in plan of the horizontal motion, from the x axis (any type: the motion "
+        "is turned to it). Models in three dimensions only (``housner-3d``); the planar "
+        "models rock in the x plane and refuse any other. Default 0.",
+    ),
     "excitation.initial": ("", "", "Initial state of the drums."),
     "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),
     "excitation.initial.velocities": ("rad/s", "", "Angular velocity of each drum at t = 0."),

@@ -102,6 +102,7 @@ EXCITATION_KEYS = (
     "vertical",
     "processing",
     "im_periods",
+    "angle",
 )
 PROCESSING_KEYS = ("baseline", "filter")
 FILTER_KEYS = ("low_hz", "high_hz", "order")
@@ -120,6 +121,8 @@ MAX_DURATION = 1e4  # [s]
 #: Initial rotations [rad] and rates [rad/s], phase [rad]: finite and bounded.
 INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
 PHASE_MAX = 1e3
+#: Range of excitation.angle [deg]: one turn either way.
+ANGLE_RANGE_DEG = (-360.0, 360.0)
 #: Keys that apply to some excitation types only (key -> those types).
 ONLY_FOR = {
     "duration": tuple(t for t in EXCITATIONS if t != "record"),
@@ -541,6 +544,12 @@ def excitation_section(
         raise ConfigError(
             f"excitation.phase applies only to type harmonic (type is {kind}), got {fmt(phase)}"
         )
+    angle = number(e.get("angle", 0.0), "excitation.angle", "deg")
+    angle = in_bounds(angle, "excitation.angle", "deg", ANGLE_RANGE_DEG)
     return ExcitationConfig(
-        type=kind, phase=phase, initial=_initial(e.get("initial"), n, kind), **fields
+        type=kind,
+        phase=phase,
+        initial=_initial(e.get("initial"), n, kind),
+        angle=angle,
+        **fields,
     )

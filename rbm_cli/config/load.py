@@ -41,6 +41,7 @@ from rbm_cli.config.types import (
     CollapseConfig,
     ColumnConfig,
     Config,
+    ExcitationConfig,
     SolverConfig,
     TopMassConfig,
 )
@@ -330,6 +331,7 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         )
     interface = interface_section(top.get("interface"), n, model)
     excitation = excitation_section(top.get("excitation"), n, base_dir)
+    _check_dimensions(model, column, excitation)
     return Config(
         name=name,
         column=column,
@@ -348,6 +350,24 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         ),
         solver=_solver(top.get("solver")),
     )
+
+
+def _check_dimensions(model: str, column: ColumnConfig, excitation: ExcitationConfig) -> None:
+    """A model in three dimensions takes a circular column only; a planar model takes a
+    motion along its plane only (excitation.angle 0)."""
+    if MODELS[model].three_d:
+        if column.section != "circular":
+            raise ConfigError(
+                f"model {model} needs column.section: circular (a {column.section} section's"
+                " rocking capacity is not the same in every direction)"
+            )
+    elif excitation.angle != 0.0:
+        three_d = ", ".join(name for name, entry in MODELS.items() if entry.three_d)
+        raise ConfigError(
+            f"excitation.angle turns the motion out of the plane model {model} rocks in"
+            f" (got {fmt(excitation.angle)} deg): use a model in three dimensions ({three_d})"
+            " or delete excitation.angle"
+        )
 
 
 def _name(value: Any) -> str:

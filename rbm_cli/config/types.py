@@ -44,18 +44,22 @@ IMPLEMENTATIONS = ("compiled", "python")
 
 @dataclass(frozen=True)
 class ModelEntry:
-    """A registered model: its runner ("module:class", rbm_cli.models.contract.Runner)
-    and whether it takes more than one drum."""
+    """A registered model: its runner ("module:class", rbm_cli.models.contract.Runner),
+    whether it takes more than one drum, and whether it moves in three dimensions (a
+    circular section only, a motion in any direction: excitation.angle)."""
 
     runner: str
     multi_drum: bool
+    three_d: bool = False
 
 
 #: The model registry, name -> runner (rbm_cli.models.registry resolves it). rbm: the
 #: Rigid Beam Model; housner: Housner's nonlinear rigid block (large rotations, true
 #: geometry); housner-linear: the piecewise-linear block of Spanos and Koh (closed form,
 #: true geometry); the last two monolithic only. bullet: stacked rigid drums in Bullet's
-#: contact dynamics (PyBullet), any drums. A new model is one module and one line here.
+#: contact dynamics (PyBullet), any drums. housner-3d: the rigid cylinder rocking and
+#: rolling on its rim in three dimensions (true geometry, circular monolithic columns).
+#: A new model is one module and one line here.
 MODELS = {
     "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True),
     "housner": ModelEntry("rbm_cli.models.housner.runner:HousnerRunner", multi_drum=False),
@@ -63,6 +67,9 @@ MODELS = {
         "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False
     ),
     "bullet": ModelEntry("rbm_cli.models.bullet.run:BulletRunner", multi_drum=True),
+    "housner-3d": ModelEntry(
+        "rbm_cli.models.housner3d.runner:Housner3dRunner", multi_drum=False, three_d=True
+    ),
 }
 
 
@@ -246,6 +253,9 @@ class ExcitationConfig:
     motion : rbm_cli.config.motions.Motion or None  Record: the motion given as arrays in
         place of a file (then ``file`` is its name and ``file_sha256`` the digest of its
         samples, which identify it); not in :meth:`resolved`, not compared
+    angle : float  Azimuth of the horizontal motion in plan [deg], from the x axis (the
+        plane the planar models rock in, where only 0 is taken): the models in three
+        dimensions take any; left out of :meth:`resolved` when 0, as before the key existed
     processing : ProcessingConfig or None  Record: its baseline correction and band-pass,
         applied to the record (and the vertical record) before scaling; None: the record
         as read (also for a processing that changes nothing, so the config's hash is the
@@ -270,6 +280,7 @@ class ExcitationConfig:
     vertical_path: str | None = field(default=None, compare=False)
     motion: Any = field(default=None, compare=False)
     processing: ProcessingConfig | None = None
+    angle: float = 0.0
 
     def resolved(self) -> dict:
         """The settings that define the motion, as plain data: the fields of other
@@ -287,6 +298,8 @@ class ExcitationConfig:
             drop.append("processing")
         if not self.im_periods:
             drop.append("im_periods")
+        if self.angle == 0.0:
+            drop.append("angle")
         for key in drop:
             out.pop(key)
         return out

@@ -65,6 +65,8 @@ class Outcome:
     history: History | None = None  # the sampled history, made by the runner when recording
     method: str = ""  # the method that ran (solver.method, `auto` resolved), set by the runner
     energy: EnergyAccount | None = None  # a recorded run's energy account, where kept
+    #: a model in three dimensions: where its lean pointed at collapse [rad from x]
+    azimuth: float = math.nan
 
     def stop(self, status: str, message: str, t: float) -> Outcome:
         """End the run at time t with a status and a reason."""

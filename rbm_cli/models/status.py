@@ -6,8 +6,8 @@ leave the process."""
 
 from __future__ import annotations
 
-from rbm_cli.base.jit import jit
 from rbm_cli.base.guard import GO_ON, PAST_DEADLINE, poll
+from rbm_cli.base.jit import jit
 
 GOING, SURVIVED, COLLAPSED, STOPPED_EARLY, AT_REST_END = 0, 1, 2, 3, 4
 FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8

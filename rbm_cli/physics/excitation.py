@@ -10,6 +10,7 @@ or a record read from its file (physics/records.py) or given as arrays
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 from functools import lru_cache
@@ -225,9 +226,19 @@ def pulse_motion(excitation: ExcitationConfig, amplitude: float, frequency_hz: f
 def make_ground_motion(
     excitation: ExcitationConfig, amplitude_g: float, frequency_hz: float | None = None
 ) -> GroundMotion:
-    """Ground motion of a run; amplitude in g and frequency in Hz at this edge only.
+    """Ground motion of a run; amplitude in g, frequency in Hz and the angle in degrees at
+    this edge only.
 
     frequency_hz is not used by 'free' and 'record' (None is accepted there)."""
+    motion = _motion(excitation, amplitude_g, frequency_hz)
+    if excitation.angle == 0.0:
+        return motion
+    return dataclasses.replace(motion, angle=math.radians(excitation.angle))
+
+
+def _motion(
+    excitation: ExcitationConfig, amplitude_g: float, frequency_hz: float | None
+) -> GroundMotion:
     if excitation.type == "free":
         return GroundMotion("free", 0.0, 1.0, 0.0, 0.0, excitation.duration)
     if excitation.type == "record":

@@ -65,6 +65,9 @@ class GroundMotion:
         [m/s^2] (excitation.vertical): every weight acts as if gravity were g + a_v(t).
         With it, the knots are the union of both records' samples, a time written twice
         where either jumps (its first or last value not 0), value before then after.
+    angle : float  Azimuth of the ground's motion in plan [rad], from the x axis: the
+        ground accelerates along (cos angle, sin angle). The planar models rock in the x
+        plane and take 0 only; the models in three dimensions take any.
     """
 
     kind: str
@@ -80,6 +83,14 @@ class GroundMotion:
     values: np.ndarray | None = None
     name: str = ""
     vertical: np.ndarray | None = None
+    angle: float = 0.0
+
+    @property
+    def direction(self) -> np.ndarray:
+        """The unit vector in plan the ground accelerates along, (cos angle, sin angle)."""
+        if self.angle == 0.0:
+            return np.array([1.0, 0.0])
+        return np.array([math.cos(self.angle), math.sin(self.angle)])
 
     @property
     def form(self) -> int:
@@ -290,4 +301,5 @@ class GroundMotion:
             knots=ts,
             values=values,
             name=f"{self.kind} (sampled)",
+            angle=self.angle,
         )

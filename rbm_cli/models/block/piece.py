@@ -36,8 +36,8 @@ from __future__ import annotations
 
 import math
 
-from rbm_cli.base.jit import jit
 from rbm_cli.base.brent import brent_step
+from rbm_cli.base.jit import jit
 from rbm_cli.models.rbm.exact.modal import HARMONIC, LINEAR, f_phase
 
 #: A piece: start time t0 [s], side s, C [rad], omega [rad/s], phi0 [rad], q0 [rad],

@@ -28,6 +28,7 @@ import math
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 
+from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.config.types import G, SolverConfig
 from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
@@ -40,7 +41,6 @@ from rbm_cli.models.housner.steps import (
     HousnerStep,
     peak_in_step,
 )
-from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.physics.arrays import REST_RATE

@@ -15,8 +15,8 @@ from typing import NamedTuple
 import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
-from rbm_cli.base.jit import plain
 from rbm_cli.base.guard import arm, disarm
+from rbm_cli.base.jit import plain
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.rbm.exact.piece import new_cache

@@ -41,8 +41,8 @@ from functools import partial
 import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
-from rbm_cli.base.jit import plain
 from rbm_cli.base.guard import arm, disarm, poll
+from rbm_cli.base.jit import plain
 from rbm_cli.models.outcome import EnergyAccount, Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.step.inputs import (
     PreparedModel,

@@ -8,9 +8,9 @@ import math
 import numpy as np
 
 from rbm_cli.base.detmath import matvec, pow_pos
+from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
-from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.models.rbm.pieces import (
     IMPACT,
     UPLIFT,

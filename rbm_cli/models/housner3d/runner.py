@@ -1,0 +1,377 @@
+"""`housner-3d`: the rigid cylinder rocking and rolling on its rim under a ground motion in
+any horizontal direction (excitation.angle), with its true geometry and large rotations.
+
+The equations are rbm_cli.physics.cylinder's, integrated by scipy's DOP853 (RK45, RK23)
+driven step by step like `housner`'s, with the events located on each step's dense output:
+
+- **uplift**: at rest, the column lifts when |a_g| exceeds (g + a_v) tan(alpha), onto the
+  rim's point away from the ground's acceleration (Housner's rule in the motion's plane);
+- **impact**: near the vertical the contact direction is pinned (rbm_cli.physics.cylinder,
+  UPRIGHT_LEAN): a lean that comes within UPRIGHT_LEAN sin(alpha) of the vertical is then
+  followed, its contact held where it leaned as it came in, until it crosses the line
+  across that direction (theta = 0 exactly in a vertical plane) or turns away: the base
+  strikes the ground flat there. The horizontal angular velocity is multiplied by the
+  restitution e (Housner's coefficient of the cylinder's planar block with ``restitution:
+  housner``), the spin about the axis is kept, the lean is set upright, and the column
+  rocks on toward where its axis now moves, its contact pinned there until the lean is
+  LEAVE_FACTOR times that distance out. A lean that passes farther from the vertical is
+  no impact: the contact point runs round the rim (rolling, Srinivasan and Ruina 2008).
+  In a vertical plane this is Housner's impact (theta' <- e theta', the side flips);
+- **collapse**: the tilt reaches collapse.ratio alpha (collapse_interface 1); the domain's
+  azimuth of collapse is where the lean then points;
+- **rest**: a post-impact rate below REST_RATE p alpha rests the column upright.
+
+The peak tilt is found where the tilt's rate turns (Brent's method on the dense output);
+max_rotation_ratio is the peak tilt over alpha, in whatever direction. The top's
+displacement is the largest distance in plan of the top's centre from where it stood
+(rolling moves the base), at the step ends and peaks. A run stops early only at rest after
+the motion; a wobbling column's later peaks can exceed its earlier ones, so a free motion
+below the collapse barrier is integrated to its end.
+
+A recorded history's rotation is the tilt seen in the motion's vertical plane, atan2(q .
+d, n_z) with d the motion's direction: Housner's theta for a motion that stays in that
+plane.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from scipy.integrate import DOP853, RK23, RK45
+from scipy.optimize import brentq
+
+from rbm_cli.base.knots import clip_at_knots
+from rbm_cli.config.types import G, SolverConfig
+from rbm_cli.models import methods
+from rbm_cli.models.block.base import BlockRunner
+from rbm_cli.models.events import EVENT_EPS, first_crossing
+from rbm_cli.models.housner.state import BlockRun
+from rbm_cli.models.methods import step_method
+from rbm_cli.models.outcome import Outcome
+from rbm_cli.physics.arrays import REST_RATE
+from rbm_cli.physics.cylinder import (
+    STATE_SIZE,
+    CylinderGeometry,
+    axis,
+    cylinder_geometry,
+    lean_direction,
+    rolling_rates,
+    tilt,
+    top_in_plan,
+    uplift_level,
+)
+from rbm_cli.physics.excitation import GroundMotion
+
+_METHODS = {m.__name__: clip_at_knots(m) for m in (DOP853, RK45, RK23)}
+
+
+@dataclasses.dataclass
+class _Run3d(BlockRun):
+    """BlockRun with the state y (q, w, centre in plan), the contact direction c at q = 0,
+    and the largest distance of the top from where it stood [m]."""
+
+    y: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(STATE_SIZE))
+    c: np.ndarray = dataclasses.field(default_factory=lambda: np.array([1.0, 0.0]))
+    top_max: float = 0.0
+    azimuth: float = math.nan
+    phase: int = 0  # LEAVING, FREE or APPROACH (near the vertical)
+
+
+class _Column:
+    """The cylinder's constants and the run's ground: g_e(t) and the event rows."""
+
+    def __init__(self, geo: CylinderGeometry, motion: GroundMotion, forced: bool, out: Outcome):
+        self.geo, self.out = geo, out
+        self.d = motion.direction
+        self.accel = motion.scalar(forced)
+        self.gravity = motion.gravity(forced)
+
+    def ge(self, t: float) -> np.ndarray:
+        """g_e = (-a_g d, -(g + a_v)) [m/s^2]."""
+        a = self.accel(t)
+        gz = G if self.gravity is None else G * self.gravity(t)
+        return np.array([-a * self.d[0], -a * self.d[1], -gz])
+
+
+def _rates(y: np.ndarray) -> np.ndarray:
+    """q' = (w x n) in plan, for states y (7,) or (7, m)."""
+    q, w = y[0:2], y[2:5]
+    s2 = q[0] * q[0] + q[1] * q[1]
+    nz = np.sqrt(np.maximum(0.0, 1.0 - s2))
+    return np.array([w[1] * nz - w[2] * q[1], w[2] * q[0] - w[0] * nz])
+
+
+def _history_angle(y: np.ndarray, d: np.ndarray) -> tuple[float, float]:
+    """The tilt seen in the motion's vertical plane [rad] and its rate [rad/s]."""
+    q = y[0:2]
+    along = float(q[0] * d[0] + q[1] * d[1])
+    nz = float(axis(q)[2])
+    dq = _rates(y)
+    d_along = float(dq[0] * d[0] + dq[1] * d[1])
+    d_nz = -float(q[0] * dq[0] + q[1] * dq[1]) / nz if nz > 0.0 else 0.0
+    den = along * along + nz * nz
+    return math.atan2(along, nz), (nz * d_along - along * d_nz) / den if den > 0.0 else 0.0
+
+
+def cylinder_run(
+    geo: CylinderGeometry,
+    motion: GroundMotion,
+    restitution: float,
+    collapse_ratio: float = 1.0,
+    solver: SolverConfig = SolverConfig(),  # noqa: B008 (frozen dataclass)
+    record: bool = False,
+    output_dt: float = 0.002,
+    *,
+    initial: tuple[float, float] = (0.0, 0.0),
+    early_stop: bool = True,
+    events: list | None = None,
+) -> Outcome:
+    """One run of the rigid cylinder in three dimensions (the module's rules).
+
+    Parameters
+    ----------
+    geo : CylinderGeometry  The cylinder (rbm_cli.physics.cylinder)
+    motion : GroundMotion  a_g(t) [m/s^2] along motion.direction, a_v(t), simulated time [s]
+    restitution : float  e [-] in (0, 1]
+    collapse_ratio : float  Collapse at a tilt of collapse_ratio alpha [-]
+    solver : SolverConfig  Runge-Kutta pair, rtol, atol (scaled by alpha [rad], p alpha
+        [rad/s] and h alpha [m]), step and event budgets
+    record : bool  Keep samples every output_dt [s] (the module's history angle)
+    initial : (float, float)  Initial tilt [rad] and its rate [rad/s] in the motion's plane
+    early_stop : bool  Stop at rest after the motion
+    events : list or None  If a list, (t [s], kind) is appended for every 'uplift',
+        'impact', 'rest' and 'collapse'
+
+    Returns
+    -------
+    Outcome  max_ratio: [peak tilt / alpha]; max_top: the top's largest distance in plan
+        from where it stood [m].
+    """
+    if not 0.0 < restitution <= 1.0:
+        raise ValueError("restitution must be in (0, 1]")
+    alpha, p = geo.slenderness, geo.block.frequency_parameter
+    limit = collapse_ratio * alpha
+    d = motion.direction
+    run = _Run3d(
+        alpha=alpha,
+        limit=limit,
+        **BlockRun.parts(record, output_dt, events),
+        top=lambda peak: 0.0,
+    )
+    run.top = lambda peak: run.top_max
+    theta0, rate0 = float(initial[0]), float(initial[1])
+    side = 1.0 if theta0 > 0.0 or (theta0 == 0.0 and rate0 >= 0.0) else -1.0
+    run.c = side * d
+    run.y[0:2] = math.sin(abs(theta0)) * run.c
+    run.y[2:4] = rate0 * np.array([-d[1], d[0]])  # about the horizontal normal to d
+    run.at_rest = theta0 == 0.0 and rate0 == 0.0
+    run.phase = LEAVING if math.sin(abs(theta0)) <= LEAVE_FACTOR * geo.upright else FREE
+    run.peak = abs(theta0)
+    if run.peak >= limit:
+        run.out.t_collapse, run.out.collapse_interface = 0.0, 1
+        run.azimuth = math.atan2(run.c[1], run.c[0])
+        return _finish(run, "collapsed", "initial rotation beyond the collapse limit")
+    scale = np.array([alpha, alpha, p * alpha, p * alpha, p * alpha])
+    atol = solver.atol * np.concatenate([scale, [geo.centre_height * alpha] * 2])
+    consts = dict(
+        geo=geo, e=restitution, s_limit=math.sin(limit), eps=EVENT_EPS * math.sin(alpha),
+        rest_rate=REST_RATE * p * alpha, level=uplift_level(geo), atol=atol,
+    )  # fmt: skip
+    for seg_start, seg_end in motion.segments():
+        if run.t >= seg_end:
+            continue
+        forced = motion.forced(seg_start)
+        can_stop = early_stop and motion.after_pulse(seg_start)
+        stop = _segment(run, motion, seg_end, forced, can_stop, solver, consts)
+        if stop is not None:
+            return stop
+    return _finish(run)
+
+
+def _finish(run: _Run3d, status: str = "survived", message: str = "") -> Outcome:
+    out = run.finish(status, message)
+    out.azimuth = run.azimuth
+    return out
+
+
+#: The phases of a rocking column near the vertical (rolling_rates' pinned contact):
+#: leaving it after an uplift or an impact (pinned to the side it rocks onto) up to
+#: LEAVE_FACTOR times the pinned lean; free (the lean's own direction); approaching it
+#: within the pinned lean (pinned to where it leaned as it came in), up to the impact.
+LEAVING, FREE, APPROACH = 0, 1, 2
+LEAVE_FACTOR = 2.0
+
+
+def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | None:
+    """Run up to seg_end [s], restarting the stepper at uplifts, impacts and where the
+    lean leaves or comes near the vertical. The Outcome if the run ends here, else None."""
+    out, geo = run.out, k["geo"]
+    col = _Column(geo, motion, forced, out)
+    d = motion.direction
+    while run.t < seg_end:
+        if run.at_rest:
+            kind = run.wait(motion, seg_end, k["level"], forced)
+            if kind == "end":  # no ground motion from here on: rests to the end
+                return _finish(run, message="at rest in free motion: stopped")
+            if kind == "segment":
+                return None
+            run.c, run.y, run.phase = run.side * d, np.zeros(STATE_SIZE), LEAVING
+            if out.n_uplifts + out.n_impacts > solver.max_events:
+                return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+        c0, pinned = run.c.copy(), run.phase != FREE
+
+        def rhs(t, y, c0=c0, pinned=pinned):
+            out.n_rhs += 1
+            return rolling_rates(geo, y, c0, col.ge(t), pinned)
+
+        stepper = _METHODS[step_method(solver)]
+        integ = stepper(rhs, run.t, run.y, seg_end, rtol=solver.rtol, atol=k["atol"])
+        integ.knots = motion.knots if motion.clipped else None
+        kind = _steps(run, integ, k, solver, d)
+        if isinstance(kind, Outcome):
+            return kind
+        if kind == "left":
+            run.phase = FREE
+        elif kind == "near":
+            run.phase, run.c = APPROACH, lean_direction(run.y[0:2], run.c)
+        elif kind == "impact":
+            stop = _impact(run, k, solver)
+            if stop is not None:
+                return stop
+    return None
+
+
+def _steps(run, integ, k, solver, d):
+    """Step until the phase's event, the state on it: 'left' (leaving: the lean is
+    LEAVE_FACTOR pinned leans out), 'near' (free: the lean is within the pinned lean),
+    'impact' (approaching: the lean crosses the line across where it leaned as it came in,
+    or turns away from the vertical), None at the segment's end, or the Outcome when the
+    run ends (a collapse, a budget)."""
+    out, upright, s_limit, eps = run.out, k["geo"].upright, k["s_limit"], k["eps"]
+    phase, c0 = run.phase, run.c
+    while integ.status == "running":
+        t_old = run.t
+        msg = integ.step()
+        if integ.status == "failed":
+            return _fail(run, f"integrator: {msg} at t={run.t:.6g} s")
+        out.n_steps += 1
+        if out.n_steps > solver.max_steps:
+            return _fail(run, f"step budget exceeded ({solver.max_steps} steps)")
+        dense = integ.dense_output()
+
+        def rows(ts, dense=dense):
+            yy = dense(np.atleast_1d(ts))
+            q, dq = yy[0:2], _rates(yy)
+            lean = np.hypot(q[0], q[1])
+            d_lean = (q[0] * dq[0] + q[1] * dq[1]) / np.where(lean > 0.0, lean, 1.0)
+            collapse, d_collapse = s_limit - lean, -d_lean
+            if phase == LEAVING:
+                dist, rate = LEAVE_FACTOR * upright - lean, -d_lean
+                return np.array([dist, collapse]), np.array([rate, d_collapse])
+            if phase == FREE:
+                return np.array([lean - upright, collapse]), np.array([d_lean, d_collapse])
+            across = q[0] * c0[0] + q[1] * c0[1] + eps
+            d_across = dq[0] * c0[0] + dq[1] * c0[1]
+            turned = -d_lean  # > 0 while it comes nearer
+            return (np.array([across, collapse, turned]),
+                    np.array([d_across, d_collapse, np.zeros_like(lean)]))  # fmt: skip
+
+        hit = first_crossing(rows, t_old, integ.t, xtol=1e-15)
+        t_new = integ.t if hit is None else hit[0]
+        _peaks(run, dense, t_old, t_new, k["geo"])
+        if run.rec.samples is not None:
+            _emit(run, dense, t_new, d)
+        run.t, run.y = t_new, dense(t_new) if hit is not None else integ.y.copy()
+        if hit is None:
+            continue
+        if hit[1] == 1:
+            out.t_collapse, out.collapse_interface = run.t, 1
+            run.peak = max(run.peak, run.limit)
+            q = run.y[0:2]
+            run.azimuth = math.atan2(q[1], q[0])
+            run.note((run.t, "collapse"))
+            return _finish(run, "collapsed", "the column reached its collapse limit")
+        return ("left", "near", "impact")[phase]
+    return None
+
+
+def _impact(run, k, solver) -> Outcome | None:
+    """The base strikes flat: horizontal rate times e, spin kept, q = 0, the contact
+    direction where the axis now moves; rest below the rest rate."""
+    out = run.out
+    out.n_impacts += 1
+    run.note((run.t, "impact"))
+    if out.n_uplifts + out.n_impacts > solver.max_events:
+        return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+    y = run.y.copy()
+    y[0:2] = 0.0
+    y[2:4] *= k["e"]
+    moving = np.array([y[3], -y[2]])  # n' = w x e_z in plan
+    speed = math.hypot(moving[0], moving[1])
+    run.phase = LEAVING
+    if speed < k["rest_rate"]:
+        y[2:5] = 0.0
+        run.y, run.at_rest = y, True
+        run.note((run.t, "rest"))
+        return None
+    run.c, run.y = moving / speed, y
+    return None
+
+
+def _peaks(run, dense, t_old, t_new, geo) -> None:
+    """The peak tilt and the top's farthest place on [t_old, t_new]: at the end, and where
+    the tilt's rate turns from rising to falling (Brent on the dense output)."""
+
+    def lean_rate(t):
+        yy = dense(t)
+        dq = _rates(yy)
+        return float(yy[0] * dq[0] + yy[1] * dq[1])
+
+    def consider(y):
+        run.peak = max(run.peak, tilt(y[0:2]))
+        run.top_max = max(run.top_max, float(np.hypot(*top_in_plan(geo, y))))
+
+    consider(dense(t_new))
+    r0, r1 = lean_rate(t_old), lean_rate(t_new)
+    if r0 > 0.0 and r1 < 0.0:
+        consider(dense(brentq(lean_rate, t_old, t_new, xtol=1e-15)))
+
+
+def _emit(run, dense, t_stop, d) -> None:
+    ts = run.rec.times(t_stop)
+    for t in ts:
+        th, rate = _history_angle(dense(t), d)
+        run.rec.emit(np.array([t]), th, rate)
+
+
+def _fail(run: _Run3d, message: str) -> Outcome:
+    out = _finish(run)
+    out.status, out.message = "failed", message
+    return out
+
+
+class Housner3dRunner(BlockRunner):
+    """`housner-3d` (rbm_cli.models.contract.Runner): the config's monolithic circular
+    column as the rigid cylinder rocking and rolling on its rim."""
+
+    def __init__(self, config) -> None:
+        super().__init__(config)
+        self.cylinder = cylinder_geometry(config.column)
+        methods.resolve(config)  # an explicit method that does not apply: refused
+
+    def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
+        method = methods.resolve(self.config, solver).name
+        solver = dataclasses.replace(solver, method=method)  # auto: DOP853
+        out = cylinder_run(
+            self.cylinder,
+            motion,
+            restitution=self.restitution,
+            collapse_ratio=self.config.collapse.ratio,
+            solver=solver,
+            initial=self.initial,
+            **options,
+        )
+        out.method = solver.method
+        return out

@@ -1,0 +1,196 @@
+"""`housner-3d`: the rigid cylinder rocking and rolling on its rim in three dimensions.
+
+Checked against what does not follow its code:
+
+- in a vertical plane its equations are Housner's (the closed form of the planar block,
+  rbm_cli.physics.block's geometry), and a whole run is `housner`'s (an independent
+  integrator of the planar equation) on a grid: outcome, peak and collapse time;
+- its energy is conserved in free rolling, where the cylinder moves in three dimensions;
+- a steady wobble derived by hand here (the centre of mass at rest, the axis precessing at
+  a constant tilt: the balance of angular momentum about the centre gives the rate) stays
+  on its solution;
+- isotropy: the same motion turned to any azimuth gives the same response;
+- the side it lifts to is away from the ground's acceleration, in any direction.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config import parse_config
+from rbm_cli.config.types import G
+from rbm_cli.physics.cylinder import (
+    cylinder_energy,
+    cylinder_geometry,
+    rolling_rates,
+    tilt,
+)
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.study.simulate import simulate
+from rbm_cli.study.sweep import config_hash
+
+COLUMN = {"height": 4.0, "base_width": 1.0, "top_width": 0.8, "section": "circular",
+          "density": 2700}  # fmt: skip
+SOLVER = {"rtol": 1e-10, "atol": 1e-12}
+
+
+def config(model: str = "housner-3d", angle: float = 0.0, kind: str = "harmonic", **exc):
+    excitation = {"type": kind, "duration": 4.0, **exc}
+    if angle:
+        excitation["angle"] = angle
+    return parse_config({
+        "name": "cyl", "model": model, "column": dict(COLUMN),
+        "interface": {"stiffness": "rigid", "restitution": 0.9},
+        "excitation": excitation, "solver": dict(SOLVER),
+    })  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def geo():
+    return cylinder_geometry(config().column)
+
+
+def test_in_a_vertical_plane_the_equations_are_housners(geo):
+    """theta'' = -p^2 [sin(alpha - theta) + (a/g) cos(alpha - theta)] for a lean and rate
+    in the x plane, to round-off; nothing leaves the plane."""
+    alpha, p = geo.slenderness, geo.block.frequency_parameter
+    for theta, rate, a in [(0.05, 0.3, 1.2), (0.2, -0.5, -3.0), (0.0, 0.4, 2.0), (0.26, 0.0, 0.0)]:
+        y = np.zeros(7)
+        y[0], y[3] = math.sin(theta), rate
+        dy = rolling_rates(geo, y, np.array([1.0, 0.0]), np.array([-a, 0.0, -G]))
+        housner = -p * p * (math.sin(alpha - theta) + a / G * math.cos(alpha - theta))
+        assert dy[3] == pytest.approx(housner, rel=1e-13, abs=1e-13)
+        assert dy[0] == pytest.approx(rate * math.cos(theta), rel=1e-15)
+        assert dy[1] == 0.0 and dy[2] == 0.0 and dy[4] == 0.0 and dy[6] == 0.0
+
+
+def test_energy_is_conserved_in_free_rolling(geo):
+    """A lean, a tilt rate, a rolling rate and a spin: the motion is three-dimensional
+    (the lean turns), its energy constant to 1e-11 of its kinetic energy at the start."""
+    y0 = np.zeros(7)
+    y0[0], y0[2:5] = math.sin(0.1), (0.3, 0.1, 0.5)
+    c0, ge = np.array([1.0, 0.0]), np.array([0.0, 0.0, -G])
+    sol = solve_ivp(lambda t, y: rolling_rates(geo, y, c0, ge), (0.0, 0.4), y0,
+                    method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)  # fmt: skip
+    ys = sol.sol(np.linspace(0.0, 0.4, 9))
+    turned = math.atan2(ys[1, -1], ys[0, -1])
+    assert abs(turned) > 0.05  # the lean has turned: the motion is not planar
+    energies = [cylinder_energy(geo, ys[:, i], c0) for i in range(ys.shape[1])]
+    kinetic0 = energies[0] - cylinder_energy(geo, np.r_[y0[:2], 0.0, 0.0, 0.0, 0.0, 0.0], c0)
+    assert max(energies) - min(energies) < 1e-11 * kinetic0
+
+
+@pytest.mark.parametrize("theta", [0.05, 0.15])
+def test_a_steady_wobble_stays_on_its_solution(geo, theta):
+    """The centre of mass at rest, the axis at a constant tilt theta precessing at Omega
+    about the vertical: w = lambda r (v_G = w x r = 0) with lambda = Omega sin(theta) / R,
+    and Omega e_z x (I_G w) = m r x g_e gives, with the cylinder's h, R, I_t, I_a,
+
+        Omega^2 = m g R (R cos theta - h sin theta) / (sin theta (I_t R cos theta
+                  - I_a h sin theta)).
+
+    Over three turns the tilt stays theta to 1e-12, the lean turns at Omega and the
+    centre stays put."""
+    m, rad, h = geo.mass, geo.radius, geo.centre_height
+    i_t, i_a = geo.transverse, geo.axial
+    st, ct = math.sin(theta), math.cos(theta)
+    omega = math.sqrt(m * G * rad * (rad * ct - h * st) / (st * (i_t * rad * ct - i_a * h * st)))
+    n = np.array([st, 0.0, ct])
+    u = np.array([ct, 0.0, -st])
+    y0 = np.zeros(7)
+    y0[0], y0[2:5] = st, omega * st / rad * (h * n - rad * u)
+    c0, ge = np.array([1.0, 0.0]), np.array([0.0, 0.0, -G])
+    period = 2.0 * math.pi / omega
+    sol = solve_ivp(lambda t, y: rolling_rates(geo, y, c0, ge), (0.0, 3 * period), y0,
+                    method="DOP853", rtol=1e-12, atol=1e-14, dense_output=True)  # fmt: skip
+    ts = np.linspace(0.0, 3 * period, 25)
+    ys = sol.sol(ts)
+    for i, t in enumerate(ts):
+        assert abs(tilt(ys[0:2, i]) - theta) < 1e-12
+        turned = math.atan2(ys[1, i], ys[0, i]) - omega * t
+        assert abs(math.remainder(turned, 2 * math.pi)) < 1e-10
+        assert np.hypot(ys[5, i], ys[6, i]) < 1e-12
+
+
+#: A grid across uplift, rocking with many impacts, and collapse.
+GRID = [(0.3, 1.0), (0.4, 1.0), (0.3, 2.0), (0.6, 1.5), (0.8, 2.5), (1.0, 0.5), (0.5, 0.7)]
+
+
+@pytest.fixture(scope="module")
+def planar():
+    return {cell: simulate(config("housner"), *cell) for cell in GRID}
+
+
+@pytest.fixture(scope="module")
+def along_x():
+    return {cell: simulate(config(), *cell) for cell in GRID}
+
+
+def test_along_x_it_is_housners_block(planar, along_x):
+    """The same outcome, impacts and uplifts on every cell; peaks and collapse times to
+    1e-8 relative (the planar runs agree with each other to that on these cells)."""
+    collapsed = 0
+    for cell in GRID:
+        a, b = planar[cell], along_x[cell]
+        assert (a.status, a.n_impacts, a.n_uplifts) == (b.status, b.n_impacts, b.n_uplifts), cell
+        assert b.max_rotation_ratio == pytest.approx(a.max_rotation_ratio, rel=1e-8), cell
+        if a.status == "collapsed":
+            collapsed += 1
+            assert b.t_collapse_s == pytest.approx(a.t_collapse_s, rel=1e-8), cell
+    assert 0 < collapsed < len(GRID)
+
+
+@pytest.mark.parametrize("angle", [37.0, 90.0, -123.0])
+def test_a_turned_motion_gives_the_same_response(along_x, angle):
+    """Isotropy: the motion turned to any azimuth, the same outcome, impacts, peak and
+    collapse time to 1e-8 on every cell of the grid (the motion stays in its plane: no
+    cell here leaves it through round-off)."""
+    for cell in GRID:
+        a, b = along_x[cell], simulate(config(angle=angle), *cell)
+        assert (a.status, a.n_impacts, a.n_uplifts) == (b.status, b.n_impacts, b.n_uplifts), cell
+        assert b.max_rotation_ratio == pytest.approx(a.max_rotation_ratio, rel=1e-8), cell
+        if a.status == "collapsed":
+            assert b.t_collapse_s == pytest.approx(a.t_collapse_s, rel=1e-8), cell
+
+
+@pytest.mark.parametrize("angle", [0.0, 37.0, -123.0])
+def test_it_lifts_and_falls_away_from_the_grounds_acceleration(angle):
+    """A strong half-sine pulse (positive first) overturns the column toward the opposite
+    of the motion's direction: the azimuth of collapse is angle + 180 degrees."""
+    cfg = config(angle=angle, kind="half-sine")
+    motion = make_ground_motion(cfg.excitation, 3.0, 1.0)
+    from rbm_cli.models.registry import make_runner
+
+    out = make_runner(cfg).run(motion, cfg.solver)
+    assert out.status == "collapsed"
+    expected = math.radians(angle + 180.0)
+    assert abs(math.remainder(out.azimuth - expected, 2 * math.pi)) < 1e-9
+
+
+def test_the_config_refuses_what_the_model_cannot_take():
+    """A rectangular column for housner-3d, and a turned motion for a planar model, are
+    refused in one line; an angle of 0 leaves a config's hash as it was."""
+    raw = {"name": "c", "model": "housner-3d", "column": {"height": 4.0, "base_width": 1.0}}
+    with pytest.raises(RbmError, match="needs column.section: circular") as err:
+        parse_config(raw)
+    assert "\n" not in str(err.value)
+    planar = {"name": "c", "model": "housner", "column": dict(COLUMN),
+              "excitation": {"type": "harmonic", "angle": 30.0}}  # fmt: skip
+    with pytest.raises(RbmError, match="excitation.angle turns the motion") as err:
+        parse_config(planar)
+    assert "housner-3d" in str(err.value) and "\n" not in str(err.value)
+    with pytest.raises(RbmError, match="excitation.angle"):
+        parse_config({**planar, "model": "housner-3d",
+                      "excitation": {"type": "harmonic", "angle": 400.0}})  # fmt: skip
+    zero = parse_config({**planar, "excitation": {"type": "harmonic", "angle": 0.0}})
+    none = parse_config({**planar, "excitation": {"type": "harmonic"}})
+    assert config_hash(zero) == config_hash(none)
+    turned = parse_config({**planar, "model": "housner-3d"})
+    assert config_hash(turned) != config_hash(
+        parse_config({**planar, "model": "housner-3d", "excitation": {"type": "harmonic"}})
+    )

@@ -160,8 +160,8 @@ def test_free_rocking_conserves_energy_at_the_closed_form_period():
     - theta^2/2) at every sample equals its initial value to round-off for housner-linear's
     impacts (at theta = 0); the RBM's (where s theta = -eps, then projected onto 0) each
     add p^2 alpha eps, no more; the impacts come at T/4, 3T/4, ... of free_rocking_period."""
+    from rbm_cli.base.events import EVENT_EPS
     from rbm_cli.models.block.closed_form import linear_block, rbm_block, run_closed_form
-    from rbm_cli.models.events import EVENT_EPS
 
     cfg = parse_config({"name": "free", "column": COLUMN, "interface": {"restitution": 1.0},
                         "excitation": {"type": "free", "duration": 8.0,

@@ -1,4 +1,4 @@
-"""Unit tests of the event search of a solver step (rbm_cli.models.events).
+"""Unit tests of the event search of a solver step (rbm_cli.base.events).
 
 The functions are given distances whose crossings are known in closed form, so
 the expected times come from the formulas, not from the code.
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rbm_cli.models.events import first_crossing, hermite_dip
+from rbm_cli.base.events import first_crossing, hermite_dip
 from rbm_cli.models.rbm.step.events import within_reach
 
 

@@ -30,9 +30,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.config.load import load_config
 from rbm_cli.models.block.closed_form import linear_run
-from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.models.rbm.exact.bounds import FULL, THIRD, empty_bounds, row_lower, track_upper
 from rbm_cli.models.rbm.exact.integrate import integrate_exact
 from rbm_cli.models.rbm.exact.modal import advance

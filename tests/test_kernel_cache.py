@@ -207,7 +207,7 @@ def test_the_key_covers_every_compiled_module():
     compiled = _compiled_modules(PACKAGE)
     assert len(compiled) >= 7  # detmath and the kernel's modules today
     assert compiled <= sources
-    # run_kernel reads EVENT_EPS and BIG of models/events.py: frozen into its code
+    # run_kernel reads EVENT_EPS and BIG of base/events.py: frozen into its code
     assert PACKAGE / "models" / "events.py" in sources
     # a module no compiled function reads from does not make the kernel compile again
     assert PACKAGE / "cli" / "main.py" not in sources

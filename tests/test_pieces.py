@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
+from rbm_cli.base.events import BIG, EVENT_EPS
 from rbm_cli.base.jit import plain
 from rbm_cli.config.load import load_config
-from rbm_cli.models.events import BIG, EVENT_EPS
 from rbm_cli.models.rbm import pieces as compiled
 from rbm_cli.physics.arrays import rest_levels
 from rbm_cli.physics.assembly import model_from_config

@@ -397,7 +397,7 @@ def test_a_motion_given_as_arrays_is_processed_as_its_file(folder):
 
 
 def _history(ground_m, top_m):
-    from rbm_cli.models.result import History
+    from rbm_cli.models.history import History
 
     t = np.linspace(0.0, 10.0, 501)
     rel = top_m * np.sin(2 * np.pi * t)

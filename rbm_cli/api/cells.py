@@ -14,9 +14,9 @@ from rbm_cli.api.configs import as_config, check_cell, check_output_dt
 from rbm_cli.api.motions import Motion, motion_config
 from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.types import Config
-from rbm_cli.models.result import CSV_FIELDS, RunResult
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import history_frame, vertical_history
+from rbm_cli.study.result import CSV_FIELDS, RunResult
 from rbm_cli.study.simulate import simulate
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` never does
@@ -100,7 +100,7 @@ class CellResult(Mapping):
 
     @property
     def run_result(self) -> RunResult:
-        """The model's RunResult it was read from (rbm_cli.models.result)."""
+        """The model's RunResult it was read from (rbm_cli.study.result)."""
         return self._run
 
 

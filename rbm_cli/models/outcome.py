@@ -1,7 +1,7 @@
 """The raw outcome of one run, the one type every model's runner returns.
 
 study.simulate adds the cell (amplitude, frequency) and the wall time and turns it into a
-rbm_cli.models.result.RunResult, the row of a domain.
+rbm_cli.study.result.RunResult, the row of a domain.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from rbm_cli.models.result import History
+from rbm_cli.models.history import History
 
 
 class EnergyAccount(NamedTuple):

@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rbm_cli.models.result import History
+from rbm_cli.models.history import History
 from rbm_cli.report.shape_geometry import base_slip, drum_outlines, round_factor
 
 #: Target of the shape exaggeration: largest drawn top displacement / height.
@@ -85,7 +85,7 @@ def plot_history(
     displacement of the top node. Harmonic runs use the steady ground motion
     u_g = -a_g / omega^2; pulses and records the ground's displacement integrated from
     rest (a record's after its processing, excitation.processing) (see
-    :class:`rbm_cli.models.result.History`).
+    :class:`rbm_cli.models.history.History`).
     """
     ax = _new_axes(ax)
     t = np.asarray(history.t, dtype=float)

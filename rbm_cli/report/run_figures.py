@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rbm_cli.models.result import History
+from rbm_cli.models.history import History
 
 #: Number of deformed shapes drawn in shapes.png.
 N_SHAPES = 6

@@ -28,7 +28,7 @@ from rbm_cli.base.files import (
     write_chunks_atomic,
     write_json_atomic,
 )
-from rbm_cli.models.result import History, RunResult
+from rbm_cli.models.history import History
 from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figures, here before)
     N_SHAPES,
     RUN_PNGS,
@@ -37,6 +37,7 @@ from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figure
     run_title,
     shape_instants,
 )
+from rbm_cli.study.result import RunResult
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -19,10 +19,10 @@ from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import Motion
 from rbm_cli.config.points import GridPoint, expand
 from rbm_cli.config.types import Config
-from rbm_cli.models.result import SLIDES_FIELD
 from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
 from rbm_cli.study.domain import cell_key, row_key
 from rbm_cli.study.intensities import column_period, measure_fields, measure_values
+from rbm_cli.study.result import SLIDES_FIELD
 
 Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
 

@@ -1,7 +1,7 @@
 """Safe-unsafe domains as tables: rows, CSV text, boundary, comparison.
 
 A domain is a pandas DataFrame with the columns of domain.csv
-(:data:`rbm_cli.models.result.CSV_FIELDS`), one row per (amplitude, frequency) cell, or
+(:data:`rbm_cli.study.result.CSV_FIELDS`), one row per (amplitude, frequency) cell, or
 the list of its rows (dicts) a sweep makes. pandas is imported where a DataFrame is built
 or read, not with this module: a sweep writes domain.csv and boundary.csv from its rows
 (:func:`csv_text`, :func:`boundary_table`) without it.
@@ -21,7 +21,6 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
-from rbm_cli.models.result import CSV_FIELDS, STATUSES
 from rbm_cli.study.boundary_lines import BOUNDARY_FIELDS as BOUNDARY_FIELDS
 from rbm_cli.study.boundary_lines import MAJORITY as MAJORITY
 from rbm_cli.study.boundary_lines import MEMBER0_FIELDS as MEMBER0_FIELDS
@@ -29,6 +28,7 @@ from rbm_cli.study.boundary_lines import axis_columns as axis_columns
 from rbm_cli.study.boundary_lines import boundary as boundary
 from rbm_cli.study.boundary_lines import boundary_table as boundary_table
 from rbm_cli.study.boundary_lines import line_ident, line_order, line_row
+from rbm_cli.study.result import CSV_FIELDS, STATUSES
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 
-from rbm_cli.models.result import STATUSES
 from rbm_cli.study.domain import row_key
+from rbm_cli.study.result import STATUSES
 
 COUNT_FIELDS = ("n_uplifts", "n_impacts", "n_steps", "n_rhs")
 

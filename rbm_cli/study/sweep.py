@@ -29,7 +29,6 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import Config, hash_form
 from rbm_cli.models.methods import compiled_code
-from rbm_cli.models.result import CSV_FIELDS
 from rbm_cli.study.cells import (
     Cell,
     add_point,
@@ -46,6 +45,7 @@ from rbm_cli.study.cells import (
 from rbm_cli.study.domain import csv_text, parse_domain
 from rbm_cli.study.intensities import column_period
 from rbm_cli.study.parallel import run_chunks
+from rbm_cli.study.result import CSV_FIELDS
 from rbm_cli.study.robustness import member_config, members, summarise
 from rbm_cli.study.store import JOURNAL, SweepStore
 from rbm_cli.study.sweep_folder import (

@@ -3,7 +3,7 @@
 - :func:`zero_crossings` and :func:`period_from_crossings`: the rocking period of a
   recorded history (t, theta, theta'), from its zero crossings on the cubic Hermite
   interpolant, found by the integrator's own crossing search
-  (:func:`rbm_cli.models.events.first_crossing`).
+  (:func:`rbm_cli.base.events.first_crossing`).
 - :func:`linear_domain`: the closed-form (housner-linear) domain over a config's grid.
 - :func:`differing_cells`: the cells where two domains disagree, and whether each is
   next to the boundary.
@@ -16,9 +16,9 @@ import math
 import numpy as np
 import pandas as pd
 
+from rbm_cli.base.events import first_crossing
 from rbm_cli.config.types import Config
 from rbm_cli.models.block.closed_form import linear_run
-from rbm_cli.models.events import first_crossing
 from rbm_cli.physics.excitation import make_ground_motion
 
 
@@ -58,7 +58,7 @@ def zero_crossings(t, theta, rate) -> np.ndarray:
     -------
     (c,) array  One time per sample interval where theta changes sign strictly [s]:
         the first zero of the interval's cubic Hermite, found by
-        :func:`rbm_cli.models.events.first_crossing` (Brent's method, xtol 1e-15 of the
+        :func:`rbm_cli.base.events.first_crossing` (Brent's method, xtol 1e-15 of the
         interval).
 
     Notes

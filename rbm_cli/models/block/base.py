@@ -8,8 +8,8 @@ import numpy as np
 
 from rbm_cli.config.types import Config, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
+from rbm_cli.models.history import history_from_samples
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.result import history_from_samples
 from rbm_cli.physics.block import block_geometry, block_initial
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.restitution import block_restitution, resolve

@@ -36,6 +36,7 @@ import numpy as np
 
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.errors import RbmError
+from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import CLOSED_FORM_KINDS, G, SolverConfig
@@ -49,7 +50,6 @@ from rbm_cli.models.block.run import (
     T_SLIP,
     run_block,
 )
-from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.models.methods import model_why_not
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.modal import LINEAR

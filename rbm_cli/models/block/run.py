@@ -32,6 +32,7 @@ import math
 
 import numpy as np
 
+from rbm_cli.base.events import STOP_MARGIN
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.models.block.piece import (
@@ -58,7 +59,6 @@ from rbm_cli.models.block.piece import (
     scan_piece,
     start_piece,
 )
-from rbm_cli.models.events import STOP_MARGIN
 from rbm_cli.models.rbm.exact.modal import (
     LINEAR,
     ZERO,

@@ -66,8 +66,8 @@ from rbm_cli.models.bullet.watch import (
     RunWatch,
 )
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
+from rbm_cli.models.history import History
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.result import History
 from rbm_cli.physics.excitation import GroundMotion
 
 __all__ = [

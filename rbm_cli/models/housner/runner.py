@@ -28,11 +28,11 @@ import math
 import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 
+from rbm_cli.base.events import EVENT_EPS, STOP_MARGIN, first_crossing, hermite_dip
 from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.config.types import G, SolverConfig
 from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
-from rbm_cli.models.events import EVENT_EPS, STOP_MARGIN, first_crossing, hermite_dip
 from rbm_cli.models.housner.state import BlockRun, Recorder
 from rbm_cli.models.housner.steps import (
     HousnerBlock,

@@ -1,36 +1,24 @@
-"""`housner-3d`: the rigid cylinder rocking and rolling on its rim under a ground motion in
-any horizontal direction (excitation.angle), with its true geometry and large rotations.
+"""`housner-3d`: the rigid cylinder rocking and rolling on its rim (rbm_cli.physics.cylinder)
+under a ground motion in any horizontal direction, integrated by scipy's DOP853 (RK45,
+RK23) step by step like `housner`, the events located on each step's dense output:
 
-The equations are rbm_cli.physics.cylinder's, integrated by scipy's DOP853 (RK45, RK23)
-driven step by step like `housner`'s, with the events located on each step's dense output:
+- **uplift** when |a_g| exceeds (g + a_v) tan(alpha), onto the rim's point away from a_g;
+- **impact** where the lean crosses the vertical. Within UPRIGHT_LEAN sin(alpha) of it
+  the contact is pinned: a lean that comes that near is followed, its contact held where
+  it leaned as it came in, until it crosses the line across that direction (theta = 0
+  exactly in a plane) or turns away. The horizontal angular velocity then becomes e times
+  itself, the spin about the axis is kept, the lean is set upright, and the column rocks
+  on toward where its axis moves, pinned until its lean is LEAVE_FACTOR times that
+  distance out. A lean that passes farther from the vertical rolls round it (Srinivasan
+  and Ruina 2008). In a plane this is Housner's impact (theta' <- e theta');
+- **collapse** at a tilt of collapse.ratio alpha (Outcome.azimuth: where it leaned);
+- **rest** after an impact below REST_RATE p alpha.
 
-- **uplift**: at rest, the column lifts when |a_g| exceeds (g + a_v) tan(alpha), onto the
-  rim's point away from the ground's acceleration (Housner's rule in the motion's plane);
-- **impact**: near the vertical the contact direction is pinned (rbm_cli.physics.cylinder,
-  UPRIGHT_LEAN): a lean that comes within UPRIGHT_LEAN sin(alpha) of the vertical is then
-  followed, its contact held where it leaned as it came in, until it crosses the line
-  across that direction (theta = 0 exactly in a vertical plane) or turns away: the base
-  strikes the ground flat there. The horizontal angular velocity is multiplied by the
-  restitution e (Housner's coefficient of the cylinder's planar block with ``restitution:
-  housner``), the spin about the axis is kept, the lean is set upright, and the column
-  rocks on toward where its axis now moves, its contact pinned there until the lean is
-  LEAVE_FACTOR times that distance out. A lean that passes farther from the vertical is
-  no impact: the contact point runs round the rim (rolling, Srinivasan and Ruina 2008).
-  In a vertical plane this is Housner's impact (theta' <- e theta', the side flips);
-- **collapse**: the tilt reaches collapse.ratio alpha (collapse_interface 1); the domain's
-  azimuth of collapse is where the lean then points;
-- **rest**: a post-impact rate below REST_RATE p alpha rests the column upright.
-
-The peak tilt is found where the tilt's rate turns (Brent's method on the dense output);
-max_rotation_ratio is the peak tilt over alpha, in whatever direction. The top's
-displacement is the largest distance in plan of the top's centre from where it stood
-(rolling moves the base), at the step ends and peaks. A run stops early only at rest after
-the motion; a wobbling column's later peaks can exceed its earlier ones, so a free motion
-below the collapse barrier is integrated to its end.
-
-A recorded history's rotation is the tilt seen in the motion's vertical plane, atan2(q .
-d, n_z) with d the motion's direction: Housner's theta for a motion that stays in that
-plane.
+max_rotation_ratio is the peak tilt over alpha in any direction (Brent on the dense output
+where the tilt turns); max_top the top centre's largest distance in plan from where it
+stood (rolling moves the base), at step ends and peaks. A run stops early only at rest
+after the motion (a wobbling column's later peaks can exceed its earlier ones). A history's
+rotation is the tilt in the motion's vertical plane: Housner's theta in a planar motion.
 """
 
 from __future__ import annotations
@@ -42,11 +30,11 @@ import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 from scipy.optimize import brentq
 
+from rbm_cli.base.events import EVENT_EPS, first_crossing
 from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.config.types import G, SolverConfig
 from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
-from rbm_cli.models.events import EVENT_EPS, first_crossing
 from rbm_cli.models.housner.state import BlockRun
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import Outcome
@@ -79,20 +67,15 @@ class _Run3d(BlockRun):
     phase: int = 0  # LEAVING, FREE or APPROACH (near the vertical)
 
 
-class _Column:
-    """The cylinder's constants and the run's ground: g_e(t) and the event rows."""
+def _ground(motion: GroundMotion, forced: bool):
+    """g_e(t) = (-a_g(t) d, -(g + a_v(t))) [m/s^2] of a segment, d the motion's direction."""
+    d, accel, gravity = motion.direction, motion.scalar(forced), motion.gravity(forced)
 
-    def __init__(self, geo: CylinderGeometry, motion: GroundMotion, forced: bool, out: Outcome):
-        self.geo, self.out = geo, out
-        self.d = motion.direction
-        self.accel = motion.scalar(forced)
-        self.gravity = motion.gravity(forced)
+    def ge(t: float) -> np.ndarray:
+        a = accel(t)
+        return np.array([-a * d[0], -a * d[1], -(G if gravity is None else G * gravity(t))])
 
-    def ge(self, t: float) -> np.ndarray:
-        """g_e = (-a_g d, -(g + a_v)) [m/s^2]."""
-        a = self.accel(t)
-        gz = G if self.gravity is None else G * self.gravity(t)
-        return np.array([-a * self.d[0], -a * self.d[1], -gz])
+    return ge
 
 
 def _rates(y: np.ndarray) -> np.ndarray:
@@ -208,7 +191,7 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
     """Run up to seg_end [s], restarting the stepper at uplifts, impacts and where the
     lean leaves or comes near the vertical. The Outcome if the run ends here, else None."""
     out, geo = run.out, k["geo"]
-    col = _Column(geo, motion, forced, out)
+    ge = _ground(motion, forced)
     d = motion.direction
     while run.t < seg_end:
         if run.at_rest:
@@ -224,7 +207,7 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
 
         def rhs(t, y, c0=c0, pinned=pinned):
             out.n_rhs += 1
-            return rolling_rates(geo, y, c0, col.ge(t), pinned)
+            return rolling_rates(geo, y, c0, ge(t), pinned)
 
         stepper = _METHODS[step_method(solver)]
         integ = stepper(rhs, run.t, run.y, seg_end, rtol=solver.rtol, atol=k["atol"])

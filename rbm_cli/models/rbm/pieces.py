@@ -20,8 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from rbm_cli.base.detmath import dot, matvec
+from rbm_cli.base.events import BIG, EVENT_EPS
 from rbm_cli.base.jit import jit
-from rbm_cli.models.events import BIG, EVENT_EPS
 
 #: What crossing a bound of a piece is (cross returns it): leaving the elastic branch, another
 #: piece of the same side, a zero crossing after an excursion (the side flips).

@@ -15,9 +15,9 @@ import numpy as np
 
 from rbm_cli.config.types import Config, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
+from rbm_cli.models.history import history_from_samples
 from rbm_cli.models.methods import resolve
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.models.result import history_from_samples
 from rbm_cli.physics.assembly import SHAPE_CHANGE, model_from_config, shape_change
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion

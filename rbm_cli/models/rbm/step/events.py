@@ -1,5 +1,5 @@
 """Event search for the compiled kernel (numba): the earliest crossing on the dense output
-and cubic Hermite dips (as rbm_cli.models.events), the event distances of a state, and the
+and cubic Hermite dips (as rbm_cli.base.events), the event distances of a state, and the
 linear system and energy of the current law pieces (the pieces themselves:
 rbm_cli.models.rbm.pieces); the moving kinks of a vertical record are step.vertical's (the
 exact uplift time of a rigid block at rest is in physics.ground, time-history sampling in

@@ -20,9 +20,9 @@ the moving part is mv_e m(gam; mv_w), and the row's h0 keeps only EVENT_EPS.
 
 from __future__ import annotations
 
+from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
-from rbm_cli.models.events import EVENT_EPS
 from rbm_cli.physics.ground import gravity_factor
 
 

@@ -1,6 +1,7 @@
-"""Event location shared by the integrators written in Python (Housner's block, the
-validation): the offsets of event surfaces, where the first event of a step is, and cubic
-Hermite checks between points (peaks, grazing dips)."""
+"""Event location shared by the integrators written in Python (Housner's block, the rigid
+cylinder, the validation): the offsets of event surfaces, where the first event of a step
+is, and cubic Hermite checks between points (peaks, grazing dips). Nothing here knows a
+column: the rows are whatever distances a model watches."""
 
 from __future__ import annotations
 

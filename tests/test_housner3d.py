@@ -15,6 +15,7 @@ Checked against what does not follow its code:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -194,3 +195,51 @@ def test_the_config_refuses_what_the_model_cannot_take():
     assert config_hash(turned) != config_hash(
         parse_config({**planar, "model": "housner-3d", "excitation": {"type": "harmonic"}})
     )
+
+
+def test_a_wobble_counts_its_turns_and_a_planar_motion_none(geo):
+    """Started on the steady wobble (above) in free motion for three of its periods, a run
+    reports a peak tilt of theta, no impact, and 3 turns of its lean; a planar rocking run
+    (impacts and all) sweeps no angle but round-off's (a lean 2e-6 sin(alpha) from the
+    vertical points within 1e-16 / 2e-6 rad of the motion's plane)."""
+    from rbm_cli.models.housner3d.runner import cylinder_run
+    from rbm_cli.physics.motion import GroundMotion
+
+    theta = 0.1
+    m, rad, h = geo.mass, geo.radius, geo.centre_height
+    i_t, i_a = geo.transverse, geo.axial
+    st, ct = math.sin(theta), math.cos(theta)
+    omega = math.sqrt(m * G * rad * (rad * ct - h * st) / (st * (i_t * rad * ct - i_a * h * st)))
+    n, u = np.array([st, 0.0, ct]), np.array([ct, 0.0, -st])
+    y0 = np.zeros(7)
+    y0[0], y0[2:5] = st, omega * st / rad * (h * n - rad * u)
+    period = 2.0 * math.pi / omega
+    free = GroundMotion("free", 0.0, 1.0, 0.0, 0.0, 3 * period)
+    cfg = config()
+    out = cylinder_run(geo, free, 0.9, solver=cfg.solver, state=y0)
+    assert out.status == "survived" and out.n_impacts == 0
+    assert out.max_ratio[0] == pytest.approx(theta / geo.slenderness, rel=1e-9)
+    assert out.turns == pytest.approx(3.0, rel=1e-8)
+    rocking = simulate(config(angle=37.0), 0.3, 2.0)
+    assert rocking.n_impacts > 10 and rocking.wobble_turns < 1e-6  # round-off only
+    assert math.isnan(rocking.collapse_azimuth_deg)
+
+
+def test_a_domain_of_the_cylinder_has_its_azimuth_and_turns(tmp_path):
+    """domain.csv of housner-3d carries collapse_azimuth_deg (the motion's azimuth plus 180
+    degrees for a harmonic that starts positive, where it collapses before any impact) and
+    wobble_turns; a planar model's domain has neither column."""
+    import rbm
+
+    cfg = config(angle=30.0)
+    cfg = dataclasses.replace(cfg, grid=parse_config({
+        "name": "g", "column": dict(COLUMN), "grid": {"amplitudes": [0.3, 1.2],
+                                                      "frequencies": [0.5]}}).grid)  # fmt: skip
+    df = rbm.sweep(cfg)
+    assert list(df.columns[df.columns.get_loc("max_top_displacement_m") + 1:][:2]) == [
+        "collapse_azimuth_deg", "wobble_turns"]  # fmt: skip
+    fast = df[df.amplitude_g == 1.2].iloc[0]
+    assert fast.status == "collapsed" and fast.n_impacts == 0
+    assert fast.collapse_azimuth_deg == pytest.approx(-150.0, abs=1e-9)
+    planar = rbm.sweep(dataclasses.replace(config("housner"), grid=cfg.grid))
+    assert "collapse_azimuth_deg" not in planar.columns and "wobble_turns" not in planar.columns

@@ -65,8 +65,10 @@ class Outcome:
     history: History | None = None  # the sampled history, made by the runner when recording
     method: str = ""  # the method that ran (solver.method, `auto` resolved), set by the runner
     energy: EnergyAccount | None = None  # a recorded run's energy account, where kept
-    #: a model in three dimensions: where its lean pointed at collapse [rad from x]
+    #: a model in three dimensions: where its lean pointed at collapse [rad from x], and
+    #: the angle its lean's direction swept while it rolled, in turns [-]
     azimuth: float = math.nan
+    turns: float = math.nan
 
     def stop(self, status: str, message: str, t: float) -> Outcome:
         """End the run at time t with a status and a reason."""

@@ -18,11 +18,11 @@ import numpy as np
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import Motion
 from rbm_cli.config.points import GridPoint, expand
-from rbm_cli.config.types import Config
+from rbm_cli.config.types import MODELS, Config
 from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
 from rbm_cli.study.domain import cell_key, row_key
 from rbm_cli.study.intensities import column_period, measure_fields, measure_values
-from rbm_cli.study.result import SLIDES_FIELD
+from rbm_cli.study.result import SLIDES_FIELD, THREE_D_FIELDS
 
 Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
 
@@ -74,13 +74,17 @@ def record_name(config: Config) -> str:
 def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
     """domain.csv's columns: the axis paths, ``record`` (the record's name, for record
     excitations), the result's ``fields`` (with ``slides`` after friction_demand when
-    model rbm's demand is checked against interface.friction), the scales, the record's
-    intensity measures (record excitations only)."""
+    model rbm's demand is checked against interface.friction; the collapse azimuth and the
+    wobbling turns after max_top_displacement_m for a model in three dimensions), the
+    scales, the record's intensity measures (record excitations only)."""
     record = ("record",) if has_records(config) else ()
     fields = tuple(fields)
     if config.model == "rbm" and config.interface.friction_limit is not None:
         at = fields.index("friction_demand") + 1 if "friction_demand" in fields else len(fields)
         fields = fields[:at] + (SLIDES_FIELD,) + fields[at:]
+    if MODELS[config.model].three_d:
+        at = fields.index("max_top_displacement_m") + 1
+        fields = fields[:at] + THREE_D_FIELDS + fields[at:]
     return config.grid.axis_paths + record + fields + SCALE_FIELDS + measure_fields(config)
 
 

@@ -137,7 +137,7 @@ def parse_domain(source, path: str | Path) -> pd.DataFrame:
 INTEGER_COLUMNS = ("collapsed", "collapse_interface", "n_uplifts", "n_impacts", "n_steps",
                    "n_rhs", "robust", "slides")  # fmt: skip
 FLOAT_COLUMNS = ("t_collapse_s", "max_rotation_ratio", "max_top_displacement_m",
-                 "friction_demand",
+                 "friction_demand", "collapse_azimuth_deg", "wobble_turns",
                  "collapse_fraction", "alpha_rad", "p_rad_s", "static_multiplier",
                  "a_over_g_alpha", "omega_over_p", "pga_g", "pgv_m_s", "pgd_m", "arias_m_s",
                  "cav_m_s", "d5_95_s", "t1_s", "sa_t1_g", "pga_over_g_tan_alpha",

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rbm_cli.config.types import MODELS
 from rbm_cli.models.history import History
 
 STATUSES = ("collapsed", "survived", "failed")
@@ -31,6 +32,10 @@ CSV_FIELDS = (
 #: The column a domain of model rbm with interface.friction given adds after
 #: friction_demand: 1 where the demand exceeds the coefficient, else 0.
 SLIDES_FIELD = "slides"
+#: The columns a domain of a model in three dimensions adds after max_top_displacement_m:
+#: the azimuth its lean pointed to at collapse [deg from x, in (-180, 180]; empty if it
+#: survived], and the angle its lean's direction swept while it rolled [turns].
+THREE_D_FIELDS = ("collapse_azimuth_deg", "wobble_turns")
 
 
 @dataclass(frozen=True)
@@ -58,6 +63,10 @@ class RunResult:
         against (interface.friction of model rbm), None: not checked
     slip : (t [s], interface) or None  Where the demand first exceeded friction_limit
         (interface from 1, at the ground); None: it did not, or no check
+    collapse_azimuth_deg : float  Model in three dimensions: where its lean pointed at
+        collapse [deg] (nan: no collapse, or a planar model)
+    wobble_turns : float  Model in three dimensions: the angle its lean's direction swept
+        while it rolled [turns] (nan for a planar model)
     energy : dict or None  A recorded run's energy account [J] (models.outcome.EnergyAccount
         as_dict: start, end, the ground's work, what damping and impacts took, the residual
         of the balance); None where the method keeps none (not in domain.csv)
@@ -83,6 +92,8 @@ class RunResult:
     friction_limit: float | None = None
     slip: tuple[float, int] | None = None
     energy: dict | None = None
+    collapse_azimuth_deg: float = float("nan")
+    wobble_turns: float = float("nan")
 
     @property
     def collapsed(self) -> bool:
@@ -116,6 +127,8 @@ class RunResult:
         out["friction_demand"] = self.domain_friction_demand
         if self.friction_limit is not None:
             out[SLIDES_FIELD] = self.slides
+        if MODELS[self.model].three_d:
+            out.update({k: getattr(self, k) for k in THREE_D_FIELDS})
         return out
 
     def summary(self) -> dict:

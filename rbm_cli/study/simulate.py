@@ -100,4 +100,6 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         friction_limit=config.interface.friction_limit if config.model == "rbm" else None,
         slip=out.slip,
         energy=None if out.energy is None else out.energy.as_dict(),
+        collapse_azimuth_deg=math.degrees(math.remainder(out.azimuth, 2.0 * math.pi)),
+        wobble_turns=float(out.turns),
     )

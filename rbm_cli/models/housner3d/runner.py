@@ -12,6 +12,8 @@ RK23) step by step like `housner`, the events located on each step's dense outpu
   distance out. A lean that passes farther from the vertical rolls round it (Srinivasan
   and Ruina 2008). In a plane this is Housner's impact (theta' <- e theta');
 - **collapse** at a tilt of collapse.ratio alpha (Outcome.azimuth: where it leaned);
+  Outcome.turns is the angle the lean's direction swept while the column rolled (away
+  from the vertical, where the contact is not pinned), in turns;
 - **rest** after an impact below REST_RATE p alpha.
 
 max_rotation_ratio is the peak tilt over alpha in any direction (Brent on the dense output
@@ -65,6 +67,7 @@ class _Run3d(BlockRun):
     top_max: float = 0.0
     azimuth: float = math.nan
     phase: int = 0  # LEAVING, FREE or APPROACH (near the vertical)
+    swept: float = 0.0  # the angle the lean's direction swept while it rolled [rad]
 
 
 def _ground(motion: GroundMotion, forced: bool):
@@ -110,6 +113,7 @@ def cylinder_run(
     initial: tuple[float, float] = (0.0, 0.0),
     early_stop: bool = True,
     events: list | None = None,
+    state: np.ndarray | None = None,
 ) -> Outcome:
     """One run of the rigid cylinder in three dimensions (the module's rules).
 
@@ -126,6 +130,8 @@ def cylinder_run(
     early_stop : bool  Stop at rest after the motion
     events : list or None  If a list, (t [s], kind) is appended for every 'uplift',
         'impact', 'rest' and 'collapse'
+    state : (7,) array or None  A whole initial state in place of ``initial``: the lean q,
+        the angular velocity w [rad/s] and the centre in plan [m] (a wobble, say)
 
     Returns
     -------
@@ -149,9 +155,13 @@ def cylinder_run(
     run.c = side * d
     run.y[0:2] = math.sin(abs(theta0)) * run.c
     run.y[2:4] = rate0 * np.array([-d[1], d[0]])  # about the horizontal normal to d
-    run.at_rest = theta0 == 0.0 and rate0 == 0.0
-    run.phase = LEAVING if math.sin(abs(theta0)) <= LEAVE_FACTOR * geo.upright else FREE
-    run.peak = abs(theta0)
+    if state is not None:
+        run.y = np.array(state, dtype=float)
+        run.c = lean_direction(run.y[0:2], run.c)
+    run.at_rest = not np.any(run.y[0:5])
+    lean = math.hypot(run.y[0], run.y[1])
+    run.phase = LEAVING if lean <= LEAVE_FACTOR * geo.upright else FREE
+    run.peak = tilt(run.y[0:2])
     if run.peak >= limit:
         run.out.t_collapse, run.out.collapse_interface = 0.0, 1
         run.azimuth = math.atan2(run.c[1], run.c[0])
@@ -175,7 +185,7 @@ def cylinder_run(
 
 def _finish(run: _Run3d, status: str = "survived", message: str = "") -> Outcome:
     out = run.finish(status, message)
-    out.azimuth = run.azimuth
+    out.azimuth, out.turns = run.azimuth, run.swept / (2.0 * math.pi)
     return out
 
 
@@ -266,7 +276,10 @@ def _steps(run, integ, k, solver, d):
         _peaks(run, dense, t_old, t_new, k["geo"])
         if run.rec.samples is not None:
             _emit(run, dense, t_new, d)
-        run.t, run.y = t_new, dense(t_new) if hit is not None else integ.y.copy()
+        y_new = dense(t_new) if hit is not None else integ.y.copy()
+        if phase == FREE:  # near the vertical the contact is pinned: no rolling there
+            run.swept += _turned(run.y, y_new)
+        run.t, run.y = t_new, y_new
         if hit is None:
             continue
         if hit[1] == 1:
@@ -278,6 +291,14 @@ def _steps(run, integ, k, solver, d):
             return _finish(run, "collapsed", "the column reached its collapse limit")
         return ("left", "near", "impact")[phase]
     return None
+
+
+def _turned(y0: np.ndarray, y1: np.ndarray) -> float:
+    """|angle| [rad] between the leans' directions at two states (0 if either is upright):
+    a step turns the lean by less than a half turn."""
+    cross = y0[0] * y1[1] - y0[1] * y1[0]
+    dot = y0[0] * y1[0] + y0[1] * y1[1]
+    return abs(math.atan2(cross, dot)) if cross or dot else 0.0
 
 
 def _impact(run, k, solver) -> Outcome | None:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -243,3 +244,99 @@ def test_a_domain_of_the_cylinder_has_its_azimuth_and_turns(tmp_path):
     assert fast.collapse_azimuth_deg == pytest.approx(-150.0, abs=1e-9)
     planar = rbm.sweep(dataclasses.replace(config("housner"), grid=cfg.grid))
     assert "collapse_azimuth_deg" not in planar.columns and "wobble_turns" not in planar.columns
+
+
+RECORDS = Path(__file__).resolve().parents[1] / "configs" / "records" / "synthetic"
+
+
+def pair_config(tmp_path, model: str = "housner-3d", **exc):
+    return parse_config({
+        "name": "pair", "model": model, "column": dict(COLUMN),
+        "interface": {"restitution": 0.9},
+        "excitation": {"type": "record", "units": "g", "free_time": 2.0, **exc},
+        "solver": dict(SOLVER),
+    }, base_dir=tmp_path)  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def pair_dir(tmp_path_factory):
+    """Two synthetic records of the project (the same sampling), and a record of zeros
+    sampled as they are."""
+    from rbm_cli.physics.records import read_record
+
+    folder = tmp_path_factory.mktemp("pair")
+    for name in ("rdk_01", "rdk_02"):
+        (folder / f"{name}.AT2").write_bytes((RECORDS / f"{name}.AT2").read_bytes())
+    t = read_record(str(folder / "rdk_01.AT2")).t
+    np.savetxt(folder / "zero.csv", np.c_[t, np.zeros_like(t)], delimiter=",",
+               header="time_s,acc_g", comments="")  # fmt: skip
+    return folder
+
+
+def test_a_pair_with_a_zero_second_record_is_the_one_component_run(pair_dir):
+    """x record plus a y record of zeros: the run of the x record alone, to the bit (on
+    cells that rock with impacts and that collapse), and Housner's block along x: the same
+    impacts, peaks within 1e-8."""
+    for amplitude in (0.5, 0.8):
+        one = simulate(pair_config(pair_dir, file="rdk_01.AT2"), amplitude, None)
+        pair = simulate(pair_config(pair_dir, file="rdk_01.AT2", file_y="zero.csv"),
+                        amplitude, None)  # fmt: skip
+        planar = simulate(pair_config(pair_dir, "housner", file="rdk_01.AT2"), amplitude, None)
+        assert (pair.status, pair.n_impacts) == (one.status, one.n_impacts)
+        assert pair.max_rotation_ratio == one.max_rotation_ratio
+        assert pair.t_collapse_s == one.t_collapse_s or math.isnan(one.t_collapse_s)
+        assert (planar.status, planar.n_impacts) == (one.status, one.n_impacts)
+        assert one.max_rotation_ratio == pytest.approx(planar.max_rotation_ratio, rel=1e-8)
+        assert one.n_impacts > 20
+
+
+def test_swapping_the_components_with_the_angle_turned_gives_the_same_run(pair_dir):
+    """(x, y) = (rdk_01, rdk_02) against (rdk_02, rdk_01) turned by 90 degrees (rdk_01
+    then acts along -x: the mirror image): the same outcome, impacts, peak and collapse
+    time to 1e-9, wobbling turns to 1e-6."""
+    for amplitude in (0.3, 0.8):
+        a = simulate(pair_config(pair_dir, file="rdk_01.AT2", file_y="rdk_02.AT2"),
+                     amplitude, None)  # fmt: skip
+        b = simulate(pair_config(pair_dir, file="rdk_02.AT2", file_y="rdk_01.AT2", angle=90.0),
+                     amplitude, None)  # fmt: skip
+        assert (a.status, a.n_impacts, a.n_uplifts) == (b.status, b.n_impacts, b.n_uplifts)
+        assert b.max_rotation_ratio == pytest.approx(a.max_rotation_ratio, rel=1e-9)
+        # the turns add the angle between the leans at step ends: a step in which the
+        # lean's direction turns back counts its net turn, so two step sequences (the
+        # turned run's round-off) differ where it does (6e-8 of 38 turns measured)
+        assert b.wobble_turns == pytest.approx(a.wobble_turns, rel=1e-6)
+        if a.status == "collapsed":
+            assert b.t_collapse_s == pytest.approx(a.t_collapse_s, rel=1e-9)
+
+
+def test_a_pair_is_scaled_by_its_larger_pga(pair_dir):
+    """scale: pga takes the larger of the two components' PGAs to the amplitude; both are
+    multiplied by the same factor."""
+    from rbm_cli.physics.records import read_record
+
+    x = read_record(str(pair_dir / "rdk_01.AT2")).acceleration
+    y = read_record(str(pair_dir / "rdk_02.AT2")).acceleration
+    cfg = pair_config(pair_dir, file="rdk_01.AT2", file_y="rdk_02.AT2")
+    motion = make_ground_motion(cfg.excitation, 0.4)
+    factor = 0.4 * G / max(np.max(np.abs(x)), np.max(np.abs(y)))
+    np.testing.assert_allclose(motion.values, x * factor, rtol=1e-15)
+    np.testing.assert_allclose(motion.values_y, y * factor, rtol=1e-15)
+    assert max(np.max(np.abs(motion.values)), np.max(np.abs(motion.values_y))) == pytest.approx(
+        0.4 * G, rel=1e-15
+    )
+
+
+def test_a_second_component_is_refused_where_it_cannot_apply(pair_dir, tmp_path):
+    """file_y for a planar model, sampled otherwise than file, or for a type that is not
+    a record: one line each."""
+    with pytest.raises(RbmError, match="excitation.file_y is a second horizontal") as err:
+        pair_config(pair_dir, "housner", file="rdk_01.AT2", file_y="rdk_02.AT2")
+    assert "\n" not in str(err.value)
+    short = pair_dir / "short.csv"
+    np.savetxt(short, np.c_[np.arange(10) * 0.01, np.ones(10) * 0.1], delimiter=",",
+               header="time_s,acc_g", comments="")  # fmt: skip
+    with pytest.raises(RbmError, match="must be sampled as excitation.file"):
+        pair_config(pair_dir, file="rdk_01.AT2", file_y="short.csv")
+    with pytest.raises(RbmError, match="file_y"):
+        parse_config({"name": "c", "model": "housner-3d", "column": dict(COLUMN),
+                      "excitation": {"type": "harmonic", "file_y": "x.csv"}})  # fmt: skip

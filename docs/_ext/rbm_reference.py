@@ -415,6 +415,14 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "(the whole pulse is always simulated). Not for ``record``.",
     ),
     "excitation.phase": ("rad", "", "Phase of a harmonic excitation."),
+    "excitation.file_y": (
+        "",
+        "a file sampled as ``file``",
+        "``record`` only, models in three dimensions: the record's second horizontal "
+        "component, at 90 degrees counter-clockwise from ``file`` (a station's two "
+        "components). Same formats and units; scaled by the same factor, with "
+        "``scale: pga`` the larger of the two components' PGAs is the amplitude.",
+    ),
     "excitation.angle": (
         "deg",
         "",

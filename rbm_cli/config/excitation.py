@@ -103,6 +103,7 @@ EXCITATION_KEYS = (
     "processing",
     "im_periods",
     "angle",
+    "file_y",
 )
 PROCESSING_KEYS = ("baseline", "filter")
 FILTER_KEYS = ("low_hz", "high_hz", "order")
@@ -133,6 +134,7 @@ ONLY_FOR = {
     "gamma": ("mavroeidis-papageorgiou",),
     "nu": ("mavroeidis-papageorgiou",),
     "vertical": ("record",),
+    "file_y": ("record",),
     "processing": ("record",),
     "im_periods": ("record",),
 }
@@ -386,8 +388,14 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
                               " arrays is horizontal")  # fmt: skip
         fields.update(vertical=ver.written, vertical_sha256=ver.sha256, vertical_path=ver.path)
         end = max(end, ver.end)
+    if "file_y" in e:
+        rec_y = record_file(e["file_y"], "excitation.file_y", base_dir, units)
+        _check_pair(rec, rec_y)
+        fields.update(file_y=rec_y.written, file_y_sha256=rec_y.sha256, file_y_path=rec_y.path)
     if "processing" in e:
         records = [("excitation.file", rec)]
+        if "file_y" in e:
+            records.append(("excitation.file_y", rec_y))
         if "vertical" in e:
             records.append(("excitation.vertical", ver))
         fields["processing"] = processing_section(e["processing"], records)
@@ -399,6 +407,21 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
         free_time=free_time,
         duration=_record_duration(end, free_time, "excitation.file"),
     )
+
+
+def _check_pair(rec: RecordFile, rec_y: RecordFile) -> None:
+    """A second horizontal component sampled as the first: a file (not arrays), the same
+    number of samples, step and last time (a station's two components are)."""
+    if rec.motion is not None or rec_y.motion is not None:
+        raise ConfigError(
+            "excitation.file_y pairs two record files; a motion given as arrays has one component"
+        )
+    if (rec.samples, rec.step, rec.end) != (rec_y.samples, rec_y.step, rec_y.end):
+        raise ConfigError(
+            f"excitation.file_y ({rec_y.path}) must be sampled as excitation.file"
+            f" ({rec.path}): {rec_y.samples} samples to {fmt(rec_y.end)} s against"
+            f" {rec.samples} to {fmt(rec.end)} s"
+        )
 
 
 def filter_padding(order: int) -> int:

@@ -241,7 +241,7 @@ GLOB_CHARS = "*?["
 
 
 #: Grid paths whose values are record files: each value may be a file, a folder or a glob.
-RECORD_PATHS = ("excitation.file", "excitation.vertical")
+RECORD_PATHS = ("excitation.file", "excitation.vertical", "excitation.file_y")
 
 
 def hoist_suite(top: Mapping[str, Any], base_dir: str | os.PathLike | None) -> dict:

@@ -354,19 +354,26 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
 
 def _check_dimensions(model: str, column: ColumnConfig, excitation: ExcitationConfig) -> None:
     """A model in three dimensions takes a circular column only; a planar model takes a
-    motion along its plane only (excitation.angle 0)."""
+    motion along its plane only (excitation.angle 0, no excitation.file_y)."""
     if MODELS[model].three_d:
         if column.section != "circular":
             raise ConfigError(
                 f"model {model} needs column.section: circular (a {column.section} section's"
                 " rocking capacity is not the same in every direction)"
             )
-    elif excitation.angle != 0.0:
-        three_d = ", ".join(name for name, entry in MODELS.items() if entry.three_d)
+        return
+    three_d = ", ".join(name for name, entry in MODELS.items() if entry.three_d)
+    if excitation.angle != 0.0:
         raise ConfigError(
             f"excitation.angle turns the motion out of the plane model {model} rocks in"
             f" (got {fmt(excitation.angle)} deg): use a model in three dimensions ({three_d})"
             " or delete excitation.angle"
+        )
+    if excitation.file_y is not None:
+        raise ConfigError(
+            f"excitation.file_y is a second horizontal component, and model {model} rocks in"
+            f" one plane: use a model in three dimensions ({three_d}) or delete"
+            " excitation.file_y"
         )
 
 

@@ -189,8 +189,9 @@ class InitialConfig:
 #: written and the file's digest identify the record).
 _RECORD_FIELDS = ("file", "file_sha256", "units", "free_time", "scale")
 _VERTICAL_FIELDS = ("vertical", "vertical_sha256")
+_FILE_Y_FIELDS = ("file_y", "file_y_sha256")
 _MP_FIELDS = ("gamma", "nu")
-_LOCAL_FIELDS = ("file_path", "vertical_path", "motion")
+_LOCAL_FIELDS = ("file_path", "vertical_path", "file_y_path", "motion")
 
 
 @dataclass(frozen=True)
@@ -253,6 +254,10 @@ class ExcitationConfig:
     motion : rbm_cli.config.motions.Motion or None  Record: the motion given as arrays in
         place of a file (then ``file`` is its name and ``file_sha256`` the digest of its
         samples, which identify it); not in :meth:`resolved`, not compared
+    file_y : str or None  Record: a second file, the record's horizontal component at 90
+        degrees counter-clockwise from it (same formats, units and sampling; scaled by the
+        same factor; models in three dimensions only)
+    file_y_sha256, file_y_path : str or None  Its SHA-256 and absolute path
     angle : float  Azimuth of the horizontal motion in plan [deg], from the x axis (the
         plane the planar models rock in, where only 0 is taken): the models in three
         dimensions take any; left out of :meth:`resolved` when 0, as before the key existed
@@ -281,6 +286,9 @@ class ExcitationConfig:
     motion: Any = field(default=None, compare=False)
     processing: ProcessingConfig | None = None
     angle: float = 0.0
+    file_y: str | None = None
+    file_y_sha256: str | None = None
+    file_y_path: str | None = field(default=None, compare=False)
 
     def resolved(self) -> dict:
         """The settings that define the motion, as plain data: the fields of other
@@ -292,6 +300,8 @@ class ExcitationConfig:
             drop += _RECORD_FIELDS
         if self.vertical is None:
             drop += _VERTICAL_FIELDS
+        if self.file_y is None:
+            drop += _FILE_Y_FIELDS
         if self.type != "mavroeidis-papageorgiou":
             drop += _MP_FIELDS
         if self.processing is None:
@@ -444,6 +454,7 @@ class Config:
             for key, written, digest in (
                 ("file", e.file, e.file_sha256),
                 ("vertical", e.vertical, e.vertical_sha256),
+                ("file_y", e.file_y, e.file_y_sha256),
             )
             if e.type == "record" and written is not None and digest is not None
         )

@@ -79,7 +79,8 @@ def processed_record(
 def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMotion:
     """The ground motion of a record excitation at amplitude [g] (its PGA after scaling
     with scale 'pga', a plain factor [-] with scale 'factor'): the scaled record (and its
-    vertical record, scaled by the same factor), then free motion for
+    second horizontal component and its vertical record, scaled by the same factor; with
+    scale 'pga' a pair's PGA is the larger of its two components'), then free motion for
     excitation.free_time [s].
 
     The records are processed (excitation.processing: baseline, band-pass) before they
@@ -95,22 +96,33 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
     else:
         rec = processed_record(str(path), excitation.units, excitation.file_sha256,
                                excitation.processing)  # fmt: skip
+    rec_y = None
+    if excitation.file_y is not None:
+        path_y = excitation.file_y_path or excitation.file_y
+        rec_y = processed_record(str(path_y), excitation.units, excitation.file_y_sha256,
+                                 excitation.processing)  # fmt: skip
     with np.errstate(all="ignore"):  # checked below, with the file named
-        if excitation.scale == "pga":
-            factor = amplitude_g * G / rec.pga
+        if excitation.scale == "pga":  # a pair: the larger of its two components' PGAs
+            factor = amplitude_g * G / max(rec.pga, 0.0 if rec_y is None else rec_y.pga)
         else:
             factor = float(amplitude_g)
         knots, values, vertical = rec.t, _scaled(rec, factor, path), None
+        values_y = None if rec_y is None else _scaled(rec_y, factor, path_y)
     end = rec.duration
     if excitation.vertical is not None:
         path = excitation.vertical_path or excitation.vertical
         ver = processed_record(str(path), excitation.units, excitation.vertical_sha256,
                                excitation.processing)  # fmt: skip
-        knots, values, vertical = merge_records(rec.t, values, ver.t, _scaled(ver, factor, path))
+        merged = merge_records(rec.t, values, ver.t, _scaled(ver, factor, path), values_y)
+        knots, values, vertical = merged[:3]
+        values_y = merged[3] if values_y is not None else None
         end = max(end, ver.duration)
         vertical.setflags(write=False)
     values.setflags(write=False)
     peak = float(np.max(np.abs(values)))
+    if values_y is not None:
+        values_y.setflags(write=False)
+        peak = float(np.max(np.hypot(values, values_y)))
     return GroundMotion(
         "record",
         peak,
@@ -123,6 +135,7 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
         values=values,
         name=rec.name,
         vertical=vertical,
+        values_y=values_y,
     )
 
 
@@ -156,31 +169,31 @@ def _limits(t: float, ts: np.ndarray, vs: np.ndarray) -> tuple[float, float]:
 
 
 def merge_records(
-    th: np.ndarray, ah: np.ndarray, tv: np.ndarray, av: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    th: np.ndarray, ah: np.ndarray, tv: np.ndarray, av: np.ndarray, ay: np.ndarray | None = None
+) -> tuple[np.ndarray, ...]:
     """Two records (times [s], values), each linear between its samples and 0 outside them,
-    on one set of knots: (knots, horizontal, vertical). Both are linear between the union
-    of their sample times; where either jumps (its first or last value not 0, inside the
-    run) the time is written twice, the values before then after. At the first knot the
-    values after it are kept (the ground rests before), at the last those before it."""
+    on one set of knots: (knots, horizontal, vertical), and the second horizontal
+    component ay (on the times th) after them when given. All are linear between the union
+    of their sample times; where any jumps (its first or last value not 0, inside the run)
+    the time is written twice, the values before then after. At the first knot the values
+    after it are kept (the ground rests before), at the last those before it."""
     times = np.union1d(th, tv)
+    series = [(th, ah), (tv, av)] + ([] if ay is None else [(th, ay)])
     knots: list[float] = []
-    hs: list[float] = []
-    vs: list[float] = []
+    columns: list[list[float]] = [[] for _ in series]
     for i, t in enumerate(times):
-        hb, ha = _limits(t, th, ah)
-        vb, va = _limits(t, tv, av)
+        limits = [_limits(t, ts, vs) for ts, vs in series]
         if i == len(times) - 1:
-            ha, va = hb, vb
-        if 0 < i < len(times) - 1 and (hb != ha or vb != va):
+            limits = [(b, b) for b, _ in limits]
+        if 0 < i < len(times) - 1 and any(b != a for b, a in limits):
             knots += [t, t]
-            hs += [hb, ha]
-            vs += [vb, va]
+            for col, (b, a) in zip(columns, limits, strict=True):
+                col += [b, a]
         else:
             knots.append(t)
-            hs.append(ha)
-            vs.append(va)
-    return np.array(knots), np.array(hs), np.array(vs)
+            for col, (_, a) in zip(columns, limits, strict=True):
+                col.append(a)
+    return (np.array(knots), *(np.array(col) for col in columns))
 
 
 def pulse_motion(excitation: ExcitationConfig, amplitude: float, frequency_hz: float):

@@ -68,6 +68,9 @@ class GroundMotion:
     angle : float  Azimuth of the ground's motion in plan [rad], from the x axis: the
         ground accelerates along (cos angle, sin angle). The planar models rock in the x
         plane and take 0 only; the models in three dimensions take any.
+    values_y : ndarray or None  A record's second horizontal component at the knots
+        [m/s^2], acting along (-sin angle, cos angle) (excitation.file_y; models in three
+        dimensions only)
     """
 
     kind: str
@@ -84,6 +87,7 @@ class GroundMotion:
     name: str = ""
     vertical: np.ndarray | None = None
     angle: float = 0.0
+    values_y: np.ndarray | None = None
 
     @property
     def direction(self) -> np.ndarray:
@@ -91,6 +95,59 @@ class GroundMotion:
         if self.angle == 0.0:
             return np.array([1.0, 0.0])
         return np.array([math.cos(self.angle), math.sin(self.angle)])
+
+    @cached_property
+    def _y_component(self) -> GroundMotion:
+        """The second horizontal component as a motion of its own (its samples on the same
+        knots), whose compiled form a run evaluates."""
+        peak = float(np.max(np.abs(self.values_y)))
+        return dataclasses.replace(self, amplitude=peak, values=self.values_y, values_y=None)
+
+    def horizontal(self, forced: bool = True):
+        """(a_x(t), a_y(t)) [m/s^2] in the ground's axes as a function of a float t [s]: the
+        motion along ``direction``, plus the second component across it (a pair of
+        records); 0 off a forced segment."""
+        d = self.direction
+        a = self.scalar(forced)
+        if self.values_y is None:
+            return lambda tt: (a(tt) * d[0], a(tt) * d[1])
+        b = self._y_component.scalar(forced)
+
+        def pair(tt):
+            ax, ay = a(tt), b(tt)
+            return ax * d[0] - ay * d[1], ax * d[1] + ay * d[0]
+
+        return pair
+
+    def next_pair_exceedance(self, t0: float, ratio: float, t_stop: float) -> float | None:
+        """A pair of records: the first time t in [t0, t_stop) where the horizontal
+        acceleration's magnitude exceeds ratio (g + a_v(t)) [m/s^2] (ratio = tan(alpha) for
+        a block's uplift), or None. Both components and a_v are linear between the knots,
+        so on each interval the excess |a|^2 - (ratio (g + a_v))^2 is a quadratic in time,
+        solved exactly."""
+        knots, ax, ay = self.knots, self.values, self.values_y
+        av = self.vertical if self.vertical is not None else np.zeros_like(ax)
+        last = min(self.pulse_end, self.t_end, t_stop)
+        i0 = max(int(np.searchsorted(knots, t0, side="right")) - 1, 0)
+        for i in range(i0, knots.size - 1):
+            ta, tb = float(knots[i]), float(knots[i + 1])
+            if ta >= last:
+                return None
+            if tb <= ta:
+                continue
+            lo = max(t0, ta)
+            # on [ta, tb]: a(s) = a0 + s da, s = (t - ta) / (tb - ta)
+            x0, dx = float(ax[i]), float(ax[i + 1] - ax[i])
+            y0, dy = float(ay[i]), float(ay[i + 1] - ay[i])
+            w0, dw = ratio * (G + float(av[i])), ratio * float(av[i + 1] - av[i])
+            qa, qb = dx * dx + dy * dy - dw * dw, 2.0 * (x0 * dx + y0 * dy - w0 * dw)
+            qc = x0 * x0 + y0 * y0 - w0 * w0
+            s_lo = (lo - ta) / (tb - ta)
+            s = _first_positive(qa, qb, qc, s_lo)
+            if s is not None:
+                t = ta + s * (tb - ta)
+                return t if t < last else None
+        return None
 
     @property
     def form(self) -> int:
@@ -303,3 +360,28 @@ class GroundMotion:
             name=f"{self.kind} (sampled)",
             angle=self.angle,
         )
+
+
+def _first_positive(qa: float, qb: float, qc: float, s_lo: float) -> float | None:
+    """The first s in [s_lo, 1] where qa s^2 + qb s + qc > 0 (where it is 0 and rising, or
+    s_lo itself when already above), or None."""
+
+    def f(s):
+        return (qa * s + qb) * s + qc
+
+    if f(s_lo) > 0.0:
+        return s_lo
+    roots = []
+    if qa == 0.0:
+        if qb != 0.0:
+            roots.append(-qc / qb)
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            r = math.sqrt(disc)
+            q = -0.5 * (qb + math.copysign(r, qb))
+            roots += [q / qa] + ([qc / q] if q != 0.0 else [])
+    for s in sorted(roots):
+        if s_lo <= s <= 1.0 and (2.0 * qa * s + qb) > 0.0:
+            return s
+    return None

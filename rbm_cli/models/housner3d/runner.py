@@ -71,14 +71,42 @@ class _Run3d(BlockRun):
 
 
 def _ground(motion: GroundMotion, forced: bool):
-    """g_e(t) = (-a_g(t) d, -(g + a_v(t))) [m/s^2] of a segment, d the motion's direction."""
-    d, accel, gravity = motion.direction, motion.scalar(forced), motion.gravity(forced)
+    """g_e(t) = (-a_x(t), -a_y(t), -(g + a_v(t))) [m/s^2] of a segment."""
+    horizontal, gravity = motion.horizontal(forced), motion.gravity(forced)
 
     def ge(t: float) -> np.ndarray:
-        a = accel(t)
-        return np.array([-a * d[0], -a * d[1], -(G if gravity is None else G * gravity(t))])
+        ax, ay = horizontal(t)
+        return np.array([-ax, -ay, -(G if gravity is None else G * gravity(t))])
 
     return ge
+
+
+def _wait(run: _Run3d, motion: GroundMotion, seg_end: float, level: float, forced: bool) -> str:
+    """At rest: BlockRun.wait for a motion along one direction (the contact then away
+    from a_g along it); for a pair of records, until the horizontal acceleration's
+    magnitude exceeds (g + a_v) tan(alpha), the contact away from it. Returns 'uplift',
+    'segment' or 'end' (BlockRun.wait); run.c is the contact's direction on 'uplift'."""
+    if motion.values_y is None:
+        kind = run.wait(motion, seg_end, level, forced)
+        run.c = run.side * motion.direction
+        return kind
+    if not forced:
+        run.rec.rest(motion.t_end)
+        run.t = motion.t_end
+        return "end"
+    t_up = motion.next_pair_exceedance(run.t, level / G, seg_end)
+    t_stop = seg_end if t_up is None else t_up
+    run.rec.rest(t_stop - (1e-15 if t_up is not None else 0.0))
+    run.t = t_stop
+    if t_up is None:
+        return "segment"
+    ax, ay = motion.horizontal(True)(t_up)
+    size = math.hypot(ax, ay)
+    run.c = np.array([-ax / size, -ay / size])
+    run.at_rest = False
+    run.out.n_uplifts += 1
+    run.note((run.t, "uplift"))
+    return "uplift"
 
 
 def _rates(y: np.ndarray) -> np.ndarray:
@@ -205,12 +233,12 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
     d = motion.direction
     while run.t < seg_end:
         if run.at_rest:
-            kind = run.wait(motion, seg_end, k["level"], forced)
+            kind = _wait(run, motion, seg_end, k["level"], forced)
             if kind == "end":  # no ground motion from here on: rests to the end
                 return _finish(run, message="at rest in free motion: stopped")
             if kind == "segment":
                 return None
-            run.c, run.y, run.phase = run.side * d, np.zeros(STATE_SIZE), LEAVING
+            run.y, run.phase = np.zeros(STATE_SIZE), LEAVING
             if out.n_uplifts + out.n_impacts > solver.max_events:
                 return _fail(run, f"event budget exceeded ({solver.max_events} events)")
         c0, pinned = run.c.copy(), run.phase != FREE
@@ -239,9 +267,9 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
 def _steps(run, integ, k, solver, d):
     """Step until the phase's event, the state on it: 'left' (leaving: the lean is
     LEAVE_FACTOR pinned leans out), 'near' (free: the lean is within the pinned lean),
-    'impact' (approaching: the lean crosses the line across where it leaned as it came in,
-    or turns away from the vertical), None at the segment's end, or the Outcome when the
-    run ends (a collapse, a budget)."""
+    'impact' (leaving or approaching: the lean crosses the line across its pinned
+    direction; approaching: or turns away from the vertical), None at the segment's end,
+    or the Outcome when the run ends (a collapse, a budget)."""
     out, upright, s_limit, eps = run.out, k["geo"].upright, k["s_limit"], k["eps"]
     phase, c0 = run.phase, run.c
     while integ.status == "running":
@@ -260,13 +288,15 @@ def _steps(run, integ, k, solver, d):
             lean = np.hypot(q[0], q[1])
             d_lean = (q[0] * dq[0] + q[1] * dq[1]) / np.where(lean > 0.0, lean, 1.0)
             collapse, d_collapse = s_limit - lean, -d_lean
-            if phase == LEAVING:
-                dist, rate = LEAVE_FACTOR * upright - lean, -d_lean
-                return np.array([dist, collapse]), np.array([rate, d_collapse])
             if phase == FREE:
                 return np.array([lean - upright, collapse]), np.array([d_lean, d_collapse])
+            # leaving or approaching: the lean back across the line across c0 (an impact)
             across = q[0] * c0[0] + q[1] * c0[1] + eps
             d_across = dq[0] * c0[0] + dq[1] * c0[1]
+            if phase == LEAVING:  # or out to LEAVE_FACTOR pinned leans (free from there)
+                dist, rate = LEAVE_FACTOR * upright - lean, -d_lean
+                return (np.array([dist, collapse, across]),
+                        np.array([rate, d_collapse, d_across]))  # fmt: skip
             turned = -d_lean  # > 0 while it comes nearer
             return (np.array([across, collapse, turned]),
                     np.array([d_across, d_collapse, np.zeros_like(lean)]))  # fmt: skip
@@ -289,6 +319,8 @@ def _steps(run, integ, k, solver, d):
             run.azimuth = math.atan2(q[1], q[0])
             run.note((run.t, "collapse"))
             return _finish(run, "collapsed", "the column reached its collapse limit")
+        if phase == LEAVING and hit[1] == 2:  # it fell back before it left the vertical
+            return "impact"
         return ("left", "near", "impact")[phase]
     return None
 

@@ -294,6 +294,8 @@ class GroundMotion:
         last = min(self.pulse_end, self.t_end)
         if t0 >= last:
             return None
+        if self.values_y is not None:  # a pair: the magnitude of the two components
+            return self.next_pair_exceedance(t0, level / G, last)
         t = next_uplift(float(t0), float(level), float(self.amplitude), self._ground,
                         *self._samples, float(last))  # fmt: skip
         return None if t < 0.0 else t
@@ -322,6 +324,15 @@ class GroundMotion:
         if t_up is None or t_up >= seg_end:
             return "segment", seg_end
         return "uplift", t_up
+
+    def uplift_direction(self, t: float) -> np.ndarray:
+        """The unit vector in plan a block at rest lifts toward at time t: away from the
+        horizontal acceleration (a pair's resultant, or a_g along ``direction``)."""
+        if self.values_y is None:
+            return self.uplift_side(t) * self.direction
+        ax, ay = self.horizontal(True)(t)
+        size = math.hypot(ax, ay)
+        return np.array([-ax / size, -ay / size])
 
     def uplift_side(self, t: float) -> int:
         """Side (sign of theta) a block lifts on at time t: away from a_g (a pulse's

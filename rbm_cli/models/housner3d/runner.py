@@ -81,34 +81,6 @@ def _ground(motion: GroundMotion, forced: bool):
     return ge
 
 
-def _wait(run: _Run3d, motion: GroundMotion, seg_end: float, level: float, forced: bool) -> str:
-    """At rest: BlockRun.wait for a motion along one direction (the contact then away
-    from a_g along it); for a pair of records, until the horizontal acceleration's
-    magnitude exceeds (g + a_v) tan(alpha), the contact away from it. Returns 'uplift',
-    'segment' or 'end' (BlockRun.wait); run.c is the contact's direction on 'uplift'."""
-    if motion.values_y is None:
-        kind = run.wait(motion, seg_end, level, forced)
-        run.c = run.side * motion.direction
-        return kind
-    if not forced:
-        run.rec.rest(motion.t_end)
-        run.t = motion.t_end
-        return "end"
-    t_up = motion.next_pair_exceedance(run.t, level / G, seg_end)
-    t_stop = seg_end if t_up is None else t_up
-    run.rec.rest(t_stop - (1e-15 if t_up is not None else 0.0))
-    run.t = t_stop
-    if t_up is None:
-        return "segment"
-    ax, ay = motion.horizontal(True)(t_up)
-    size = math.hypot(ax, ay)
-    run.c = np.array([-ax / size, -ay / size])
-    run.at_rest = False
-    run.out.n_uplifts += 1
-    run.note((run.t, "uplift"))
-    return "uplift"
-
-
 def _rates(y: np.ndarray) -> np.ndarray:
     """q' = (w x n) in plan, for states y (7,) or (7, m)."""
     q, w = y[0:2], y[2:5]
@@ -233,11 +205,12 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
     d = motion.direction
     while run.t < seg_end:
         if run.at_rest:
-            kind = _wait(run, motion, seg_end, k["level"], forced)
+            kind = run.wait(motion, seg_end, k["level"], forced)
             if kind == "end":  # no ground motion from here on: rests to the end
                 return _finish(run, message="at rest in free motion: stopped")
             if kind == "segment":
                 return None
+            run.c = motion.uplift_direction(run.t)
             run.y, run.phase = np.zeros(STATE_SIZE), LEAVING
             if out.n_uplifts + out.n_impacts > solver.max_events:
                 return _fail(run, f"event budget exceeded ({solver.max_events} events)")

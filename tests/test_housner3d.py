@@ -340,3 +340,32 @@ def test_a_second_component_is_refused_where_it_cannot_apply(pair_dir, tmp_path)
     with pytest.raises(RbmError, match="file_y"):
         parse_config({"name": "c", "model": "housner-3d", "column": dict(COLUMN),
                       "excitation": {"type": "harmonic", "file_y": "x.csv"}})  # fmt: skip
+
+
+def test_a_suite_of_pairs_is_a_linked_axis(pair_dir):
+    """Two pairs as a linked grid axis over excitation.file and excitation.file_y: each row
+    is the run of its own pair."""
+    import rbm
+
+    for name in ("rdk_03", "rdk_04"):
+        (pair_dir / f"{name}.AT2").write_bytes((RECORDS / f"{name}.AT2").read_bytes())
+    pairs = [("rdk_01.AT2", "rdk_02.AT2"), ("rdk_03.AT2", "rdk_04.AT2")]
+    raw = {
+        "name": "pairs", "model": "housner-3d", "column": dict(COLUMN),
+        "interface": {"restitution": 0.9},
+        "excitation": {"type": "record", "file": pairs[0][0], "file_y": pairs[0][1],
+                       "free_time": 1.0},
+        "solver": dict(SOLVER),
+        "grid": {"amplitudes": [0.8], "linked": [{"excitation.file": [x for x, _ in pairs],
+                                                  "excitation.file_y": [y for _, y in pairs]}]},
+    }  # fmt: skip
+    df = rbm.sweep(parse_config(raw, base_dir=pair_dir))
+    assert list(zip(df["excitation.file"], df["excitation.file_y"], strict=True)) == pairs
+    for (x, y), (_, row) in zip(pairs, df.iterrows(), strict=True):
+        one = dict(raw, excitation=dict(raw["excitation"], file=x, file_y=y))
+        del one["grid"]
+        alone = simulate(parse_config(one, base_dir=pair_dir), 0.8, None)
+        assert row.status == alone.status
+        # a domain's numbers have 12 significant digits
+        assert row.max_rotation_ratio == pytest.approx(alone.max_rotation_ratio, rel=1e-11)
+        assert row.wobble_turns == pytest.approx(alone.wobble_turns, rel=1e-11)

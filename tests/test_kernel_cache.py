@@ -208,7 +208,7 @@ def test_the_key_covers_every_compiled_module():
     assert len(compiled) >= 7  # detmath and the kernel's modules today
     assert compiled <= sources
     # run_kernel reads EVENT_EPS and BIG of base/events.py: frozen into its code
-    assert PACKAGE / "models" / "events.py" in sources
+    assert PACKAGE / "base" / "events.py" in sources
     # a module no compiled function reads from does not make the kernel compile again
     assert PACKAGE / "cli" / "main.py" not in sources
     assert PACKAGE / "physics" / "equations.py" not in sources
@@ -229,7 +229,7 @@ def test_the_digest_moves_with_the_compiled_sources_only(tmp_path):
     assert not changed(cli, cli.read_text() + "\n# a comment\n")
     rk = root / "models" / "rbm" / "step" / "rk.py"
     assert changed(rk, rk.read_text().replace("SAFETY, MIN_FACTOR", "SAFETY,  MIN_FACTOR"))
-    events = root / "models" / "events.py"
+    events = root / "base" / "events.py"
     assert changed(events, events.read_text() + "\n# EVENT_EPS is read by run_kernel\n")
     new = root / "models" / "rbm" / "step" / "new.py"  # a new kernel module, named nowhere
     assert changed(new, "from numba import njit\n\n\n@njit(cache=True)\ndef f(x):\n    return x\n")

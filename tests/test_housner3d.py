@@ -369,3 +369,54 @@ def test_a_suite_of_pairs_is_a_linked_axis(pair_dir):
         # a domain's numbers have 12 significant digits
         assert row.max_rotation_ratio == pytest.approx(alone.max_rotation_ratio, rel=1e-11)
         assert row.wobble_turns == pytest.approx(alone.wobble_turns, rel=1e-11)
+
+
+def test_a_recorded_run_draws_the_tops_path_in_plan(geo):
+    """A run of housner-3d keeps the top's path in plan: under a motion turned to 30 degrees
+    it stays on that line through where the column stood, as far out as the top
+    displacement; history.csv has it as top_x_m, top_y_m and history.png draws it."""
+    import rbm
+    from rbm_cli.report.run_figures import history_figure
+
+    cfg = config(angle=30.0)
+    run = rbm.run(cfg, amplitude_g=0.4, frequency_hz=1.0, output_dt=0.01)
+    history, result = run.result.history, run.result
+    plan = history.top_plan
+    assert plan is not None and plan.shape == (history.t.size, 2)
+    assert np.all(plan[0] == 0.0)
+    across = -plan[:, 0] * math.sin(math.radians(30.0)) + plan[:, 1] * math.cos(math.radians(30))
+    assert np.max(np.abs(across)) < 1e-9 * np.max(np.abs(plan))  # on the motion's line
+    reach = np.max(np.hypot(plan[:, 0], plan[:, 1]))
+    assert (
+        0.5 * result.max_top_displacement_m < reach <= result.max_top_displacement_m * (1 + 1e-12)
+    )
+    table = run.history  # history.csv's table
+    np.testing.assert_array_equal(table[["top_x_m", "top_y_m"]].to_numpy(), plan + 0.0)
+    fig = history_figure(history, None)
+    (line,) = [a for ax in fig.axes for a in ax.get_lines() if a.get_gid() == "top_plan"]
+    np.testing.assert_array_equal(np.c_[line.get_xdata(), line.get_ydata()], plan)
+
+
+def test_a_pair_runs_history_and_title_name_both_records(pair_dir):
+    """A recorded run of a pair keeps a_y beside a_x (history.csv's ag_y_m_s2, the y record
+    as scaled), and its title names both records and the pair's PGA (the larger)."""
+    import rbm
+    from rbm_cli.physics.records import read_record
+    from rbm_cli.report.run_figures import record_title
+    from rbm_cli.report.run_folder import record_of_run
+
+    cfg = pair_config(pair_dir, file="rdk_01.AT2", file_y="rdk_02.AT2")
+    run = rbm.run(cfg, amplitude_g=0.8, output_dt=0.01)
+    table = run.history
+    motion = make_ground_motion(cfg.excitation, 0.8)
+    t = table["t_s"].to_numpy()
+    np.testing.assert_array_equal(table["ag_y_m_s2"].to_numpy(), motion.accel_y(t) + 0.0)
+    x = read_record(str(pair_dir / "rdk_01.AT2")).acceleration
+    y = read_record(str(pair_dir / "rdk_02.AT2")).acceleration
+    factor = 0.8 * G / max(np.max(np.abs(x)), np.max(np.abs(y)))
+    at = int(np.searchsorted(t, 5.0))  # inside the record: a sample time
+    assert table["ag_y_m_s2"][at] == pytest.approx(y[int(round(t[at] / 0.01))] * factor)
+    info = record_of_run(cfg, 0.8)
+    assert info["record_y"] == "rdk_02" and info["pga_g"] == pytest.approx(0.8, rel=1e-12)
+    title = record_title("pair", info, 0.8)
+    assert "rdk_01 (x)" in title and "rdk_02 (y)" in title and "0.8 g" in title

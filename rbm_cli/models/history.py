@@ -19,6 +19,10 @@ class History:
         relative to the ground [m] (node 1 is the base: always 0)
     rotations : (k, n) Absolute drum rotations theta_i [rad]
     rates : (k, n) Their rates theta_i' [rad/s]
+    top_plan : (k, 2) or None  A model in three dimensions: the top centre's place in plan
+        [m] (x, y) from where it stood
+    ground_acceleration_y : (k,) or None  A pair of records: the second component a_y(t)
+        [m/s^2] (ground_acceleration is then the first's)
     """
 
     t: np.ndarray
@@ -27,6 +31,8 @@ class History:
     node_displacements: np.ndarray
     rotations: np.ndarray
     rates: np.ndarray | None = None
+    top_plan: np.ndarray | None = None
+    ground_acceleration_y: np.ndarray | None = None
 
 
 def history_from_samples(node_map: np.ndarray, motion, samples) -> History:
@@ -46,4 +52,5 @@ def history_from_samples(node_map: np.ndarray, motion, samples) -> History:
         node_displacements=theta @ node_map.T,
         rotations=theta,
         rates=rates,
+        ground_acceleration_y=motion.accel_y(t),
     )

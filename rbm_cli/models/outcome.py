@@ -69,6 +69,7 @@ class Outcome:
     #: the angle its lean's direction swept while it rolled, in turns [-]
     azimuth: float = math.nan
     turns: float = math.nan
+    top_plan: np.ndarray | None = None  # a recorded 3D run: the top in plan per sample [m]
 
     def stop(self, status: str, message: str, t: float) -> Outcome:
         """End the run at time t with a status and a reason."""

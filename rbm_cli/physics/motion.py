@@ -103,6 +103,13 @@ class GroundMotion:
         peak = float(np.max(np.abs(self.values_y)))
         return dataclasses.replace(self, amplitude=peak, values=self.values_y, values_y=None)
 
+    def accel_y(self, t: np.ndarray) -> np.ndarray | None:
+        """A pair's second component a_y(t) [m/s^2] as read (along (-sin angle, cos angle)),
+        vectorised as :meth:`accel`; None for a motion of one component."""
+        if self.values_y is None:
+            return None
+        return self._y_component.accel(t)
+
     def horizontal(self, forced: bool = True):
         """(a_x(t), a_y(t)) [m/s^2] in the ground's axes as a function of a float t [s]: the
         motion along ``direction``, plus the second component across it (a pair of

@@ -65,7 +65,11 @@ def run_title(summary: dict) -> str | None:
 def record_title(name: str, record: dict, amplitude: float) -> str:
     """Title of a record run: the config's name, the record's, its scaled PGA [g] (and the
     scale factor with ``scale: factor``), the vertical record's name and scaled peak."""
-    title = f"{name}: record {record['record']} scaled to PGA {float(record['pga_g']):.4g} g"
+    if record.get("record_y"):
+        title = (f"{name}: records {record['record']} (x) and {record['record_y']} (y) scaled"
+                 f" to PGA {float(record['pga_g']):.4g} g (the larger)")  # fmt: skip
+    else:
+        title = f"{name}: record {record['record']} scaled to PGA {float(record['pga_g']):.4g} g"
     if record.get("scale") == "factor":
         title += f" (factor {amplitude:.4g})"
     if record.get("vertical"):
@@ -81,7 +85,13 @@ def plot_ground(history: History, ax, vertical=None, t_collapse: float | None = 
 
     t = np.asarray(history.t, dtype=float)
     ag = np.asarray(history.ground_acceleration, dtype=float) / G
-    ax.plot(t, ag, color="0.35", linewidth=0.8, label="$a_g$ (horizontal)", gid="a_g")
+    pair = history.ground_acceleration_y is not None
+    label = "$a_x$ (horizontal, x record)" if pair else "$a_g$ (horizontal)"
+    ax.plot(t, ag, color="0.35", linewidth=0.8, label=label, gid="a_g")
+    if pair:
+        ay = np.asarray(history.ground_acceleration_y, dtype=float) / G
+        ax.plot(t, ay, color="tab:purple", linewidth=0.8, label="$a_y$ (horizontal, y record)",
+                gid="a_y")  # fmt: skip
     if vertical is not None:
         av = np.asarray(vertical, dtype=float) / G
         ax.plot(t, av, color="tab:green", linewidth=0.8, label="$a_v$ (vertical, upward)",
@@ -129,7 +139,8 @@ def history_figure(
     displacement (the top relative to the ground, and the ground on a right axis, when the
     ground drifts: rbm_cli.report.plots.ground_drifts), top relative to base, and for more
     than one drum each joint's rotation over its limit (``joints`` = (Column, formulation,
-    collapse ratio), see :func:`rbm_cli.report.plots.plot_joint_rotations`)."""
+    collapse ratio), see :func:`rbm_cli.report.plots.plot_joint_rotations`); for a model in
+    three dimensions the top's path in plan below them (:func:`plot_top_plan`)."""
     from matplotlib.figure import Figure
 
     from rbm_cli.report.plots import (
@@ -142,8 +153,18 @@ def history_figure(
     multi = joints is not None and joints[0].n > 1
     ground = bool(ground or vertical is not None)
     count = 2 + int(multi) + int(ground)
-    fig = Figure(figsize=(9.0, 2.0 + 2.2 * count if count > 2 else 6.0))
-    axes = list(fig.subplots(count, 1, sharex=True))
+    height = 2.0 + 2.2 * count if count > 2 else 6.0
+    if history.top_plan is None:
+        fig = Figure(figsize=(9.0, height))
+        axes = list(fig.subplots(count, 1, sharex=True))
+    else:  # a model in three dimensions: the top's path in plan below the time panels
+        fig = Figure(figsize=(9.0, height + 4.0))
+        grid = fig.add_gridspec(count + 1, 1, height_ratios=[1.0] * count + [2.0])
+        axes = [fig.add_subplot(grid[0])]
+        axes += [fig.add_subplot(grid[k], sharex=axes[0]) for k in range(1, count)]
+        for ax in axes[:-1]:
+            ax.tick_params(labelbottom=False)
+        plot_top_plan(history, fig.add_subplot(grid[count]), t_collapse)
     if ground:
         plot_ground(history, axes.pop(0), vertical, t_collapse)
     relative = ground_drifts(history)  # the ground then on a right axis of the first panel
@@ -171,6 +192,20 @@ def history_figure(
         fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def plot_top_plan(history: History, ax, t_collapse: float | None = None) -> None:
+    """The top centre's path in plan [m] (a model in three dimensions), from where it
+    stood (a dot) to where the run ended or the column fell (an x), equal scales."""
+    xy = np.asarray(history.top_plan, dtype=float)
+    ax.plot(xy[:, 0], xy[:, 1], lw=0.8, color="C0", label="top centre in plan", gid="top_plan")
+    ax.plot([xy[0, 0]], [xy[0, 1]], "o", color="k", ms=4, label="start")
+    end = "collapse" if t_collapse is not None else "end"
+    ax.plot([xy[-1, 0]], [xy[-1, 1]], "x", color="C3", ms=7, label=end)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title("the top's path in plan", fontsize="medium")
 
 
 def shapes_figure(

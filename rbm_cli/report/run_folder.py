@@ -65,17 +65,22 @@ def run_folder_name(amplitude_g: float, frequency_hz: float | None, excitation_t
 
 
 def history_columns(history: History, vertical=None) -> dict[str, np.ndarray]:
-    """The columns of history.csv: t_s [s], ag_m_s2 [m/s2], av_m_s2 [m/s2] (the upward
+    """The columns of history.csv: t_s [s], ag_m_s2 [m/s2], ag_y_m_s2 [m/s2] (a pair's
+    second component), av_m_s2 [m/s2] (the upward
     ground acceleration, only when a vertical record is given: ``vertical``, a_v at the
     history's times, :func:`vertical_history`), ug_m [m], u1_m..u{n+1}_m [m] (node
     displacements relative to the ground), theta1_rad..thetan_rad [rad] (absolute drum
-    rotations); -0.0 made 0.0, so the file never shows "-0"."""
+    rotations; a model in three dimensions: the tilt in the motion's plane), and for a model
+    in three dimensions top_x_m, top_y_m [m] (the top centre in plan from where it stood);
+    -0.0 made 0.0, so the file never shows "-0"."""
     u = np.atleast_2d(np.asarray(history.node_displacements, dtype=float))
     theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
     data: dict[str, np.ndarray] = {
         "t_s": np.asarray(history.t, dtype=float),
         "ag_m_s2": np.asarray(history.ground_acceleration, dtype=float),
     }
+    if history.ground_acceleration_y is not None:  # a pair of records
+        data["ag_y_m_s2"] = np.asarray(history.ground_acceleration_y, dtype=float)
     if vertical is not None:
         av = np.asarray(vertical, dtype=float)
         if av.shape != data["t_s"].shape:
@@ -86,6 +91,9 @@ def history_columns(history: History, vertical=None) -> dict[str, np.ndarray]:
         data[f"u{i + 1}_m"] = u[:, i]
     for i in range(theta.shape[1]):
         data[f"theta{i + 1}_rad"] = theta[:, i]
+    if history.top_plan is not None:  # a model in three dimensions
+        plan = np.asarray(history.top_plan, dtype=float)
+        data["top_x_m"], data["top_y_m"] = plan[:, 0], plan[:, 1]
     return {k: v + 0.0 for k, v in data.items()}
 
 
@@ -122,8 +130,9 @@ def _csv_line(row: list[float]) -> str:
 def record_of_run(config, amplitude_g: float) -> dict | None:
     """What a record run ran, for its summary.json and its figures' titles: the record's
     name, its peak acceleration as scaled [g] (the amplitude with ``scale: pga``; the
-    factor times the processed record's PGA with ``scale: factor``), and the vertical
-    record's name and scaled peak [g] (None without one); None for another excitation."""
+    factor times the processed record's PGA with ``scale: factor``; a pair's: the larger
+    component's, with ``record_y`` the second record's name), and the vertical record's
+    name and scaled peak [g] (None without one); None for another excitation."""
     from rbm_cli.config.types import G
     from rbm_cli.physics.excitation import make_ground_motion
 
@@ -133,6 +142,9 @@ def record_of_run(config, amplitude_g: float) -> dict | None:
     motion = make_ground_motion(excitation, amplitude_g)
     info = {"record": motion.name, "pga_g": float(np.max(np.abs(motion.values))) / G,
             "scale": excitation.scale, "vertical": None, "vertical_peak_g": None}  # fmt: skip
+    if motion.values_y is not None:  # a pair: its PGA is the larger component's
+        info["record_y"] = Path(str(excitation.file_y)).stem
+        info["pga_g"] = max(info["pga_g"], float(np.max(np.abs(motion.values_y))) / G)
     if motion.vertical is not None:
         info["vertical"] = Path(str(excitation.vertical)).stem
         info["vertical_peak_g"] = float(np.max(np.abs(motion.vertical))) / G

@@ -65,6 +65,8 @@ class _Run3d(BlockRun):
     y: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(STATE_SIZE))
     c: np.ndarray = dataclasses.field(default_factory=lambda: np.array([1.0, 0.0]))
     top_max: float = 0.0
+    plan: dict = dataclasses.field(default_factory=dict)  # sample index -> top in plan [m]
+    start_top: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(2))
     azimuth: float = math.nan
     phase: int = 0  # LEAVING, FREE or APPROACH (near the vertical)
     swept: float = 0.0  # the angle the lean's direction swept while it rolled [rad]
@@ -159,6 +161,7 @@ def cylinder_run(
         run.y = np.array(state, dtype=float)
         run.c = lean_direction(run.y[0:2], run.c)
     run.at_rest = not np.any(run.y[0:5])
+    run.start_top = top_in_plan(geo, run.y)
     lean = math.hypot(run.y[0], run.y[1])
     run.phase = LEAVING if lean <= LEAVE_FACTOR * geo.upright else FREE
     run.peak = tilt(run.y[0:2])
@@ -186,6 +189,12 @@ def cylinder_run(
 def _finish(run: _Run3d, status: str = "survived", message: str = "") -> Outcome:
     out = run.finish(status, message)
     out.azimuth, out.turns = run.azimuth, run.swept / (2.0 * math.pi)
+    if run.rec.samples is not None:  # the top in plan at each sample; at rest where it was
+        place, top_plan = run.start_top, np.zeros((len(out.samples), 2))
+        for i in range(len(out.samples)):
+            place = run.plan.get(i, place)
+            top_plan[i] = place
+        out.top_plan = top_plan
     return out
 
 
@@ -278,7 +287,7 @@ def _steps(run, integ, k, solver, d):
         t_new = integ.t if hit is None else hit[0]
         _peaks(run, dense, t_old, t_new, k["geo"])
         if run.rec.samples is not None:
-            _emit(run, dense, t_new, d)
+            _emit(run, dense, t_new, d, k["geo"])
         y_new = dense(t_new) if hit is not None else integ.y.copy()
         if phase == FREE:  # near the vertical the contact is pinned: no rolling there
             run.swept += _turned(run.y, y_new)
@@ -348,11 +357,13 @@ def _peaks(run, dense, t_old, t_new, geo) -> None:
         consider(dense(brentq(lean_rate, t_old, t_new, xtol=1e-15)))
 
 
-def _emit(run, dense, t_stop, d) -> None:
+def _emit(run, dense, t_stop, d, geo) -> None:
     ts = run.rec.times(t_stop)
     for t in ts:
-        th, rate = _history_angle(dense(t), d)
+        y = dense(t)
+        th, rate = _history_angle(y, d)
         run.rec.emit(np.array([t]), th, rate)
+        run.plan[len(run.out.samples) - 1] = top_in_plan(geo, y)
 
 
 def _fail(run: _Run3d, message: str) -> Outcome:
@@ -383,4 +394,12 @@ class Housner3dRunner(BlockRunner):
             **options,
         )
         out.method = solver.method
+        return out
+
+    def run(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
+        """One run (rbm_cli.models.contract.Runner.run); a recorded history carries the
+        top's path in plan."""
+        out = super().run(motion, solver, **options)
+        if out.history is not None and out.top_plan is not None:
+            out.history = dataclasses.replace(out.history, top_plan=out.top_plan)
         return out

@@ -420,3 +420,15 @@ def test_a_pair_runs_history_and_title_name_both_records(pair_dir):
     assert info["record_y"] == "rdk_02" and info["pga_g"] == pytest.approx(0.8, rel=1e-12)
     title = record_title("pair", info, 0.8)
     assert "rdk_01 (x)" in title and "rdk_02 (y)" in title and "0.8 g" in title
+
+
+def test_with_a_vertical_record_along_x_it_is_housners_block(pair_dir):
+    """g + a_v(t) in the weight and in the uplift level: along x the same impacts as
+    housner and peaks within 1e-8 (rdk_01 horizontal, rdk_03 vertical at 0.4 g)."""
+    (pair_dir / "rdk_03.AT2").write_bytes((RECORDS / "rdk_03.AT2").read_bytes())
+    exc = {"file": "rdk_01.AT2", "vertical": "rdk_03.AT2", "free_time": 1.0}
+    a = simulate(pair_config(pair_dir, "housner", **exc), 0.4, None)
+    b = simulate(pair_config(pair_dir, **exc), 0.4, None)
+    assert (a.status, a.n_impacts, a.n_uplifts) == (b.status, b.n_impacts, b.n_uplifts)
+    assert a.n_impacts > 50
+    assert b.max_rotation_ratio == pytest.approx(a.max_rotation_ratio, rel=1e-8)

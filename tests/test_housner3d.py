@@ -20,6 +20,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.integrate import solve_ivp
 
@@ -432,3 +433,34 @@ def test_with_a_vertical_record_along_x_it_is_housners_block(pair_dir):
     assert (a.status, a.n_impacts, a.n_uplifts) == (b.status, b.n_impacts, b.n_uplifts)
     assert a.n_impacts > 50
     assert b.max_rotation_ratio == pytest.approx(a.max_rotation_ratio, rel=1e-8)
+
+
+def test_a_suites_fragility_takes_each_records_worst_angle():
+    """Two records x three intensities x two angles, outcomes set by hand: each record and
+    intensity counts as collapsed when either angle collapsed, failed when one failed and
+    none collapsed; the per-intensity counts are those, and the fit is of them."""
+    from rbm_cli.study.fragility import fragility
+    from rbm_cli.study.outcomes import worst_angle
+
+    rows = []
+    outcome = {  # (record, amplitude) -> statuses at 0 and 90 degrees
+        ("a", 0.2): ("survived", "survived"), ("a", 0.4): ("survived", "collapsed"),
+        ("a", 0.6): ("collapsed", "collapsed"), ("b", 0.2): ("survived", "failed"),
+        ("b", 0.4): ("survived", "survived"), ("b", 0.6): ("collapsed", "survived"),
+    }  # fmt: skip
+    for (record, amplitude), statuses in outcome.items():
+        for angle, status in zip((0.0, 90.0), statuses, strict=True):
+            rows.append({"excitation.angle": angle, "record": record, "amplitude_g": amplitude,
+                         "status": status, "collapsed": int(status == "collapsed"),
+                         "max_rotation_ratio": 1.0 if status == "collapsed" else 0.1})  # fmt: skip
+    df = pd.DataFrame(rows)
+    worst = worst_angle(df)
+    assert list(zip(worst.record, worst.amplitude_g, worst.status, strict=True)) == [
+        ("a", 0.2, "survived"), ("a", 0.4, "collapsed"), ("a", 0.6, "collapsed"),
+        ("b", 0.2, "failed"), ("b", 0.4, "survived"), ("b", 0.6, "collapsed"),
+    ]  # fmt: skip
+    table = fragility(df, n_resamples=0).table
+    assert table["n_collapsed"].tolist() == [0, 1, 2]
+    assert table["n_records"].tolist() == [1, 2, 2]  # the failed run is left out
+    assert worst_angle(df.drop(columns="excitation.angle")).equals(
+        df.drop(columns="excitation.angle"))  # fmt: skip

@@ -54,6 +54,7 @@ from rbm_cli.study.outcomes import (
     is_ensemble,
     level_table,
     prepare_outcomes,
+    worst_angle,
 )
 
 METHOD = (
@@ -187,7 +188,8 @@ def fragility(
         One row per run: ``record``, an intensity column [g] (``intensity_g``,
         ``amplitude_g`` or ``intensity``, or ``intensity_column``), ``collapsed`` (0/1),
         optional ``status`` (collapsed | survived | failed: failed rows are left out of
-        the fit and counted)
+        the fit and counted); a suite over ``excitation.angle`` counts each record's worst
+        angle at each intensity (rbm_cli.study.outcomes.worst_angle)
     n_resamples : int
         Bootstrap resamples of the records, 0 to :data:`MAX_RESAMPLES` (0: no bootstrap)
     seed : int
@@ -222,6 +224,7 @@ def fragility(
         nothing but failed runs), or options out of range (:func:`check_options`).
     """
     lo_pct, hi_pct = check_options(n_resamples, seed, ci_percentiles)
+    df = worst_angle(df) if isinstance(df, pd.DataFrame) else df
     rows, column = prepare_outcomes(df, intensity_column, ensemble_outcome, n_members)
     ensemble = is_ensemble(df)
     table = level_table(rows, trials=ensemble and ensemble_outcome == "members")

@@ -194,6 +194,35 @@ def level_table(rows: pd.DataFrame, trials: bool = False) -> pd.DataFrame:
     return pd.DataFrame(table)
 
 
+#: A suite swept over the ground motion's azimuth (a model in three dimensions) has a row
+#: per angle: its fragility takes, per record and intensity, the worst angle's run.
+ANGLE_AXIS = "excitation.angle"
+
+
+def worst_angle(df: pd.DataFrame) -> pd.DataFrame:
+    """A suite's rows with one run per record and intensity: where the table has an
+    ``excitation.angle`` column, the worst angle's row of each record and amplitude_g (a
+    collapse before a failed run before a survival; then the larger collapse_fraction,
+    then the larger max_rotation_ratio), in the order of their first rows; the table as
+    it is otherwise."""
+    if not {ANGLE_AXIS, "amplitude_g", "record", "collapsed"} <= set(df.columns):
+        return df  # (a table without them is refused, in one line, by prepare_outcomes)
+    df = df.reset_index(drop=True)
+    status = df["status"].astype(str) if "status" in df.columns else None
+    collapsed = pd.to_numeric(df["collapsed"], errors="coerce").fillna(0.0)
+    rank = 2.0 * collapsed + (status == "failed").astype(float) if status is not None else collapsed
+    keys = pd.DataFrame({"_rank": rank.to_numpy()}, index=df.index)
+    for column in ("collapse_fraction", "max_rotation_ratio"):
+        if column in df.columns:
+            keys[column] = pd.to_numeric(df[column], errors="coerce").fillna(-np.inf)
+    order = keys.sort_values(list(keys.columns), ascending=False, kind="stable").index
+    worst = df.loc[order].drop_duplicates(["record", "amplitude_g"], keep="first")
+    cells = list(zip(df["record"], df["amplitude_g"], strict=True))
+    position = {cell: i for i, cell in enumerate(dict.fromkeys(cells))}  # first rows' order
+    at = [position[cell] for cell in zip(worst["record"], worst["amplitude_g"], strict=True)]
+    return worst.iloc[np.argsort(at, kind="stable")].reset_index(drop=True)
+
+
 def read_suite_domain(path: str | Path) -> pd.DataFrame:
     """Read the ``domain.csv`` of a record-suite sweep (records x intensities).
 
@@ -214,8 +243,9 @@ def read_suite_domain_hashed(path: str | Path) -> tuple[pd.DataFrame, str]:
     Returns
     -------
     pandas.DataFrame  The rows as written, ``record`` as text, ``collapsed`` 0/1 agreeing
-        with ``status``; checked further by :func:`prepare_outcomes` (intensities, status,
-        one run per record and intensity)
+        with ``status``, a suite over ``excitation.angle`` reduced to its worst angle per
+        record and intensity (:func:`worst_angle`); checked further by
+        :func:`prepare_outcomes` (intensities, status, one run per record and intensity)
     str  The SHA-256 of the file's bytes (hex)
 
     Raises
@@ -254,4 +284,4 @@ def read_suite_domain_hashed(path: str | Path) -> tuple[pd.DataFrame, str]:
         raise RbmError(f"{path}: line {int(np.argmax(empty)) + 2}: the record field is empty")
     if "collapsed" in df.columns:
         check_collapsed(df, path)
-    return df, hashlib.sha256(data).hexdigest()
+    return worst_angle(df), hashlib.sha256(data).hexdigest()

@@ -241,6 +241,27 @@ def cylinder_energy(
     return kinetic + m * G * (float(r[2]) - geo.centre_height)
 
 
+def lean_rates(y: np.ndarray) -> np.ndarray:
+    """q' = (w x n) in plan [1/s], the lean's rate, of states y (7,) or (7, m)."""
+    q, w = y[0:2], y[2:5]
+    s2 = q[0] * q[0] + q[1] * q[1]
+    nz = np.sqrt(np.maximum(0.0, 1.0 - s2))
+    return np.array([w[1] * nz - w[2] * q[1], w[2] * q[0] - w[0] * nz])
+
+
+def tilt_in_plane(y: np.ndarray, d: np.ndarray) -> tuple[float, float]:
+    """The tilt seen in the vertical plane of the unit vector d in plan, atan2(q . d, n_z)
+    [rad], and its rate [rad/s]: Housner's theta and theta' for a motion in that plane."""
+    q = y[0:2]
+    along = float(q[0] * d[0] + q[1] * d[1])
+    nz = float(axis(q)[2])
+    dq = lean_rates(y)
+    d_along = float(dq[0] * d[0] + dq[1] * d[1])
+    d_nz = -float(q[0] * dq[0] + q[1] * dq[1]) / nz if nz > 0.0 else 0.0
+    den = along * along + nz * nz
+    return math.atan2(along, nz), (nz * d_along - along * d_nz) / den if den > 0.0 else 0.0
+
+
 def top_in_plan(geo: CylinderGeometry, y: np.ndarray) -> np.ndarray:
     """The top's centre in plan [m], from where it stood: x_G + (H - h) q."""
     return y[5:7] + (geo.height - geo.centre_height) * y[0:2]
@@ -260,8 +281,10 @@ __all__ = [
     "cylinder_energy",
     "cylinder_geometry",
     "lean_direction",
+    "lean_rates",
     "rolling_rates",
     "tilt",
+    "tilt_in_plane",
     "top_in_plan",
     "uplift_level",
 ]

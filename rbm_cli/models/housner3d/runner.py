@@ -44,11 +44,12 @@ from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.cylinder import (
     STATE_SIZE,
     CylinderGeometry,
-    axis,
     cylinder_geometry,
     lean_direction,
+    lean_rates,
     rolling_rates,
     tilt,
+    tilt_in_plane,
     top_in_plan,
     uplift_level,
 )
@@ -81,26 +82,6 @@ def _ground(motion: GroundMotion, forced: bool):
         return np.array([-ax, -ay, -(G if gravity is None else G * gravity(t))])
 
     return ge
-
-
-def _rates(y: np.ndarray) -> np.ndarray:
-    """q' = (w x n) in plan, for states y (7,) or (7, m)."""
-    q, w = y[0:2], y[2:5]
-    s2 = q[0] * q[0] + q[1] * q[1]
-    nz = np.sqrt(np.maximum(0.0, 1.0 - s2))
-    return np.array([w[1] * nz - w[2] * q[1], w[2] * q[0] - w[0] * nz])
-
-
-def _history_angle(y: np.ndarray, d: np.ndarray) -> tuple[float, float]:
-    """The tilt seen in the motion's vertical plane [rad] and its rate [rad/s]."""
-    q = y[0:2]
-    along = float(q[0] * d[0] + q[1] * d[1])
-    nz = float(axis(q)[2])
-    dq = _rates(y)
-    d_along = float(dq[0] * d[0] + dq[1] * d[1])
-    d_nz = -float(q[0] * dq[0] + q[1] * dq[1]) / nz if nz > 0.0 else 0.0
-    den = along * along + nz * nz
-    return math.atan2(along, nz), (nz * d_along - along * d_nz) / den if den > 0.0 else 0.0
 
 
 def cylinder_run(
@@ -266,7 +247,7 @@ def _steps(run, integ, k, solver, d):
 
         def rows(ts, dense=dense):
             yy = dense(np.atleast_1d(ts))
-            q, dq = yy[0:2], _rates(yy)
+            q, dq = yy[0:2], lean_rates(yy)
             lean = np.hypot(q[0], q[1])
             d_lean = (q[0] * dq[0] + q[1] * dq[1]) / np.where(lean > 0.0, lean, 1.0)
             collapse, d_collapse = s_limit - lean, -d_lean
@@ -344,7 +325,7 @@ def _peaks(run, dense, t_old, t_new, geo) -> None:
 
     def lean_rate(t):
         yy = dense(t)
-        dq = _rates(yy)
+        dq = lean_rates(yy)
         return float(yy[0] * dq[0] + yy[1] * dq[1])
 
     def consider(y):
@@ -361,7 +342,7 @@ def _emit(run, dense, t_stop, d, geo) -> None:
     ts = run.rec.times(t_stop)
     for t in ts:
         y = dense(t)
-        th, rate = _history_angle(y, d)
+        th, rate = tilt_in_plane(y, d)
         run.rec.emit(np.array([t]), th, rate)
         run.plan[len(run.out.samples) - 1] = top_in_plan(geo, y)
 

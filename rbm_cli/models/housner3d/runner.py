@@ -266,10 +266,11 @@ def _steps(run, integ, k, solver, d):
 
         hit = first_crossing(rows, t_old, integ.t, xtol=1e-15)
         t_new = integ.t if hit is None else hit[0]
-        _peaks(run, dense, t_old, t_new, k["geo"])
+        y_end = dense(t_new)  # the dense output at the step's (cut) end, evaluated once
+        _peaks(run, dense, t_old, t_new, y_end, k["geo"])
         if run.rec.samples is not None:
             _emit(run, dense, t_new, d, k["geo"])
-        y_new = dense(t_new) if hit is not None else integ.y.copy()
+        y_new = y_end if hit is not None else integ.y.copy()
         if phase == FREE:  # near the vertical the contact is pinned: no rolling there
             run.swept += _turned(run.y, y_new)
         run.t, run.y = t_new, y_new
@@ -319,12 +320,12 @@ def _impact(run, k, solver) -> Outcome | None:
     return None
 
 
-def _peaks(run, dense, t_old, t_new, geo) -> None:
-    """The peak tilt and the top's farthest place on [t_old, t_new]: at the end, and where
-    the tilt's rate turns from rising to falling (Brent on the dense output)."""
+def _peaks(run, dense, t_old, t_new, y_end, geo) -> None:
+    """The peak tilt and the top's farthest place on [t_old, t_new]: at the end (y_end, the
+    dense output there), and where the tilt's rate turns from rising to falling (Brent on
+    the dense output)."""
 
-    def lean_rate(t):
-        yy = dense(t)
+    def lean_rate(yy):
         dq = lean_rates(yy)
         return float(yy[0] * dq[0] + yy[1] * dq[1])
 
@@ -332,10 +333,10 @@ def _peaks(run, dense, t_old, t_new, geo) -> None:
         run.peak = max(run.peak, tilt(y[0:2]))
         run.top_max = max(run.top_max, float(np.hypot(*top_in_plan(geo, y))))
 
-    consider(dense(t_new))
-    r0, r1 = lean_rate(t_old), lean_rate(t_new)
+    consider(y_end)
+    r0, r1 = lean_rate(dense(t_old)), lean_rate(y_end)
     if r0 > 0.0 and r1 < 0.0:
-        consider(dense(brentq(lean_rate, t_old, t_new, xtol=1e-15)))
+        consider(dense(brentq(lambda t: lean_rate(dense(t)), t_old, t_new, xtol=1e-15)))
 
 
 def _emit(run, dense, t_stop, d, geo) -> None:

@@ -189,8 +189,12 @@ def test_auto_runs_a_damped_column_with_a_method_that_damps():
         ({"stiffness": SOFT, "damping": 1.0}, "rbm", "damping must be a number in [0, 1)"),
         ({"stiffness": SOFT, "damping": -0.01}, "rbm", "interface.damping must be a number"),
         ({"stiffness": SOFT, "damping": "5%"}, "rbm", "interface.damping must be a number"),
-        ({"damping": 0.05}, "housner", "interface.damping applies only to model rbm"),
-        ({"damping": 0.05}, "housner-linear", "interface.damping applies only to model rbm"),
+        ({"damping": 0.05}, "housner", "interface.damping applies only to models rbm and rbm-3d"),
+        (
+            {"damping": 0.05},
+            "housner-linear",
+            "interface.damping applies only to models rbm and rbm-3d",
+        ),
         ({"damping": 0.05}, "rbm", "a rigid interface does not have"),
     ],
 )

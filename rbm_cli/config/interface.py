@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from rbm_cli.base.errors import ConfigError
-from rbm_cli.config.types import FORMULATIONS, InterfaceConfig, StiffnessConfig
+from rbm_cli.config.types import FORMULATIONS, MODELS, InterfaceConfig, StiffnessConfig
 from rbm_cli.config.validate import (
     SOUND_WHY,
     choice,
@@ -80,20 +80,21 @@ def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
         restitution=restitution,
         formulation=choice(i.get("formulation", "relative"), "interface.formulation", FORMULATIONS),
         friction=friction,
-        friction_limit=friction if model == "rbm" and "friction" in i else None,
+        friction_limit=friction if MODELS[model].beam and "friction" in i else None,
         damping=damping,
     )
 
 
 def damping_value(i: Mapping, model: str) -> float:
     """``interface.damping``: the ratio zeta of critical damping of the first elastic mode,
-    a number in [0, 1) (model rbm only; 0 when not given)."""
+    a number in [0, 1) (the Rigid Beam Model's joints only; 0 when not given)."""
     if "damping" not in i:
         return 0.0
-    if model != "rbm":
+    if not MODELS[model].beam:
+        beams = " and ".join(name for name, entry in MODELS.items() if entry.beam)
         raise ConfigError(
-            f"interface.damping applies only to model rbm (model is {model}, which has no"
-            " elastic joints to damp): delete it"
+            f"interface.damping applies only to models {beams} (model is {model}, which has"
+            " no elastic joints to damp): delete it"
         )
     return number(i["damping"], "interface.damping", "", 0.0, 1.0, lo_open=False, hi_open=True)
 

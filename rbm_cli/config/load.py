@@ -313,7 +313,7 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
     column = _column(top["column"])
     n = column.n_drums
     for key in ("capital", "top_mass"):
-        if model != "rbm" and getattr(column, key) is not None:
+        if not MODELS[model].beam and getattr(column, key) is not None:
             raise ConfigError(
                 f"column.{key} is taken by model rbm only (model {model} has no such body):"
                 " delete it or use model: rbm"

@@ -45,12 +45,15 @@ IMPLEMENTATIONS = ("compiled", "python")
 @dataclass(frozen=True)
 class ModelEntry:
     """A registered model: its runner ("module:class", rbm_cli.models.contract.Runner),
-    whether it takes more than one drum, and whether it moves in three dimensions (a
-    circular section only, a motion in any direction: excitation.angle)."""
+    whether it takes more than one drum, whether it moves in three dimensions (a
+    circular section only, a motion in any direction: excitation.angle), and whether its
+    joints are the Rigid Beam Model's (their laws, stiffness and damping, a capital or a
+    top mass, the friction demand)."""
 
     runner: str
     multi_drum: bool
     three_d: bool = False
+    beam: bool = False
 
 
 #: The model registry, name -> runner (rbm_cli.models.registry resolves it). rbm: the
@@ -59,9 +62,10 @@ class ModelEntry:
 #: true geometry); the last two monolithic only. bullet: stacked rigid drums in Bullet's
 #: contact dynamics (PyBullet), any drums. housner-3d: the rigid cylinder rocking and
 #: rolling on its rim in three dimensions (true geometry, circular monolithic columns).
+#: rbm-3d: the Rigid Beam Model in two horizontal directions (circular drums).
 #: A new model is one module and one line here.
 MODELS = {
-    "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True),
+    "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True, beam=True),
     "housner": ModelEntry("rbm_cli.models.housner.runner:HousnerRunner", multi_drum=False),
     "housner-linear": ModelEntry(
         "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False
@@ -69,6 +73,9 @@ MODELS = {
     "bullet": ModelEntry("rbm_cli.models.bullet.run:BulletRunner", multi_drum=True),
     "housner-3d": ModelEntry(
         "rbm_cli.models.housner3d.runner:Housner3dRunner", multi_drum=False, three_d=True
+    ),
+    "rbm-3d": ModelEntry(
+        "rbm_cli.models.rbm3d.runner:Rbm3dRunner", multi_drum=True, three_d=True, beam=True
     ),
 }
 

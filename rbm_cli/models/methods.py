@@ -12,8 +12,8 @@ here and nowhere else (:func:`resolve`):
   sine pulses, records exact per sample interval), no vertical record, `solver.implementation:
   compiled` -- else DOP853 (the step integrator, rbm_cli.models.rbm.step);
 - `housner-linear`: `closed-form`, whatever the method says;
-- `housner` and `housner-3d`: DOP853 (scipy's pairs); `bullet`: its engine (the method
-  does not apply).
+- `housner`, `housner-3d` and `rbm-3d`: DOP853 (scipy's pairs); `bullet`: its engine (the
+  method does not apply).
 
 An explicit method is kept where it applies (`DOP853` on a rigid monolith runs the step
 integrator) and refused in one line where it does not. Every compiled method also runs its
@@ -147,6 +147,8 @@ class Method:
 
 
 _STEP = "rbm_cli.models.rbm.step:prepare"
+#: The models whose runners step scipy's Runge-Kutta pairs themselves (no compiled code).
+_PAIRS = {"housner": None, "housner-3d": None, "rbm-3d": None}
 
 #: The methods, by name: where each applies, what it prepares, what it compiles.
 METHODS: dict[str, Method] = {
@@ -161,9 +163,9 @@ METHODS: dict[str, Method] = {
         Method(
             "exact", {"rbm": "exact"}, "rbm_cli.models.rbm.exact.integrate:prepare", _exact_why_not
         ),
-        Method("DOP853", {"rbm": "kernel", "housner": None, "housner-3d": None}, _STEP),
-        Method("RK45", {"rbm": "kernel", "housner": None, "housner-3d": None}, _STEP),
-        Method("RK23", {"rbm": "kernel", "housner": None, "housner-3d": None}, _STEP),
+        Method("DOP853", {"rbm": "kernel", **_PAIRS}, _STEP),
+        Method("RK45", {"rbm": "kernel", **_PAIRS}, _STEP),
+        Method("RK23", {"rbm": "kernel", **_PAIRS}, _STEP),
         Method("engine", {"bullet": None}),
     )
 }

@@ -30,7 +30,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from rbm_cli.config.types import Config, InterfaceConfig, StiffnessConfig
+from rbm_cli.config.types import MODELS, Config, InterfaceConfig, StiffnessConfig
 
 #: The columns a domain gets from :func:`cell_scales` (domain.csv).
 SCALE_FIELDS = ("alpha_rad", "p_rad_s", "static_multiplier", "a_over_g_alpha", "omega_over_p")
@@ -62,14 +62,14 @@ def rocking_scales(config: Config) -> RockingScales:
     rigid = InterfaceConfig(stiffness=StiffnessConfig("rigid", ()))
     column = build_column(config.column, rigid)
     glued = dataclasses.replace(config.column, drum_heights=(config.column.height,))
-    if config.model == "rbm" and config.column.capital is not None:
+    if MODELS[config.model].beam and config.column.capital is not None:
         # shaft and capital glued into one rigid stack: its base's theta_u and its p
         from rbm_cli.physics.equations import build_model
 
         p = build_model(build_column(glued, rigid)).rocking_p
         tan_alpha = float(column.rotation_capacity[0])
         return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)
-    if config.model == "rbm":
+    if MODELS[config.model].beam:
         tan_alpha, p = linear_rocking_parameters(build_column(glued, rigid))
         return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)
     from rbm_cli.physics.block import block_geometry

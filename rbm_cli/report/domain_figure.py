@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import Config
+from rbm_cli.config.types import MODELS, Config
 from rbm_cli.physics.column import build_column
 from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
 from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
@@ -66,7 +66,7 @@ def column_note(config: Config) -> str:
     ]
     if itf.damping > 0 or "interface.damping" in axes:
         parts.insert(5, f"damping zeta = {value('interface.damping', f'{itf.damping:.3g}')}")
-    if config.model == "rbm" and itf.friction_limit is not None:
+    if MODELS[config.model].beam and itf.friction_limit is not None:
         parts.append(f"interface.friction = {itf.friction_limit:.3g}")
     return "column: " + ", ".join(parts)
 

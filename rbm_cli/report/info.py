@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from rbm_cli.config.grid import VIRTUAL_PATHS
-from rbm_cli.config.types import Config, G
+from rbm_cli.config.types import MODELS, Config, G
 from rbm_cli.physics.assembly import model_from_config
 from rbm_cli.physics.similarity import rocking_scales
 
@@ -106,14 +106,14 @@ def p_meaning(config: Config, n: int, lever: float) -> dict[str, str]:
              f"the RBM's monolith on its base (its weight at zbar_1 = {lever:.4g} m over the "
              "base's centre: tan alpha = theta_u,1 = (B_1/2)/zbar_1, p^2 = m g zbar_1 / "
              "(I_G + m zbar_1^2))")  # fmt: skip
-    if config.model == "rbm" and config.column.capital is not None:
+    if MODELS[config.model].beam and config.column.capital is not None:
         domain = "the RBM's shaft and capital glued into one rigid stack: the rocking p"
-    elif config.model == "rbm" and n > 1:
+    elif MODELS[config.model].beam and n > 1:
         domain = (
             "the RBM's one-drum monolith (the drums glued into one drum of height H: "
             "its weight at H/2, tan alpha = B_1/H), not the stack of the rocking p"
         )
-    elif config.model == "rbm":
+    elif MODELS[config.model].beam:
         domain = "the RBM's monolith: the rocking p"
     else:
         domain = (f"the true solid's ({config.model}: a rigid block, tan alpha = b/z_c with "

@@ -79,7 +79,7 @@ def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
     scales, the record's intensity measures (record excitations only)."""
     record = ("record",) if has_records(config) else ()
     fields = tuple(fields)
-    if config.model == "rbm" and config.interface.friction_limit is not None:
+    if MODELS[config.model].beam and config.interface.friction_limit is not None:
         at = fields.index("friction_demand") + 1 if "friction_demand" in fields else len(fields)
         fields = fields[:at] + (SLIDES_FIELD,) + fields[at:]
     if MODELS[config.model].three_d:

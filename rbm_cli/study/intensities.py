@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from rbm_cli.config.types import Config, G
+from rbm_cli.config.types import MODELS, Config, G
 from rbm_cli.physics.intensity import RecordMeasures, first_elastic_period, record_measures
 
 #: The measures every record row has, before the spectral accelerations at im_periods.
@@ -75,7 +75,7 @@ def measure_fields(config: Config) -> tuple[str, ...]:
 
 def column_period(config: Config) -> float | None:
     """The column's first elastic period [s], None for a rigid one (module docstring)."""
-    if config.model != "rbm":
+    if not MODELS[config.model].beam:
         return None
     from rbm_cli.physics.assembly import model_from_config
 

@@ -108,7 +108,7 @@ class RunResult:
     def domain_friction_demand(self) -> float:
         """domain.csv's friction_demand: max_friction_demand for model rbm, else NaN (not
         computed, or a contact engine's friction, capped by Coulomb, not a demand)."""
-        return self.max_friction_demand if self.model == "rbm" else float("nan")
+        return self.max_friction_demand if MODELS[self.model].beam else float("nan")
 
     @property
     def slides(self) -> int | None:

@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.types import Config
+from rbm_cli.config.types import MODELS, Config
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT, Runner
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.assembly import check_derived, model_from_config
@@ -97,7 +97,7 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         history=history,
         method=out.method,
         model=config.model,
-        friction_limit=config.interface.friction_limit if config.model == "rbm" else None,
+        friction_limit=config.interface.friction_limit if MODELS[config.model].beam else None,
         slip=out.slip,
         energy=None if out.energy is None else out.energy.as_dict(),
         collapse_azimuth_deg=math.degrees(math.remainder(out.azimuth, 2.0 * math.pi)),

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
-from rbm_cli.config.types import Config, hash_form
+from rbm_cli.config.types import MODELS, Config, hash_form
 from rbm_cli.models.methods import compiled_code
 from rbm_cli.study.cells import (
     Cell,
@@ -306,7 +306,7 @@ def _check_points(points: list[GridPoint]) -> list[GridPoint]:
     from rbm_cli.physics.assembly import model_from_config
 
     for point in points:
-        if point.config.model == "rbm":
+        if MODELS[point.config.model].beam:
             try:
                 model_from_config(point.config)
             except RbmError as exc:

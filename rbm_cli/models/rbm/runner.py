@@ -48,6 +48,11 @@ class RbmRunner:
         self._integrators: dict = {}  # (method, implementation) -> integrator, on first use
         resolve(config, model=self.model)  # an explicit method that does not apply: refused
 
+    def integrator_of(self, method):
+        """The integrator a method prepares for this runner's column (made once per method
+        and implementation)."""
+        return method.integrator(self.model)
+
     def run(
         self,
         motion: GroundMotion,
@@ -64,7 +69,7 @@ class RbmRunner:
         key = (method.prepare, solver.implementation)
         integrator = self._integrators.get(key)
         if integrator is None:
-            integrator = self._integrators[key] = method.integrator(self.model)
+            integrator = self._integrators[key] = self.integrator_of(method)
         n = self.model.n
         t_lift = motion.lift_off  # a vertical record dropping faster than gravity
         t_shape = shape_change(self.model, motion)  # or changing the order of a law's pieces

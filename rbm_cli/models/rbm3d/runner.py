@@ -89,6 +89,13 @@ class _Run:
     friction: np.ndarray | None = None
     slip: tuple | None = None
     gam = None  # (g + a_v(t)) / g of the current segment, a function of t [s]
+    end = None  # a list the final state is appended to (integrate3d's end)
+
+
+def _pinned(run: _Run) -> np.ndarray:
+    """(n,) bool: the joints whose law reads along their pinned direction (rigid laws near
+    closure; an elastic joint's pinned direction only tells where it closes)."""
+    return (run.phase != FREE) & run.beam.rigid
 
 
 def _phi(beam: Beam3d, y: np.ndarray):
@@ -119,6 +126,7 @@ def integrate3d(
     friction_limit: float = math.inf,
     beam: Beam3d | None = None,
     state: np.ndarray | None = None,
+    end: list | None = None,
 ) -> Outcome:
     """One run of a column's RBM in two directions (the module's rules).
 
@@ -136,6 +144,7 @@ def integrate3d(
     beam : Beam3d, optional  The equations in two directions, made once by a caller
     state : (4n,) array, optional  A whole initial state (theta_x, theta_y, their rates) in
         place of theta0, rate0
+    end : list, optional  If a list, the state where the run ended is appended to it
     """
     beam = beam3d(model) if beam is None else beam
     n = model.n
@@ -159,6 +168,7 @@ def integrate3d(
         atol=solver.atol * np.concatenate([np.full(2 * n, scale), np.full(2 * n, 10 * scale)]),
         rigid_mono=level is not None, deadline=time.monotonic() + float(solver.max_wall_time),
     )  # fmt: skip
+    run.end = end
     _locate(run, k)
     if np.any(beam.ratios(run.y)[0] >= model.collapse_ratio):
         i = int(np.argmax(beam.ratios(run.y)[0]))
@@ -218,7 +228,7 @@ def _segment(run: _Run, motion: GroundMotion, seg_end: float, forced: bool, k: d
             run.phase[0], run.c[0] = LEAVING, motion.uplift_direction(run.t)
             run.at_rest, run.h = False, None
             out.n_uplifts += 1
-        kk, pinned, c = run.k.copy(), run.phase != FREE, run.c.copy()
+        kk, pinned, c = run.k.copy(), _pinned(run), run.c.copy()
 
         def rhs(t, y, kk=kk, pinned=pinned, c=c):
             out.n_rhs += 1
@@ -319,8 +329,8 @@ def _steps(run: _Run, integ, k: dict, gam_at, horizontal):
         _friction(run, t_new, y_new, integ.f if hit is None else None, k, horizontal)
         _swept(run, y_old, y_new)
         run.t, run.y = t_new, y_new
+        _silent(run)  # before the event's change of pieces (an uplift on the other side)
         if hit is None:
-            _silent(run)
             continue
         return rows[hit[1]]
     return None
@@ -355,6 +365,9 @@ def _event(run: _Run, hit: tuple[int, int], k: dict) -> Outcome | None:
             run.k[i] -= 1
             if run.k[i] == 0 and run.pending[i]:
                 run.phase[i], run.c[i] = APPROACH, (px / r, py / r)
+                # a silent closure (e = 1) is counted, not stopped at: back on its elastic
+                # branch the joint is closed, as in the plane (a new excursion is an uplift)
+                run.pending[i] = beam.model.restitution != 1.0
         return None
     if kind == NEAR:
         run.phase[i], run.c[i] = APPROACH, (px / r, py / r)
@@ -455,7 +468,7 @@ def _friction(run: _Run, t, y, f, k, horizontal) -> None:
     ax, ay = horizontal(t)
     g = run.gam(t)
     if f is None:
-        f = beam.rates(y, ax, ay, g, run.k, run.phase != FREE, run.c)
+        f = beam.rates(y, ax, ay, g, run.k, _pinned(run), run.c)
         run.out.n_rhs += 1
     demand = beam.shear_demand(f[2 * n : 3 * n], f[3 * n :], ax, ay, g)
     np.maximum(run.friction, demand, out=run.friction)
@@ -484,6 +497,8 @@ def _collapse(run: _Run, i: int) -> Outcome:
 
 
 def _finish(run: _Run, status: str = "survived", message: str = "") -> Outcome:
+    if run.end is not None:
+        run.end.append(run.y.copy())
     out = run.out
     out.status, out.message, out.t_end = status, message, run.t
     out.max_ratio, out.max_top = run.peaks.copy(), run.top_max

@@ -311,7 +311,9 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "Spanos and Koh; both monolithic only; ``bullet`` the rigid-body contact "
         "engine (any drums; it ignores the joint law's stiffness, xi, restitution "
         "and formulation); ``housner-3d`` the rigid cylinder rocking and rolling on "
-        "its rim in three dimensions (monolithic, ``column.section: circular``).",
+        "its rim in three dimensions (monolithic, ``column.section: circular``); "
+        "``rbm-3d`` the Rigid Beam Model of circular drums in two horizontal directions "
+        "(any drums, ``column.section: circular``).",
     ),
     "column.height": ("m", "", "Required. Height H of the column."),
     "column.base_width": ("m", "", "Required. Width B_1 at the base."),
@@ -427,7 +429,7 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "deg",
         "",
         "Azimuth in plan of the horizontal motion, from the x axis (any type: the motion "
-        "is turned to it). Models in three dimensions only (``housner-3d``); the planar "
+        "is turned to it). Models in three dimensions only (``housner-3d``, ``rbm-3d``); the planar "
         "models rock in the x plane and refuse any other. Default 0.",
     ),
     "excitation.initial": ("", "", "Initial state of the drums."),

@@ -429,8 +429,8 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "deg",
         "",
         "Azimuth in plan of the horizontal motion, from the x axis (any type: the motion "
-        "is turned to it). Models in three dimensions only (``housner-3d``, ``rbm-3d``); the planar "
-        "models rock in the x plane and refuse any other. Default 0.",
+        "is turned to it). Models in three dimensions only (``housner-3d``, ``rbm-3d``); "
+        "the planar models rock in the x plane and refuse any other. Default 0.",
     ),
     "excitation.initial": ("", "", "Initial state of the drums."),
     "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),

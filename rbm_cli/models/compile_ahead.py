@@ -39,16 +39,18 @@ TARGETS = {
     "kernel": ("rbm_cli.models.rbm.step", "run_kernel"),
     "closed-form": ("rbm_cli.models.block.closed_form", "run_block"),
     "exact": ("rbm_cli.models.rbm.exact.integrate", "run_exact"),
+    "rbm3d": ("rbm_cli.models.rbm3d.runner", "run3d"),
 }
 #: What each is called in a note.
 NAMES = {
     "kernel": "the integrator",
     "closed-form": "the rigid block's closed form",
     "exact": "the exact integrator",
+    "rbm3d": "the integrator in two directions",
 }
 #: About how long a first compile takes [s]: measured on two shared cores at a load of 1-2
 #: (kernel 45-57 s, exact integrator 76 s, closed form 6-10 s).
-ABOUT_S = {"kernel": 50, "closed-form": 10, "exact": 80}
+ABOUT_S = {"kernel": 50, "closed-form": 10, "exact": 80, "rbm3d": 60}
 
 
 def _module(target: str):

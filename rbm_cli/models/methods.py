@@ -12,8 +12,8 @@ here and nowhere else (:func:`resolve`):
   sine pulses, records exact per sample interval), no vertical record, `solver.implementation:
   compiled` -- else DOP853 (the step integrator, rbm_cli.models.rbm.step);
 - `housner-linear`: `closed-form`, whatever the method says;
-- `housner`, `housner-3d` and `rbm-3d`: DOP853 (scipy's pairs); `bullet`: its engine (the
-  method does not apply).
+- `housner` and `housner-3d`: DOP853 (scipy's pairs); `rbm-3d`: DOP853 (the step kernel's
+  pairs, in its own compiled run); `bullet`: its engine (the method does not apply).
 
 An explicit method is kept where it applies (`DOP853` on a rigid monolith runs the step
 integrator) and refused in one line where it does not. Every compiled method also runs its
@@ -147,8 +147,9 @@ class Method:
 
 
 _STEP = "rbm_cli.models.rbm.step:prepare"
-#: The models whose runners step scipy's Runge-Kutta pairs themselves (no compiled code).
-_PAIRS = {"housner": None, "housner-3d": None, "rbm-3d": None}
+#: The models of the step pairs but `rbm`: their compiled code (None: scipy's pairs, stepped
+#: by the model's runner).
+_PAIRS = {"housner": None, "housner-3d": None, "rbm-3d": "rbm3d"}
 
 #: The methods, by name: where each applies, what it prepares, what it compiles.
 METHODS: dict[str, Method] = {

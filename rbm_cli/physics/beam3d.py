@@ -27,148 +27,102 @@ Near a closed joint of a rigid law (f jumps at 0: a rigid monolith) the directio
 round-off; there the law reads the component x = phi . c of phi along a pinned direction c
 (the side the joint rocks onto), as a base flat to that side, and m = -f(x) c
 (rbm_cli.models.rbm3d says when).
+
+The equations are compiled (numba) as the planar kernel's are, into the same slots of its
+right-hand side (rbm_cli.models.rbm.step.rk.rhs: a state of 4n values is this model's):
+
+- ``As`` (n, 3n): [M^-1 D^T | M^-1 K_g | the argument map];
+- ``cs`` (9n): per joint, the piece it is on: intercept, weight slope, elastic slope, its
+  damping (0 off the elastic branch), pinned (1.0 or 0.0), the pinned direction (x, y),
+  then 2n of scratch for the moments (:func:`pack_pieces` fills it);
+- ``es`` (n + 8): -M^-1 r, the motion's direction in plan (cos, sin), then the second
+  horizontal component's straight piece of a record pair (flag, gain, a_{k+1} - a_k, a_k,
+  t_k, t_{k+1} - t_k; flag 0 for one component).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
 
-import numpy as np
+from rbm_cli.base.jit import jit
+from rbm_cli.physics.ground import gravity_factor, ground
 
-from rbm_cli.physics.equations import Model
-from rbm_cli.physics.law import law_arrays
-
-
-@dataclass(frozen=True)
-class Beam3d:
-    """The arrays of one column's equations in two directions (SI units), made once by
-    :func:`beam3d` from its planar Model.
-
-    model : Model  The planar equations (mass, maps, laws, restitution, damping)
-    minv, dt, argmap, gravity, load : the planar M^-1, D^T, the argument map, K_g, r
-    edges : (n, m) each law's edges [rad], padded with inf; nedges (n,) their number
-    a, bw, be : (n, m + 1) each piece's intercept [N m] and the weight and elastic parts of
-        its slope [N m/rad] (Model.slope_parts)
-    edge_w : (n, m) the kinks' weight shares (Model.edge_weight_shares)
-    rigid : (n,) rigid laws; damp : (n,) the joints' damping on their elastic branch
-    collapse : (n, n) theta -> collapse quantity over its limit, per direction
-    heights : (n,) theta -> the top's displacement, per direction [m/rad]
-    """
-
-    model: Model
-    minv: np.ndarray
-    dt: np.ndarray
-    argmap: np.ndarray
-    gravity: np.ndarray
-    load: np.ndarray
-    edges: np.ndarray
-    nedges: np.ndarray
-    a: np.ndarray
-    bw: np.ndarray
-    be: np.ndarray
-    edge_w: np.ndarray
-    rigid: np.ndarray
-    damp: np.ndarray
-    collapse: np.ndarray
-    heights: np.ndarray
-
-    @property
-    def n(self) -> int:
-        return self.model.n
-
-    def arguments(self, theta_x: np.ndarray, theta_y: np.ndarray):
-        """(phi_x, phi_y): the joints' relative rotation vectors (n, ...) [rad]."""
-        return self.argmap @ theta_x, self.argmap @ theta_y
-
-    def edge(self, i: int, q: int, gam: float | np.ndarray = 1.0):
-        """Joint i's kink q [rad] under gam = (g + a_v) / g: E gam / (1 + w (gam - 1)) (where
-        the pieces' lines cross, Model.edge_weight_shares); inf past the last."""
-        if q >= self.nedges[i]:
-            return np.inf
-        e, w = self.edges[i, q], self.edge_w[i, q]
-        return e * gam / (1.0 + w * (gam - 1.0))
-
-    def moments(self, phx, phy, dphx, dphy, k, pinned, c, gam: float = 1.0):
-        """The joints' moment vectors (m_x, m_y) (n,) [N m] at arguments phi (n,) and their
-        rates [rad/s], each joint on piece k_i of its law (|phi_i| between its edges k_i - 1
-        and k_i), read along its pinned direction c_i (n, 2) where pinned_i."""
-        rows = np.arange(phx.size)
-        a, slope = gam * self.a[rows, k], gam * self.bw[rows, k] + self.be[rows, k]
-        r = np.hypot(phx, phy)
-        per_r = np.divide(a, r, out=np.zeros_like(r), where=r > 0.0)
-        mx, my = -(per_r + slope) * phx, -(per_r + slope) * phy
-        if pinned.any():
-            along = a + slope * (phx * c[:, 0] + phy * c[:, 1])
-            mx = np.where(pinned, -along * c[:, 0], mx)
-            my = np.where(pinned, -along * c[:, 1], my)
-        if self.model.damping > 0.0:
-            elastic = self.damp * ((k == 0) & ~self.rigid)
-            mx, my = mx - elastic * dphx, my - elastic * dphy
-        return mx, my
-
-    def rates(self, y: np.ndarray, ax: float, ay: float, gam: float, k, pinned, c):
-        """y' of the state y = (theta_x, theta_y, theta_x', theta_y') (4n,) under the ground
-        acceleration (a_x, a_y) [m/s^2] and gam (:meth:`moments` for k, pinned, c)."""
-        n = self.n
-        tx, ty, vx, vy = y[:n], y[n : 2 * n], y[2 * n : 3 * n], y[3 * n :]
-        phx, phy = self.argmap @ tx, self.argmap @ ty
-        mx, my = self.moments(phx, phy, self.argmap @ vx, self.argmap @ vy, k, pinned, c, gam)
-        accx = self.minv @ (self.dt @ mx + gam * (self.gravity @ tx) - self.load * ax)
-        accy = self.minv @ (self.dt @ my + gam * (self.gravity @ ty) - self.load * ay)
-        return np.concatenate([vx, vy, accx, accy])
-
-    def ratios(self, yy: np.ndarray):
-        """The collapse quantities over their limits (n, ...) [-] and their rates [-/s] of
-        states yy (4n, ...): the magnitude of each joint's pair (collapse @ theta_x,
-        collapse @ theta_y)."""
-        return _magnitudes(self.collapse, yy, self.n)
-
-    def top(self, yy: np.ndarray):
-        """The top's displacement in plan from the column's axis, its magnitude [m] and
-        rate [m/s] (...)."""
-        v, dv = _magnitudes(self.heights[None, :], yy, self.n)
-        return v[0], dv[0]
-
-    def shear_demand(self, acc_x, acc_y, ax: float, ay: float, gam: float) -> np.ndarray:
-        """|T_i| / (N_i gam) (n,) [-]: the resultant shear of the drums above each joint over
-        its normal force, from the drums' theta'' (n,) per direction [rad/s^2] and the
-        ground's acceleration (a_x, a_y) [m/s^2]."""
-        col = self.model.column
-        cm = self.model.centre_map
-        fx = (cm @ acc_x + ax) * col.masses
-        fy = (cm @ acc_y + ay) * col.masses
-        tx, ty = np.cumsum(fx[::-1])[::-1], np.cumsum(fy[::-1])[::-1]
-        return np.hypot(tx, ty) / (col.normal_forces * gam)
+#: Entries of ``es`` after the n loads: the direction, then the second component's piece.
+ES_EXTRA = 8
+#: Entries per joint of ``cs`` (pieces, pinned direction, scratch).
+CS_PER_JOINT = 9
 
 
-def _magnitudes(rows: np.ndarray, yy: np.ndarray, n: int):
-    """|(rows @ theta_x, rows @ theta_y)| and its rate, for states yy (4n, ...)."""
-    vx, vy = rows @ yy[:n], rows @ yy[n : 2 * n]
-    dx, dy = rows @ yy[2 * n : 3 * n], rows @ yy[3 * n :]
-    mag = np.hypot(vx, vy)
-    safe = np.where(mag > 0.0, mag, 1.0)
-    return mag, (vx * dx + vy * dy) / safe
+@jit(inline=True)
+def second_component(t, es, n):
+    """a_y(t) [m/s^2] of a pair's second record on its current straight piece (0 without)."""
+    if es[n + 2] == 0.0 or es[n + 3] == 0.0:
+        return 0.0
+    v = es[n + 5] + es[n + 4] * ((t - es[n + 6]) / es[n + 7])
+    return v if es[n + 3] == 1.0 else es[n + 3] * v
 
 
-def beam3d(model: Model) -> Beam3d:
-    """The equations in two directions of a column's planar Model (circular drums)."""
-    edges, nedges, a, _, rigid = law_arrays(model.laws)
-    weight, elastic = model.slope_parts
-    return Beam3d(
-        model=model,
-        minv=model.mass_inv,
-        dt=model.diff.T.copy(),
-        argmap=model.arg_map,
-        gravity=model.gravity,
-        load=model.ground_load,
-        edges=edges,
-        nedges=nedges,
-        a=a,
-        bw=weight,
-        be=elastic,
-        edge_w=model.edge_weight_shares,
-        rigid=rigid,
-        damp=model.joint_damping,
-        collapse=model.collapse_map / model.collapse_limit[:, None],
-        heights=model.column.heights.astype(float),
-    )
+@jit(inline=True)
+def horizontal(t, es, n, gr):
+    """(a_x, a_y) [m/s^2]: the motion along its direction, plus a pair's second component
+    across it."""
+    ag, ay = ground(t, gr), second_component(t, es, n)
+    d0, d1 = es[n], es[n + 1]
+    return ag * d0 - ay * d1, ag * d1 + ay * d0
+
+
+@jit(inline=True)
+def beam_rates(t, y, n, As, cs, es, gr, out):
+    """y' of the state y = (theta_x, theta_y, theta_x', theta_y') (4n,) into out, the
+    pieces and pinned directions in cs (:func:`pack_pieces`)."""
+    ax, ay = horizontal(t, es, n, gr)
+    gam = gravity_factor(t, gr)
+    for i in range(n):
+        px, py, vx, vy = 0.0, 0.0, 0.0, 0.0
+        for j in range(n):
+            a = As[i, 2 * n + j]
+            px += a * y[j]
+            py += a * y[n + j]
+            vx += a * y[2 * n + j]
+            vy += a * y[3 * n + j]
+        a0 = gam * cs[i]
+        slope = gam * cs[n + i] + cs[2 * n + i]
+        if cs[4 * n + i] != 0.0:  # pinned: the law of the component along c
+            cx, cy = cs[5 * n + i], cs[6 * n + i]
+            along = a0 + slope * (px * cx + py * cy)
+            mx, my = -along * cx, -along * cy
+        else:
+            r = math.sqrt(px * px + py * py)
+            k = (a0 / r if r > 0.0 else 0.0) + slope
+            mx, my = -k * px, -k * py
+        damp = cs[3 * n + i]
+        if damp != 0.0:
+            mx -= damp * vx
+            my -= damp * vy
+        cs[7 * n + i], cs[8 * n + i] = mx, my
+    for i in range(n):
+        out[i] = y[2 * n + i]
+        out[n + i] = y[3 * n + i]
+        sx, sy = es[i] * ax, es[i] * ay
+        for j in range(n):
+            sx += As[i, j] * cs[7 * n + j] + gam * As[i, n + j] * y[j]
+            sy += As[i, j] * cs[8 * n + j] + gam * As[i, n + j] * y[n + j]
+        out[2 * n + i] = sx
+        out[3 * n + i] = sy
+
+
+@jit
+def pack_pieces(k, pinned, c, intercepts, weight, elastic, damp, rigid, cs):
+    """cs's pieces (beam_rates) of joints on pieces k (n,) of their laws, pinned (n,) bool
+    along c (n, 2): each piece's intercept and slopes, the damping of an elastic joint on
+    its elastic branch."""
+    n = k.size
+    for i in range(n):
+        q = k[i]
+        cs[i] = intercepts[i, q]
+        cs[n + i] = weight[i, q]
+        cs[2 * n + i] = elastic[i, q]
+        cs[3 * n + i] = damp[i] if (q == 0 and not rigid[i]) else 0.0
+        cs[4 * n + i] = 1.0 if pinned[i] else 0.0
+        cs[5 * n + i] = c[i, 0]
+        cs[6 * n + i] = c[i, 1]

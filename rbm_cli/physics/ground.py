@@ -297,6 +297,58 @@ def _exceedance_pieces(t0, level, last, gr, knots, values, vertical):
 
 
 @jit
+def _first_positive(qa, qb, qc, s_lo):
+    """The first s in [s_lo, 1] where qa s^2 + qb s + qc > 0 (where it is 0 and rising, or
+    s_lo itself when already above), or -1."""
+    if (qa * s_lo + qb) * s_lo + qc > 0.0:
+        return s_lo
+    r0, r1 = math.inf, math.inf
+    if qa == 0.0:
+        if qb != 0.0:
+            r0 = -qc / qb
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            q = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))
+            r0 = q / qa
+            if q != 0.0:
+                r1 = qc / q
+    for s in (min(r0, r1), max(r0, r1)):
+        if s_lo <= s <= 1.0 and (2.0 * qa * s + qb) > 0.0:
+            return s
+    return -1.0
+
+
+@jit
+def pair_exceedance(t0, ratio, last, knots, ax, ay, av):
+    """A pair of records (ax, ay at the knots; av the vertical's, or empty): the first
+    time t in [t0, last) where the horizontal acceleration's magnitude exceeds ratio
+    (g + a_v(t)) [m/s^2], or -1. Both components and a_v are linear between the knots, so
+    on each interval the excess |a|^2 - (ratio (g + a_v))^2 is a quadratic in time, solved
+    exactly."""
+    i0 = max(_first_after(knots, t0) - 1, 0)
+    for i in range(i0, knots.size - 1):
+        ta, tb = knots[i], knots[i + 1]
+        if ta >= last:
+            return -1.0
+        if tb <= ta:
+            continue
+        lo = max(t0, ta)
+        # on [ta, tb]: a(s) = a0 + s da, s = (t - ta) / (tb - ta)
+        x0, dx = ax[i], ax[i + 1] - ax[i]
+        y0, dy = ay[i], ay[i + 1] - ay[i]
+        v0, dv = (av[i], av[i + 1] - av[i]) if av.size > 0 else (0.0, 0.0)
+        w0, dw = ratio * (G + v0), ratio * dv
+        qa, qb = dx * dx + dy * dy - dw * dw, 2.0 * (x0 * dx + y0 * dy - w0 * dw)
+        qc = x0 * x0 + y0 * y0 - w0 * w0
+        s = _first_positive(qa, qb, qc, (lo - ta) / (tb - ta))
+        if s >= 0.0:
+            t = ta + s * (tb - ta)
+            return t if t < last else -1.0
+    return -1.0
+
+
+@jit
 def next_uplift(t0, level, peak, gr, knots, values, vertical, last):
     """The first time >= t0 with |a_g| > level [m/s^2]
     (times (g + a_v) / g with a vertical record; peak = max |a_g|); -1 for none before

@@ -27,6 +27,7 @@ from rbm_cli.physics.ground import (
     as_samples,
     form_function,
     next_uplift,
+    pair_exceedance,
     sampled_displacement,
     vertical_factor,
 )
@@ -129,32 +130,13 @@ class GroundMotion:
     def next_pair_exceedance(self, t0: float, ratio: float, t_stop: float) -> float | None:
         """A pair of records: the first time t in [t0, t_stop) where the horizontal
         acceleration's magnitude exceeds ratio (g + a_v(t)) [m/s^2] (ratio = tan(alpha) for
-        a block's uplift), or None. Both components and a_v are linear between the knots,
-        so on each interval the excess |a|^2 - (ratio (g + a_v))^2 is a quadratic in time,
-        solved exactly."""
-        knots, ax, ay = self.knots, self.values, self.values_y
-        av = self.vertical if self.vertical is not None else np.zeros_like(ax)
+        a block's uplift), or None (physics.ground.pair_exceedance: exact on each sample
+        interval)."""
+        knots, values, vertical = self._samples
         last = min(self.pulse_end, self.t_end, t_stop)
-        i0 = max(int(np.searchsorted(knots, t0, side="right")) - 1, 0)
-        for i in range(i0, knots.size - 1):
-            ta, tb = float(knots[i]), float(knots[i + 1])
-            if ta >= last:
-                return None
-            if tb <= ta:
-                continue
-            lo = max(t0, ta)
-            # on [ta, tb]: a(s) = a0 + s da, s = (t - ta) / (tb - ta)
-            x0, dx = float(ax[i]), float(ax[i + 1] - ax[i])
-            y0, dy = float(ay[i]), float(ay[i + 1] - ay[i])
-            w0, dw = ratio * (G + float(av[i])), ratio * float(av[i + 1] - av[i])
-            qa, qb = dx * dx + dy * dy - dw * dw, 2.0 * (x0 * dx + y0 * dy - w0 * dw)
-            qc = x0 * x0 + y0 * y0 - w0 * w0
-            s_lo = (lo - ta) / (tb - ta)
-            s = _first_positive(qa, qb, qc, s_lo)
-            if s is not None:
-                t = ta + s * (tb - ta)
-                return t if t < last else None
-        return None
+        t = pair_exceedance(float(t0), float(ratio), float(last), knots, values,
+                            as_samples(self.values_y), vertical)  # fmt: skip
+        return None if t < 0.0 else t
 
     @property
     def form(self) -> int:
@@ -378,28 +360,3 @@ class GroundMotion:
             name=f"{self.kind} (sampled)",
             angle=self.angle,
         )
-
-
-def _first_positive(qa: float, qb: float, qc: float, s_lo: float) -> float | None:
-    """The first s in [s_lo, 1] where qa s^2 + qb s + qc > 0 (where it is 0 and rising, or
-    s_lo itself when already above), or None."""
-
-    def f(s):
-        return (qa * s + qb) * s + qc
-
-    if f(s_lo) > 0.0:
-        return s_lo
-    roots = []
-    if qa == 0.0:
-        if qb != 0.0:
-            roots.append(-qc / qb)
-    else:
-        disc = qb * qb - 4.0 * qa * qc
-        if disc >= 0.0:
-            r = math.sqrt(disc)
-            q = -0.5 * (qb + math.copysign(r, qb))
-            roots += [q / qa] + ([qc / q] if q != 0.0 else [])
-    for s in sorted(roots):
-        if s_lo <= s <= 1.0 and (2.0 * qa * s + qb) > 0.0:
-            return s
-    return None

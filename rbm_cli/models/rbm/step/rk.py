@@ -11,6 +11,7 @@ import numpy as np
 import rbm_cli.base.rk_tableaux as _tb
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.base.jit import jit
+from rbm_cli.physics.beam3d import beam_rates
 from rbm_cli.physics.ground import gravity_factor, ground
 
 #: method name -> code in the kernel
@@ -95,6 +96,9 @@ def _damping(i, y, n, As):
 
 @jit(inline=True)
 def rhs(t, y, n, As, cs, es, gr, out):
+    if y.size != 2 * n:  # a state in two directions: rbm-3d's (physics.beam3d)
+        beam_rates(t, y, n, As, cs, es, gr, out)
+        return
     g = ground(t, gr)
     damped = As.shape[1] > 2 * n
     if gr[6] == 0.0:

@@ -1,0 +1,694 @@
+"""The compiled run of `rbm-3d` (numba; the rules: rbm_cli.models.rbm3d.runner).
+
+One call runs a whole motion. The Runge-Kutta steps are the planar step kernel's
+(rbm_cli.models.rbm.step.rk: scipy's tableaux, error norm, step control and dense output,
+whose right-hand side takes a state of 4n values as this model's, physics.beam3d); the
+events are located on each step's dense output: the watched distances are evaluated at
+CHECK_INTERVALS + 1 points of the step, and in the first sub-interval where one ends below
+zero, or where its cubic Hermite dips below zero (confirmed on the dense output), each
+such row's crossing is found by Brent's method (base.brent) and the earliest wins.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rbm_cli.base.brent import brent_step
+from rbm_cli.base.detmath import pow_pos
+from rbm_cli.base.events import EVENT_EPS
+from rbm_cli.base.guard import POLL_STEPS
+from rbm_cli.base.jit import jit
+from rbm_cli.config.types import G
+from rbm_cli.models.rbm.step.rk import (
+    MAX_FACTOR,
+    MIN_FACTOR,
+    NS_MAX,
+    SAFETY,
+    TAB_EST,
+    TAB_NS,
+    dense_eval,
+    dense_prepare,
+    error_norm,
+    initial_step,
+    rhs,
+    rk_attempt,
+)
+from rbm_cli.models.status import (
+    COLLAPSED,
+    FAILED_EVENTS,
+    FAILED_NONFINITE,
+    FAILED_STEP,
+    FAILED_STEPS,
+    GOING,
+    SURVIVED,
+    guard_code,
+)
+from rbm_cli.physics.arrays import ColumnArrays
+from rbm_cli.physics.beam3d import CS_PER_JOINT, ES_EXTRA, horizontal, pack_pieces
+from rbm_cli.physics.ground import (
+    gravity_factor,
+    ground_at,
+    next_uplift,
+    pair_exceedance,
+    record_piece,
+)
+
+#: A closed rigid joint's direction is pinned within UPRIGHT_LEAN theta_u of closure ...
+UPRIGHT_LEAN = 1e-6
+#: ... and after an uplift or an impact, until LEAVE_FACTOR times that distance.
+LEAVE_FACTOR = 2.0
+#: A joint's phase: free (its own direction), leaving or approaching closure (pinned).
+FREE, LEAVING, APPROACH = 0, 1, 2
+#: The events watched: a kink up or down, near closure, left it, across the pinned line,
+#: turned away near closure, collapse.
+UP, DOWN, NEAR, LEFT, ACROSS, TURNED, COLLAPSE = 0, 1, 2, 3, 4, 5, 6
+#: Points of a step at which the watched distances are checked (sub-intervals).
+CHECK_INTERVALS = 8
+#: Brent's tolerances (scipy's rtol, 4 eps; xtol [s]) and iterations.
+XTOL, RTOL, MAXITER = 1e-15, 8.881784197001252e-16, 100
+#: The run ended at rest in the free motion after the ground motion.
+AT_REST = 11
+
+
+@jit(inline=True)
+def _phi(i, y, n, argmap):
+    """Joint i's rotation vector (x, y) [rad] and its rate [rad/s]."""
+    px, py, vx, vy = 0.0, 0.0, 0.0, 0.0
+    for j in range(n):
+        a = argmap[i, j]
+        px += a * y[j]
+        py += a * y[n + j]
+        vx += a * y[2 * n + j]
+        vy += a * y[3 * n + j]
+    return px, py, vx, vy
+
+
+@jit(inline=True)
+def _magnitude(row, y, n):
+    """|(row @ theta_x, row @ theta_y)| and its rate."""
+    px, py, vx, vy = 0.0, 0.0, 0.0, 0.0
+    for j in range(n):
+        px += row[j] * y[j]
+        py += row[j] * y[n + j]
+        vx += row[j] * y[2 * n + j]
+        vy += row[j] * y[3 * n + j]
+    m = math.sqrt(px * px + py * py)
+    return m, ((px * vx + py * vy) / m if m > 0.0 else 0.0)
+
+
+@jit(inline=True)
+def _edge(i, q, gam, edges, nedges, edge_w):
+    """Joint i's kink q [rad] under gam = (g + a_v) / g (inf past the last)."""
+    if q >= nedges[i]:
+        return np.inf
+    return edges[i, q] * gam / (1.0 + edge_w[i, q] * (gam - 1.0))
+
+
+@jit(inline=True)
+def distance(kind, i, y, n, col, k, c, gam):
+    """A watched event's distance [-] and its rate [-/s] at state y."""
+    if kind == COLLAPSE:
+        m, dm = _magnitude(col.families[n + i], y, n)
+        return col.c_ratio + EVENT_EPS - m, -dm
+    px, py, vx, vy = _phi(i, y, n, col.argmap)
+    r = math.sqrt(px * px + py * py)
+    dr = (px * vx + py * vy) / r if r > 0.0 else 0.0
+    tu = col.tu[i]
+    if kind == UP:
+        e = _edge(i, k[i], gam, col.edges, col.nedges, col.edge_w)
+        return (e - r) / tu + EVENT_EPS, -dr / tu
+    if kind == DOWN:
+        e = _edge(i, k[i] - 1, gam, col.edges, col.nedges, col.edge_w)
+        return (r - e) / tu + EVENT_EPS, dr / tu
+    pin = UPRIGHT_LEAN * tu
+    if kind == NEAR:
+        return (r - pin) / tu, dr / tu
+    if kind == LEFT:
+        return (LEAVE_FACTOR * pin - r) / tu, -dr / tu
+    if kind == ACROSS:
+        return (px * c[i, 0] + py * c[i, 1]) / tu + EVENT_EPS, (vx * c[i, 0] + vy * c[i, 1]) / tu
+    return -dr / tu, 0.0  # TURNED
+
+
+@jit
+def watch(n, k, phase, pending, col, kinds, joints):
+    """The events (kinds, joints) of the current pieces and phases; returns how many."""
+    m = 0
+    quiet = col.e_rest == 1.0  # an elastic joint's closure changes nothing: counted only
+    for i in range(n):
+        if k[i] < col.nedges[i]:
+            kinds[m], joints[m] = UP, i
+            m += 1
+        if k[i] > 0:
+            kinds[m], joints[m] = DOWN, i
+            m += 1
+        if col.rigid[i]:
+            if phase[i] == FREE and k[i] == 0:
+                kinds[m], joints[m] = NEAR, i
+                m += 1
+            elif phase[i] == LEAVING:
+                kinds[m], joints[m], kinds[m + 1], joints[m + 1] = LEFT, i, ACROSS, i
+                m += 2
+            elif phase[i] == APPROACH:
+                kinds[m], joints[m], kinds[m + 1], joints[m + 1] = ACROSS, i, TURNED, i
+                m += 2
+        elif phase[i] == APPROACH and pending[i] and not quiet:
+            kinds[m], joints[m] = ACROSS, i
+            m += 1
+        kinds[m], joints[m] = COLLAPSE, i
+        m += 1
+    return m
+
+
+@jit
+def _row_at(t, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds, joints):
+    dense_eval(mc, t, t_old, h, y_old, F, yq)
+    return distance(kinds[r], joints[r], yq, n, col, k, c, gravity_factor(t, gr))[0]
+
+
+@jit
+def _root(a, b, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds, joints):
+    """Brent's root of row r on [a, b] (its value > 0 at a, < 0 at b)."""
+    xpre, xcur = a, b
+    xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
+    fpre = _row_at(xpre, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds, joints)
+    fcur = _row_at(xcur, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds, joints)
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    for _ in range(MAXITER):
+        done, xpre, xcur, xblk, fpre, fblk, spre, scur = brent_step(
+            xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, XTOL, RTOL
+        )
+        if done:
+            return xcur
+        fcur = _row_at(xcur, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds, joints)
+    return xcur
+
+
+@jit
+def _hermite_min(p0, p1, m0, m1):
+    """s in (0, 1) of the lowest interior minimum of the cubic Hermite of values p0, p1 and
+    slopes m0, m1 (per unit s), with its value; (-1, 0) if none."""
+    a = 2.0 * p0 + m0 - 2.0 * p1 + m1
+    b = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1
+    qa, qb, qc = 3.0 * a, 2.0 * b, m0
+    best_s, best = -1.0, 0.0
+    r0, r1 = np.nan, np.nan
+    if qa == 0.0:
+        if qb != 0.0:
+            r0 = -qc / qb
+    else:
+        disc = qb * qb - 4.0 * qa * qc
+        if disc >= 0.0:
+            q = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))
+            r0 = q / qa
+            if q != 0.0:
+                r1 = qc / q
+    for s in (r0, r1):
+        if 0.0 < s < 1.0:
+            v = ((a * s + b) * s + m0) * s + p0
+            if best_s < 0.0 or v < best:
+                best_s, best = s, v
+    return best_s, best
+
+
+@jit
+def first_event(mc, t_old, t_new, h, y_old, F, yq, n, col, k, c, gr, kinds, joints, m, D, R):
+    """(t, row) of the earliest crossing of a watched distance in [t_old, t_new], or
+    (-1, -1) (the module's scan)."""
+    ts = np.empty(CHECK_INTERVALS + 1)
+    for j in range(CHECK_INTERVALS + 1):
+        ts[j] = t_old + (t_new - t_old) * (j / CHECK_INTERVALS) if j < CHECK_INTERVALS else t_new
+        dense_eval(mc, ts[j], t_old, h, y_old, F, yq)
+        gam = gravity_factor(ts[j], gr)
+        for r in range(m):
+            D[r, j], R[r, j] = distance(kinds[r], joints[r], yq, n, col, k, c, gam)
+    for r in range(m):
+        if D[r, 0] <= 0.0:
+            return t_old, r
+    for j in range(CHECK_INTERVALS):
+        a, b = ts[j], ts[j + 1]
+        ds = b - a
+        best_t, best_r = np.inf, -1
+        for r in range(m):
+            hi = -1.0
+            if D[r, j + 1] < 0.0:
+                hi = b
+            elif R[r, j] < 0.0 < R[r, j + 1]:
+                if min(D[r, j], D[r, j + 1]) <= 0.5 * ds * (abs(R[r, j]) + abs(R[r, j + 1])):
+                    s, v = _hermite_min(D[r, j], D[r, j + 1], ds * R[r, j], ds * R[r, j + 1])
+                    if s > 0.0 and v < 0.0:
+                        tm = a + s * ds
+                        if _row_at(tm, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds,
+                                   joints) < 0.0:  # fmt: skip
+                            hi = tm
+            if hi > 0.0:
+                root = _root(a, hi, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds,
+                             joints)  # fmt: skip
+                if root < best_t:
+                    best_t, best_r = root, r
+        if best_r >= 0:
+            return best_t, best_r
+    return -1.0, -1
+
+
+@jit
+def _rate_at(t, row, mc, t_old, h, y_old, F, yq, n):
+    dense_eval(mc, t, t_old, h, y_old, F, yq)
+    return _magnitude(row, yq, n)[1]
+
+
+@jit
+def _peak_in(row, a, b, mc, t_old, h, y_old, F, yq, n):
+    """The magnitude of row where its rate turns from rising to falling in [a, b]."""
+    xpre, xcur = a, b
+    xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
+    fpre = _rate_at(xpre, row, mc, t_old, h, y_old, F, yq, n)
+    fcur = _rate_at(xcur, row, mc, t_old, h, y_old, F, yq, n)
+    if fpre != 0.0 and fcur != 0.0:
+        for _ in range(MAXITER):
+            done, xpre, xcur, xblk, fpre, fblk, spre, scur = brent_step(
+                xpre, xcur, xblk, fpre, fcur, fblk, spre, scur, XTOL, RTOL
+            )
+            if done:
+                break
+            fcur = _rate_at(xcur, row, mc, t_old, h, y_old, F, yq, n)
+    dense_eval(mc, xcur if fpre != 0.0 else xpre, t_old, h, y_old, F, yq)
+    return _magnitude(row, yq, n)[0]
+
+
+@jit
+def _move(i, y, n, arg_inv, dx, dy):
+    """Move joint i's rotation vector by (dx, dy) [rad], in place."""
+    for j in range(n):
+        y[j] += arg_inv[j, i] * dx
+        y[n + j] += arg_inv[j, i] * dy
+
+
+@jit
+def _friction(t, y, f, n, col, es, gr, friction):
+    """Raise friction to |T_i| / (N_i gam) of y' = f at (t, y); return the largest."""
+    ax, ay = horizontal(t, es, n, gr)
+    gam = gravity_factor(t, gr)
+    sx, sy, top = 0.0, 0.0, 0.0
+    for i in range(n - 1, -1, -1):
+        bx, by = ax, ay
+        for j in range(n):
+            bx += col.centre_map[i, j] * f[2 * n + j]
+            by += col.centre_map[i, j] * f[3 * n + j]
+        sx += bx * col.masses[i]
+        sy += by * col.masses[i]
+        d = math.sqrt(sx * sx + sy * sy) / (col.normal_forces[i] * gam)
+        if d > friction[i]:
+            friction[i] = d
+        top = max(top, d)
+    return top
+
+
+@jit
+def _emit(mc, t_stop, t_old, h, y_old, F, yq, samples, n_out, next_out, dt, n, d0, d1, col):
+    """Samples (t, theta and rate seen in the motion's plane, the top in plan) up to t_stop;
+    F None-like (h = 0): the state y_old itself."""
+    top = col.families[2 * n]
+    while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
+        if h > 0.0:
+            dense_eval(mc, next_out, t_old, h, y_old, F, yq)
+        else:
+            yq[:] = y_old
+        row = samples[n_out]
+        row[0] = next_out
+        tx, ty = 0.0, 0.0
+        for j in range(n):
+            row[1 + j] = yq[j] * d0 + yq[n + j] * d1
+            row[1 + n + j] = yq[2 * n + j] * d0 + yq[3 * n + j] * d1
+            tx += top[j] * yq[j]
+            ty += top[j] * yq[n + j]
+        row[1 + 2 * n], row[2 + 2 * n] = tx, ty
+        n_out += 1
+        next_out += dt
+    return n_out, next_out
+
+
+@jit
+def run3d(col, motion, solver, task, pair):
+    """Run one motion of one column in two directions.
+
+    Parameters
+    ----------
+    col : ColumnArrays  The column (physics.arrays), as the planar kernel reads it
+    motion : Excitation  The motion along its direction (step.inputs)
+    solver : SolverSettings  atol of 4n entries
+    task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 2n), friction_limit); y0
+        is the state, changed in place: the state where the run ended
+    pair : tuple  (d0, d1, values_y: the second record's samples, or empty)
+
+    Returns
+    -------
+    tuple  (code, t_end, t_collapse, collapsed joint (from 0; -1), max_ratio (n), max_top,
+        friction (n), slip (2), n_uplifts, n_impacts, n_steps, n_rhs, n_events, n_samples,
+        azimuth [rad], swept (n) [rad])
+    """
+    col = ColumnArrays(*col)
+    y0, record, output_dt, samples, mu = task
+    d0, d1, values_y = pair
+    mc, rtol, atol = solver[0], solver[1], solver[2]
+    max_steps, max_events, deadline = solver[3], solver[4], solver[5]
+    form, gain, center, gamma = motion[6], motion[7], motion[8], motion[9]
+    knots, values, vertical, clipped = motion[10], motion[11], motion[12], motion[13]
+    bounds, forced, pulse_end, t_end = motion[14], motion[15], motion[4], motion[5]
+    gr_full = (form, gain, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
+    gr_free = (form, 0.0, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
+    pair_on = values_y.size > 0
+    n = col.tu.size
+    m4 = 4 * n
+    nrow_max = 5 * n
+    weight, elastic = col.slope_parts[0], col.slope_parts[1]
+    As = np.empty((n, 3 * n))
+    for i in range(n):
+        for j in range(n):
+            As[i, j] = col.md[i, j]
+            As[i, n + j] = col.mg[i, j]
+            As[i, 2 * n + j] = col.argmap[i, j]
+    cs = np.zeros(CS_PER_JOINT * n)
+    es = np.zeros(n + ES_EXTRA)
+    es[:n] = col.es
+    es[n], es[n + 1] = d0, d1
+
+    k = np.zeros(n, dtype=np.int64)
+    pending = np.zeros(n, dtype=np.bool_)
+    phase = np.zeros(n, dtype=np.int64)
+    c = np.zeros((n, 2))
+    for i in range(n):
+        c[i, 0], c[i, 1] = d0, d1
+    kinds, joints = np.zeros(nrow_max, dtype=np.int64), np.zeros(nrow_max, dtype=np.int64)
+    D, R = np.empty((nrow_max, CHECK_INTERVALS + 1)), np.empty((nrow_max, CHECK_INTERVALS + 1))
+    max_ratio, friction, swept = np.zeros(n), np.zeros(n), np.zeros(n)
+    slip = np.array([np.nan, 0.0])
+    max_top, azimuth = 0.0, np.nan
+    n_upl, n_imp, n_steps, n_rhs, n_ev, n_out = 0, 0, 0, 0, 0, 0
+    next_out = 0.0
+    t_col, c_if = np.nan, -1
+    K = np.empty((NS_MAX, m4))
+    F = np.empty((8, m4))
+    f, ynew, tmp, work, scale = (np.empty(m4), np.empty(m4), np.empty(m4), np.empty(m4),
+                                 np.empty(m4))  # fmt: skip
+    yq, y_new = np.empty(m4), np.empty(m4)
+    est_order = TAB_EST[mc]
+    err_exp = -1.0 / (est_order + 1)
+    ns = TAB_NS[mc]
+    top_row = col.families[2 * n]
+
+    t = 0.0
+    y = y0  # the state, in place: the caller reads where the run ended
+    # the pieces and phases of the initial state
+    for i in range(n):
+        px, py, vx, vy = _phi(i, y, n, col.argmap)
+        r = math.sqrt(px * px + py * py)
+        q = 0
+        while q < col.nedges[i] and col.edges[i, q] <= r:
+            q += 1
+        k[i] = q
+        pending[i] = q > 0 and not col.rigid[i]
+    at_rest = False
+    if col.rigid_mono:
+        at_rest = True
+        for j in range(m4):
+            if y[j] != 0.0:
+                at_rest = False
+        px, py, vx, vy = _phi(0, y, n, col.argmap)
+        r = math.sqrt(px * px + py * py)
+        if not at_rest and r <= LEAVE_FACTOR * UPRIGHT_LEAN * col.tu[0]:
+            if r > 0.0:
+                c[0, 0], c[0, 1] = px / r, py / r
+            else:
+                s = math.sqrt(vx * vx + vy * vy)
+                c[0, 0], c[0, 1] = vx / s, vy / s
+            phase[0] = LEAVING
+    for i in range(n):
+        v, _ = _magnitude(col.families[n + i], y, n)
+        max_ratio[i] = v
+        if v >= col.c_ratio:
+            vx_, vy_ = 0.0, 0.0
+            for j in range(n):
+                vx_ += col.families[n + i, j] * y[j]
+                vy_ += col.families[n + i, j] * y[n + j]
+            azimuth = math.atan2(vy_, vx_)
+            max_ratio[i] = max(v, col.c_ratio)
+            return (COLLAPSED, 0.0, 0.0, i, max_ratio, max_top, friction, slip, n_upl,
+                    n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+    max_top = _magnitude(top_row, y, n)[0]
+
+    for seg in range(bounds.size - 1):
+        seg_end = bounds[seg + 1]
+        if t >= seg_end:
+            continue
+        free_seg = not forced[seg]
+        gr = gr_free if free_seg else gr_full
+        seg_gain = gr[1]
+        h_carry = -1.0
+        while t < seg_end:
+            if at_rest:
+                if free_seg:  # no ground motion from here on: rests to the end
+                    if record:
+                        n_out, next_out = _emit(mc, t_end, t, 0.0, y, F, yq, samples, n_out,
+                                                next_out, output_dt, n, d0, d1, col)  # fmt: skip
+                    return (AT_REST, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                last = min(pulse_end, t_end)
+                if pair_on:
+                    t_up = pair_exceedance(t, col.uplift_level / G, min(last, seg_end), knots,
+                                           values, values_y, vertical)  # fmt: skip
+                else:
+                    t_up = next_uplift(t, col.uplift_level, motion[1], gr_full, knots, values,
+                                       vertical, last)  # fmt: skip
+                if t_up < 0.0 or t_up >= seg_end:
+                    if record:
+                        n_out, next_out = _emit(mc, seg_end, t, 0.0, y, F, yq, samples, n_out,
+                                                next_out, output_dt, n, d0, d1, col)  # fmt: skip
+                    t = seg_end
+                    break
+                if record:
+                    n_out, next_out = _emit(mc, t_up - 1e-15, t, 0.0, y, F, yq, samples,
+                                            n_out, next_out, output_dt, n, d0, d1, col)  # fmt: skip
+                t = t_up
+                y[:] = 0.0
+                a_d = ground_at(t, gr_full, knots, values)
+                a_y = ground_at(t, gr_full, knots, values_y) if pair_on else 0.0
+                ax, ay = a_d * d0 - a_y * d1, a_d * d1 + a_y * d0
+                size = math.sqrt(ax * ax + ay * ay)
+                c[0, 0], c[0, 1] = -ax / size, -ay / size
+                phase[0] = LEAVING
+                at_rest = False
+                n_upl += 1
+                h_carry = -1.0
+
+            # a new stepper from (t, y), its pieces packed
+            pinned = np.zeros(n, dtype=np.bool_)
+            for i in range(n):
+                pinned[i] = phase[i] != FREE and col.rigid[i]
+            pack_pieces(k, pinned, c, col.intercepts, weight, elastic, col.damp, col.rigid, cs)
+            m = watch(n, k, phase, pending, col, kinds, joints)
+            t_bound = seg_end
+            if clipped:
+                gr, t_bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
+                if pair_on:
+                    gy, _ = record_piece(t, knots, values_y, vertical, seg_gain, seg_end)
+                    es[n + 2], es[n + 3], es[n + 4] = 1.0, gy[1], gy[2]
+                    es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
+            rhs(t, y, n, As, cs, es, gr, f)
+            if h_carry > 0.0:
+                h_abs = min(h_carry, seg_end - t)
+                n_rhs += 1
+            else:
+                h_abs = initial_step(t, y, f, t_bound, est_order, rtol, atol, n, As, cs, es,
+                                     gr, work)  # fmt: skip
+                n_rhs += 2
+            event = False
+            running = True
+            while running:
+                min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+                if h_abs < min_step:
+                    h_abs = min_step
+                bound = seg_end
+                if clipped:
+                    gr, bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
+                    if pair_on:
+                        gy, _ = record_piece(t, knots, values_y, vertical, seg_gain, seg_end)
+                        es[n + 2], es[n + 3], es[n + 4] = 1.0, gy[1], gy[2]
+                        es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
+                rejected = False
+                while True:
+                    if not (h_abs >= min_step):
+                        return (FAILED_STEP, t, t_col, c_if, max_ratio, max_top, friction,
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth,
+                                swept)  # fmt: skip
+                    t_new = t + h_abs
+                    if t_new - bound > 0:
+                        t_new = bound
+                    h = t_new - t
+                    h_abs = abs(h)
+                    rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr)
+                    n_rhs += ns
+                    err = error_norm(mc, K, h, y, ynew, atol, rtol, scale)
+                    if not (err == err and abs(err) < math.inf):
+                        return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top,
+                                friction, slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
+                                azimuth, swept)  # fmt: skip
+                    if err < 1.0:
+                        factor = (MAX_FACTOR if err == 0.0
+                                  else min(MAX_FACTOR, SAFETY * pow_pos(err, err_exp)))  # fmt: skip
+                        if rejected:
+                            factor = min(1.0, factor)
+                        h_abs *= factor
+                        break
+                    h_abs *= max(MIN_FACTOR, SAFETY * pow_pos(err, err_exp))
+                    rejected = True
+                n_steps += 1
+                if n_steps > max_steps:
+                    return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                if n_steps % POLL_STEPS == 0:
+                    code = guard_code(deadline)
+                    if code != GOING:
+                        return (code, t, t_col, c_if, max_ratio, max_top, friction,
+                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth,
+                                swept)  # fmt: skip
+                if t_new - seg_end >= 0:
+                    running = False
+                t_old = t
+                n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs, es, gr)
+                t_e, hit = first_event(mc, t_old, t_new, h, y, F, yq, n, col, k, c, gr, kinds,
+                                       joints, m, D, R)  # fmt: skip
+                if hit >= 0:
+                    t_new = t_e
+                    dense_eval(mc, t_new, t_old, h, y, F, y_new)
+                    event = True
+                    rhs(t_new, y_new, n, As, cs, es, gr, work)
+                    n_rhs += 1
+                    fr = _friction(t_new, y_new, work, n, col, es, gr, friction)
+                else:
+                    y_new[:] = ynew
+                    fr = _friction(t_new, y_new, K[ns], n, col, es, gr, friction)
+                if slip[1] == 0.0 and fr > mu:
+                    best = 0
+                    for i in range(n):
+                        if friction[i] > friction[best]:
+                            best = i
+                    slip[0], slip[1] = t_new, best + 1.0
+                if record:
+                    n_out, next_out = _emit(mc, t_new, t_old, h, y, F, yq, samples, n_out,
+                                            next_out, output_dt, n, d0, d1, col)  # fmt: skip
+                # peaks: at the end, and where a magnitude's rate turns inside the step
+                for i in range(n + 1):
+                    row = col.families[n + i] if i < n else top_row
+                    v1, r1 = _magnitude(row, y_new, n)
+                    _, r0 = _magnitude(row, y, n)
+                    if r0 > 0.0 and r1 < 0.0:
+                        v1 = max(v1, _peak_in(row, t_old, t_new, mc, t_old, h, y, F, yq, n))
+                    if i < n:
+                        max_ratio[i] = max(max_ratio[i], v1)
+                    else:
+                        max_top = max(max_top, v1)
+                # the angle each open joint's direction turned
+                for i in range(n):
+                    if k[i] > 0 or (col.rigid[i] and phase[i] == FREE):
+                        ax_, ay_, _, _ = _phi(i, y, n, col.argmap)
+                        bx_, by_, _, _ = _phi(i, y_new, n, col.argmap)
+                        cr, dt_ = ax_ * by_ - ay_ * bx_, ax_ * bx_ + ay_ * by_
+                        if cr != 0.0 or dt_ != 0.0:
+                            swept[i] += abs(math.atan2(cr, dt_))
+                # silent closures (e = 1, elastic joints): counted at the step's end
+                if col.e_rest == 1.0:
+                    for i in range(n):
+                        if phase[i] == APPROACH and not col.rigid[i]:
+                            px, py, _, _ = _phi(i, y_new, n, col.argmap)
+                            if px * c[i, 0] + py * c[i, 1] <= 0.0:
+                                n_imp += 1
+                                pending[i], phase[i] = False, FREE
+                t = t_new
+                y[:] = y_new
+                if event:
+                    break
+                f[:] = K[ns]
+            if not event:
+                t = seg_end if not running else t
+                continue
+
+            # ---- the event at (t, y)
+            h_carry = h_abs
+            n_ev += 1
+            if n_ev > max_events:
+                return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction, slip,
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+            kind, i = kinds[hit], joints[hit]
+            px, py, vx, vy = _phi(i, y, n, col.argmap)
+            r = math.sqrt(px * px + py * py)
+            if kind == COLLAPSE:
+                vx_, vy_ = 0.0, 0.0
+                for j in range(n):
+                    vx_ += col.families[n + i, j] * y[j]
+                    vy_ += col.families[n + i, j] * y[n + j]
+                azimuth = math.atan2(vy_, vx_)
+                max_ratio[i] = max(max_ratio[i], col.c_ratio)
+                return (COLLAPSED, t, t, i, max_ratio, max_top, friction, slip, n_upl, n_imp,
+                        n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+            if kind == UP or kind == DOWN:
+                q = k[i] if kind == UP else k[i] - 1
+                e = _edge(i, q, gravity_factor(t, gr), col.edges, col.nedges, col.edge_w)
+                if r > 0.0:
+                    _move(i, y, n, col.arg_inv, px * (e / r - 1.0), py * (e / r - 1.0))
+                if kind == UP:
+                    if k[i] == 0 and not col.rigid[i] and not pending[i]:
+                        n_upl += 1
+                    if not col.rigid[i]:
+                        pending[i] = True
+                        if phase[i] == APPROACH:
+                            phase[i] = FREE
+                    k[i] += 1
+                else:
+                    k[i] -= 1
+                    if k[i] == 0 and pending[i]:
+                        phase[i] = APPROACH
+                        c[i, 0], c[i, 1] = px / r, py / r
+                        # a silent closure (e = 1) is counted, not stopped at: back on its
+                        # elastic branch the joint is closed, as in the plane
+                        pending[i] = col.e_rest != 1.0
+            elif kind == NEAR:
+                phase[i] = APPROACH
+                c[i, 0], c[i, 1] = px / r, py / r
+            elif kind == LEFT:
+                phase[i] = FREE
+            else:  # ACROSS or TURNED: the joint closes
+                cx, cy = c[i, 0], c[i, 1]
+                if col.rigid[i]:
+                    _move(i, y, n, col.arg_inv, -px, -py)
+                else:
+                    along = px * cx + py * cy
+                    _move(i, y, n, col.arg_inv, -along * cx, -along * cy)
+                xdot = vx * cx + vy * cy
+                e_rest = col.e_rest
+                for j in range(n):
+                    if col.literal_impact:
+                        dv = col.arg_inv[j, i] * (e_rest - 1.0) * xdot
+                    else:
+                        dv = col.impulse_dir[j, i] * ((e_rest - 1.0) * xdot / col.impulse_w[i])
+                    y[2 * n + j] += dv * cx
+                    y[3 * n + j] += dv * cy
+                n_imp += 1
+                pending[i], phase[i] = False, FREE
+                if col.rigid[i]:
+                    _, _, vx, vy = _phi(i, y, n, col.argmap)
+                    speed = math.sqrt(vx * vx + vy * vy)
+                    if col.rigid_mono and speed < col.rest_rate:
+                        y[:] = 0.0
+                        at_rest = True
+                    else:
+                        phase[i] = LEAVING
+                        if speed > 0.0:
+                            c[i, 0], c[i, 1] = vx / speed, vy / speed
+    return (SURVIVED, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl, n_imp,
+            n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip

@@ -36,6 +36,7 @@ from rbm_cli.config.validate import (
     grid_axis,
     is_number,
     join,
+    mapping,
 )
 
 #: Grid and command-line excitation ranges [assumption]: g and Hz at the edges.
@@ -252,6 +253,9 @@ def hoist_suite(top: Mapping[str, Any], base_dir: str | os.PathLike | None) -> d
     ``base_dir`` as written), the excitation keeping the first so that it validates as one
     record. A folder or a glob given as a value of a grid axis over ``excitation.file`` or
     ``excitation.vertical`` is replaced by its files in the same way, in the order written.
+    A suite of pairs (``excitation.file_y`` a list, folder or glob parallel to
+    ``excitation.file``'s, or ``excitation.file`` a list of ``{x: FILE, y: FILE}``) becomes
+    a linked axis over ``excitation.file`` and ``excitation.file_y`` (:func:`_suite_pairs`).
     Any other mapping comes back as it is."""
     top = dict(top)
     base = Path(base_dir or ".")
@@ -266,6 +270,9 @@ def hoist_suite(top: Mapping[str, Any], base_dir: str | os.PathLike | None) -> d
     excitation = top.get("excitation")
     if not isinstance(excitation, Mapping) or "file" not in excitation:
         return top
+    pairs = _suite_pairs(excitation, base)
+    if pairs is not None:
+        return _hoist_pairs(top, excitation, grid, pairs)
     files = _suite_files(excitation["file"], base)
     if files is None:
         return top
@@ -276,6 +283,131 @@ def hoist_suite(top: Mapping[str, Any], base_dir: str | os.PathLike | None) -> d
         )
     grid["excitation.file"] = files
     return {**top, "excitation": {**excitation, "file": files[0]}, "grid": grid}
+
+
+#: Keys of a pair of records written as one item of ``excitation.file``.
+PAIR_KEYS = ("x", "y")
+PAIR_PATHS = ("excitation.file", "excitation.file_y")
+
+
+def _suite_pairs(excitation: Mapping[str, Any], base: Path) -> tuple[list, list] | None:
+    """The (x files, y files) of a suite of pairs, in pair order, or None when the
+    excitation names no such suite (one file, a suite of single records, or a value left to
+    the excitation's own checks).
+
+    Two forms: ``excitation.file`` a list of ``{x: FILE, y: FILE}`` (``file_y`` absent),
+    or ``excitation.file_y`` beside ``excitation.file`` with either a list, a folder or a
+    glob: both expand (:func:`_suite_files`; one file counts as one) to as many files,
+    paired in the order each expands to (a list's as written, a folder's or a glob's
+    sorted)."""
+    value = excitation["file"]
+    if isinstance(value, Mapping):
+        raise ConfigError(
+            "excitation.file: a pair {x: FILE, y: FILE} goes in a list (a suite of pairs);"
+            " one record's two components are excitation.file and excitation.file_y"
+        )
+    if isinstance(value, list | tuple) and any(isinstance(v, Mapping) for v in value):
+        return _written_pairs(value, excitation, base)
+    y_value = excitation.get("file_y")
+    if y_value is None or not isinstance(value, str | list | tuple):
+        return None
+    if not isinstance(y_value, str | list | tuple):
+        raise ConfigError(
+            "excitation.file_y must be a record file, a list of them, a folder or a glob"
+            f" (paired with excitation.file's), got {describe(y_value)}"
+        )
+    xs = _suite_files(value, base)
+    ys = _suite_files(y_value, base, "excitation.file_y")
+    if xs is None and ys is None:
+        return None  # one pair: the excitation's own file and file_y
+    xs, ys = xs or [value], ys or [y_value]
+    if len(xs) != len(ys):
+        raise ConfigError(
+            f"excitation.file names {_count(xs)} and excitation.file_y {_count(ys)}: a"
+            " suite of pairs takes one y record per x record, paired in order (a list's as"
+            " written, a folder's or a glob's sorted)"
+        )
+    _check_pairs(xs, ys, [(join("excitation.file", i), join("excitation.file_y", i))
+                          for i in range(len(xs))])  # fmt: skip
+    return xs, ys
+
+
+def _count(files: list) -> str:
+    return "1 record" if len(files) == 1 else f"{len(files)} records"
+
+
+def _written_pairs(value: list | tuple, excitation: Mapping[str, Any], base: Path) -> tuple:
+    """The (x files, y files) of ``excitation.file`` written as a list of {x, y}."""
+    if "file_y" in excitation:
+        raise ConfigError(
+            "excitation.file lists pairs {x, y} and excitation.file_y is given too: give the"
+            " y records in the pairs or in excitation.file_y, not both"
+        )
+    xs, ys, wheres = [], [], []
+    for i, item in enumerate(value):
+        at = join("excitation.file", i)
+        if not isinstance(item, Mapping):
+            raise ConfigError(
+                f"{at} must be a pair {{x: FILE, y: FILE}} as the list's other items are, got"
+                f" {describe(item)}"
+            )
+        pair = mapping(item, at, PAIR_KEYS, required=PAIR_KEYS)
+        for key in PAIR_KEYS:
+            where, file = join(at, key), pair[key]
+            if not isinstance(file, str) or not file.strip():
+                raise ConfigError(f"{where} must be a record file's path, got {describe(file)}")
+            if _suite_files(file, base, where) is not None:
+                raise ConfigError(
+                    f"{where}: {file!r} is a folder or a pattern: a pair names one file for"
+                    " each component (parallel folders or patterns go in excitation.file and"
+                    " excitation.file_y)"
+                )
+        xs.append(pair["x"])
+        ys.append(pair["y"])
+        wheres.append((join(at, "x"), join(at, "y")))
+    _check_pairs(xs, ys, wheres)
+    return xs, ys
+
+
+def _check_pairs(xs: list, ys: list, wheres: list[tuple[str, str]]) -> None:
+    """Each file once in a suite of pairs, never paired with itself (``wheres``: where
+    each pair's x and y are written)."""
+    seen: dict[str, str] = {}
+    for x, y, (at_x, at_y) in zip(xs, ys, wheres, strict=True):
+        if x == y:
+            raise ConfigError(
+                f"{at_y}: {y!r} is the pair's x record too: a pair is a record's two"
+                " horizontal components"
+            )
+        for file, at in ((x, at_x), (y, at_y)):
+            if file in seen:
+                raise ConfigError(
+                    f"{at}: {file!r} is named twice (at {seen[file]} too): each record file"
+                    " once in a suite of pairs"
+                )
+            seen[file] = at
+
+
+def _hoist_pairs(top: dict, excitation: Mapping[str, Any], grid: Any, pairs: tuple) -> dict:
+    """The config with its suite of pairs as a linked axis over excitation.file and
+    excitation.file_y (after the grid's other linked axes), the excitation keeping the first
+    pair: the config a linked axis written by hand makes, to its hash."""
+    xs, ys = pairs
+    grid = dict(grid) if isinstance(grid, Mapping) else {}
+    linked = grid.get(LINKED)
+    if linked is not None and (not isinstance(linked, list | tuple) or not linked):
+        _linked(linked)  # refuses it, in its own words
+    for path in PAIR_PATHS:
+        named = path in grid or any(
+            isinstance(group, Mapping) and path in group for group in linked or ()
+        )
+        if named:
+            raise ConfigError(
+                f"excitation.file names a suite of pairs and the grid has an axis over {path}"
+                " too: use one"
+            )
+    grid[LINKED] = [*(linked or ()), {"excitation.file": xs, "excitation.file_y": ys}]
+    return {**top, "excitation": {**excitation, "file": xs[0], "file_y": ys[0]}, "grid": grid}
 
 
 def _axis_files(value: Any, where: str, base: Path) -> Any:

@@ -354,7 +354,8 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
 
 def _check_dimensions(model: str, column: ColumnConfig, excitation: ExcitationConfig) -> None:
     """A model in three dimensions takes a circular column only; a planar model takes a
-    motion along its plane only (excitation.angle 0, no excitation.file_y)."""
+    motion along its plane only (excitation.angle 0, no excitation.file_y, so no suite of
+    pairs either)."""
     if MODELS[model].three_d:
         if column.section != "circular":
             raise ConfigError(
@@ -371,9 +372,10 @@ def _check_dimensions(model: str, column: ColumnConfig, excitation: ExcitationCo
         )
     if excitation.file_y is not None:
         raise ConfigError(
-            f"excitation.file_y is a second horizontal component, and model {model} rocks in"
-            f" one plane: use a model in three dimensions ({three_d}) or delete"
-            " excitation.file_y"
+            "excitation.file_y is a second horizontal component (so is the y of a pair"
+            f" {{x, y}} in excitation.file), and model {model} rocks in one plane: use a model"
+            f" in three dimensions ({three_d}) or delete excitation.file_y (write"
+            " excitation.file as files, not pairs)"
         )
 
 

@@ -419,11 +419,14 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
     "excitation.phase": ("rad", "", "Phase of a harmonic excitation."),
     "excitation.file_y": (
         "",
-        "a file sampled as ``file``",
+        "a file sampled as ``file``; a list, a folder or a glob beside ``file``'s",
         "``record`` only, models in three dimensions: the record's second horizontal "
         "component, at 90 degrees counter-clockwise from ``file`` (a station's two "
         "components). Same formats and units; scaled by the same factor, with "
-        "``scale: pga`` the larger of the two components' PGAs is the amplitude.",
+        "``scale: pga`` the larger of the two components' PGAs is the amplitude. "
+        "Beside a list, folder or glob in ``file``, a list, folder or glob of as many "
+        "files: a suite of pairs, the k-th file of each (a list's as written, a folder's "
+        "or a glob's sorted) one record, named as its x file. Not with pairs in ``file``.",
     ),
     "excitation.angle": (
         "deg",
@@ -437,10 +440,14 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
     "excitation.initial.velocities": ("rad/s", "", "Angular velocity of each drum at t = 0."),
     "excitation.file": (
         "",
-        "a file, a list of files, a folder or a glob",
+        "a file, a list of files, a folder, a glob, or a list of ``{x: FILE, y: FILE}``",
         "``record`` only: a PEER NGA ``.AT2`` or CSV (time [s], "
         "acceleration) file, relative to the config's folder. Several files "
-        "are a suite: the grid axis ``excitation.file``.",
+        "are a suite: the grid axis ``excitation.file``. A list of pairs "
+        "``{x, y}`` (models in three dimensions, no ``file_y``) is a suite of pairs, "
+        "the x and y files a record's two horizontal components (as ``file`` and "
+        "``file_y``): a grid axis linking ``excitation.file`` and ``excitation.file_y``, "
+        "each pair named as its x file.",
     ),
     "excitation.units": (
         "",

@@ -82,7 +82,19 @@ def plot_domain(
 
     Returns
     -------
-    matplotlib Axes  (panels: the list of their axes, in the place of ``ax``)
+    matplotlib Axes  (panels: the list of their axes, in the place of ``ax``; a domain over
+        ``excitation.angle``: a polar axes, in the place of ``ax`` unless it is polar)
+
+    Notes
+    -----
+    A domain over the ground motion's azimuth (an ``excitation.angle`` axis: models
+    housner-3d and rbm-3d) is drawn in polar axes with layout 'auto' in physical axes: per
+    angle [deg], the lowest amplitude that collapsed (solid) and the highest below it that
+    survived (dashed) [g] as radii, the band between them shaded, one curve per frequency
+    and point of any other axis; an angle where nothing collapsed is drawn open on a ring
+    beyond the largest amplitude; failed runs count as neither and the legend says how
+    many were left out (rbm_cli.report.plot_polar.polar_boundary computes the radii).
+    'panels', 'overlay' or ``dimensionless`` lay it out as any other domain.
 
     Examples
     --------

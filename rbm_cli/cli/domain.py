@@ -68,12 +68,17 @@ def plot_domain_cmd(
     drawn as one panel per point (--panels), or as one axes with each point's boundary
     (--overlay); with one frequency, the innermost axis goes on x instead of the
     frequency. --dimensionless draws any domain in omega/p and A/(g tan alpha).
+    A domain over excitation.angle (housner-3d, rbm-3d) is drawn in polar axes: per
+    angle [deg], the lowest collapsed and the highest survived amplitude below it [g] as
+    radii, one curve per frequency (and point of other axes); --panels, --overlay or
+    --dimensionless lay it out as above instead.
 
     \b
     Example:
         rbm plot-domain out/spanos_koh_slender/domain.csv -o slender.png
         rbm plot-domain out/a/domain.csv --compare results/a/domain.csv
         rbm plot-domain out/size_effect/domain.csv --dimensionless --overlay
+        rbm plot-domain out/polar/domain.csv -o polar.png
     """
     from matplotlib.backend_bases import FigureCanvasBase
 

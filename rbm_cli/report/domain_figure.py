@@ -2,7 +2,10 @@
 level at which the column starts to rock (the RBM's static multiplier, or the engine's own
 uplift level for `bullet`) and the closed forms that apply; a domain over more axes as
 panels or an overlay, and any domain in dimensionless axes (rbm_cli.report.domain_view
-states the layout rule, rbm_cli.report.plot_axes what is drawn)."""
+states the layout rule, rbm_cli.report.plot_axes what is drawn). A domain over the ground
+motion's azimuth (an ``excitation.angle`` axis) is drawn in polar axes by default
+(rbm_cli.report.plot_polar); asked for panels, an overlay or dimensionless axes, it is laid
+out as any other."""
 
 from __future__ import annotations
 
@@ -17,9 +20,13 @@ from rbm_cli.physics.column import build_column
 from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
 from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
+from rbm_cli.report.plot_polar import ANGLE_AXIS, draw_polar, has_angle_axis
 from rbm_cli.study.domain import axis_columns
 
-__all__ = ["column_note", "domain_figure", "draw_domain_on", "uplift_level"]
+__all__ = ["POLAR_SIZE", "column_note", "domain_figure", "draw_domain_on", "uplift_level"]
+
+#: Width and height [in] of the polar picture's figure (the legend beside the circle).
+POLAR_SIZE = (11.0, 6.5)
 
 if TYPE_CHECKING:  # matplotlib is imported when a figure is drawn, not with this module
     import pandas as pd
@@ -30,12 +37,13 @@ def _metres(value: float) -> str:
     return f"{value:.4g} m"
 
 
-def column_note(config: Config) -> str:
+def column_note(config: Config, model: bool = True) -> str:
     """The column a domain was swept with, in one line under its title: H, B (base and
     top width where they differ), drums, the joint stiffness (k_n, K_M or rigid), the
     restitution e, the joints' damping zeta where there is some, and interface.friction where
     model rbm's demand is checked against it.
-    A grid over one of these says so ("over the grid") instead of one value."""
+    A grid over one of these says so ("over the grid") instead of one value. ``model``
+    False leaves the model out (a title that names it already)."""
     col, itf = config.column, config.interface
     axes = set(config.grid.axis_paths)
 
@@ -62,8 +70,9 @@ def column_note(config: Config) -> str:
         f"drums = {value('column.drums', str(col.n_drums))}",
         joint,
         f"e = {value('interface.restitution', e)}",
-        f"model {config.model}",
     ]
+    if model:
+        parts.append(f"model {config.model}")
     if itf.damping > 0 or "interface.damping" in axes:
         parts.insert(5, f"damping zeta = {value('interface.damping', f'{itf.damping:.3g}')}")
     if MODELS[config.model].beam and itf.friction_limit is not None:
@@ -74,6 +83,35 @@ def column_note(config: Config) -> str:
 def _plain(df: pd.DataFrame, dimensionless: bool, layout: str) -> bool:
     """Today's plot: physical axes, a domain with no axis beside amplitude and frequency."""
     return not dimensionless and layout == "auto" and not axis_columns(df.columns)
+
+
+def _polar(df: pd.DataFrame, dimensionless: bool, layout: str) -> bool:
+    """The polar picture: a domain over excitation.angle, physical axes, layout 'auto'."""
+    return not dimensionless and layout == "auto" and has_angle_axis(df)
+
+
+def _polar_axes(ax, df: pd.DataFrame, config: Config | None, compare, where: str):
+    """The polar picture of the domain on ``ax`` (a polar axes in its place when it is
+    not one; a new Figure's when None); returns the polar axes."""
+    if list(compare):
+        raise RbmError(
+            f"the polar picture of {where} (over {ANGLE_AXIS}) draws one domain: compare"
+            " domains in panels (--panels)"
+        )
+    if ax is None:
+        from matplotlib.figure import Figure
+
+        ax = Figure(figsize=POLAR_SIZE).add_subplot(projection="polar")
+    elif ax.name != "polar":
+        fig, spec = ax.figure, ax.get_subplotspec()
+        if spec is None:
+            raise RbmError(
+                f"the polar picture of {where} takes the place of an axes on a grid:"
+                " pass ax=None, a subplot or a polar axes"
+            )
+        ax.remove()
+        ax = fig.add_subplot(spec, projection="polar")
+    return draw_polar(ax, df, config, where)
 
 
 def _config_options(config: Config | None) -> dict:
@@ -133,7 +171,10 @@ def draw_domain_on(
     static_label of rbm_cli.report.plot_domain.plot_domain) apply to the plain plot only;
     ``config`` gives them otherwise. ``compare_configs``: the compared domains' configs,
     for dimensionless axes of domains written without their scale columns; ``colorbar``
-    False: panels of an ensemble leave their colour bar to the caller."""
+    False: panels of an ensemble leave their colour bar to the caller. A domain over
+    excitation.angle in physical axes with layout 'auto' is drawn in polar axes
+    (rbm_cli.report.plot_polar), on ``ax`` if it is polar, else on a polar axes that takes
+    its place; the polar axes is returned."""
     if _plain(df, dimensionless, layout):
         options = {**_config_options(config), **options}
         return plot_domain(df, ax=ax, compare=compare, labels=labels, **options)
@@ -142,6 +183,8 @@ def draw_domain_on(
             f"{', '.join(options)}: for the plain plot only; with dimensionless axes or"
             " more axes the config gives the column and its levels"
         )
+    if _polar(df, dimensionless, layout):
+        return _polar_axes(ax, df, config, compare, where)
     view = domain_view(df, config, dimensionless, layout, where)
     others = _compared(view, compare, labels, compare_configs, where)
     if ax is None:
@@ -170,7 +213,8 @@ def _numeric(view: DomainView) -> bool:
 
 
 def figure_size(view: DomainView) -> tuple[float, float]:
-    """Width and height [in] of a view's figure: panels 3.4 x 2.7 each, legend beside."""
+    """Width and height [in] of a view's figure: panels 3.4 x 2.7 each, legend beside
+    (a polar picture's: :data:`POLAR_SIZE`)."""
     if view.layout != "panels":
         return (9.5, 5.0)
     n = len(view.points)
@@ -205,6 +249,8 @@ def domain_figure(
     """
     if _plain(df, dimensionless, layout):
         return _plain_figure(df, config, compare, labels)
+    if _polar(df, dimensionless, layout):
+        return _polar_figure(df, config, compare, labels, where)
     from matplotlib.figure import Figure
 
     view = domain_view(df, config, dimensionless, layout, where)
@@ -246,6 +292,22 @@ def _colorbar_below(fig, axes: list) -> None:
     x1 = max(ax.get_position().x1 for ax in axes)
     cax = fig.add_axes((x0, 0.45 / height, x1 - x0, 0.12 / height))
     fraction_colorbar(fig, None, cax=cax)
+
+
+def _polar_figure(df, config, compare, labels, where) -> Figure:
+    """The polar picture of a domain over excitation.angle, titled by its config and model
+    (rbm_cli.report.plot_polar)."""
+    ax = _polar_axes(None, df, config, compare, where)
+    fig = ax.figure
+    what = "critical amplitude against the azimuth of the ground motion"
+    if config is None:
+        name = labels[0] if labels else "domain"
+        ax.set_title(f"{name}: {what}")
+    else:
+        ax.set_title(f"{config.name}, model {config.model}: {what} ({config.excitation.type})"
+                     f"\n{column_note(config, model=False)}")  # fmt: skip
+    fig.tight_layout()
+    return fig
 
 
 def _plain_figure(df, config, compare, labels) -> Figure:

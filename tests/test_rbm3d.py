@@ -278,3 +278,39 @@ def test_the_uncompiled_source_gives_the_same_bits():
         assert np.array_equal(a.max_ratio, b.max_ratio) and a.max_top == b.max_top
         assert a.t_collapse == b.t_collapse or (np.isnan(a.t_collapse) and np.isnan(b.t_collapse))
         assert a.turns == b.turns
+
+
+def test_a_recorded_run_keeps_both_elevations():
+    """A recorded run keeps the rotations seen across the motion's plane: zero to the bit
+    for a motion along x, round-off along 30 degrees (three elastic drums), not zero under
+    a pair; history.csv has them, and shapes.png draws two elevations."""
+    from rbm_cli.models.registry import make_runner
+    from rbm_cli.physics.column import build_column
+    from rbm_cli.report.run_figures import shapes_figure
+    from rbm_cli.report.run_folder import history_columns
+
+    for angle in (0.0, 30.0):
+        cfg = config(drums=3, stiffness=ELASTIC, angle=angle, rtol=1e-8)
+        planar = make_runner(cfg).run(make_ground_motion(cfg.excitation, 0.6, 1.5),
+                                      cfg.solver, record=True).history  # fmt: skip
+        peak = np.abs(planar.rotations).max()
+        assert planar.rotations_across.shape == planar.rotations.shape and peak > 0.01
+        across = np.abs(planar.rotations_across).max()
+        assert across == 0.0 if angle == 0.0 else across < 1e-6 * peak  # round-off at 30
+    folder = Path(__file__).resolve().parents[1] / "configs" / "records" / "synthetic"
+    pair = parse_config({
+        "name": "pair", "model": "rbm-3d", "column": {**COLUMN, "drums": 3},
+        "interface": {"stiffness": ELASTIC, "restitution": 0.9},
+        "excitation": {"type": "record", "units": "g", "free_time": 1.0,
+                       "file": str(folder / "rdk_01.AT2"), "file_y": str(folder / "rdk_02.AT2")},
+    })  # fmt: skip
+    out = make_runner(pair).run(make_ground_motion(pair.excitation, 0.3), pair.solver,
+                                record=True)  # fmt: skip
+    history = out.history
+    assert np.abs(history.rotations_across).max() > 1e-4
+    columns = history_columns(history)
+    assert np.array_equal(columns["theta2_across_rad"], history.rotations_across[:, 1])
+    widths = build_column(pair.column, pair.interface).widths
+    fig = shapes_figure(history, widths, None, out.t_collapse)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert len(titles) == 2 and "across the motion's plane" in titles[1]

@@ -23,6 +23,9 @@ class History:
         [m] (x, y) from where it stood
     ground_acceleration_y : (k,) or None  A pair of records: the second component a_y(t)
         [m/s^2] (ground_acceleration is then the first's)
+    rotations_across : (k, n) or None  A model in three dimensions: the drums' rotations
+        seen in the vertical plane across the motion's (its direction turned by +90
+        degrees) [rad]; ``rotations`` are those seen in the motion's plane
     """
 
     t: np.ndarray
@@ -33,6 +36,7 @@ class History:
     rates: np.ndarray | None = None
     top_plan: np.ndarray | None = None
     ground_acceleration_y: np.ndarray | None = None
+    rotations_across: np.ndarray | None = None
 
 
 def history_from_samples(node_map: np.ndarray, motion, samples) -> History:

@@ -70,6 +70,7 @@ class Outcome:
     azimuth: float = math.nan
     turns: float = math.nan
     top_plan: np.ndarray | None = None  # a recorded 3D run: the top in plan per sample [m]
+    across: np.ndarray | None = None  # ... and the rotations seen across the motion's plane
 
     def stop(self, status: str, message: str, t: float) -> Outcome:
         """End the run at time t with a status and a reason."""

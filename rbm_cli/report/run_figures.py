@@ -9,6 +9,7 @@ where a figure is built, not with this module.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 from collections.abc import Sequence
 
@@ -211,23 +212,36 @@ def plot_top_plan(history: History, ax, t_collapse: float | None = None) -> None
 def shapes_figure(
     history: History, widths, elevations, t_collapse: float | None, title: str | None = None
 ):
+    """shapes.png's figure: the deformed column at chosen instants; for a model in three
+    dimensions in two elevations, the motion's vertical plane above and the plane across
+    it below (the same instants and exaggeration)."""
     from matplotlib.figure import Figure
 
-    from rbm_cli.report.plots import plot_shapes
+    from rbm_cli.report.plots import exaggeration_factor, infer_elevations, plot_shapes
 
-    fig = Figure(figsize=(10.0, 5.0))
-    ax = fig.subplots()
-    plot_shapes(
-        history,
-        widths,
-        shape_instants(history.t),
-        ax=ax,
-        elevations=elevations,
-        t_collapse=t_collapse,
-    )
-    x0, x1 = ax.get_xlim()
-    y0, y1 = ax.get_ylim()
-    fig.set_size_inches(10.0, float(np.clip(9.0 * (y1 - y0) / (x1 - x0) + 1.0, 3.0, 8.0)))
+    instants = shape_instants(history.t)
+    z = np.asarray(infer_elevations(history) if elevations is None else elevations, float)
+    views, scale = [(history, "in the motion's plane")], None
+    if history.rotations_across is not None:
+        theta = np.atleast_2d(np.asarray(history.rotations_across, dtype=float))
+        rise = np.cumsum(theta * np.diff(z)[None, :], axis=1)  # the nodes, drum by drum
+        nodes = np.hstack([np.zeros((theta.shape[0], 1)), rise])
+        seen = dataclasses.replace(history, rotations=theta, node_displacements=nodes)
+        views.append((seen, "across the motion's plane (its direction turned +90 degrees)"))
+        # one exaggeration for both views: the smaller of their own
+        scale = min(exaggeration_factor(v, instants, float(z[-1] - z[0])) for v, _ in views)
+    fig = Figure(figsize=(10.0, 5.0 * len(views)))
+    axes = fig.subplots(len(views), 1, squeeze=False)[:, 0]
+    for ax, (view, label) in zip(axes, views, strict=True):
+        plot_shapes(view, widths, instants, ax=ax, elevations=z, scale=scale,
+                    t_collapse=t_collapse)  # fmt: skip
+        if len(views) > 1:
+            ax.set_title(ax.get_title().replace("Deformed shapes", f"Deformed shapes {label}"),
+                         fontsize="medium")  # fmt: skip
+    x0, x1 = axes[0].get_xlim()
+    y0, y1 = axes[0].get_ylim()
+    per_view = float(np.clip(9.0 * (y1 - y0) / (x1 - x0) + 1.0, 3.0, 8.0))
+    fig.set_size_inches(10.0, per_view * len(views))
     if title:
         fig.suptitle(title)
     fig.tight_layout()

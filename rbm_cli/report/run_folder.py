@@ -71,7 +71,8 @@ def history_columns(history: History, vertical=None) -> dict[str, np.ndarray]:
     history's times, :func:`vertical_history`), ug_m [m], u1_m..u{n+1}_m [m] (node
     displacements relative to the ground), theta1_rad..thetan_rad [rad] (absolute drum
     rotations; a model in three dimensions: the tilt in the motion's plane), and for a model
-    in three dimensions top_x_m, top_y_m [m] (the top centre in plan from where it stood);
+    in three dimensions top_x_m, top_y_m [m] (the top centre in plan from where it stood)
+    and theta1_across_rad.. [rad] (the rotations seen across the motion's plane);
     -0.0 made 0.0, so the file never shows "-0"."""
     u = np.atleast_2d(np.asarray(history.node_displacements, dtype=float))
     theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
@@ -94,6 +95,10 @@ def history_columns(history: History, vertical=None) -> dict[str, np.ndarray]:
     if history.top_plan is not None:  # a model in three dimensions
         plan = np.asarray(history.top_plan, dtype=float)
         data["top_x_m"], data["top_y_m"] = plan[:, 0], plan[:, 1]
+    if history.rotations_across is not None:
+        across = np.atleast_2d(np.asarray(history.rotations_across, dtype=float))
+        for i in range(across.shape[1]):
+            data[f"theta{i + 1}_across_rad"] = across[:, i]
     return {k: v + 0.0 for k, v in data.items()}
 
 

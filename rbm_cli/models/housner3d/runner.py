@@ -67,6 +67,7 @@ class _Run3d(BlockRun):
     c: np.ndarray = dataclasses.field(default_factory=lambda: np.array([1.0, 0.0]))
     top_max: float = 0.0
     plan: dict = dataclasses.field(default_factory=dict)  # sample index -> top in plan [m]
+    across: dict = dataclasses.field(default_factory=dict)  # ... -> tilt across the plane
     start_top: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(2))
     azimuth: float = math.nan
     phase: int = 0  # LEAVING, FREE or APPROACH (near the vertical)
@@ -172,10 +173,12 @@ def _finish(run: _Run3d, status: str = "survived", message: str = "") -> Outcome
     out.azimuth, out.turns = run.azimuth, run.swept / (2.0 * math.pi)
     if run.rec.samples is not None:  # the top in plan at each sample; at rest where it was
         place, top_plan = run.start_top, np.zeros((len(out.samples), 2))
+        across = np.zeros((len(out.samples), 1))
         for i in range(len(out.samples)):
             place = run.plan.get(i, place)
             top_plan[i] = place
-        out.top_plan = top_plan
+            across[i, 0] = run.across.get(i, 0.0)
+        out.top_plan, out.across = top_plan, across
     return out
 
 
@@ -345,7 +348,9 @@ def _emit(run, dense, t_stop, d, geo) -> None:
         y = dense(t)
         th, rate = tilt_in_plane(y, d)
         run.rec.emit(np.array([t]), th, rate)
-        run.plan[len(run.out.samples) - 1] = top_in_plan(geo, y)
+        at = len(run.out.samples) - 1
+        run.plan[at] = top_in_plan(geo, y)
+        run.across[at] = tilt_in_plane(y, np.array([-d[1], d[0]]))[0]
 
 
 def _fail(run: _Run3d, message: str) -> Outcome:
@@ -383,5 +388,6 @@ class Housner3dRunner(BlockRunner):
         top's path in plan."""
         out = super().run(motion, solver, **options)
         if out.history is not None and out.top_plan is not None:
-            out.history = dataclasses.replace(out.history, top_plan=out.top_plan)
+            out.history = dataclasses.replace(out.history, top_plan=out.top_plan,
+                                              rotations_across=out.across)  # fmt: skip
         return out

@@ -311,7 +311,8 @@ def _friction(t, y, f, n, col, es, gr, friction):
 
 @jit
 def _emit(mc, t_stop, t_old, h, y_old, F, yq, samples, n_out, next_out, dt, n, d0, d1, col):
-    """Samples (t, theta and rate seen in the motion's plane, the top in plan) up to t_stop;
+    """Samples (t, theta and rate seen in the motion's plane, the top in plan, theta seen
+    across it) up to t_stop;
     F None-like (h = 0): the state y_old itself."""
     top = col.families[2 * n]
     while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
@@ -328,6 +329,8 @@ def _emit(mc, t_stop, t_old, h, y_old, F, yq, samples, n_out, next_out, dt, n, d
             tx += top[j] * yq[j]
             ty += top[j] * yq[n + j]
         row[1 + 2 * n], row[2 + 2 * n] = tx, ty
+        for j in range(n):  # seen across the motion's plane (its direction turned +90 deg)
+            row[3 + 2 * n + j] = -yq[j] * d1 + yq[n + j] * d0
         n_out += 1
         next_out += dt
     return n_out, next_out
@@ -342,7 +345,7 @@ def run3d(col, motion, solver, task, pair):
     col : ColumnArrays  The column (physics.arrays), as the planar kernel reads it
     motion : Excitation  The motion along its direction (step.inputs)
     solver : SolverSettings  atol of 4n entries
-    task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 2n), friction_limit); y0
+    task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 3n), friction_limit); y0
         is the state, changed in place: the state where the run ended
     pair : tuple  (d0, d1, values_y: the second record's samples, or empty)
 

@@ -100,7 +100,7 @@ def integrate3d(
                             prepared.atol_scale[n:], prepared.atol_scale[n:]])  # fmt: skip
     deadline = time.monotonic() + float(solver.max_wall_time)
     rows = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
-    samples = np.zeros((rows, 3 + 2 * n))
+    samples = np.zeros((rows, 3 + 3 * n))
     task = (y0, bool(record), float(output_dt), samples, float(friction_limit))
     pair = (float(d[0]), float(d[1]), as_samples(motion.values_y))
     armed = arm()
@@ -124,7 +124,8 @@ def integrate3d(
         rows = samples[:n_out]
         out.samples = [(float(r[0]), r[1 : 1 + n].copy(), r[1 + n : 1 + 2 * n].copy())
                        for r in rows]  # fmt: skip
-        out.top_plan = rows[:, 1 + 2 * n :].copy()
+        out.top_plan = rows[:, 1 + 2 * n : 3 + 2 * n].copy()
+        out.across = rows[:, 3 + 2 * n :].copy()
     if code == COLLAPSED:
         out.collapse(float(t_col), int(c_if) + 1)
     elif code == AT_REST:
@@ -177,7 +178,8 @@ class Rbm3dRunner(RbmRunner):
         top's path in plan."""
         out = super().run(motion, solver, **options)
         if out.history is not None and out.top_plan is not None:
-            out.history = dataclasses.replace(out.history, top_plan=out.top_plan)
+            out.history = dataclasses.replace(out.history, top_plan=out.top_plan,
+                                              rotations_across=out.across)  # fmt: skip
         return out
 
 

@@ -37,7 +37,7 @@ right-hand side (rbm_cli.models.rbm.step.rk.rhs: a state of 4n values is this mo
   then 2n of scratch for the moments (:func:`pack_pieces` fills it);
 - ``es`` (n + 8): -M^-1 r, the motion's direction in plan (cos, sin), then the second
   horizontal component's straight piece of a record pair (flag, gain, a_{k+1} - a_k, a_k,
-  t_k, t_{k+1} - t_k; flag 0 for one component).
+  t_k, t_{k+1} - t_k; flag 0 for one component), then 1.0 if K_g is not zero.
 """
 
 from __future__ import annotations
@@ -47,8 +47,9 @@ import math
 from rbm_cli.base.jit import jit
 from rbm_cli.physics.ground import gravity_factor, ground
 
-#: Entries of ``es`` after the n loads: the direction, then the second component's piece.
-ES_EXTRA = 8
+#: Entries of ``es`` after the n loads: the direction, the second component's piece, and
+#: whether gravity's term K_g is there (`geometric`).
+ES_EXTRA = 9
 #: Entries per joint of ``cs`` (pieces, pinned direction, scratch).
 CS_PER_JOINT = 9
 
@@ -105,8 +106,12 @@ def beam_rates(t, y, n, As, cs, es, gr, out):
         out[n + i] = y[3 * n + i]
         sx, sy = es[i] * ax, es[i] * ay
         for j in range(n):
-            sx += As[i, j] * cs[7 * n + j] + gam * As[i, n + j] * y[j]
-            sy += As[i, j] * cs[8 * n + j] + gam * As[i, n + j] * y[n + j]
+            sx += As[i, j] * cs[7 * n + j]
+            sy += As[i, j] * cs[8 * n + j]
+        if es[n + 8] != 0.0:  # gravity's term (`geometric`)
+            for j in range(n):
+                sx += gam * As[i, n + j] * y[j]
+                sy += gam * As[i, n + j] * y[n + j]
         out[2 * n + i] = sx
         out[3 * n + i] = sy
 

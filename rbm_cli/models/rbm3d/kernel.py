@@ -163,6 +163,28 @@ def watch(n, k, phase, pending, col, kinds, joints):
 
 
 @jit
+def rows_at(y, gam, n, col, k, c, kinds, joints, m, dist, rate):
+    """Every watched distance and its rate at state y (gam = (g + a_v) / g there)."""
+    for r in range(m):
+        dist[r], rate[r] = distance(kinds[r], joints[r], y, n, col, k, c, gam)
+
+
+@jit
+def within_reach(d0, r0, d1, r1, dt, kinds, m, near):
+    """The watched distances that may cross zero inside a step of dt [s], from their values
+    and rates at both ends, into near (m,) bool; returns whether any may: it ends below
+    zero, or its smaller end is within dt (|r0| + |r1|) of zero (some seven times the
+    largest dip of the ends' cubic Hermite, 4/27 dt (|r0| + |r1|)); a turn near closure
+    (TURNED, whose rate is not watched) always."""
+    found = False
+    for r in range(m):
+        near[r] = (d1[r] < 0.0 or kinds[r] == TURNED
+                   or min(d0[r], d1[r]) <= dt * (abs(r0[r]) + abs(r1[r])))  # fmt: skip
+        found = found or near[r]
+    return found
+
+
+@jit
 def _row_at(t, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds, joints):
     dense_eval(mc, t, t_old, h, y_old, F, yq)
     return distance(kinds[r], joints[r], yq, n, col, k, c, gravity_factor(t, gr))[0]
@@ -217,24 +239,28 @@ def _hermite_min(p0, p1, m0, m1):
 
 
 @jit
-def first_event(mc, t_old, t_new, h, y_old, F, yq, n, col, k, c, gr, kinds, joints, m, D, R):
-    """(t, row) of the earliest crossing of a watched distance in [t_old, t_new], or
-    (-1, -1) (the module's scan)."""
+def first_event(mc, t_old, t_new, h, y_old, F, yq, n, col, k, c, gr, kinds, joints, m, D, R,
+                near):  # fmt: skip
+    """(t, row) of the earliest crossing of a watched distance near (within_reach) in
+    [t_old, t_new], or (-1, -1) (the module's scan)."""
     ts = np.empty(CHECK_INTERVALS + 1)
     for j in range(CHECK_INTERVALS + 1):
         ts[j] = t_old + (t_new - t_old) * (j / CHECK_INTERVALS) if j < CHECK_INTERVALS else t_new
         dense_eval(mc, ts[j], t_old, h, y_old, F, yq)
         gam = gravity_factor(ts[j], gr)
         for r in range(m):
-            D[r, j], R[r, j] = distance(kinds[r], joints[r], yq, n, col, k, c, gam)
+            if near[r]:
+                D[r, j], R[r, j] = distance(kinds[r], joints[r], yq, n, col, k, c, gam)
     for r in range(m):
-        if D[r, 0] <= 0.0:
+        if near[r] and D[r, 0] <= 0.0:
             return t_old, r
     for j in range(CHECK_INTERVALS):
         a, b = ts[j], ts[j + 1]
         ds = b - a
         best_t, best_r = np.inf, -1
         for r in range(m):
+            if not near[r]:
+                continue
             hi = -1.0
             if D[r, j + 1] < 0.0:
                 hi = b
@@ -380,6 +406,7 @@ def run3d(col, motion, solver, task, pair):
     es = np.zeros(n + ES_EXTRA)
     es[:n] = col.es
     es[n], es[n + 1] = d0, d1
+    es[n + 8] = 1.0 if np.any(col.mg != 0.0) else 0.0
 
     k = np.zeros(n, dtype=np.int64)
     pending = np.zeros(n, dtype=np.bool_)
@@ -388,6 +415,9 @@ def run3d(col, motion, solver, task, pair):
     for i in range(n):
         c[i, 0], c[i, 1] = d0, d1
     kinds, joints = np.zeros(nrow_max, dtype=np.int64), np.zeros(nrow_max, dtype=np.int64)
+    d_old, r_old = np.empty(nrow_max), np.empty(nrow_max)
+    d_new, r_new = np.empty(nrow_max), np.empty(nrow_max)
+    near = np.zeros(nrow_max, dtype=np.bool_)
     D, R = np.empty((nrow_max, CHECK_INTERVALS + 1)), np.empty((nrow_max, CHECK_INTERVALS + 1))
     max_ratio, friction, swept = np.zeros(n), np.zeros(n), np.zeros(n)
     slip = np.array([np.nan, 0.0])
@@ -495,6 +525,7 @@ def run3d(col, motion, solver, task, pair):
                 pinned[i] = phase[i] != FREE and col.rigid[i]
             pack_pieces(k, pinned, c, col.intercepts, weight, elastic, col.damp, col.rigid, cs)
             m = watch(n, k, phase, pending, col, kinds, joints)
+            rows_at(y, gravity_factor(t, gr), n, col, k, c, kinds, joints, m, d_old, r_old)
             t_bound = seg_end
             if clipped:
                 gr, t_bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
@@ -563,9 +594,18 @@ def run3d(col, motion, solver, task, pair):
                 if t_new - seg_end >= 0:
                     running = False
                 t_old = t
-                n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs, es, gr)
-                t_e, hit = first_event(mc, t_old, t_new, h, y, F, yq, n, col, k, c, gr, kinds,
-                                       joints, m, D, R)  # fmt: skip
+                rows_at(ynew, gravity_factor(t_new, gr), n, col, k, c, kinds, joints, m, d_new,
+                        r_new)  # fmt: skip
+                dense_ready = False
+                hit = -1
+                if within_reach(d_old, r_old, d_new, r_new, t_new - t_old, kinds, m, near):
+                    n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs, es, gr)
+                    dense_ready = True
+                    t_e, hit = first_event(mc, t_old, t_new, h, y, F, yq, n, col, k, c, gr,
+                                           kinds, joints, m, D, R, near)  # fmt: skip
+                if record and not dense_ready:
+                    n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs, es, gr)
+                    dense_ready = True
                 if hit >= 0:
                     t_new = t_e
                     dense_eval(mc, t_new, t_old, h, y, F, y_new)
@@ -591,6 +631,10 @@ def run3d(col, motion, solver, task, pair):
                     v1, r1 = _magnitude(row, y_new, n)
                     _, r0 = _magnitude(row, y, n)
                     if r0 > 0.0 and r1 < 0.0:
+                        if not dense_ready:
+                            n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs,
+                                                   es, gr)  # fmt: skip
+                            dense_ready = True
                         v1 = max(v1, _peak_in(row, t_old, t_new, mc, t_old, h, y, F, yq, n))
                     if i < n:
                         max_ratio[i] = max(max_ratio[i], v1)
@@ -617,6 +661,8 @@ def run3d(col, motion, solver, task, pair):
                 if event:
                     break
                 f[:] = K[ns]
+                d_old, d_new = d_new, d_old
+                r_old, r_new = r_new, r_old
             if not event:
                 t = seg_end if not running else t
                 continue

@@ -155,3 +155,21 @@ def pytest_runtest_makereport(item, call):
         " @pytest.mark.may_skip(reason=...))"
     )
     return report
+
+
+@pytest.fixture(scope="module")
+def pair_dir(tmp_path_factory):
+    """Two synthetic records of the project (the same sampling), and a record of zeros
+    sampled as they are: the records of a pair (models in three dimensions)."""
+    import numpy as np
+
+    from rbm_cli.physics.records import read_record
+
+    records = Path(__file__).resolve().parents[1] / "configs" / "records" / "synthetic"
+    folder = tmp_path_factory.mktemp("pair")
+    for name in ("rdk_01", "rdk_02"):
+        (folder / f"{name}.AT2").write_bytes((records / f"{name}.AT2").read_bytes())
+    t = read_record(str(folder / "rdk_01.AT2")).t
+    np.savetxt(folder / "zero.csv", np.c_[t, np.zeros_like(t)], delimiter=",",
+               header="time_s,acc_g", comments="")  # fmt: skip
+    return folder

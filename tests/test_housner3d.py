@@ -259,21 +259,6 @@ def pair_config(tmp_path, model: str = "housner-3d", **exc):
     }, base_dir=tmp_path)  # fmt: skip
 
 
-@pytest.fixture(scope="module")
-def pair_dir(tmp_path_factory):
-    """Two synthetic records of the project (the same sampling), and a record of zeros
-    sampled as they are."""
-    from rbm_cli.physics.records import read_record
-
-    folder = tmp_path_factory.mktemp("pair")
-    for name in ("rdk_01", "rdk_02"):
-        (folder / f"{name}.AT2").write_bytes((RECORDS / f"{name}.AT2").read_bytes())
-    t = read_record(str(folder / "rdk_01.AT2")).t
-    np.savetxt(folder / "zero.csv", np.c_[t, np.zeros_like(t)], delimiter=",",
-               header="time_s,acc_g", comments="")  # fmt: skip
-    return folder
-
-
 def test_a_pair_with_a_zero_second_record_is_the_one_component_run(pair_dir):
     """x record plus a y record of zeros: the run of the x record alone, to the bit (on
     cells that rock with impacts and that collapse), and Housner's block along x: the same

@@ -202,23 +202,6 @@ def test_free_motion_in_three_dimensions_conserves_energy():
     assert _energy(model, end[0]) == pytest.approx(_energy(model, y0), rel=1e-9)
 
 
-RECORDS = Path(__file__).resolve().parents[1] / "configs" / "records" / "synthetic"
-
-
-@pytest.fixture(scope="module")
-def pair_dir(tmp_path_factory):
-    """Two synthetic records of the project and a record of zeros sampled as they are."""
-    from rbm_cli.physics.records import read_record
-
-    folder = tmp_path_factory.mktemp("pair3d")
-    for name in ("rdk_01", "rdk_02"):
-        (folder / f"{name}.AT2").write_bytes((RECORDS / f"{name}.AT2").read_bytes())
-    t = read_record(str(folder / "rdk_01.AT2")).t
-    np.savetxt(folder / "zero.csv", np.c_[t, np.zeros_like(t)], delimiter=",",
-               header="time_s,acc_g", comments="")  # fmt: skip
-    return folder
-
-
 def pair_config(folder, model="rbm-3d", **exc):
     return parse_config({
         "name": "pair", "model": model, "column": dict(COLUMN),

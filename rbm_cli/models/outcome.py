@@ -6,6 +6,7 @@ rbm_cli.study.result.RunResult, the row of a domain.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -71,6 +72,15 @@ class Outcome:
     turns: float = math.nan
     top_plan: np.ndarray | None = None  # a recorded 3D run: the top in plan per sample [m]
     across: np.ndarray | None = None  # ... and the rotations seen across the motion's plane
+
+    def carry_plan(self) -> Outcome:
+        """A recorded run of a model in three dimensions: its history takes the top's path
+        in plan and the rotations seen across the motion's plane (kept beside the samples
+        by the run). Returns the outcome itself."""
+        if self.history is not None and self.top_plan is not None:
+            self.history = dataclasses.replace(self.history, top_plan=self.top_plan,
+                                               rotations_across=self.across)  # fmt: skip
+        return self
 
     def stop(self, status: str, message: str, t: float) -> Outcome:
         """End the run at time t with a status and a reason."""

@@ -386,8 +386,4 @@ class Housner3dRunner(BlockRunner):
     def run(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
         """One run (rbm_cli.models.contract.Runner.run); a recorded history carries the
         top's path in plan."""
-        out = super().run(motion, solver, **options)
-        if out.history is not None and out.top_plan is not None:
-            out.history = dataclasses.replace(out.history, top_plan=out.top_plan,
-                                              rotations_across=out.across)  # fmt: skip
-        return out
+        return super().run(motion, solver, **options).carry_plan()

@@ -16,24 +16,21 @@ import math
 import numpy as np
 
 from rbm_cli.base.brent import brent_step
-from rbm_cli.base.detmath import pow_pos
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.models.rbm.step.rk import (
-    MAX_FACTOR,
-    MIN_FACTOR,
     NS_MAX,
-    SAFETY,
+    STEP_TAKEN,
+    STEP_TOO_SMALL,
     TAB_EST,
     TAB_NS,
+    attempt_step,
     dense_eval,
     dense_prepare,
-    error_norm,
     initial_step,
     rhs,
-    rk_attempt,
 )
 from rbm_cli.models.status import (
     COLLAPSED,
@@ -525,7 +522,6 @@ def run3d(col, motion, solver, task, pair):
                 pinned[i] = phase[i] != FREE and col.rigid[i]
             pack_pieces(k, pinned, c, col.intercepts, weight, elastic, col.damp, col.rigid, cs)
             m = watch(n, k, phase, pending, col, kinds, joints)
-            rows_at(y, gravity_factor(t, gr), n, col, k, c, kinds, joints, m, d_old, r_old)
             t_bound = seg_end
             if clipped:
                 gr, t_bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
@@ -533,6 +529,7 @@ def run3d(col, motion, solver, task, pair):
                     gy, _ = record_piece(t, knots, values_y, vertical, seg_gain, seg_end)
                     es[n + 2], es[n + 3], es[n + 4] = 1.0, gy[1], gy[2]
                     es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
+            rows_at(y, gravity_factor(t, gr), n, col, k, c, kinds, joints, m, d_old, r_old)
             rhs(t, y, n, As, cs, es, gr, f)
             if h_carry > 0.0:
                 h_abs = min(h_carry, seg_end - t)
@@ -544,9 +541,6 @@ def run3d(col, motion, solver, task, pair):
             event = False
             running = True
             while running:
-                min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
-                if h_abs < min_step:
-                    h_abs = min_step
                 bound = seg_end
                 if clipped:
                     gr, bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
@@ -554,33 +548,14 @@ def run3d(col, motion, solver, task, pair):
                         gy, _ = record_piece(t, knots, values_y, vertical, seg_gain, seg_end)
                         es[n + 2], es[n + 3], es[n + 4] = 1.0, gy[1], gy[2]
                         es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
-                rejected = False
-                while True:
-                    if not (h_abs >= min_step):
-                        return (FAILED_STEP, t, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth,
-                                swept)  # fmt: skip
-                    t_new = t + h_abs
-                    if t_new - bound > 0:
-                        t_new = bound
-                    h = t_new - t
-                    h_abs = abs(h)
-                    rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr)
-                    n_rhs += ns
-                    err = error_norm(mc, K, h, y, ynew, atol, rtol, scale)
-                    if not (err == err and abs(err) < math.inf):
-                        return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top,
-                                friction, slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
-                                azimuth, swept)  # fmt: skip
-                    if err < 1.0:
-                        factor = (MAX_FACTOR if err == 0.0
-                                  else min(MAX_FACTOR, SAFETY * pow_pos(err, err_exp)))  # fmt: skip
-                        if rejected:
-                            factor = min(1.0, factor)
-                        h_abs *= factor
-                        break
-                    h_abs *= max(MIN_FACTOR, SAFETY * pow_pos(err, err_exp))
-                    rejected = True
+                taken, t_new, h, h_abs, calls = attempt_step(
+                    mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
+                    scale, err_exp)  # fmt: skip
+                n_rhs += calls
+                if taken != STEP_TAKEN:
+                    code = FAILED_STEP if taken == STEP_TOO_SMALL else FAILED_NONFINITE
+                    return (code, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl,
+                            n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
                 n_steps += 1
                 if n_steps > max_steps:
                     return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,

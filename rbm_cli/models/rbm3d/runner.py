@@ -34,7 +34,6 @@ plane (theta_x cos angle + theta_y sin angle); the top's path in plan is kept be
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 
@@ -176,11 +175,7 @@ class Rbm3dRunner(RbmRunner):
     def run(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
         """One run (rbm_cli.models.contract.Runner.run); a recorded history carries the
         top's path in plan."""
-        out = super().run(motion, solver, **options)
-        if out.history is not None and out.top_plan is not None:
-            out.history = dataclasses.replace(out.history, top_plan=out.top_plan,
-                                              rotations_across=out.across)  # fmt: skip
-        return out
+        return super().run(motion, solver, **options).carry_plan()
 
 
 __all__ = ["Rbm3dRunner", "integrate3d", "needs_compile", "run3d", "warm_up"]

@@ -242,6 +242,53 @@ def error_norm(mc, K, h, y, ynew, atol, rtol, scale):
     return math.sqrt(s / m)
 
 
+#: How :func:`attempt_step` ends: a step taken, a step below the spacing of the numbers at
+#: t, a state that became NaN or infinite.
+STEP_TAKEN, STEP_TOO_SMALL, STEP_NONFINITE = 0, 1, 2
+
+
+@jit(inline=True)
+def attempt_step(mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
+                 scale, err_exp):  # fmt: skip
+    """One accepted step from (t, y) (scipy's RungeKutta._step_impl): a step of h_abs [s]
+    (at least 10 ulp of t, cut at bound), shrunk until its error norm is below 1. The new
+    state in ynew, the stages in K.
+
+    Returns
+    -------
+    (code, t_new, h, h_abs, calls)  STEP_TAKEN (else the failure, at t), the step's end and
+        size [s], the size proposed for the next step [s], and the right-hand side's calls.
+    """
+    min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+    if h_abs < min_step:
+        h_abs = min_step
+    calls = 0
+    rejected = False
+    while True:
+        if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
+            return STEP_TOO_SMALL, t, 0.0, h_abs, calls
+        t_new = t + h_abs
+        if t_new - bound > 0:
+            t_new = bound
+        h = t_new - t
+        h_abs = abs(h)
+        rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr)
+        calls += TAB_NS[mc]
+        err = error_norm(mc, K, h, y, ynew, atol, rtol, scale)
+        if not (err == err and abs(err) < math.inf):  # NaN or inf state
+            return STEP_NONFINITE, t, h, h_abs, calls
+        if err < 1.0:
+            if err == 0.0:
+                factor = MAX_FACTOR
+            else:
+                factor = min(MAX_FACTOR, SAFETY * pow_pos(err, err_exp))
+            if rejected:
+                factor = min(1.0, factor)
+            return STEP_TAKEN, t_new, h, h_abs * factor, calls
+        h_abs *= max(MIN_FACTOR, SAFETY * pow_pos(err, err_exp))
+        rejected = True
+
+
 @jit
 def dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
     """Coefficients F of the step's interpolant (DOP853: extra stages)."""

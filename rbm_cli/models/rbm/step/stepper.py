@@ -3,11 +3,9 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from rbm_cli.base.detmath import matvec, pow_pos
+from rbm_cli.base.detmath import matvec
 from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
@@ -34,21 +32,19 @@ from rbm_cli.models.rbm.step.events import (
 )
 from rbm_cli.models.rbm.step.inputs import Excitation, RunTask, SolverSettings
 from rbm_cli.models.rbm.step.rk import (
-    MAX_FACTOR,
-    MIN_FACTOR,
     NS_MAX,
-    SAFETY,
+    STEP_TAKEN,
+    STEP_TOO_SMALL,
     TAB_EST,
     TAB_NS,
     acc_of,
+    attempt_step,
     dense_eval,
     dense_prepare,
     emit,
     emit_rest,
-    error_norm,
     initial_step,
     rhs,
-    rk_attempt,
 )
 from rbm_cli.models.rbm.step.state import REST, switch
 from rbm_cli.models.rbm.step.vertical import bound_now, moving_rows
@@ -212,7 +208,6 @@ def run_kernel(model, motion, solver, task):
     est_order = TAB_EST[mc]
     err_exp = -1.0 / (est_order + 1)
     ns = TAB_NS[mc]
-    stage_rhs = ns  # rhs calls per attempt (stages 1..ns-1 and f_new)
 
     t = 0.0
     y = np.empty(m)
@@ -299,42 +294,17 @@ def run_kernel(model, motion, solver, task):
             running = True
             while running:
                 # ---- one accepted step (scipy RungeKutta._step_impl)
-                min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
-                if h_abs < min_step:
-                    h_abs = min_step
                 bound = seg_end  # a record's steps end at its samples (python.Stepper's)
                 if clipped:
                     gr, bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
-                rejected = False
-                while True:
-                    if not (h_abs >= min_step):  # also a NaN step or time: no endless loop
-                        t_fail = t
-                        return (FAILED_STEP, t_fail, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
-                                ledger)  # fmt: skip
-                    t_new = t + h_abs
-                    if t_new - bound > 0:
-                        t_new = bound
-                    h = t_new - t
-                    h_abs = abs(h)
-                    rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr)
-                    n_rhs += stage_rhs
-                    err = error_norm(mc, K, h, y, ynew, atol, rtol, scale)
-                    if not (err == err and abs(err) < math.inf):  # NaN or inf state
-                        return (FAILED_NONFINITE, t, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
-                                ledger)  # fmt: skip
-                    if err < 1.0:
-                        if err == 0.0:
-                            factor = MAX_FACTOR
-                        else:
-                            factor = min(MAX_FACTOR, SAFETY * pow_pos(err, err_exp))
-                        if rejected:
-                            factor = min(1.0, factor)
-                        h_abs *= factor
-                        break
-                    h_abs *= max(MIN_FACTOR, SAFETY * pow_pos(err, err_exp))
-                    rejected = True
+                taken, t_new, h, h_abs, calls = attempt_step(
+                    mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
+                    scale, err_exp)  # fmt: skip
+                n_rhs += calls
+                if taken != STEP_TAKEN:
+                    code = FAILED_STEP if taken == STEP_TOO_SMALL else FAILED_NONFINITE
+                    return (code, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl,
+                            n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
                 n_steps += 1
                 if n_steps > max_steps:
                     return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,

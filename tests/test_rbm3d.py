@@ -297,3 +297,27 @@ def test_a_recorded_run_keeps_both_elevations():
     fig = shapes_figure(history, widths, None, out.t_collapse)
     titles = [ax.get_title() for ax in fig.axes]
     assert len(titles) == 2 and "across the motion's plane" in titles[1]
+
+
+def test_a_pairs_intensity_measures_are_its_larger_components(pair_dir):
+    """A pair is scaled by one factor (its larger PGA to the amplitude) and each measure of
+    its row is the larger of its two components' measured on the records scaled so, here
+    by physics.intensity on the arrays: PGA is then the amplitude."""
+    from rbm_cli.config.types import G
+    from rbm_cli.physics.intensity import record_measures
+    from rbm_cli.physics.records import read_record
+    from rbm_cli.physics.similarity import rocking_scales
+    from rbm_cli.study.intensities import column_period, measure_values
+
+    cfg = pair_config(pair_dir, file="rdk_01.AT2", file_y="rdk_02.AT2", scale="pga",
+                      im_periods=[0.5])  # fmt: skip
+    t1 = column_period(cfg)
+    row = measure_values(cfg, 0.4, rocking_scales(cfg), t1)
+    x, y = (read_record(str(pair_dir / f"{r}.AT2")) for r in ("rdk_01", "rdk_02"))
+    factor = 0.4 * G / max(np.abs(x.acceleration).max(), np.abs(y.acceleration).max())
+    mx, my = (record_measures(r.t, factor * r.acceleration, (0.5,)) for r in (x, y))
+    assert row["pga_g"] == pytest.approx(0.4, rel=1e-12)
+    assert row["pgv_m_s"] == pytest.approx(max(mx.pgv, my.pgv), rel=1e-12)
+    assert row["arias_m_s"] == pytest.approx(max(mx.arias, my.arias), rel=1e-12)
+    assert row["sa_0p5s_g"] == pytest.approx(max(mx.sa[0.5], my.sa[0.5]) / G, rel=1e-12)
+    assert mx.pgv != my.pgv  # the two components differ: the larger one is taken

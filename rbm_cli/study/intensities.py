@@ -20,7 +20,10 @@ chunk of that record it runs) and scaled to each cell: the record is multiplied 
 amplitude / its PGA (``excitation.scale: pga``) or by the amplitude (``factor``), so PGA,
 PGV, PGD, CAV and Sa scale linearly, Arias intensity as the square, D5-95 not at all.
 Rows of other excitations have none of these columns (domain.csv is as before). The
-vertical record, if any, is not measured: these are the horizontal record's.
+vertical record, if any, is not measured: these are the horizontal record's. A pair of
+records (``excitation.file_y``) is scaled by one factor (the larger of its two PGAs to the
+amplitude, with ``scale: pga``), and each of its measures is the larger of its two
+components' (the longer D5-95): its ``pga_g`` is then the amplitude.
 """
 
 from __future__ import annotations
@@ -87,14 +90,18 @@ def column_period(config: Config) -> float | None:
     return first_elastic_period(model.mass, stiffness)
 
 
-def _record(config: Config):
-    """(times [s], accelerations [m/s^2]) of a record config's record, as the run reads
-    it: processed as ``excitation.processing`` says (rbm_cli.physics.records.process)."""
+def _record(config: Config, second: bool = False):
+    """(times [s], accelerations [m/s^2]) of a record config's record (its second
+    horizontal component, ``excitation.file_y``, if second), as the run reads it:
+    processed as ``excitation.processing`` says (rbm_cli.physics.records.process)."""
     from rbm_cli.physics.excitation import load_record
     from rbm_cli.physics.records import process
 
     exc = config.excitation
-    if exc.motion is not None:
+    if second:
+        rec = load_record(str(exc.file_y_path or exc.file_y), exc.units, exc.file_y_sha256)
+        t, a, name = rec.t, rec.acceleration, rec.name
+    elif exc.motion is not None:
         t, a = exc.motion.time_s, exc.motion.acceleration_m_s2
         name = exc.motion.name
     else:
@@ -110,16 +117,30 @@ def _record(config: Config):
 _MEASURED: dict = {}
 
 
-def record_measures_of(config: Config, t1: float | None) -> RecordMeasures:
-    """The measures of a record config's record as read (unscaled), at the periods t1 (if
-    any) and excitation.im_periods; once per record and process."""
+def record_measures_of(config: Config, t1: float | None, second: bool = False) -> RecordMeasures:
+    """The measures of a record config's record (its second horizontal component if
+    second) as read (unscaled), at the periods t1 (if any) and excitation.im_periods; once
+    per record and process."""
     exc = config.excitation
-    identity = (str(exc.file_path or exc.file), exc.units, exc.file_sha256, exc.processing)
+    if second:
+        identity = (str(exc.file_y_path or exc.file_y), exc.units, exc.file_y_sha256,
+                    exc.processing)  # fmt: skip
+    else:
+        identity = (str(exc.file_path or exc.file), exc.units, exc.file_sha256, exc.processing)
     periods = ((t1,) if t1 is not None else ()) + tuple(exc.im_periods)
     key = (identity, periods)
     if key not in _MEASURED:
-        _MEASURED[key] = record_measures(*_record(config), periods)
+        _MEASURED[key] = record_measures(*_record(config, second), periods)
     return _MEASURED[key]
+
+
+def _larger(a: RecordMeasures, b: RecordMeasures) -> RecordMeasures:
+    """A pair's measures: each the larger of its two components' (the longer D5-95)."""
+    return RecordMeasures(
+        pga=max(a.pga, b.pga), pgv=max(a.pgv, b.pgv), pgd=max(a.pgd, b.pgd),
+        arias=max(a.arias, b.arias), cav=max(a.cav, b.cav), d5_95=max(a.d5_95, b.d5_95),
+        sa={period: max(value, b.sa[period]) for period, value in a.sa.items()},
+    )  # fmt: skip
 
 
 def scale_factor(config: Config, amplitude_g: float, pga: float) -> float:
@@ -133,6 +154,8 @@ def scale_factor(config: Config, amplitude_g: float, pga: float) -> float:
 def measure_values(config: Config, amplitude_g: float, scales, t1: float | None) -> dict:
     """The measure columns of one cell's row (g, m, s in the names' units)."""
     unit = record_measures_of(config, t1)
+    if config.excitation.file_y is not None:  # a pair: scaled as one, the larger of each
+        unit = _larger(unit, record_measures_of(config, t1, second=True))
     m = unit.scaled(scale_factor(config, amplitude_g, unit.pga))
     tan_alpha = math.tan(scales.alpha)
     out = {

@@ -1,0 +1,58 @@
+"""docs/make_pairs_study.py: the planar assessment of a pair is the worse of its two
+components, a cell's outcome its members' majority (tables set by hand), and the figure of
+the stored studies is drawn."""
+
+from __future__ import annotations
+
+import importlib.util
+
+import pandas as pd
+import pytest
+
+from .paths import CONFIGS, RESULTS
+
+
+@pytest.fixture(scope="module")
+def study():
+    spec = importlib.util.spec_from_file_location(
+        "make_pairs_study", CONFIGS.parent / "docs" / "make_pairs_study.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_cell_collapses_when_most_of_its_members_did(study):
+    domain = pd.DataFrame({
+        "record": ["a", "a", "a", "a"], "amplitude_g": [0.1, 0.2, 0.3, 0.4],
+        "status": ["survived", "collapsed", "collapsed", "failed"],
+        "collapsed": [0, 1, 1, 0], "collapse_fraction": [0.4375, 0.5, 1.0, 0.0],
+    })  # fmt: skip
+    out = study.majority(domain)
+    assert list(out["collapsed"]) == [0, 1, 1] and list(out["amplitude_g"]) == [0.1, 0.2, 0.3]
+    assert list(out["status"]) == ["survived", "collapsed", "collapsed"]
+
+
+def test_a_pair_collapses_in_the_plane_when_either_component_does(study):
+    pairs = pd.DataFrame({"excitation.file": ["r/x1.AT2", "r/x2.AT2"],
+                          "excitation.file_y": ["r/y1.AT2", "r/y2.AT2"]})  # fmt: skip
+    planar = pd.DataFrame({
+        "record": ["x1", "y1", "x1", "y1", "x2", "y2", "x2", "y2"],
+        "amplitude_g": [0.1, 0.1, 0.2, 0.2, 0.1, 0.1, 0.2, 0.2],
+        "collapsed": [0, 0, 0, 1, 1, 0, 1, 1],
+    })  # fmt: skip
+    worse = study.worse_of_pairs(planar, pairs).sort_values(["record", "amplitude_g"])
+    assert list(worse["record"]) == ["x1", "x1", "x2", "x2"]
+    assert list(worse["collapsed"]) == [0, 1, 1, 1]
+    with pytest.raises(SystemExit):
+        study.worse_of_pairs(planar.iloc[:-1], pairs)
+
+
+def test_the_figure_of_the_stored_studies(study, tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(study, "RESAMPLES", 50)
+    out = tmp_path / "pairs.png"
+    study.main(out)
+    assert out.stat().st_size > 10_000
+    text = capsys.readouterr().out
+    assert "1 drum:" in text and "8 drums:" in text and "of 100 pair-levels" in text
+    assert (RESULTS / "suite_pairs" / "meta.json").is_file()

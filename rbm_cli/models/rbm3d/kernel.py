@@ -360,6 +360,19 @@ def _emit(mc, t_stop, t_old, h, y_old, F, yq, samples, n_out, next_out, dt, n, d
 
 
 @jit
+def _pieces(t, knots, values, values_y, vertical, gain, seg_end, es):
+    """A record's straight piece from t (physics.ground.record_piece) and the time its step
+    ends at; a pair's second record's piece written into es (physics.beam3d)."""
+    gr, bound = record_piece(t, knots, values, vertical, gain, seg_end)
+    if values_y.size > 0:
+        n = es.size - ES_EXTRA
+        gy, _ = record_piece(t, knots, values_y, vertical, gain, seg_end)
+        es[n + 2], es[n + 3], es[n + 4] = 1.0, gy[1], gy[2]
+        es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
+    return gr, bound
+
+
+@jit
 def run3d(col, motion, solver, task, pair):
     """Run one motion of one column in two directions.
 
@@ -524,11 +537,7 @@ def run3d(col, motion, solver, task, pair):
             m = watch(n, k, phase, pending, col, kinds, joints)
             t_bound = seg_end
             if clipped:
-                gr, t_bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
-                if pair_on:
-                    gy, _ = record_piece(t, knots, values_y, vertical, seg_gain, seg_end)
-                    es[n + 2], es[n + 3], es[n + 4] = 1.0, gy[1], gy[2]
-                    es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
+                gr, t_bound = _pieces(t, knots, values, values_y, vertical, seg_gain, seg_end, es)
             rows_at(y, gravity_factor(t, gr), n, col, k, c, kinds, joints, m, d_old, r_old)
             rhs(t, y, n, As, cs, es, gr, f)
             if h_carry > 0.0:
@@ -543,11 +552,7 @@ def run3d(col, motion, solver, task, pair):
             while running:
                 bound = seg_end
                 if clipped:
-                    gr, bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
-                    if pair_on:
-                        gy, _ = record_piece(t, knots, values_y, vertical, seg_gain, seg_end)
-                        es[n + 2], es[n + 3], es[n + 4] = 1.0, gy[1], gy[2]
-                        es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
+                    gr, bound = _pieces(t, knots, values, values_y, vertical, seg_gain, seg_end, es)
                 taken, t_new, h, h_abs, calls = attempt_step(
                     mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
                     scale, err_exp)  # fmt: skip

@@ -574,5 +574,6 @@ def excitation_section(
         phase=phase,
         initial=_initial(e.get("initial"), n, kind),
         angle=angle,
+        directed="angle" in e,
         **fields,
     )

@@ -41,7 +41,6 @@ from rbm_cli.config.types import (
     CollapseConfig,
     ColumnConfig,
     Config,
-    ExcitationConfig,
     SolverConfig,
     TopMassConfig,
 )
@@ -331,8 +330,7 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         )
     interface = interface_section(top.get("interface"), n, model)
     excitation = excitation_section(top.get("excitation"), n, base_dir)
-    _check_dimensions(model, column, excitation)
-    return Config(
+    config = Config(
         name=name,
         column=column,
         model=model,
@@ -350,20 +348,31 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         ),
         solver=_solver(top.get("solver")),
     )
+    _check_dimensions(config)
+    return config
 
 
-def _check_dimensions(model: str, column: ColumnConfig, excitation: ExcitationConfig) -> None:
-    """A model in three dimensions takes a circular column only; a planar model takes a
-    motion along its plane only (excitation.angle 0, no excitation.file_y, so no suite of
-    pairs either)."""
-    if MODELS[model].three_d:
-        if column.section != "circular":
+def _check_dimensions(config: Config) -> None:
+    """A model that moves in three dimensions (Config.three_d) takes a circular column only;
+    a planar model takes a motion along its plane only (excitation.angle 0, no
+    excitation.file_y, so no suite of pairs either)."""
+    model, excitation = config.model, config.excitation
+    section = config.column.section
+    if config.three_d:
+        if section != "circular":
+            when = (
+                ""
+                if MODELS[model].three_d
+                else " in three dimensions (its motion given a direction or a second component)"
+            )
             raise ConfigError(
-                f"model {model} needs column.section: circular (a {column.section} section's"
+                f"model {model}{when} needs column.section: circular (a {section} section's"
                 " rocking capacity is not the same in every direction)"
             )
         return
-    three_d = ", ".join(name for name, entry in MODELS.items() if entry.three_d)
+    three_d = ", ".join(
+        name for name, entry in MODELS.items() if entry.three_d or entry.any_direction
+    )
     if excitation.angle != 0.0:
         raise ConfigError(
             f"excitation.angle turns the motion out of the plane model {model} rocks in"

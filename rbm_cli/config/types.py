@@ -46,22 +46,27 @@ IMPLEMENTATIONS = ("compiled", "python")
 class ModelEntry:
     """A registered model: its runner ("module:class", rbm_cli.models.contract.Runner),
     whether it takes more than one drum, whether it moves in three dimensions (a
-    circular section only, a motion in any direction: excitation.angle), and whether its
-    joints are the Rigid Beam Model's (their laws, stiffness and damping, a capital or a
-    top mass, the friction demand)."""
+    circular section only, a motion in any direction: excitation.angle), whether it moves
+    in three dimensions when its motion is given a direction or a second component and in
+    the plane otherwise (``any_direction``: Config.three_d), and whether its joints are the
+    Rigid Beam Model's (their laws, stiffness and damping, a capital or a top mass, the
+    friction demand)."""
 
     runner: str
     multi_drum: bool
     three_d: bool = False
     beam: bool = False
+    any_direction: bool = False
 
 
 #: The model registry, name -> runner (rbm_cli.models.registry resolves it). rbm: the
 #: Rigid Beam Model; housner: Housner's nonlinear rigid block (large rotations, true
 #: geometry); housner-linear: the piecewise-linear block of Spanos and Koh (closed form,
 #: true geometry); the last two monolithic only. bullet: stacked rigid drums in Bullet's
-#: contact dynamics (PyBullet), any drums. housner-3d: the rigid cylinder rocking and
-#: rolling on its rim in three dimensions (true geometry, circular monolithic columns).
+#: contact dynamics (PyBullet), any drums, in the plane or free in three dimensions
+#: (circular drums, when the motion is given a direction or a second component).
+#: housner-3d: the rigid cylinder rocking and rolling on its rim in three dimensions (true
+#: geometry, circular monolithic columns).
 #: rbm-3d: the Rigid Beam Model in two horizontal directions (circular drums).
 #: A new model is one module and one line here.
 MODELS = {
@@ -70,7 +75,9 @@ MODELS = {
     "housner-linear": ModelEntry(
         "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False
     ),
-    "bullet": ModelEntry("rbm_cli.models.bullet.run:BulletRunner", multi_drum=True),
+    "bullet": ModelEntry(
+        "rbm_cli.models.bullet.run:BulletRunner", multi_drum=True, any_direction=True
+    ),
     "housner-3d": ModelEntry(
         "rbm_cli.models.housner3d.runner:Housner3dRunner", multi_drum=False, three_d=True
     ),
@@ -198,7 +205,7 @@ _RECORD_FIELDS = ("file", "file_sha256", "units", "free_time", "scale")
 _VERTICAL_FIELDS = ("vertical", "vertical_sha256")
 _FILE_Y_FIELDS = ("file_y", "file_y_sha256")
 _MP_FIELDS = ("gamma", "nu")
-_LOCAL_FIELDS = ("file_path", "vertical_path", "file_y_path", "motion")
+_LOCAL_FIELDS = ("file_path", "vertical_path", "file_y_path", "motion", "directed")
 
 
 @dataclass(frozen=True)
@@ -268,6 +275,9 @@ class ExcitationConfig:
     angle : float  Azimuth of the horizontal motion in plan [deg], from the x axis (the
         plane the planar models rock in, where only 0 is taken): the models in three
         dimensions take any; left out of :meth:`resolved` when 0, as before the key existed
+    directed : bool  excitation.angle was written (0 included): a model that moves in three
+        dimensions when its motion is given a direction does so (ModelEntry.any_direction);
+        never in :meth:`resolved` (Config.resolved says the dimensions instead)
     processing : ProcessingConfig or None  Record: its baseline correction and band-pass,
         applied to the record (and the vertical record) before scaling; None: the record
         as read (also for a processing that changes nothing, so the config's hash is the
@@ -293,6 +303,7 @@ class ExcitationConfig:
     motion: Any = field(default=None, compare=False)
     processing: ProcessingConfig | None = None
     angle: float = 0.0
+    directed: bool = False
     file_y: str | None = None
     file_y_sha256: str | None = None
     file_y_path: str | None = field(default=None, compare=False)
@@ -449,7 +460,31 @@ class Config:
         for key in ("axes", "records"):  # a plain grid resolves (and hashes) as it always did
             if not out["grid"][key]:
                 del out["grid"][key]
+        if MODELS[self.model].any_direction and self.three_d:  # planar: as it always did
+            out["dimensions"] = 3
         return out
+
+    @property
+    def three_d(self) -> bool:
+        """Whether the model moves in three dimensions: always for a model in three
+        dimensions (ModelEntry.three_d); for a model that takes any direction
+        (ModelEntry.any_direction), when the motion is given a direction
+        (``excitation.angle`` written, 0 included, or an axis over it) or a second
+        horizontal component (``excitation.file_y``, or an axis over it: a suite of pairs)."""
+        entry = MODELS[self.model]
+        if entry.three_d:
+            return True
+        if not entry.any_direction:
+            return False
+        e = self.excitation
+        paths = self.grid.axis_paths
+        return (
+            e.directed
+            or e.angle != 0.0
+            or e.file_y is not None
+            or "excitation.angle" in paths
+            or "excitation.file_y" in paths
+        )
 
     def record_files(self) -> tuple[tuple[str, str, str], ...]:
         """Every record file the config names, by content: (key path, file as written,

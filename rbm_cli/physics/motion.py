@@ -111,6 +111,18 @@ class GroundMotion:
             return None
         return self._y_component.accel(t)
 
+    def accel_plan(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(a_x(t), a_y(t)) [m/s^2] in the ground's axes at times t [s] (vectorised as
+        :meth:`accel`): the motion along ``direction``, plus a pair's second component
+        across it (the values :meth:`horizontal` gives one time at a time)."""
+        d = self.direction
+        a = np.asarray(self.accel(t), dtype=float)
+        b = self.accel_y(t)
+        if b is None:
+            return a * d[0], a * d[1]
+        b = np.asarray(b, dtype=float)
+        return a * d[0] - b * d[1], a * d[1] + b * d[0]
+
     def horizontal(self, forced: bool = True):
         """(a_x(t), a_y(t)) [m/s^2] in the ground's axes as a function of a float t [s]: the
         motion along ``direction``, plus the second component across it (a pair of

@@ -82,7 +82,7 @@ def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
     if MODELS[config.model].beam and config.interface.friction_limit is not None:
         at = fields.index("friction_demand") + 1 if "friction_demand" in fields else len(fields)
         fields = fields[:at] + (SLIDES_FIELD,) + fields[at:]
-    if MODELS[config.model].three_d:
+    if config.three_d:
         at = fields.index("max_top_displacement_m") + 1
         fields = fields[:at] + THREE_D_FIELDS + fields[at:]
     return config.grid.axis_paths + record + fields + SCALE_FIELDS + measure_fields(config)

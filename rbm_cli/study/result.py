@@ -67,6 +67,8 @@ class RunResult:
         collapse [deg] (nan: no collapse, or a planar model)
     wobble_turns : float  Model in three dimensions: the angle its lean's direction swept
         while it rolled [turns] (nan for a planar model)
+    three_d : bool  The run moved in three dimensions (Config.three_d): domain.csv keeps
+        the collapse azimuth and the wobbling turns
     energy : dict or None  A recorded run's energy account [J] (models.outcome.EnergyAccount
         as_dict: start, end, the ground's work, what damping and impacts took, the residual
         of the balance); None where the method keeps none (not in domain.csv)
@@ -94,6 +96,7 @@ class RunResult:
     energy: dict | None = None
     collapse_azimuth_deg: float = float("nan")
     wobble_turns: float = float("nan")
+    three_d: bool = False
 
     @property
     def collapsed(self) -> bool:
@@ -127,7 +130,7 @@ class RunResult:
         out["friction_demand"] = self.domain_friction_demand
         if self.friction_limit is not None:
             out[SLIDES_FIELD] = self.slides
-        if MODELS[self.model].three_d:
+        if self.three_d:
             out.update({k: getattr(self, k) for k in THREE_D_FIELDS})
         return out
 

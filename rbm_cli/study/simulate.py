@@ -102,4 +102,5 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         energy=None if out.energy is None else out.energy.as_dict(),
         collapse_azimuth_deg=math.degrees(math.remainder(out.azimuth, 2.0 * math.pi)),
         wobble_turns=float(out.turns),
+        three_d=config.three_d,
     )

@@ -21,6 +21,13 @@ contact dynamics, measured by :func:`measure_restitution`), no linear or
 angular damping (PyBullet's defaults are not 0), collision margin 0, split
 impulse on, erp 0.2.
 
+In three dimensions (Config.three_d: the motion given a direction, ``excitation.angle``,
+or a second horizontal component, ``excitation.file_y``; circular drums), the drums are
+the engine's cylinders (:func:`rbm_cli.models.bullet.scene.cylinder_shape`) and nothing
+holds them in a plane: they rock, roll on their rims, slide and twist as the contacts
+let them, the gravity vector (-a_x(t), -a_y(t), -(g + a_v(t))); the joints are read by
+:mod:`rbm_cli.models.bullet.space` (the same rules in any direction).
+
 Collapse: the run stops when, at a joint (or the base), the centre of mass of
 the drums above it passes over the pivot edge of the contact, i.e. when the
 line from the pivot to that centre of mass turns by ``collapse.ratio`` times
@@ -49,7 +56,6 @@ from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.impact import impact_rate_ratios, measure_restitution
 from rbm_cli.models.bullet.scene import (
     Frame,
-    Joints,
     build_scene,
     keep_in_plane,
     read_frame,
@@ -116,18 +122,24 @@ def upward_accel(motion: GroundMotion, t: np.ndarray) -> np.ndarray | None:
 
 
 def ground_friction_demand(motion: GroundMotion) -> float:
-    """max over t of |a_g(t)| / (g + a_v(t)) [-]: the friction a stack moving with the
-    ground needs (inf where g + a_v reaches 0). With a vertical record both are linear
-    between the same knots, so the ratio is monotone there and its maximum is at a knot."""
+    """max over t of |a_h(t)| / (g + a_v(t)) [-]: the friction a stack moving with the
+    ground needs (inf where g + a_v reaches 0), a_h the horizontal acceleration (a pair's
+    resultant). With a vertical record both are linear between the same knots (a pair's
+    resultant convex), so the ratio is at most its value at an end of each interval and
+    its maximum is at a knot."""
+    horizontal = None
+    if motion.values_y is not None:  # a pair: the resultant, convex on each interval
+        horizontal = np.hypot(motion.values, motion.values_y)
     if not motion.has_vertical:
-        return motion.amplitude / G
+        return motion.amplitude / G if horizontal is None else float(np.max(horizontal)) / G
     weight = G + np.asarray(motion.vertical)
     if np.any(weight <= 0.0):
         return math.inf
-    return float(np.max(np.abs(motion.values) / weight))
+    horizontal = np.abs(motion.values) if horizontal is None else horizontal
+    return float(np.max(horizontal / weight))
 
 
-def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, observe):
+def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, observe, space):
     """Step the engine from t = 0 to the motion's end or a stop, checking the stack
     every CHECK_DT (and at every sample); fills `out`. Returns (samples, watch)."""
     p, cid = client.module, client.id
@@ -137,27 +149,36 @@ def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, o
     set_gravity, step = p.setGravity, p.stepSimulation
     # a_g and a_v at every mid-step, at once (the same numbers as one call per step)
     mid = (np.arange(n_steps) + 0.5) * dt
-    accel_array = np.asarray(motion.accel(mid), dtype=float)
-    accel = accel_array.tolist()
+    if space:
+        ax, ay = motion.accel_plan(mid)
+        accel_array = np.stack([ax, ay], axis=1)
+        accel, side = ax.tolist(), (-ay).tolist()
+    else:
+        accel_array = np.asarray(motion.accel(mid), dtype=float)
+        accel, side = accel_array.tolist(), [0.0] * n_steps
     upward = upward_accel(motion, mid)
     down = (-(G + upward)).tolist() if upward is not None else [-G] * n_steps
     frame = read_frame(p, cid, bodies)
-    watch = RunWatch(solids, alpha, limit, dt, accel_array, frame, upward)
-    samples = [_sample(0.0, frame, watch.joints(frame))] if sample else []
+    watch = RunWatch(solids, alpha, limit, dt, accel_array, frame, upward, space)
+    look = _Look(motion) if space else None
+    samples = [_sample(0.0, frame, watch.joints(frame), look)] if sample else []
     k = 0
     while k < n_steps:
-        set_gravity(-accel[k], 0.0, down[k], physicsClientId=cid)
+        set_gravity(-accel[k], side[k], down[k], physicsClientId=cid)
         step(physicsClientId=cid)
         k += 1
         if observe is not None:
             observe(p, cid, bodies)
-        checked = keep_in_plane(p, cid, bodies, pose=k % check == 0)
+        if space:
+            checked = read_frame(p, cid, bodies) if k % check == 0 else None
+        else:
+            checked = keep_in_plane(p, cid, bodies, pose=k % check == 0)
         if checked is None and not (sample and k % sample == 0) and k != n_steps:
             continue
         frame = checked if checked is not None else read_frame(p, cid, bodies)
         joints = watch.see(frame)
         if sample and k % sample == 0:
-            samples.append(_sample(k * dt, frame, joints))
+            samples.append(_sample(k * dt, frame, joints, look))
         if watch.check(out, k, frame, joints, motion, early_stop):
             break
     else:
@@ -225,6 +246,8 @@ def bullet_run(
         # the stack moves with the ground: every joint carries m_above a_g on m_above (g + a_v)
         out.friction = np.full(n, demand)
         out.message = "at rest: ground acceleration below the uplift and sliding levels"
+        if config.three_d:
+            out.turns = 0.0
         return out.stop("survived", out.message, motion.t_end).lifted_off(t_lift), None
 
     dt = settings.time_step
@@ -232,12 +255,28 @@ def bullet_run(
     out.friction = np.full(n, np.nan)
     if client is None:
         client = PhysicsClient.for_process()
-    bodies = build_scene(client, solids, settings, tilt, rate)
+    space = config.three_d
+    bodies = build_scene(client, solids, settings, tilt, rate, cylinders=space)
     samples, watch = _drive(
-        client, bodies, solids, config.collapse.ratio, dt, motion, out, sample, early_stop, observe
+        client,
+        bodies,
+        solids,
+        config.collapse.ratio,
+        dt,
+        motion,
+        out,
+        sample,
+        early_stop,
+        observe,
+        space,
     )
-    out.lifted_off(t_lift).message += "; " + _slip_text(watch.max_slip)
-    history = _history(samples, motion) if record else None
+    if space:
+        out.turns = float(np.max(watch.swept)) / (2.0 * math.pi)
+        out.lifted_off(t_lift).message += "; " + _slip_text(watch.slid, "slid")
+        out.message += "; " + _twist_text(watch.max_twist)
+    else:
+        out.lifted_off(t_lift).message += "; " + _slip_text(watch.max_slip)
+    history = _history(samples, motion, space) if record else None
     return out, history
 
 
@@ -253,21 +292,56 @@ def _initial(config: Config) -> tuple[float, float]:
     return float(rot.pop()), float(vel.pop())
 
 
-def _slip_text(max_slip: np.ndarray) -> str:
-    text = f"max slip: base {1e3 * max_slip[0]:.3g} mm"
+def _slip_text(max_slip: np.ndarray, what: str = "max slip") -> str:
+    text = f"{what}: base {1e3 * max_slip[0]:.3g} mm"
     if max_slip.size > 1:
         j = int(np.argmax(max_slip[1:])) + 1
         text += f", joints {1e3 * max_slip[j]:.3g} mm (joint {j + 1})"
     return text
 
 
-def _sample(t: float, frame: Frame, joints: Joints):
-    nodes = np.concatenate([joints.bottoms[:, 0], [joints.top[0]]])
-    return t, frame.tilts, frame.rates, nodes
+def _twist_text(max_twist: np.ndarray) -> str:
+    j = int(np.argmax(max_twist))
+    return f"max twist {np.degrees(max_twist[j]):.3g} deg (joint {j + 1})"
 
 
-def _history(samples, motion: GroundMotion) -> History:
+class _Look:
+    """How a sample sees the stack in three dimensions: its rotations in the motion's
+    vertical plane and across it (the direction turned by +90 degrees), as the models
+    in three dimensions give them."""
+
+    def __init__(self, motion: GroundMotion) -> None:
+        self.d = motion.direction
+
+    def rotations(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(in the plane, across it, the rate in the plane) per drum [rad, rad, rad/s]:
+        the drum's axis leaning to +x by atan2(z_x, z_z), to +y by atan2(z_y, z_z);
+        its lean towards +x turns at omega_y, towards +y at -omega_x."""
+        axis = frame.rotations[:, :, 2]
+        tx = np.arctan2(axis[:, 0], axis[:, 2])
+        ty = np.arctan2(axis[:, 1], axis[:, 2])
+        (c, s), w = self.d, frame.angular
+        return tx * c + ty * s, -tx * s + ty * c, w[:, 1] * c - w[:, 0] * s
+
+
+def _sample(t: float, frame: Frame, joints, look: _Look | None = None):
+    if look is None:
+        nodes = np.concatenate([joints.bottoms[:, 0], [joints.top[0]]])
+        return t, frame.tilts, frame.rates, nodes, None, None
+    along, across, rates = look.rotations(frame)
+    points = np.concatenate([joints.bottoms[:, :2], joints.top[None, :2]])
+    return t, along, rates, points @ look.d, across, joints.top[:2].copy()
+
+
+def _history(samples, motion: GroundMotion, space: bool = False) -> History:
     t = np.array([s[0] for s in samples])
+    extra = {}
+    if space:
+        extra = {
+            "rotations_across": np.array([s[4] for s in samples]),
+            "top_plan": np.array([s[5] for s in samples]),
+        }
+        extra["ground_acceleration_y"] = motion.accel_y(t)  # None: one component
     return History(
         t=t,
         ground_acceleration=np.asarray(motion.accel(t), dtype=float),
@@ -275,6 +349,7 @@ def _history(samples, motion: GroundMotion) -> History:
         node_displacements=np.array([s[3] for s in samples]),
         rotations=np.array([s[1] for s in samples]),
         rates=np.array([s[2] for s in samples]),
+        **extra,
     )
 
 

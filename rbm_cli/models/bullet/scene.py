@@ -3,8 +3,9 @@
 Builds the drums (:mod:`rbm_cli.models.bullet.geometry`) in a PyBullet client
 (:mod:`rbm_cli.models.bullet.engine`) with the engine settings of a run, and
 reads back the stack's state: drum positions and tilts, and per joint the
-relative rotation, the overturning ratio and the slip. Axes: x in the plane of
-motion, y out of plane, z up. SI units.
+relative rotation, the overturning ratio and the slip in the plane
+(:mod:`rbm_cli.models.bullet.space` reads them in three dimensions). Axes: x in the plane
+of motion, y out of plane, z up. SI units.
 """
 
 from __future__ import annotations
@@ -21,13 +22,20 @@ from rbm_cli.models.bullet.settings import EngineSettings
 
 
 def build_scene(
-    client: PhysicsClient, solids, settings: EngineSettings, tilt: float = 0.0, rate: float = 0.0
+    client: PhysicsClient,
+    solids,
+    settings: EngineSettings,
+    tilt: float = 0.0,
+    rate: float = 0.0,
+    cylinders: bool = False,
 ) -> list[int]:
     """Reset the client's world and build ground and drums in it; returns the drums'
     body ids (bottom first).
 
     tilt [rad], rate [rad/s]: the whole stack turned rigidly about the bottom
     corner of the base on the side of the tilt (positive: towards +x).
+    cylinders: circular drums collided as the engine's cylinders (:func:`cylinder_shape`)
+    rather than as polygonal prisms (the run in three dimensions).
     """
     p, cid = client.module, client.id
     _reset_world(p, cid, settings)
@@ -38,7 +46,7 @@ def build_scene(
     bodies = []
     for d in solids:
         centre = pivot + rot @ (np.array([0.0, 0.0, d.bottom + d.centre]) - pivot)
-        body = _add_drum(p, cid, d, settings, centre, quat)
+        body = _add_drum(p, cid, d, settings, centre, quat, cylinders)
         if rate:
             arm = centre - pivot
             p.resetBaseVelocity(
@@ -72,9 +80,13 @@ def _reset_world(p, cid, settings: EngineSettings) -> None:
     _contact_dynamics(p, cid, ground, settings)
 
 
-def _add_drum(p, cid, d, settings: EngineSettings, centre: np.ndarray, quat) -> int:
+def _add_drum(
+    p, cid, d, settings: EngineSettings, centre: np.ndarray, quat, cylinders: bool = False
+) -> int:
     """One drum (a DrumSolid) as a multibody with its centre of mass at `centre` [m]."""
-    if d.box:
+    if cylinders:
+        shape = cylinder_shape(p, cid, d)
+    elif d.box:
         shape = p.createCollisionShape(
             p.GEOM_BOX, halfExtents=[float(v) for v in d.half_extents], physicsClientId=cid
         )
@@ -99,6 +111,24 @@ def _add_drum(p, cid, d, settings: EngineSettings, centre: np.ndarray, quat) -> 
     )
     _contact_dynamics(p, cid, body, settings)
     return body
+
+
+def cylinder_shape(p, cid, d) -> int:
+    """A circular drum (a DrumSolid) as two of the engine's cylinders, one on the other,
+    each half the drum high: the lower of the drum's bottom radius, the upper of its top
+    radius (relative to its centre of mass). Its two faces are the true ones, so every
+    joint's contact is the true circle and every pivot on its true rim; the side between
+    them is stepped (it touches nothing while the drums stand on one another). The engine
+    holds a cylinder's rim on a face better than a polygon's: measured on a straight
+    drum rolling round its rim (docs/engine.md)."""
+    h, zc = d.height, d.centre
+    return p.createCollisionShapeArray(
+        [p.GEOM_CYLINDER, p.GEOM_CYLINDER],
+        radii=[float(d.half_bottom), float(d.half_top)],
+        lengths=[0.5 * h, 0.5 * h],
+        collisionFramePositions=[[0.0, 0.0, 0.25 * h - zc], [0.0, 0.0, 0.75 * h - zc]],
+        physicsClientId=cid,
+    )
 
 
 def keep_in_plane(p, cid, bodies, pose: bool = False) -> Frame | None:
@@ -144,7 +174,9 @@ def keep_in_plane(p, cid, bodies, pose: bool = False) -> Frame | None:
         rates[i] = ang[1]
         speeds[i] = math.sqrt(sum(v * v for v in lin))
         vels[i] = lin
-    return Frame(centres, np.reshape(rots, (n, 3, 3)), rates, speeds, vels)
+    angular = np.zeros((n, 3))
+    angular[:, 1] = rates
+    return Frame(centres, np.reshape(rots, (n, 3, 3)), rates, speeds, vels, angular)
 
 
 def _contact_dynamics(p, cid, body, settings: EngineSettings) -> None:
@@ -176,6 +208,7 @@ class Frame:
     rates: np.ndarray  # (n,) in-plane angular velocities (about y) [rad/s]
     speeds: np.ndarray  # (n,) |linear velocity| [m/s]
     velocities: np.ndarray  # (n, 3) linear velocities of the centres of mass [m/s]
+    angular: np.ndarray  # (n, 3) angular velocities [rad/s]
 
     @cached_property
     def tilts(self) -> np.ndarray:
@@ -188,6 +221,7 @@ def read_frame(p, cid, bodies) -> Frame:
     n = len(bodies)
     centres, rots = np.empty((n, 3)), np.empty((n, 3, 3))
     rates, speeds, vels = np.empty(n), np.empty(n), np.empty((n, 3))
+    angular = np.empty((n, 3))
     for i, b in enumerate(bodies):
         pos, quat = p.getBasePositionAndOrientation(b, physicsClientId=cid)
         lin, ang = p.getBaseVelocity(b, physicsClientId=cid)
@@ -196,7 +230,8 @@ def read_frame(p, cid, bodies) -> Frame:
         rates[i] = ang[1]
         speeds[i] = max(math.sqrt(sum(v * v for v in lin)), abs(ang[0]), abs(ang[2]))
         vels[i] = lin
-    return Frame(centres, rots, rates, speeds, vels)
+        angular[i] = ang
+    return Frame(centres, rots, rates, speeds, vels, angular)
 
 
 @dataclass(frozen=True)

@@ -349,7 +349,9 @@ def _frame(tilts):
         [[[math.cos(t), 0, math.sin(t)], [0, 1, 0], [-math.sin(t), 0, math.cos(t)]] for t in tilts]
     )
     n = len(tilts)
-    return Frame(np.zeros((n, 3)), rot, np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3)))
+    return Frame(
+        np.zeros((n, 3)), rot, np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3))
+    )
 
 
 def _two_drums():

@@ -4,22 +4,15 @@ the stored studies is drawn."""
 
 from __future__ import annotations
 
-import importlib.util
-
 import pandas as pd
 import pytest
 
-from .paths import CONFIGS, RESULTS
+from .paths import RESULTS, docs_script
 
 
 @pytest.fixture(scope="module")
 def study():
-    spec = importlib.util.spec_from_file_location(
-        "make_pairs_study", CONFIGS.parent / "docs" / "make_pairs_study.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return docs_script("make_pairs_study")
 
 
 def test_a_cell_collapses_when_most_of_its_members_did(study):
@@ -56,3 +49,38 @@ def test_the_figure_of_the_stored_studies(study, tmp_path, monkeypatch, capsys):
     text = capsys.readouterr().out
     assert "1 drum:" in text and "8 drums:" in text and "of 100 pair-levels" in text
     assert (RESULTS / "suite_pairs" / "meta.json").is_file()
+
+
+@pytest.fixture(scope="module")
+def engine_study():
+    return docs_script("make_pairs_engine")
+
+
+def test_the_engine_is_compared_on_robust_cells_only(engine_study):
+    """docs/make_pairs_engine.py: an 8-drum rbm-3d cell is robust or not by its members;
+    only robust cells count for agreement, and a difference is put down to the side that
+    collapsed (a table set by hand; the 1-drum cells and a failed run left out)."""
+    beam = pd.DataFrame({
+        "column.drums": [8, 8, 8, 8, 1],
+        "record": ["a", "a", "b", "b", "a"], "amplitude_g": [0.2, 0.4, 0.2, 0.4, 0.2],
+        "collapse_fraction": [0.0, 1.0, 0.5, 1.0, 1.0], "robust": [1, 1, 0, 1, 1],
+        "t_collapse_s": [float("nan"), 3.0, 4.0, 2.0, 1.0],
+    })  # fmt: skip
+    engine = pd.DataFrame({
+        "record": ["a", "a", "b", "b", "c"], "amplitude_g": [0.2, 0.4, 0.2, 0.4, 0.2],
+        "status": ["collapsed", "collapsed", "survived", "failed", "survived"],
+        "t_collapse_s": [5.0, 3.1, float("nan"), float("nan"), float("nan")],
+    })  # fmt: skip
+    both = engine_study.compare(engine, beam)
+    assert list(both["rbm3d"]) == ["survived", "collapsed", "sensitive"]
+    assert list(both["agree"].fillna(-1)) == [0.0, 1.0, -1]
+    s = engine_study.summary(both)
+    assert s == {"cells": 3, "robust": 2, "agree": 1, "engine_only": 1, "rbm3d_only": 0}
+
+
+def test_the_stored_engine_study_compares(engine_study):
+    """The stored domains make the comparison the docs give: every cell of the engine's
+    study is one of rbm-3d's 8-drum cells."""
+    engine = pd.read_csv(RESULTS / "suite_pairs_bullet" / "domain.csv")
+    both = engine_study.compare(engine, pd.read_csv(RESULTS / "suite_pairs" / "domain.csv"))
+    assert len(both) == len(engine[engine["status"] != "failed"]) == 25

@@ -310,7 +310,8 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "rotations, true geometry); ``housner-linear`` the piecewise-linear block of "
         "Spanos and Koh; both monolithic only; ``bullet`` the rigid-body contact "
         "engine (any drums; it ignores the joint law's stiffness, xi, restitution "
-        "and formulation); ``housner-3d`` the rigid cylinder rocking and rolling on "
+        "and formulation; free in three dimensions, circular drums only, when the motion "
+        "is given a direction or a second component); ``housner-3d`` the rigid cylinder rocking and rolling on "
         "its rim in three dimensions (monolithic, ``column.section: circular``); "
         "``rbm-3d`` the Rigid Beam Model of circular drums in two horizontal directions "
         "(any drums, ``column.section: circular``).",
@@ -432,8 +433,10 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "deg",
         "",
         "Azimuth in plan of the horizontal motion, from the x axis (any type: the motion "
-        "is turned to it). Models in three dimensions only (``housner-3d``, ``rbm-3d``); "
-        "the planar models rock in the x plane and refuse any other. Default 0.",
+        "is turned to it). Models in three dimensions only (``housner-3d``, ``rbm-3d``, "
+        "and ``bullet``: written, 0 included, it runs the engine free in three "
+        "dimensions); the planar models rock in the x plane and refuse any other. "
+        "Default 0.",
     ),
     "excitation.initial": ("", "", "Initial state of the drums."),
     "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),

@@ -10,7 +10,9 @@ tests that fork run in a fresh interpreter; on Linux a skipped test is a failed 
   theirs); each reports its own outcome, a failure with the fresh interpreter's report.
 - A run of many tests (:data:`WARM_UP_ITEMS` or more: the whole suite) first compiles the
   package's compiled code (the step kernel, the exact integrator, the rigid block's closed
-  form) into numba's cache, each once: every worker takes them in its own order through
+  form, the run in two directions) into numba's cache, each once: the longest compiles
+  are shared out first so that the workers finish together (:func:`warm_up_order`), and
+  each takes its share, then the others', through
   rbm_cli.models.compile_ahead.compile_once, whose lock makes a worker that needs a target
   another one compiles wait for it and load it. Without it each worker compiled what its
   first tests needed, the same kernel in both at once (tests call the integrators directly,
@@ -56,15 +58,26 @@ def _compiled_once(request):
     compiled once across the workers (see the module)."""
     if len(request.session.items) < WARM_UP_ITEMS or os.environ.get(FRESH_ENV) == "1":
         return
-    from rbm_cli.models.compile_ahead import TARGETS, compile_once
+    from rbm_cli.models.compile_ahead import ABOUT_S, TARGETS, compile_once
 
-    # worker k starts k targets from the end (the second on the exact integrator, the
-    # longest compile, while the first compiles the kernel and the closed form)
     worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw")
-    order = list(TARGETS)
-    start = -int(worker) % len(order) if worker.isdigit() else 0
-    for target in order[start:] + order[:start]:
+    count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    for target in warm_up_order(TARGETS, ABOUT_S, int(worker) if worker.isdigit() else 0, count):
         compile_once(target)
+
+
+def warm_up_order(targets, about: dict, worker: int, count: int) -> list:
+    """The order in which a worker of `count` takes the compiled targets: the longest
+    compiles shared out first, each to the worker with the least compile time so far
+    (ABOUT_S), so that the workers finish together; a worker takes its own share first
+    (longest first), then the others' (loaded from the cache, or waited for)."""
+    load, share = [0.0] * max(count, 1), [[] for _ in range(max(count, 1))]
+    for target in sorted(targets, key=lambda t: -about[t]):
+        k = min(range(len(load)), key=lambda j: load[j])
+        share[k].append(target)
+        load[k] += about[target]
+    own = share[worker % len(share)]
+    return own + [t for part in share for t in part if t not in own]
 
 
 def pytest_configure(config):

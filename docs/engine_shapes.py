@@ -11,9 +11,13 @@ the run's settings (step 1e-4 s, 100 iterations, friction 1), collided as prisms
   the solution) and the tilt's largest departure from its start;
 - **rocking in a turned plane**: a sine of 0.3 g at 1 Hz for 4 s along the azimuths 0,
   37 and 90 degrees: the largest lean across the motion's plane over the largest in it
-  (0 for rocking that stays in its plane, as the exact cylinder's does).
+  (0 for rocking that stays in its plane, as the exact cylinder's does);
+- **the cylinders' contact under that sine**: every 5 ms, the engine's contact points
+  between the drum and the ground (Bullet keeps at most four for a pair of bodies) and
+  the centre of their normal forces: its largest distance across the motion's plane, in
+  radii (0 for contact forces that leave the rocking in its plane).
 
-    python docs/engine_shapes.py     # about a minute on one core; prints a Markdown table
+    python docs/engine_shapes.py     # about 15 s on one core; prints two Markdown tables
 """
 
 from __future__ import annotations
@@ -90,6 +94,30 @@ def turned(shape, azimuth_deg: float) -> float:
     return across / along
 
 
+def contact(azimuth_deg: float) -> tuple[int, float]:
+    """(most contact points seen, largest distance of their normal forces' centre across
+    the motion's plane over the radius) for the cylinders under 0.3 g, 1 Hz."""
+    d = np.array([math.cos(math.radians(azimuth_deg)), math.sin(math.radians(azimuth_deg))])
+    across = np.array([-d[1], d[0]])
+    radius = COLUMN["base_width"] / 2.0
+    most, worst = 0, 0.0
+    with PhysicsClient() as client:
+        p, cid = client.module, client.id
+        body = _scene(client, "cylinders")
+        for k in range(int(4.0 / STEP)):
+            a = 0.3 * G * math.sin(2 * math.pi * (k + 0.5) * STEP)
+            p.setGravity(-a * d[0], -a * d[1], -G, physicsClientId=cid)
+            p.stepSimulation(physicsClientId=cid)
+            if k % 50 == 0:
+                points = p.getContactPoints(bodyA=body, physicsClientId=cid)
+                most = max(most, len(points))
+                force = np.array([c[9] for c in points])
+                if force.sum() > 0.0:
+                    where = np.array([c[6][:2] for c in points]) @ across
+                    worst = max(worst, abs(where @ force) / force.sum() / radius)
+    return most, worst
+
+
 def main() -> None:
     print("| shape | wobble 0.05 rad: turns (3) | tilt off | wobble 0.15 rad: turns (3)"
           " | tilt off | across / along at 0 deg | at 37 deg | at 90 deg |")  # fmt: skip
@@ -100,6 +128,11 @@ def main() -> None:
         name = f"prism, {shape} sides" if shape != "cylinders" else "two cylinders"
         print(f"| {name} | {w1[0]:.3f} | {100 * w1[1]:.2f} % | {w2[0]:.3f} | {100 * w2[1]:.2f} %"
               f" | {t[0]:.3f} | {t[1]:.3f} | {t[2]:.3f} |")  # fmt: skip
+    print("\n| azimuth | contact points, most | normal forces' centre across the plane [radii] |")
+    print("|---|---|---|")
+    for az in (0.0, 37.0, 90.0):
+        most, worst = contact(az)
+        print(f"| {az:.0f} deg | {most} | {worst:.3f} |")
 
 
 if __name__ == "__main__":

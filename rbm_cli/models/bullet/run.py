@@ -160,7 +160,7 @@ def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, o
     down = (-(G + upward)).tolist() if upward is not None else [-G] * n_steps
     frame = read_frame(p, cid, bodies)
     watch = RunWatch(solids, alpha, limit, dt, accel_array, frame, upward, space)
-    look = _Look(motion) if space else None
+    look = motion.direction if space else None
     samples = [_sample(0.0, frame, watch.joints(frame), look)] if sample else []
     k = 0
     while k < n_steps:
@@ -270,12 +270,12 @@ def bullet_run(
         observe,
         space,
     )
+    out.lifted_off(t_lift)
     if space:
         out.turns = float(np.max(watch.swept)) / (2.0 * math.pi)
-        out.lifted_off(t_lift).message += "; " + _slip_text(watch.slid, "slid")
-        out.message += "; " + _twist_text(watch.max_twist)
+        out.message += "; " + _slip_text(watch.slid, "slid") + "; " + _twist_text(watch.max_twist)
     else:
-        out.lifted_off(t_lift).message += "; " + _slip_text(watch.max_slip)
+        out.message += "; " + _slip_text(watch.max_slip)
     history = _history(samples, motion, space) if record else None
     return out, history
 
@@ -305,32 +305,28 @@ def _twist_text(max_twist: np.ndarray) -> str:
     return f"max twist {np.degrees(max_twist[j]):.3g} deg (joint {j + 1})"
 
 
-class _Look:
-    """How a sample sees the stack in three dimensions: its rotations in the motion's
-    vertical plane and across it (the direction turned by +90 degrees), as the models
-    in three dimensions give them."""
-
-    def __init__(self, motion: GroundMotion) -> None:
-        self.d = motion.direction
-
-    def rotations(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(in the plane, across it, the rate in the plane) per drum [rad, rad, rad/s]:
-        the drum's axis leaning to +x by atan2(z_x, z_z), to +y by atan2(z_y, z_z);
-        its lean towards +x turns at omega_y, towards +y at -omega_x."""
-        axis = frame.rotations[:, :, 2]
-        tx = np.arctan2(axis[:, 0], axis[:, 2])
-        ty = np.arctan2(axis[:, 1], axis[:, 2])
-        (c, s), w = self.d, frame.angular
-        return tx * c + ty * s, -tx * s + ty * c, w[:, 1] * c - w[:, 0] * s
+def _seen_in(d: np.ndarray, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The drums' rotations seen in the vertical plane of the motion's direction d (unit,
+    in plan) and across it (d turned by +90 degrees), and the rate in that plane, as the
+    models in three dimensions give them [rad, rad, rad/s]: the drum's axis leaning to +x
+    by atan2(z_x, z_z), to +y by atan2(z_y, z_z); its lean towards +x turns at omega_y,
+    towards +y at -omega_x."""
+    axis = frame.rotations[:, :, 2]
+    tx = np.arctan2(axis[:, 0], axis[:, 2])
+    ty = np.arctan2(axis[:, 1], axis[:, 2])
+    (c, s), w = d, frame.angular
+    return tx * c + ty * s, -tx * s + ty * c, w[:, 1] * c - w[:, 0] * s
 
 
-def _sample(t: float, frame: Frame, joints, look: _Look | None = None):
-    if look is None:
+def _sample(t: float, frame: Frame, joints, d: np.ndarray | None = None):
+    """A history sample; d: the motion's direction in plan for a run in three dimensions
+    (None: in the plane)."""
+    if d is None:
         nodes = np.concatenate([joints.bottoms[:, 0], [joints.top[0]]])
         return t, frame.tilts, frame.rates, nodes, None, None
-    along, across, rates = look.rotations(frame)
+    along, across, rates = _seen_in(d, frame)
     points = np.concatenate([joints.bottoms[:, :2], joints.top[None, :2]])
-    return t, along, rates, points @ look.d, across, joints.top[:2].copy()
+    return t, along, rates, points @ d, across, joints.top[:2].copy()
 
 
 def _history(samples, motion: GroundMotion, space: bool = False) -> History:

@@ -173,31 +173,18 @@ class RunWatch:
         up_sum = self.up_sum
         mean_up = 0.0 if up_sum is None else (up_sum[k] - up_sum[k_prev]) / (k - k_prev)
         if self.space:
-            demand = joint_friction_3d(
-                self.frame_prev,
-                frame,
-                self.stack,
-                (k - k_prev) * self.dt,
-                mean_accel,
-                self.faces,
-                mean_up,
-            )
-            out.friction = np.fmax(out.friction, demand)
-            self.frame_prev, self.k_prev = frame, k
-            self.faces = [normals(frame)]
-            return
-        demand = joint_friction(
-            self.frame_prev,
-            frame,
-            self.stack,
-            (k - k_prev) * self.dt,
-            mean_accel,
-            (self.tilt_lo, self.tilt_hi),
-            mean_up,
-        )
+            # the window's normals, this frame's last (see() read them)
+            span, window = (k - k_prev) * self.dt, self.faces
+            demand = joint_friction_3d(self.frame_prev, frame, self.stack, span, mean_accel,
+                                       window, mean_up)  # fmt: skip
+            self.faces = window[-1:]
+        else:
+            span, tilts = (k - k_prev) * self.dt, (self.tilt_lo, self.tilt_hi)
+            demand = joint_friction(self.frame_prev, frame, self.stack, span, mean_accel, tilts,
+                                    mean_up)  # fmt: skip
+            self.tilt_lo = self.tilt_hi = frame.tilts
         out.friction = np.fmax(out.friction, demand)
         self.frame_prev, self.k_prev = frame, k
-        self.tilt_lo = self.tilt_hi = frame.tilts
 
     def _track(self, out: Outcome, joints, frame: Frame, t: float) -> np.ndarray:
         """Maxima of ratio, top displacement and slip; joint openings and closures.

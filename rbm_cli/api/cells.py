@@ -261,19 +261,20 @@ def plot_history(run: CellRun | RunResult, ax=None, relative: bool | None = None
 
 def compile_ahead(config: Config, notify: Callable[[str], None]) -> None:
     """Compile (or load) the compiled code a run of ``config`` needs (the kernel, the exact
-    integrator, or the rigid block's closed form: rbm_cli.models.methods.compiled_code)
+    integrator, or the rigid block's closed form: rbm_cli.models.methods.compiled_codes)
     before it runs; a compile another rbm process runs is waited for, not repeated
     (rbm_cli.models.compile_ahead.compile_once), and ``notify`` is told what it waits
     for. Nothing to do for a run in Python (``solver.implementation: python``) or a model
     without compiled code."""
-    from rbm_cli.models.methods import compiled_code
+    from rbm_cli.models.methods import compiled_codes
 
-    code = compiled_code(config)
-    if code is None:
+    codes = compiled_codes(config)
+    if not codes:
         return
     from rbm_cli.models.compile_ahead import compile_once
 
-    compile_once(code, notify=notify)
+    for code in codes:
+        compile_once(code, notify=notify)
 
 
 def check_run_output(config: Config, output: str | os.PathLike):

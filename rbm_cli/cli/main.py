@@ -11,10 +11,11 @@ module registers its commands on it when imported here.
 from __future__ import annotations
 
 import os
+import signal
 import sys
 
 from rbm_cli.cli import bench, domain, fragility, run, sweep  # noqa: F401  (register the commands)
-from rbm_cli.cli.common import cli
+from rbm_cli.cli.common import EXIT_INTERRUPTED, cli
 
 if "matplotlib" in sys.modules:  # (main() called from a program that drew already)
     sys.modules["matplotlib"].use("Agg")
@@ -36,6 +37,15 @@ def main(argv: list[str] | None = None) -> None:
     gc.disable()  # until the command's work starts (common.work_starts): ~10 % of start-up
     try:
         cli.main(args=argv, prog_name="rbm")
+    except SystemExit as end:
+        if end.code == EXIT_INTERRUPTED:  # Ctrl-C, said in one line: the process ends with
+            # 130, and a Ctrl-C still pending (one held back while files were moved,
+            # rbm_cli.base.folder.signals_held) or pressed again must not end it by SIGINT
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        raise
+    except KeyboardInterrupt:  # one that reached here while the command said its line
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        raise SystemExit(EXIT_INTERRUPTED) from None
     finally:
         gc.freeze()
 

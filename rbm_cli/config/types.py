@@ -32,7 +32,7 @@ BASELINES = ("none", "linear", "quadratic")
 #: still rocking when the shaking ends has time to collapse or settle; a monolithic
 #: column whose energy is below its collapse barrier is stopped early anyway.
 DEFAULT_FREE_TIME = 5.0
-METHODS = ("auto", "DOP853", "RK45", "RK23", "exact", "closed-form")
+METHODS = ("auto", "DOP853", "RK45", "RK23", "exact", "exact-first", "closed-form")
 #: Excitations with a closed-form response (sines, and records exact per sample interval):
 #: what `solver.method: closed-form` (and `exact`) take (rbm_cli.models.methods).
 CLOSED_FORM_KINDS = ("harmonic", "half-sine", "free", "one-sine", "cycloidal", "record")
@@ -385,11 +385,13 @@ class SolverConfig:
     """Integrator settings.
 
     method : str  'auto' (the default: the closed form where it applies, else DOP853;
-        rbm_cli.models.methods.resolve_method), a Runge-Kutta pair of
-        scipy.integrate.solve_ivp, 'exact' (model rbm: closed-form integration of the
-        linear pieces, rbm_cli.models.rbm.exact) or 'closed-form' (the rigid block's
+        rbm_cli.models.methods.resolve_method), a
+        Runge-Kutta pair of scipy.integrate.solve_ivp, 'exact' (model rbm: closed-form
+        integration of the linear pieces, rbm_cli.models.rbm.exact), 'exact-first' (model
+        rbm, every joint elastic: exact while every joint stays closed, else DOP853 from
+        the start; rbm_cli.models.rbm.exact_first) or 'closed-form' (the rigid block's
         closed form: a rigid RBM monolith, housner-linear; rbm_cli.models.rbm.closed_form);
-        the tolerances do not apply to the last two
+        the tolerances do not apply to exact and closed-form
     rtol, atol : float  Tolerances (atol relative to the rotation scale theta_u)
     max_steps : int  Step budget of one run; beyond it the run is 'failed'
     max_events : int  Budget of events (kinks, impacts) of one run

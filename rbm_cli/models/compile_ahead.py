@@ -33,7 +33,7 @@ LOCK_NAME = "rbm-compile.lock"
 #: Poll interval while waiting for a compile elsewhere [s].
 POLL_S = 0.1
 
-#: What can be compiled (rbm_cli.models.methods.compiled_code): the module of its
+#: What can be compiled (rbm_cli.models.methods.compiled_codes): the module of its
 #: needs_compile and warm_up, and its compiled function whose cache folder holds the lock.
 TARGETS = {
     "kernel": ("rbm_cli.models.rbm.step", "run_kernel"),

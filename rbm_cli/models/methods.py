@@ -10,7 +10,11 @@ here and nowhere else (:func:`resolve`):
   applies -- a rigid monolithic column (one drum, interface.stiffness rigid, xi 1,
   formulation relative or geometric), an excitation with a closed form (harmonic, free, the
   sine pulses, records exact per sample interval), no vertical record, `solver.implementation:
-  compiled` -- else DOP853 (the step integrator, rbm_cli.models.rbm.step);
+  compiled` -- else DOP853 (the step integrator, rbm_cli.models.rbm.step). Not `exact-first`
+  (rbm_cli.models.rbm.exact_first), though it picks the faster method per cell on an
+  elastic column: its first use compiles a second integrator, every process loads both,
+  and on the stored studies it gained 3 % (the 8-drum harmonic domain) or lost 3 % (the
+  200-run record suite; docs/performance.md);
 - `housner-linear`: `closed-form`, whatever the method says;
 - `housner` and `housner-3d`: DOP853 (scipy's pairs); `rbm-3d`: DOP853 (the step kernel's
   pairs, in its own compiled run); `bullet`: its engine (the method does not apply).
@@ -113,6 +117,20 @@ def _exact_why_not(config: Config, model: Model | None) -> str | None:
     )
 
 
+def _exact_first_why_not(config: Config, model: Model | None) -> str | None:
+    reason = _exact_why_not(config, model)
+    if reason is not None:
+        return reason.replace("solver.method exact ", "solver.method exact-first ")
+    rigid = (any(law.rigid for law in model.laws) if model is not None
+             else config.interface.stiffness.kind == "rigid")  # fmt: skip
+    if not rigid:
+        return None
+    return (
+        "solver.method exact-first takes columns whose joints are all elastic"
+        " (interface.stiffness not rigid): use DOP853 (or auto)"
+    )
+
+
 @dataclass(frozen=True)
 class Method:
     """One row of the table.
@@ -121,14 +139,14 @@ class Method:
     ----------
     name : str  As written in solver.method
     runs : dict  Model name -> the compiled code a run of that model needs with
-        `solver.implementation: compiled` (a compile_ahead target), or None
+        `solver.implementation: compiled` (compile_ahead targets, one or a tuple), or None
     prepare : str  "module:function" making the :class:`Integrator` of an RBM Model, or ""
         (the model's runner integrates itself)
     why_not : callable  (config, model or None) -> one-line reason it does not apply, or None
     """
 
     name: str
-    runs: dict[str, str | None]
+    runs: dict[str, str | tuple[str, ...] | None]
     prepare: str = ""
     why_not: Callable[[Config, Model | None], str | None] = field(
         default=lambda config, model: None
@@ -139,11 +157,12 @@ class Method:
         module, _, function = self.prepare.partition(":")
         return getattr(importlib.import_module(module), function)(model)
 
-    def compiled_code(self, config: Config) -> str | None:
-        """The compiled code the cells of config run with this method (None: none)."""
+    def compiled_codes(self, config: Config) -> tuple[str, ...]:
+        """The compiled code the cells of config run with this method (none: ())."""
         if config.solver.implementation != "compiled":
-            return None
-        return self.runs.get(config.model)
+            return ()
+        code = self.runs.get(config.model)
+        return () if code is None else (code,) if isinstance(code, str) else code
 
 
 _STEP = "rbm_cli.models.rbm.step:prepare"
@@ -163,6 +182,12 @@ METHODS: dict[str, Method] = {
         ),
         Method(
             "exact", {"rbm": "exact"}, "rbm_cli.models.rbm.exact.integrate:prepare", _exact_why_not
+        ),
+        Method(
+            "exact-first",
+            {"rbm": ("exact", "kernel")},
+            "rbm_cli.models.rbm.exact_first:prepare",
+            _exact_first_why_not,
         ),
         Method("DOP853", {"rbm": "kernel", **_PAIRS}, _STEP),
         Method("RK45", {"rbm": "kernel", **_PAIRS}, _STEP),
@@ -217,8 +242,8 @@ def step_method(solver: SolverConfig) -> str:
     return STEP_DEFAULT if solver.method == "auto" else solver.method
 
 
-def compiled_code(config: Config) -> str | None:
+def compiled_codes(config: Config) -> tuple[str, ...]:
     """Which compiled code the cells of this config run: 'kernel' (the step integrator),
-    'exact', 'closed-form', or None (Python, or a model without compiled code): a target
-    of rbm_cli.models.compile_ahead."""
-    return resolve(config).compiled_code(config)
+    'exact', both (exact-first), 'closed-form', or none (Python, or a model without compiled
+    code): targets of rbm_cli.models.compile_ahead."""
+    return resolve(config).compiled_codes(config)

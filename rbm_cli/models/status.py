@@ -14,6 +14,9 @@ FAILED_STEPS, FAILED_EVENTS, FAILED_WALL, INTERRUPTED = 5, 6, 7, 8
 #: The step kernel's own failures: a step below the spacing of the numbers at t, and a
 #: state that became NaN or infinite.
 FAILED_STEP, FAILED_NONFINITE = 9, 10
+#: The exact integrator asked to stop where a joint first leaves its elastic branch
+#: (forcing_arrays.run_settings, until_open) has stopped there.
+OPENED = 11
 #: Loop turns (pieces, certified intervals) between two polls of the wall clock and Ctrl-C.
 POLL_PIECES = 64
 

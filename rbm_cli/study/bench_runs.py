@@ -26,18 +26,13 @@ def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: 
 
 
 def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
-    from rbm_cli.models.methods import resolve_method
+    from rbm_cli.models.compile_ahead import compile_once
+    from rbm_cli.models.methods import compiled_codes
     from rbm_cli.models.registry import make_runner
     from rbm_cli.study.simulate import simulate
 
-    method = resolve_method(cfg)
-    if method == "exact":
-        from rbm_cli.models.rbm.exact.integrate import warm_up
-    elif method == "closed-form":
-        from rbm_cli.models.block.closed_form import warm_up
-    else:
-        from rbm_cli.models.rbm.step import warm_up
-    warm_up()  # load the method's compiled code in this worker before timing runs
+    for code in compiled_codes(cfg):  # load the compiled code in this worker before timing
+        compile_once(code)
     runner = make_runner(cfg)
     rows = []
     for a, f in cells:

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import MODELS, Config, hash_form
-from rbm_cli.models.methods import compiled_code
+from rbm_cli.models.methods import compiled_codes
 from rbm_cli.study.cells import (
     Cell,
     add_point,
@@ -535,7 +535,7 @@ def warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | 
     compile_ahead.compile_once, which waits for a compile another process runs instead of
     compiling a second time, and tells note what it waits for before it waits. Returns its
     time [s], which the sweep's wall time and ETA leave out, and what it was spent on."""
-    codes = sorted({compiled_code(p.config) for p in points} - {None})
+    codes = sorted({code for p in points for code in compiled_codes(p.config)})
     if not (todo and codes):
         return 0.0, ""
     from rbm_cli.models.compile_ahead import compile_once, needs_compile

@@ -73,14 +73,17 @@ def run_settings(
     record: bool,
     output_dt: float,
     friction_limit: float = math.inf,
+    until_open: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(mo, se) of one run of a compiled closed-form loop: the motion
     mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and the settings
     se = [max_steps, max_events, deadline (monotonic clock, from solver.max_wall_time),
-    early_stop, record, output_dt, friction limit [-] (inf: none)]."""
+    early_stop, record, output_dt, friction limit [-] (inf: none), until_open (the exact
+    integrator: stop at the first event of a joint, rbm_cli.models.status.OPENED)]."""
     mo = np.array([1.0 if motion.is_pulse else 0.0, motion.amplitude, motion.omega,
                    motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
     deadline = time.monotonic() + float(solver.max_wall_time)
     se = np.array([solver.max_steps, solver.max_events, deadline, float(early_stop),
-                   float(record), output_dt, friction_limit], dtype=float)  # fmt: skip
+                   float(record), output_dt, friction_limit, float(until_open)],
+                  dtype=float)  # fmt: skip
     return mo, se

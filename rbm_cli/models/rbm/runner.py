@@ -99,5 +99,5 @@ class RbmRunner:
             out.friction = np.full(n, np.nan)
         if record:
             out.history = history_from_samples(self.model.node_map, motion, out.samples)
-        out.method = method.name
+        out.method = out.method or method.name  # exact-first says which of its two ran
         return out

@@ -25,6 +25,7 @@ from rbm_cli.models.rbm.forcing_arrays import motion_arrays, run_settings
 from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
+    OPENED,
     STOPPED_EARLY,
     end_by_budget,
 )
@@ -83,7 +84,8 @@ def integrate_exact(
     early_stop: bool = True,
     prepared: PreparedExact | None = None,
     friction_limit: float = math.inf,
-) -> Outcome:
+    until_open: bool = False,
+) -> Outcome | None:
     """Integrate one motion of a model from the initial state (theta0 [rad], rate0
     [rad/s]) exactly, piece by piece (rbm_cli.models.rbm.exact): compiled, or its
     uncompiled version (the same source, rbm_cli.base.jit.plain) with
@@ -102,12 +104,15 @@ def integrate_exact(
         runs one model many times (a sweep); made here when None.
     friction_limit : float  A friction coefficient [-]: the outcome says where |T / N|
         first exceeded it (Outcome.slip); inf: none.
+    until_open : bool  Stop at the first event of a joint (its law argument reaching the
+        end of its piece: an uplift from the elastic branch) and return None; the outcome
+        otherwise (the run never met one).
     """
     seg_t, seg_fc = motion_arrays(model, motion)
     if prepared is None:
         prepared = prepare_exact(model)
     n = model.n
-    mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit)
+    mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit, until_open)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
     try:
@@ -118,6 +123,8 @@ def integrate_exact(
         )  # fmt: skip
     finally:
         disarm(armed)
+    if code == OPENED:
+        return None
     out = _outcome(code, st, cnt, maxima, fric, solver, n)
     if record:
         out.samples = sample_rows(samples, int(st[5]), n)

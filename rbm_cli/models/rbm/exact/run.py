@@ -7,7 +7,8 @@ limit se[6], nan and 0 if not) and cnt = [n_uplifts, n_impacts, n_steps, n_rhs, 
 collapse interface, the part of n_rhs spent on peaks, the current segment] (ints). A motion
 is mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and its segments
 (start, end) with their forcings (exact.modal); settings are
-se = [max_steps, max_events, deadline, early_stop, record, output_dt, friction limit].
+se = [max_steps, max_events, deadline, early_stop, record, output_dt, friction limit,
+until_open] (until_open: stop at the first event of a joint, with status.OPENED).
 
 The friction demand is the largest |T_i / N_i| at the points of the march (the step
 integrators' step ends) and, at rest, over the rest (exact: the forcing's crest or ends,
@@ -53,6 +54,7 @@ from rbm_cli.models.status import (
     FAILED_EVENTS,
     FAILED_STEPS,
     GOING,
+    OPENED,
     POLL_PIECES,
     STOPPED_EARLY,
     SURVIVED,
@@ -184,12 +186,15 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
 
 @jit
 def _handle(mdl, pc, row, s, se):
-    """Apply the event of a row at the state. Returns a code."""
+    """Apply the event of a row at the state. Returns a code (OPENED, the state left as it
+    is, when the run stops at a joint's first event: se[7])."""
     n = s.theta.size
     if row >= 4 * n:
         silent_impact(pc.silent[row - 4 * n], s.side, s.awaiting)
         s.cnt[IMPACTS] += 1
         return GOING
+    if se[7] != 0.0:
+        return OPENED
     s.cnt[EVENTS] += 1
     if s.cnt[EVENTS] > se[1]:
         return FAILED_EVENTS
@@ -323,7 +328,8 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
             break
     if code == GOING:
         code = SURVIVED
-    ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)
-    s.cnt[RHS] += ev
-    s.cnt[RHS_PEAKS] += ev
+    if code != OPENED:  # a run stopped where a joint opened is run again by another method
+        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)
+        s.cnt[RHS] += ev
+        s.cnt[RHS_PEAKS] += ev
     return code, s.st, s.cnt, s.maxima, s.fric

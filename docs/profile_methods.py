@@ -1,7 +1,7 @@
 """Which method a record run of the 8-drum column wants, and what its events cost
 (docs/performance.md, "Record suites: the method and the events").
 
-    python docs/profile_methods.py            # the 40 runs, both methods: ~4 min
+    python docs/profile_methods.py            # the 40 runs, both methods: ~2 min
     python docs/profile_methods.py --events   # first steps after each kind of event: ~1 min
 
 The runs of `configs/ci/suite_multidrum_ci.yaml` (the paper's column in 8 drums, k_n 5e9

@@ -32,18 +32,15 @@ import dataclasses
 import os
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
+from profile_records import CONFIG, points  # the script beside this one
 
-from rbm_cli.config.load import load_config, parse_config
-from rbm_cli.config.points import expand
+from rbm_cli.config.load import load_config
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.arrays import column_arrays
 from rbm_cli.physics.excitation import make_ground_motion
 
-ROOT = Path(__file__).resolve().parent.parent
-CONFIG = ROOT / "configs" / "ci" / "suite_multidrum_ci.yaml"
 #: Sample interval of the recorded run that finds the first opening [s].
 OPEN_DT = 2e-4
 REPEATS = 3
@@ -52,13 +49,6 @@ REPEATS = 3
 def _with_method(config, method: str, implementation: str = "compiled"):
     solver = dataclasses.replace(config.solver, method=method, implementation=implementation)
     return dataclasses.replace(config, solver=solver)
-
-
-def _cells(config):
-    """(record name, PGA [g], config) of every cell, in grid order."""
-    for point in expand(config, parse_config, base_dir=config.base_dir):
-        for a in config.grid.amplitudes_g:
-            yield Path(str(point.config.excitation.file)).stem, a, point.config
 
 
 def _wall(runner, motion, solver) -> tuple[float, object]:
@@ -97,33 +87,39 @@ def profile() -> list[dict]:
     t_open_s, open_share, prefix_step_s, prefix_exact_s, steps, rhs, events, motion_s."""
     config = load_config(CONFIG)
     rows = []
-    warm = True
-    for name, a, cfg in _cells(config):
+    for i, (name, cfg) in enumerate(points(config)):
         step_cfg, exact_cfg = _with_method(cfg, "DOP853"), _with_method(cfg, "exact")
-        step, exact = make_runner(step_cfg), make_runner(exact_cfg)
-        motion = make_ground_motion(cfg.excitation, a)
-        if warm:  # compile outside the timings
-            step.run(motion, step_cfg.solver)
-            exact.run(motion, exact_cfg.solver)
-            warm = False
-        wall_step, out = _wall(step, motion, step_cfg.solver)
-        wall_exact, _ = _wall(exact, motion, exact_cfg.solver)
-        t_open, share = _opening(step, motion, step_cfg.solver)
-        prefix_step = prefix_exact = wall_step if np.isinf(t_open) else 0.0
-        if np.isinf(t_open):
-            prefix_exact = wall_exact
-        elif t_open > float(motion.knots[1]):
-            head = _until(motion, t_open)
-            prefix_step, _ = _wall(step, head, step_cfg.solver)
-            prefix_exact, _ = _wall(exact, head, exact_cfg.solver)
-        rows.append({
-            "record": name, "pga_g": a, "status": out.status, "wall_step_s": wall_step,
-            "wall_exact_s": wall_exact, "t_open_s": t_open, "open_share": share,
-            "prefix_step_s": prefix_step, "prefix_exact_s": prefix_exact,
-            "steps": out.n_steps, "rhs": out.n_rhs, "events": out.n_events,
-            "motion_s": out.t_collapse if out.status == "collapsed" else motion.t_end,
-        })  # fmt: skip
+        step, exact = make_runner(step_cfg), make_runner(exact_cfg)  # one each a point
+        for a in config.grid.amplitudes_g:
+            motion = make_ground_motion(cfg.excitation, a)
+            if i == 0 and a == config.grid.amplitudes_g[0]:  # compile outside the timings
+                step.run(motion, step_cfg.solver)
+                exact.run(motion, exact_cfg.solver)
+            rows.append(_profile_run(name, a, motion, step, step_cfg.solver, exact,
+                                     exact_cfg.solver))  # fmt: skip
     return rows
+
+
+def _profile_run(name, a, motion, step, step_solver, exact, exact_solver) -> dict:
+    """One row of :func:`profile`."""
+    wall_step, out = _wall(step, motion, step_solver)
+    wall_exact, _ = _wall(exact, motion, exact_solver)
+    t_open, share = _opening(step, motion, step_solver)
+    if np.isinf(t_open):  # the whole run is before an opening
+        prefix_step, prefix_exact = wall_step, wall_exact
+    elif t_open > float(motion.knots[1]):
+        head = _until(motion, t_open)
+        prefix_step, _ = _wall(step, head, step_solver)
+        prefix_exact, _ = _wall(exact, head, exact_solver)
+    else:  # open within the record's first sample interval
+        prefix_step = prefix_exact = 0.0
+    return {
+        "record": name, "pga_g": a, "status": out.status, "wall_step_s": wall_step,
+        "wall_exact_s": wall_exact, "t_open_s": t_open, "open_share": share,
+        "prefix_step_s": prefix_step, "prefix_exact_s": prefix_exact,
+        "steps": out.n_steps, "rhs": out.n_rhs, "events": out.n_events,
+        "motion_s": out.t_collapse if out.status == "collapsed" else motion.t_end,
+    }  # fmt: skip
 
 
 def report(rows: list[dict]) -> str:
@@ -183,7 +179,7 @@ def after_events(seconds: float = 10.0, pga_g: float = 0.2) -> dict:
     from rbm_cli.models.rbm.step.rk import TAB_NS
 
     config = load_config(CONFIG)
-    name, _, cfg = next(_cells(config))
+    name, cfg = next(points(config))
     cfg = _with_method(cfg, "DOP853", "python")
     motion = make_ground_motion(cfg.excitation, pga_g)
     motion = _until(motion, seconds + 1e-9)

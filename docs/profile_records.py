@@ -33,12 +33,19 @@ ROOT = Path(__file__).resolve().parent.parent
 CONFIG = ROOT / "configs" / "ci" / "suite_multidrum_ci.yaml"
 
 
-def _runs(config):
-    """(record name, PGA [g], config, runner) of every cell, in grid order."""
+def points(config):
+    """(record name, config) of every point of the grid (one record each), in grid order."""
     for point in expand(config, parse_config, base_dir=config.base_dir):
-        runner = make_runner(point.config)
+        yield Path(str(point.config.excitation.file)).stem, point.config
+
+
+def _runs(config):
+    """(record name, PGA [g], config, runner) of every cell, in grid order (one runner a
+    point, as a sweep makes)."""
+    for name, cfg in points(config):
+        runner = make_runner(cfg)
         for a in config.grid.amplitudes_g:
-            yield Path(str(point.config.excitation.file)).stem, a, point.config, runner
+            yield name, a, cfg, runner
 
 
 def _timed(config, runner, amplitude_g):

@@ -266,14 +266,10 @@ def compile_ahead(config: Config, notify: Callable[[str], None]) -> None:
     (rbm_cli.models.compile_ahead.compile_once), and ``notify`` is told what it waits
     for. Nothing to do for a run in Python (``solver.implementation: python``) or a model
     without compiled code."""
+    from rbm_cli.models.compile_ahead import compile_once
     from rbm_cli.models.methods import compiled_codes
 
-    codes = compiled_codes(config)
-    if not codes:
-        return
-    from rbm_cli.models.compile_ahead import compile_once
-
-    for code in codes:
+    for code in compiled_codes(config):
         compile_once(code, notify=notify)
 
 

@@ -105,7 +105,7 @@ def _closed_form_why_not(config: Config, model: Model | None) -> str | None:
     return None
 
 
-def _exact_why_not(config: Config, model: Model | None) -> str | None:
+def _exact_why_not(config: Config, model: Model | None, method: str = "exact") -> str | None:
     from rbm_cli.models.rbm.exact.motion import exact_why_not
 
     excitation = config.excitation
@@ -114,13 +114,14 @@ def _exact_why_not(config: Config, model: Model | None) -> str | None:
         excitation.type,
         excitation.vertical is not None,
         config.interface.damping if model is None else model.damping,
+        method,
     )
 
 
 def _exact_first_why_not(config: Config, model: Model | None) -> str | None:
-    reason = _exact_why_not(config, model)
+    reason = _exact_why_not(config, model, "exact-first")
     if reason is not None:
-        return reason.replace("solver.method exact ", "solver.method exact-first ")
+        return reason
     rigid = (any(law.rigid for law in model.laws) if model is not None
              else config.interface.stiffness.kind == "rigid")  # fmt: skip
     if not rigid:
@@ -139,14 +140,14 @@ class Method:
     ----------
     name : str  As written in solver.method
     runs : dict  Model name -> the compiled code a run of that model needs with
-        `solver.implementation: compiled` (compile_ahead targets, one or a tuple), or None
+        `solver.implementation: compiled` (compile_ahead targets; () for none)
     prepare : str  "module:function" making the :class:`Integrator` of an RBM Model, or ""
         (the model's runner integrates itself)
     why_not : callable  (config, model or None) -> one-line reason it does not apply, or None
     """
 
     name: str
-    runs: dict[str, str | tuple[str, ...] | None]
+    runs: dict[str, tuple[str, ...]]
     prepare: str = ""
     why_not: Callable[[Config, Model | None], str | None] = field(
         default=lambda config, model: None
@@ -161,14 +162,13 @@ class Method:
         """The compiled code the cells of config run with this method (none: ())."""
         if config.solver.implementation != "compiled":
             return ()
-        code = self.runs.get(config.model)
-        return () if code is None else (code,) if isinstance(code, str) else code
+        return self.runs.get(config.model, ())
 
 
 _STEP = "rbm_cli.models.rbm.step:prepare"
-#: The models of the step pairs but `rbm`: their compiled code (None: scipy's pairs, stepped
+#: The models of the step pairs but `rbm`: their compiled code (none: scipy's pairs, stepped
 #: by the model's runner).
-_PAIRS = {"housner": None, "housner-3d": None, "rbm-3d": "rbm3d"}
+_PAIRS = {"housner": (), "housner-3d": (), "rbm-3d": ("rbm3d",)}
 
 #: The methods, by name: where each applies, what it prepares, what it compiles.
 METHODS: dict[str, Method] = {
@@ -176,12 +176,15 @@ METHODS: dict[str, Method] = {
     for m in (
         Method(
             "closed-form",
-            {"rbm": "closed-form", "housner-linear": "closed-form"},
+            {"rbm": ("closed-form",), "housner-linear": ("closed-form",)},
             "rbm_cli.models.block.closed_form:prepare",
             _closed_form_why_not,
         ),
         Method(
-            "exact", {"rbm": "exact"}, "rbm_cli.models.rbm.exact.integrate:prepare", _exact_why_not
+            "exact",
+            {"rbm": ("exact",)},
+            "rbm_cli.models.rbm.exact.integrate:prepare",
+            _exact_why_not,
         ),
         Method(
             "exact-first",
@@ -189,10 +192,10 @@ METHODS: dict[str, Method] = {
             "rbm_cli.models.rbm.exact_first:prepare",
             _exact_first_why_not,
         ),
-        Method("DOP853", {"rbm": "kernel", **_PAIRS}, _STEP),
-        Method("RK45", {"rbm": "kernel", **_PAIRS}, _STEP),
-        Method("RK23", {"rbm": "kernel", **_PAIRS}, _STEP),
-        Method("engine", {"bullet": None}),
+        Method("DOP853", {"rbm": ("kernel",), **_PAIRS}, _STEP),
+        Method("RK45", {"rbm": ("kernel",), **_PAIRS}, _STEP),
+        Method("RK23", {"rbm": ("kernel",), **_PAIRS}, _STEP),
+        Method("engine", {"bullet": ()}),
     )
 }
 

@@ -22,10 +22,7 @@ elastic. `auto` does not pick it (rbm_cli.models.methods says why).
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
-
-import numpy as np
 
 from rbm_cli.config.types import STEP_DEFAULT
 from rbm_cli.models.outcome import Outcome
@@ -41,28 +38,18 @@ def prepare(model: Model):
     integrator's modes and the step kernel's inputs, prepared once for every run."""
     exact, steps = prepare_exact(model), prepare_kernel(model)
 
-    def integrate(
-        model: Model,
-        motion: GroundMotion,
-        theta0: np.ndarray,
-        rate0: np.ndarray,
-        solver,
-        record: bool = False,
-        output_dt: float = 0.002,
-        early_stop: bool = True,
-        friction_limit: float = math.inf,
-    ) -> Outcome:
+    def integrate(model: Model, motion: GroundMotion, theta0, rate0, solver, **options) -> Outcome:
+        """One run; options: the Integrator's (record, output_dt, early_stop,
+        friction_limit), passed on to both integrators."""
         start = time.monotonic()
-        common = dict(record=record, output_dt=output_dt, early_stop=early_stop,
-                      friction_limit=friction_limit)  # fmt: skip
         out = integrate_exact(model, motion, theta0, rate0, solver, prepared=exact,
-                              until_open=True, **common)  # fmt: skip
+                              until_open=True, **options)  # fmt: skip
         if out is not None:
             out.method = "exact"
             return out
         left = max(0.0, float(solver.max_wall_time) - (time.monotonic() - start))
         solver = dataclasses.replace(solver, method=STEP_DEFAULT, max_wall_time=left)
-        out = integrate_steps(model, motion, theta0, rate0, solver, prepared=steps, **common)
+        out = integrate_steps(model, motion, theta0, rate0, solver, prepared=steps, **options)
         out.method = STEP_DEFAULT
         return out
 

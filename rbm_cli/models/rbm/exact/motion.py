@@ -31,31 +31,32 @@ _NOT_EXACT = {
 
 
 def exact_why_not(
-    formulation: str, kind: str, vertical: bool = False, damping: float = 0.0
+    formulation: str, kind: str, vertical: bool = False, damping: float = 0.0, method="exact"
 ) -> str | None:
     """Why the exact method does not take an interface formulation and an excitation type
     (vertical: whether the excitation has a vertical record; damping: interface.damping), in
-    one line; None if it does."""
+    one line naming the method asked for (exact, or exact-first, which runs it); None if it
+    does."""
     if damping > 0.0:
         return (
-            "solver.method exact does not take interface.damping (its pieces' closed form is"
+            f"solver.method {method} does not take interface.damping (its pieces' closed form is"
             " undamped): use a Runge-Kutta method (DOP853, as auto does)"
         )
     if formulation == "absolute":
         return (
-            "solver.method exact needs interface.formulation relative or geometric (absolute"
+            f"solver.method {method} needs interface.formulation relative or geometric (absolute"
             " is not symmetric): use a Runge-Kutta method (DOP853) for absolute"
         )
     if kind in _NOT_EXACT:
         return (
-            f"solver.method exact does not take excitation.type {kind} ({_NOT_EXACT[kind]}):"
+            f"solver.method {method} does not take excitation.type {kind} ({_NOT_EXACT[kind]}):"
             " use a Runge-Kutta method (DOP853)"
         )
     if kind not in EXACT_KINDS:
-        return f"solver.method exact does not take excitation.type {kind}"
+        return f"solver.method {method} does not take excitation.type {kind}"
     if vertical:
         return (
-            "solver.method exact does not take excitation.vertical (the weights vary with"
+            f"solver.method {method} does not take excitation.vertical (the weights vary with"
             " g + a_v(t): no constant-coefficient pieces): use a Runge-Kutta method (DOP853)"
         )
     return None

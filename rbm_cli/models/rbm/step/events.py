@@ -33,34 +33,57 @@ def row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
     h0[row] (or, rate, the rate event_rows[row] theta') as a polynomial in the step's
     fraction, with dense_eval's form. Fills coef, returns the constant term;
     poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
+    row_coef(mc, F, event_rows, row, n, rate, coef)
+    return row_base(y_old, event_rows, row, 1.0, 0.0 if rate else h0[row], n, rate)
+
+
+@jit(inline=True)
+def row_coef(mc, F, rows, row, n, rate, coef):
+    """The interpolant's coefficients of rows[row] theta (or theta', rate) into coef
+    (row_poly without the constant term)."""
     off = n if rate else 0
     for q in range(TAB_NP[mc]):
         v = 0.0
         for j in range(n):
-            v += event_rows[row, j] * F[q, off + j]
+            v += rows[row, j] * F[q, off + j]
         coef[q] = v
-    base = 0.0 if rate else h0[row]
+
+
+@jit(inline=True)
+def row_base(y_old, rows, row, sign, start, n, rate):
+    """The constant term of the row sign * rows[row] (row_poly): start (a distance's offset,
+    0 for a rate) plus the row at the step's start. sign is +-1: the negated row's terms
+    are the same products, negated, added in the same order."""
+    off = n if rate else 0
+    base = start
     for j in range(n):
-        base += event_rows[row, j] * y_old[off + j]
+        base += (sign * rows[row, j]) * y_old[off + j]
     return base
 
 
-@jit
-def poly_val(mc, t, t_old, h, coef, base):
-    """A projected row (row_poly) at time t: dense_eval for one row."""
-    x = (t - t_old) / h
+@jit(inline=True)
+def poly_part(mc, x, coef):
+    """The interpolant's part beyond its constant term at the step's fraction x (poly_val
+    is this plus the base). Of coefficients negated it is the value negated, to the bit:
+    each operation is a sum or product, whose rounding is symmetric."""
     v = 0.0
     nq = TAB_NP[mc]
     if mc == 2:  # DOP853's nested form (dense_eval)
         for q in range(nq):
             v += coef[nq - 1 - q]
             v *= x if q % 2 == 0 else 1.0 - x
-        return v + base
+        return v
     p = 1.0
     for r in range(nq):
         p *= x
         v += coef[r] * p
-    return base + v
+    return v
+
+
+@jit
+def poly_val(mc, t, t_old, h, coef, base):
+    """A projected row (row_poly) at time t: dense_eval for one row."""
+    return poly_part(mc, (t - t_old) / h, coef) + base
 
 
 #: Tolerances of the root finding: scipy brentq's rtol (4 eps) and our xtol [s].
@@ -177,31 +200,56 @@ def within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
 
 
 @jit
-def first_crossing(mc, t0, t1, y_old, F, event_rows, h0, n, D, R, dcol0, dcol1, rcol0, rcol1, mask,
-                    CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
+def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1, rcol0, rcol1,
+                    mask, CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
     (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
-    The masked rows' interpolants are projected once (CP, BP: distances; CR, BR:
-    rates) and evaluated as scalars; rows r < mv_e.size with mv_e[r] != 0 add their
-    moving part (step.vertical) on the step's ground piece gr."""
+
+    The 4n rows are [gx; -gx; -gc; gc] theta + h0 (_event_rows), so their interpolants
+    (polynomials in the step's fraction) are those of n rows (2n unless `same`), signed:
+    each is projected once and evaluated once a check point (poly_part), each masked row
+    adds its sign and its own constant term (CP, BP: its distance; CR, BR: its rate; the
+    same numbers as row_poly's). Rows r < mv_e.size with mv_e[r] != 0 add their moving
+    part (step.vertical) on the step's ground piece gr."""
     nseg = CHECK_INTERVALS
     h = t1 - t0
-    nrow = event_rows.shape[0]
+    nrow = 4 * n
+    nq = TAB_NP[mc]
     for r in range(nrow):
-        if mask[r]:
-            BP[r] = row_poly(mc, F, y_old, event_rows, r, h0, n, False, CP[r])
-            BR[r] = row_poly(mc, F, y_old, event_rows, r, h0, n, True, CR[r])
-    for q in range(nseg + 1):
-        tq = t0 + h * q / nseg if q < nseg else t1
-        for r in range(nrow):
-            if not mask[r]:
-                D[r, q], R[r, q] = np.inf, 0.0  # inert: never below zero, never turning
+        if not mask[r]:
+            D[r, :], R[r, :] = np.inf, 0.0  # inert: never below zero, never turning
+    for b in range(n if same else 2 * n):
+        i = b % n
+        rows = gx if b < n else gc
+        # the rows built on rows[i]: (plus, minus), and the collapse pair too when same
+        p, mneg = (i, n + i) if b < n else (3 * n + i, 2 * n + i)
+        p2, m2 = (3 * n + i, 2 * n + i) if same else (-1, -1)
+        if not (mask[p] or mask[mneg] or (same and (mask[p2] or mask[m2]))):
+            continue
+        row_coef(mc, F, rows, i, n, False, CP[p])
+        row_coef(mc, F, rows, i, n, True, CR[p])
+        for r in (p, mneg, p2, m2):
+            if r < 0 or not mask[r]:
                 continue
-            D[r, q] = poly_val(mc, tq, t0, h, CP[r], BP[r])
-            R[r, q] = poly_val(mc, tq, t0, h, CR[r], BR[r])
-            if r < mv_e.size and mv_e[r] != 0.0:
-                D[r, q] += moving_value(tq, gr, mv_e[r], mv_w[r])
-                R[r, q] += moving_rate(tq, gr, mv_e[r], mv_w[r])
+            sign = 1.0 if r == p or r == p2 else -1.0
+            if r != p:
+                for c in range(nq):
+                    CP[r, c], CR[r, c] = sign * CP[p, c], sign * CR[p, c]
+            BP[r] = row_base(y_old, rows, i, sign, h0[r], n, False)
+            BR[r] = row_base(y_old, rows, i, sign, 0.0, n, True)
+        for q in range(nseg + 1):
+            tq = t0 + h * q / nseg if q < nseg else t1
+            x = (tq - t0) / h
+            vd, vr = poly_part(mc, x, CP[p]), poly_part(mc, x, CR[p])
+            for r in (p, mneg, p2, m2):
+                if r < 0 or not mask[r]:
+                    continue
+                sign = 1.0 if r == p or r == p2 else -1.0
+                D[r, q] = sign * vd + BP[r]
+                R[r, q] = sign * vr + BR[r]
+                if r < mv_e.size and mv_e[r] != 0.0:
+                    D[r, q] += moving_value(tq, gr, mv_e[r], mv_w[r])
+                    R[r, q] += moving_rate(tq, gr, mv_e[r], mv_w[r])
     best, brow = np.inf, -1
     for r in range(nrow):
         if D[r, 0] < best:

@@ -170,7 +170,7 @@ def run_kernel(model, motion, solver, task):
     awaiting = np.zeros(n, dtype=np.bool_)
     lo, hi = np.empty(n), np.empty(n)
     nt = n + 1
-    event_rows, gx, gc, same = model.event_rows, model.gx, model.gc, model.same
+    gx, gc, same = model.gx, model.gc, model.same
     md, mg, track, es = model.md, model.mg, model.track, model.es
     peaks = np.zeros(nt)
     # As[:, n:2n]: the joints' stiffness, As[:, 2n:]: their damping (step.events.system)
@@ -329,9 +329,9 @@ def run_kernel(model, motion, solver, task):
                     n_rhs += dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
                                             cs, es, gr)  # fmt: skip
                     dense_ready = True
-                    t_e, event_row = first_crossing(mc, t_old, t_new, y_old, F, event_rows, h0,
-                                                     n, Dq, Rq, dc0, dc1, rc0, rc1, near, CP,
-                                                     BP, CR, BR, gr, mv_e, mv_w)  # fmt: skip
+                    t_e, event_row = first_crossing(mc, t_old, t_new, y_old, F, gx, gc, same,
+                                                     h0, n, Dq, Rq, dc0, dc1, rc0, rc1, near,
+                                                     CP, BP, CR, BR, gr, mv_e, mv_w)  # fmt: skip
                 if event_row >= 0:
                     dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
                     t_new = t_e

@@ -236,3 +236,34 @@ def test_the_domain_figure_states_the_damping():
     damped = column_note(load_config(CONFIGS / "harmonic_multidrum_damped.yaml"))
     assert "damping zeta = 0.05" in damped and "e = 1" in damped
     assert "damping" not in column_note(load_config(CONFIGS / "harmonic_multidrum.yaml"))
+
+
+def test_the_damping_coefficients_do_not_depend_on_the_last_bits_of_the_eigenvalues(monkeypatch):
+    """The joints' damping coefficients come from the first elastic frequency, which LAPACK
+    computes; its last bits follow the processor's kernels. A frequency a few ulp away (as
+    another machine may give) must give the same coefficients, to the bit: the stored damped
+    study is reproduced on every machine."""
+    from rbm_cli.physics.equations import Model
+
+    cfg = load_config(CONFIGS / "harmonic_multidrum_damped.yaml")
+    reference = model_from_config(cfg).joint_damping
+    assert reference.any()
+    exact = Model.elastic_frequencies_hz
+    for ulps in (-3, -1, 1, 3):
+
+        def shifted(self, ulps=ulps):
+            freqs = exact(self)
+            f = freqs[0]
+            for _ in range(abs(ulps)):
+                f = float(np.nextafter(f, math.inf if ulps > 0 else -math.inf))
+            return [f, *freqs[1:]]
+
+        monkeypatch.setattr(Model, "elastic_frequencies_hz", shifted)
+        again = model_from_config(cfg).joint_damping
+        assert again.tobytes() == reference.tobytes(), ulps
+    # the coefficients still give the first mode the ratio asked for (1e-10 relative)
+    monkeypatch.setattr(Model, "elastic_frequencies_hz", exact)
+    model = model_from_config(cfg)
+    omega_1 = 2.0 * math.pi * exact(model)[0]
+    beta = reference / np.asarray(model.column.stiffness, dtype=float)
+    assert np.allclose(beta * omega_1 / 2.0, cfg.interface.damping, rtol=1e-10, atol=0.0)

@@ -33,6 +33,13 @@ from rbm_cli.base.detmath import inverse, product
 from rbm_cli.physics.column import Column
 from rbm_cli.physics.law import Law, make_law
 
+#: Significant digits of the first elastic frequency where it sets the joints' damping. The
+#: eigenvalue solver (LAPACK) rounds its last bits as the processor's kernels do, so the
+#: frequency can differ by an ulp or two between machines; rounded, it is the same on
+#: every machine (but for a frequency within a few ulp of a rounding boundary), and so is
+#: every damped run. The damping ratio it sets is exact to 1e-10 relative.
+DAMPING_DIGITS = 10
+
 
 @dataclass(frozen=True)
 class Model:
@@ -161,11 +168,13 @@ class Model:
         exactly (C = beta K for `relative` and `absolute`; for `geometric` K also holds
         gravity's softening, and zeta is then the first mode's ratio to first order) and
         leaves rigid-body rocking undamped (impacts dissipate it, as for an undamped
-        column). Zero without damping or for a rigid law."""
+        column). Zero without damping or for a rigid law. omega_1 is that of the first
+        frequency rounded to DAMPING_DIGITS significant digits [Hz]."""
         out = np.zeros(self.n)
         if self.damping == 0.0 or self.rigid:
             return out
-        omega_1 = 2.0 * math.pi * self.elastic_frequencies_hz()[0]
+        f_1 = float(f"{self.elastic_frequencies_hz()[0]:.{DAMPING_DIGITS}g}")
+        omega_1 = 2.0 * math.pi * f_1
         beta = 2.0 * self.damping / omega_1
         return beta * np.asarray(self.column.stiffness, dtype=float)
 

@@ -6,8 +6,10 @@ The modes solve the symmetric pencil K phi = lam M phi (through the Cholesky fac
 M symmetric positive definite in the `relative` and `geometric` formulations, K symmetric,
 possibly indefinite or singular), M-orthonormal: Phi^T M Phi = I, so q = Phi^T M theta.
 They depend only on the slopes of the active pieces, so they are cached by the pieces'
-indices across the runs of one column (modes, in the cache new_cache makes); the intercepts
-(which side) only move the constant load f.
+indices across the runs of one column (modes, in the cache new_cache makes), with what
+follows from them alone (the family rows gf = Gf Phi and |gf|); the intercepts (which side)
+only move the constant load f. A piece reads its modes in the cache, not a copy: it lives
+until the next piece is made, and only making a piece can change the cache.
 
 Every event surface and every tracked peak quantity is linear in theta, so in modal
 coordinates a row is d(t) = G q(t) + h0 (event distances, >= 0 inside the piece) or
@@ -61,22 +63,25 @@ def _slot(keys, used, k):
 
 def new_cache(n: int) -> tuple:
     """An empty cache of modes for n interfaces (exact.piece.modes): a power-of-two
-    table of at most 2^22 / n^2 sets of pieces (64 MB of modes at most)."""
+    table of at most 8192 sets of pieces and 64 MB."""
+    nf = 2 * n + 1
+    per_set = 8 * (n * (2 * n + 3) + 2 * nf * n)  # bytes: keys, lam, phi, tom, g, gf, |gf|
     cap = 64
-    while cap * 2 <= min(8192, (1 << 22) // (n * n)):
+    while cap * 2 <= min(8192, (64 << 20) // per_set):
         cap *= 2
     return (
         np.zeros((cap, n), dtype=np.int64), np.zeros(cap, dtype=np.bool_), np.zeros((cap, n)),
         np.zeros((cap, n, n)), np.zeros((cap, n, n)), np.zeros((cap, n)),
-        np.zeros(1, dtype=np.int64),
+        np.zeros(1, dtype=np.int64), np.zeros((cap, nf, n)), np.zeros((cap, nf, n)),
     )  # fmt: skip
 
 
 @jit
 def modes(mdl, cache, k):
     """Slot of the cache holding the modes of the pieces k (computed when absent: the
-    pencil (K, M) through the Cholesky factor M = L L^T, eigh of L^-1 K L^-T)."""
-    keys, used, lam_s, phi_s, tom_s, g_s, count = cache
+    pencil (K, M) through the Cholesky factor M = L L^T, eigh of L^-1 K L^-T) and their
+    family rows."""
+    keys, used, lam_s, phi_s, tom_s, g_s, count, gf_s, absgf_s = cache
     if count[0] >= (used.size * 3) // 4:  # full: start again
         used[:] = False
         count[0] = 0
@@ -100,6 +105,9 @@ def modes(mdl, cache, k):
     phi_s[i, :, :] = phi
     tom_s[i, :, :] = u.T @ mdl.chol.T
     g_s[i, :] = -(phi.T @ mdl.ground_load)
+    gf = mdl.families @ phi
+    gf_s[i, :, :] = gf
+    absgf_s[i, :, :] = np.abs(gf)
     return i
 
 
@@ -135,10 +143,7 @@ def make_piece(mdl, cache, side, k, pending, awaiting, fc):
     """The linear piece of the current law pieces under the forcing fc."""
     n = side.size
     slot = modes(mdl, cache, k)
-    lam = cache[2][slot].copy()
-    phi = cache[3][slot].copy()
-    tom = cache[4][slot].copy()
-    g = cache[5][slot].copy()
+    lam, phi, tom, g = cache[2][slot], cache[3][slot], cache[4][slot], cache[5][slot]
     a = np.empty(n)
     for i in range(n):
         a[i] = side[i] * mdl.intercepts[i, k[i]]
@@ -147,10 +152,9 @@ def make_piece(mdl, cache, side, k, pending, awaiting, fc):
     if int(fc[0]) == HARMONIC:
         elig &= lam >= 4.0 * fc[2] * fc[2]
     w = np.sqrt(np.where(elig, lam, 1.0))
-    gf = mdl.families @ phi
     sgn, off, fam, silent = _rows(mdl, side, k, pending, awaiting)
-    return Piece(lam, phi, tom, f, g, elig, w, gf, np.abs(gf), sgn, off, fam, silent, fc, n,
-                 2 * n + 1)  # fmt: skip
+    return Piece(lam, phi, tom, f, g, elig, w, cache[7][slot], cache[8][slot], sgn, off, fam,
+                 silent, fc, n, 2 * n + 1)  # fmt: skip
 
 
 def point_size(n: int) -> int:
@@ -172,13 +176,10 @@ def _derived(pc, pts, i):
         pts[i, of + r] = fv
         pts[i, of + nf + r] = dv
     ag = f_accel(pc.fc, pts[i, 0])
-    acc = np.empty(n)
-    for j in range(n):
-        acc[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
     for r in range(n, nf):
         ff = 0.0
-        for j in range(n):
-            ff += pc.gf[r, j] * acc[j]
+        for j in range(n):  # the modal acceleration q''_j, as eval_family forms it
+            ff += pc.gf[r, j] * (-pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag)
         pts[i, of + 2 * nf + r] = ff
 
 

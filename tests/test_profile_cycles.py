@@ -1,0 +1,47 @@
+"""docs/profile_cycles.py finds every part it counts in today's run loops: its anchors occur
+once each, and the instrumented copies are valid Python that reads the counter (the script
+itself compiles two integrators, minutes: it is run by hand, docs/performance.md)."""
+
+import ast
+import importlib.util
+
+from tests.paths import ROOT
+
+
+def _script():
+    spec = importlib.util.spec_from_file_location("profile_cycles", ROOT / "docs" / "profile_cycles.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_counters_go_into_todays_run_loops(tmp_path):
+    script = _script()
+    script.instrumented(ROOT, tmp_path)
+    for f, parts in ((script.STEPPER, script.STEP_PARTS), (script.EXACT_RUN, script.EXACT_PARTS)):
+        text = (tmp_path / f).read_text()
+        ast.parse(text)
+        assert "from rbm_cli.base.cycles import cycles" in text
+        assert text.count("print('CYCLES'") >= 1
+        # every part has its counter: prof[i] (the step kernel) or s.cnt[8 + i] (exact)
+        for i in range(len(parts)):
+            assert (f"prof[{i}] +=" in text) or (f"s.cnt[{8 + i}] +=" in text), (f, i)
+    ast.parse((tmp_path / "rbm_cli" / "base" / "cycles.py").read_text())
+    # the package copied is untouched but for the two files
+    original = (ROOT / "rbm_cli" / "models" / "rbm" / "step" / "rk.py").read_text()
+    assert (tmp_path / "rbm_cli" / "models" / "rbm" / "step" / "rk.py").read_text() == original
+
+
+def test_a_changed_run_loop_stops_the_script_in_one_line(tmp_path, monkeypatch):
+    script = _script()
+    anchors = list(script.ANCHORS)
+    f, anchor, replacement = anchors[2]
+    anchors[2] = (f, anchor + "# not in the source\n", replacement)
+    monkeypatch.setattr(script, "ANCHORS", anchors)
+    try:
+        script.instrumented(ROOT, tmp_path)
+    except SystemExit as exc:
+        message = str(exc.code)
+        assert message.startswith("profile_cycles: ") and "\n" not in message
+    else:
+        raise AssertionError("a missing anchor was not refused")

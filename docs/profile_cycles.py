@@ -33,7 +33,7 @@ STEPPER = Path("rbm_cli/models/rbm/step/stepper.py")
 EXACT_RUN = Path("rbm_cli/models/rbm/exact/run.py")
 
 #: The cycle counter, as a numba intrinsic (the instrumented copy's rbm_cli/base/cycles.py).
-CYCLES = '''from llvmlite import ir
+CYCLES = """from llvmlite import ir
 from numba.core import cgutils, types
 from numba.extending import intrinsic
 
@@ -46,7 +46,7 @@ def cycles(typingctx):
         return builder.call(fn, [])
 
     return types.uint64(), codegen
-'''
+"""
 
 TICK = "float(cycles() - c0)"
 STEP_PARTS = ["RK steps (attempts, rejections)", "the new step end's event distances",
@@ -68,9 +68,11 @@ ANCHORS = [
     (STEPPER, "            event = False\n            running = True\n",
      f"            prof[9] += {TICK}\n            event = False\n            running = True\n"),
     (STEPPER, "                taken, t_new, h, h_abs, calls = attempt_step(",
-     "                c0 = cycles()\n                taken, t_new, h, h_abs, calls = attempt_step("),
+     "                c0 = cycles()\n"
+     "                taken, t_new, h, h_abs, calls = attempt_step("),
     (STEPPER, "                n_rhs += calls\n",
-     f"                n_rhs += calls\n                prof[0] += {TICK}\n                c0 = cycles()\n"),
+     f"                n_rhs += calls\n                prof[0] += {TICK}\n"
+     "                c0 = cycles()\n"),
     (STEPPER, "                event_row = -1\n                t_e = t_new\n",
      f"                prof[1] += {TICK}\n                c0 = cycles()\n"
      "                event_row = -1\n                t_e = t_new\n"),
@@ -87,15 +89,19 @@ ANCHORS = [
      f"                prof[4] += {TICK}\n                c0 = cycles()\n"
      "                if event_row >= 0:\n                    dense_eval("),
     (STEPPER, "                if any_silent:\n",
-     f"                prof[5] += {TICK}\n                c0 = cycles()\n                if any_silent:\n"),
+     f"                prof[5] += {TICK}\n                c0 = cycles()\n"
+     "                if any_silent:\n"),
     (STEPPER, "                friction_demand(g_new,",
-     f"                prof[6] += {TICK}\n                c0 = cycles()\n                friction_demand(g_new,"),
+     f"                prof[6] += {TICK}\n                c0 = cycles()\n"
+     "                friction_demand(g_new,"),
     (STEPPER, "                z_prev, z_old, z_new = z_old, z_new, z_prev\n",
-     f"                prof[7] += {TICK}\n                z_prev, z_old, z_new = z_old, z_new, z_prev\n"),
+     f"                prof[7] += {TICK}\n"
+     "                z_prev, z_old, z_new = z_old, z_new, z_prev\n"),
     (STEPPER, "            # ---- the event at (t, y)\n",
      "            # ---- the event at (t, y)\n            c0 = cycles()\n"),
     (STEPPER, "            if what == UPLIFT:\n                n_upl += 1\n",
-     f"            prof[8] += {TICK}\n            if what == UPLIFT:\n                n_upl += 1\n"),
+     f"            prof[8] += {TICK}\n"
+     "            if what == UPLIFT:\n                n_upl += 1\n"),
     (STEPPER, "                return (COLLAPSED, t,",
      "                prof[10] += float(cycles() - c_all)\n"
      "                print('CYCLES', prof[0], prof[1], prof[2], prof[3], prof[4], prof[5], "
@@ -110,7 +116,8 @@ ANCHORS = [
      "            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip\n"),
     (EXACT_RUN, "from rbm_cli.base.jit import jit\n",
      "from rbm_cli.base.jit import jit\nfrom rbm_cli.base.cycles import cycles\n"),
-    (EXACT_RUN, "        row, s.st[H], ev, fresh = next_point(pc, pts, s.st[H], seg_end, wk.mb, wk.fb)\n",
+    (EXACT_RUN,
+     "        row, s.st[H], ev, fresh = next_point(pc, pts, s.st[H], seg_end, wk.mb, wk.fb)\n",
      "        c0 = cycles()\n"
      "        row, s.st[H], ev, fresh = next_point(pc, pts, s.st[H], seg_end, wk.mb, wk.fb)\n"
      "        s.cnt[8] += cycles() - c0\n        c0 = cycles()\n"),
@@ -131,7 +138,8 @@ ANCHORS = [
     (EXACT_RUN, "              np.zeros(8, dtype=np.int64))  # fmt: skip\n",
      "              np.zeros(14, dtype=np.int64))  # fmt: skip\n    c_all = cycles()\n"),
     (EXACT_RUN, "        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n",
-     "        c0 = cycles()\n        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n"
+     "        c0 = cycles()\n"
+     "        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n"
      "        s.cnt[13] += cycles() - c0\n"),
     (EXACT_RUN, "    return code, s.st, s.cnt, s.maxima, s.fric\n",
      "    print('CYCLES', s.cnt[8], s.cnt[9], s.cnt[10], s.cnt[11], s.cnt[12], s.cnt[13], "

@@ -9,7 +9,8 @@ from tests.paths import ROOT
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location("profile_cycles", ROOT / "docs" / "profile_cycles.py")
+    path = ROOT / "docs" / "profile_cycles.py"
+    spec = importlib.util.spec_from_file_location("profile_cycles", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module

@@ -81,7 +81,7 @@ def provenance() -> dict:
         "cpu_model": _cpu_model(),
         "numba_target": _numba_target(),
         "arithmetic": "deterministic (rbm_cli.base.detmath): no BLAS/LAPACK or libm sin/asin "
-        "in the compiled path",
+        "in the step kernel's compiled path",
         "robustness_rule": RULE,
     }
 

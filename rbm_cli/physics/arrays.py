@@ -59,9 +59,9 @@ class ColumnArrays(NamedTuple):
     rest_rate: float  #: rate below which a rigid monolith comes to rest after an impact [rad/s]
     barrier: float  #: energy barrier of the early stop [J] (NaN unless n = 1)
     families: np.ndarray  #: watched rows: arguments / theta_u, collapse ratios, top (2n + 1, n)
-    event_rows: np.ndarray  #: event rows: argmap / tu, -argmap / tu, -cmap, cmap (4n, n)
-    gx: np.ndarray  #: event_rows[:n]
-    gc: np.ndarray  #: event_rows[3n:]
+    gx: np.ndarray  #: the joints' law arguments over theta_u, argmap / tu (n, n)
+    gc: np.ndarray  #: the collapse ratios, cmap (n, n); the step kernel's event rows are
+    #: [gx; -gx; -gc; gc] (step.events._event_rows)
     same: bool  #: gx equals gc (the same rows serve both)
     md: np.ndarray  #: minv @ diff.T, minv the inverse mass matrix (n, n)
     mg: np.ndarray  #: minv @ gravity (n, n)
@@ -95,41 +95,32 @@ def rest_levels(model: Model) -> tuple[float | None, float, float]:
 
 @jit
 def _derived(args, cmap, top, minv, diff, gravity, ground_load):
-    """The step integrator's products of the model's arrays: (event_rows, same, md, mg,
-    track, es), from the event families args, cmap, top."""
+    """The step integrator's products of the model's arrays: (same, md, mg, track, es),
+    from the event families args, cmap, top."""
     n = args.shape[0]
-    event_rows = np.empty((4 * n, n))
-    for i in range(n):
-        for j in range(n):
-            event_rows[i, j] = args[i, j]
-            event_rows[n + i, j] = -args[i, j]
-            event_rows[2 * n + i, j] = -cmap[i, j]
-            event_rows[3 * n + i, j] = cmap[i, j]
-    gx, gc = event_rows[:n], event_rows[3 * n :]
     same = True
     for i in range(n):
         for j in range(n):
-            same = same and gx[i, j] == gc[i, j]
+            same = same and args[i, j] == cmap[i, j]
     md = matmul(minv, diff.T.copy())
     mg = matmul(minv, gravity)
     track = np.empty((n + 1, n))
     track[:n, :] = cmap
     track[n, :] = top
     es = -matvec(minv, ground_load, np.empty(n))
-    return event_rows, same, md, mg, track, es
+    return same, md, mg, track, es
 
 
 def column_arrays(model: Model) -> ColumnArrays:
     """The model's arrays as the compiled integrators read them (assembled once per
     column)."""
     col = model.column
-    n = model.n
     impulse_dir, impulse_w = model.impulse_directions
     edges, nedges, inter, slopes, rigid = law_arrays(model.laws)
     args, cmap, top = event_families(model)
-    event_rows, same, md, mg, track, es = _derived(args, cmap, top, model.mass_inv,
-                                          model.diff.astype(float), model.gravity,
-                                          model.ground_load)  # fmt: skip
+    same, md, mg, track, es = _derived(args, cmap, top, model.mass_inv,
+                                       model.diff.astype(float), model.gravity,
+                                       model.ground_load)  # fmt: skip
     uplift, rest_rate, barrier = rest_levels(model)
     chol = np.linalg.cholesky(model.mass)
     return ColumnArrays(
@@ -145,7 +136,8 @@ def column_arrays(model: Model) -> ColumnArrays:
         normal_forces=col.normal_forces.astype(float), rigid_mono=uplift is not None,
         uplift_level=-1.0 if uplift is None else float(uplift), rest_rate=float(rest_rate),
         barrier=float(barrier), families=np.vstack([args, cmap, top[None, :]]),
-        event_rows=event_rows, gx=event_rows[:n], gc=event_rows[3 * n :], same=bool(same),
+        gx=np.ascontiguousarray(args, dtype=float), gc=np.ascontiguousarray(cmap, dtype=float),
+        same=bool(same),
         md=md, mg=mg, track=track, es=es, slope_parts=np.stack(model.slope_parts),
         edge_w=model.edge_weight_shares, damp=model.joint_damping.copy(),
         damped=bool(model.joint_damping.any()),

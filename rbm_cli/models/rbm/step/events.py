@@ -221,17 +221,21 @@ def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1
     for b in range(n if same else 2 * n):
         i = b % n
         rows = gx if b < n else gc
-        # the rows built on rows[i]: (plus, minus), and the collapse pair too when same
-        p, mneg = (i, n + i) if b < n else (3 * n + i, 2 * n + i)
-        p2, m2 = (3 * n + i, 2 * n + i) if same else (-1, -1)
-        if not (mask[p] or mask[mneg] or (same and (mask[p2] or mask[m2]))):
+        # the rows built on rows[i], with their signs: the first is where its interpolant is
+        # projected; the collapse pair too when same (-1: none)
+        p = i if b < n else 3 * n + i
+        signed = ((p, 1.0), (n + i if b < n else 2 * n + i, -1.0),
+                  (3 * n + i if same else -1, 1.0), (2 * n + i if same else -1, -1.0))  # fmt: skip
+        used = False
+        for r, _ in signed:
+            used = used or (r >= 0 and mask[r])
+        if not used:
             continue
         row_coef(mc, F, rows, i, n, False, CP[p])
         row_coef(mc, F, rows, i, n, True, CR[p])
-        for r in (p, mneg, p2, m2):
+        for r, sign in signed:
             if r < 0 or not mask[r]:
                 continue
-            sign = 1.0 if r == p or r == p2 else -1.0
             if r != p:
                 for c in range(nq):
                     CP[r, c], CR[r, c] = sign * CP[p, c], sign * CR[p, c]
@@ -241,10 +245,9 @@ def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1
             tq = t0 + h * q / nseg if q < nseg else t1
             x = (tq - t0) / h
             vd, vr = poly_part(mc, x, CP[p]), poly_part(mc, x, CR[p])
-            for r in (p, mneg, p2, m2):
+            for r, sign in signed:
                 if r < 0 or not mask[r]:
                     continue
-                sign = 1.0 if r == p or r == p2 else -1.0
                 D[r, q] = sign * vd + BP[r]
                 R[r, q] = sign * vr + BR[r]
                 if r < mv_e.size and mv_e[r] != 0.0:

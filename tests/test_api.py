@@ -108,6 +108,19 @@ def test_with_value_changes_a_copy_and_validates_it():
         rbm.with_value(cfg, "column..height", 3.0)
 
 
+def test_with_value_keeps_a_config_files_folder_for_its_relative_paths(tmp_path, monkeypatch):
+    """A record named relative to its config file stays the same file when a value of the
+    config changes from another current directory (a notebook's)."""
+    monkeypatch.chdir(tmp_path)
+    cfg = rbm.load_config(ROOT / "configs" / "ci" / "suite_multidrum_ci.yaml")
+    tighter = rbm.with_value(cfg, "solver.rtol", 1e-11)
+    assert tighter.excitation.file_path == cfg.excitation.file_path
+    assert tighter.grid.records == cfg.grid.records
+    other = rbm.with_value(cfg, "excitation.file", ["../records/synthetic/rdk_02.AT2"])
+    assert other.excitation.file_path == str(ROOT / "configs" / "records" / "synthetic"
+                                             / "rdk_02.AT2")  # fmt: skip
+
+
 # --------------------------------------------------------------------------- one cell
 
 

@@ -114,7 +114,7 @@ def with_values(config: Config, changes: Mapping[str, Any]) -> Config:
             _set(written, path, plain_copy(value))
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
-    return parse_config(written, source)
+    return parse_config(written, source, base_dir=config.base_dir)
 
 
 def with_value(config: Config, path: str, value: Any) -> Config:

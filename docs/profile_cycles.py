@@ -129,9 +129,9 @@ ANCHORS = [
     (EXACT_RUN, "        pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)\n",
      "        c0 = cycles()\n"
      "        pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)\n"),
-    (EXACT_RUN, "        row = _march(mdl, pc, wk, s, se, seg_end, can_stop, samples)\n",
+    (EXACT_RUN, "        row = _march(mdl, pc, wk, s, se, seg_end, can_stop, sure_stop, samples)\n",
      "        s.cnt[11] += cycles() - c0\n"
-     "        row = _march(mdl, pc, wk, s, se, seg_end, can_stop, samples)\n"),
+     "        row = _march(mdl, pc, wk, s, se, seg_end, can_stop, sure_stop, samples)\n"),
     (EXACT_RUN, "            code = _handle(mdl, pc, row, s, se)\n",
      "            c0 = cycles()\n            code = _handle(mdl, pc, row, s, se)\n"
      "            s.cnt[12] += cycles() - c0\n"),

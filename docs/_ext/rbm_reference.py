@@ -296,6 +296,7 @@ def _ranges() -> dict[str, str]:
         "solver.time_step": f"[{fmt(TIME_STEP_RANGE[0])}, {fmt(TIME_STEP_RANGE[1])}]",
         "solver.max_wall_time": f"({fmt(WALL_TIME_RANGE[0])}, {fmt(WALL_TIME_RANGE[1])}]",
         "solver.implementation": one_of(t.IMPLEMENTATIONS),
+        "solver.stop": one_of(t.STOPS),
     }
 
 
@@ -596,6 +597,16 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "",
         "Wall-clock budget of one run; beyond it the run is "
         "``failed``. Not part of the config's hash.",
+    ),
+    "solver.stop": (
+        "",
+        "",
+        "When a sweep's run may end before its motion does. ``figures``: once no figure "
+        "can change (a monolith past a peak of free motion below its collapse barrier). "
+        "``outcome`` (model ``rbm``, formulation ``relative``): once its survival is "
+        "certain (free motion, the column's energy below every joint's collapse barrier); "
+        "the peaks and the friction demand are then those up to the stop. See the user "
+        "guide (Solvers and methods, Stopping early).",
     ),
 }
 #: Keys that are sections of their own (their sub-keys have rows).

@@ -37,6 +37,7 @@ from rbm_cli.config.types import (
     METHODS,
     MODELS,
     SECTIONS,
+    STOPS,
     CapitalConfig,
     CollapseConfig,
     ColumnConfig,
@@ -95,6 +96,7 @@ SOLVER_KEYS = (
     "time_step",
     "implementation",
     "max_wall_time",
+    "stop",
 )
 
 #: Models of the config's ``model`` key that this version does not implement yet.
@@ -349,7 +351,22 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         solver=_solver(top.get("solver")),
     )
     _check_dimensions(config)
+    _check_stop(config)
     return config
+
+
+def _check_stop(config: Config) -> None:
+    """solver.stop: outcome stops by the energy of the Rigid Beam Model's laws, which bounds
+    their arguments only where the energy is the laws' potential alone (`relative`)."""
+    if config.solver.stop != "outcome":
+        return
+    formulation = config.interface.formulation
+    if config.model != "rbm" or formulation != "relative":
+        what = f"model {config.model}" if config.model != "rbm" else f"formulation {formulation}"
+        raise ConfigError(
+            "solver.stop: outcome needs model rbm with interface.formulation relative (its"
+            f" energy certificate), got {what}: delete solver.stop"
+        )
 
 
 def _check_dimensions(config: Config) -> None:
@@ -549,4 +566,5 @@ def _solver(raw: Any) -> SolverConfig:
             "s",
             *WALL_TIME_RANGE,
         ),
+        stop=choice(s.get("stop", default.stop), "solver.stop", STOPS),
     )

@@ -40,6 +40,11 @@ CLOSED_FORM_KINDS = ("harmonic", "half-sine", "free", "one-sine", "cycloidal", "
 #: hash (the default before `auto` existed: the hashes of stored domains stay valid).
 STEP_DEFAULT = "DOP853"
 IMPLEMENTATIONS = ("compiled", "python")
+#: When a run may end before its motion does (solver.stop). figures: once no figure of the
+#: run can change (a monolith past a peak of free motion below its collapse barrier);
+#: outcome: once its outcome cannot change (free motion of any column below every joint's
+#: collapse barrier; the peaks are then those up to the stop).
+STOPS = ("figures", "outcome")
 
 
 @dataclass(frozen=True)
@@ -400,6 +405,9 @@ class SolverConfig:
         rbm_cli.base.jit.plain: the same bits, 30-100x slower; for debugging)
     max_wall_time : float  Wall-clock budget of one run [s]; beyond it the run is
         'failed' (a guard against a run that would not end, not a tolerance)
+    stop : str  When a sweep's run may end before its motion does (:data:`STOPS`):
+        'figures' (the default: every figure final) or 'outcome' (model rbm, formulation
+        relative: survival certain, the peaks those up to the stop)
     """
 
     method: str = "auto"
@@ -410,6 +418,7 @@ class SolverConfig:
     time_step: float = 1e-4
     implementation: str = "compiled"
     max_wall_time: float = 3600.0
+    stop: str = "figures"
 
 
 @dataclass(frozen=True)
@@ -508,12 +517,16 @@ class Config:
 def hash_form(config: Config) -> dict:
     """What a config's hash is taken of (rbm_cli.study.sweep.config_hash): its resolved
     form, without solver.max_wall_time (a guard against a run that would not end, not a
-    setting of the domain; hashes of domains made before it existed stay valid),  and with
+    setting of the domain; hashes of domains made before it existed stay valid), without
+    solver.stop where it is the default (hashes of domains made before it existed stay
+    valid; `outcome` changes the peaks of a domain, and its hash), and with
     solver.method auto written as STEP_DEFAULT, the default before auto existed (so stored
     domains and journals keep their hashes; where auto runs the closed form instead, the two
     agree on every robust cell: tests/test_closed_form_jit.py, tests/test_regression.py)."""
     resolved = config.resolved()
     resolved["solver"].pop("max_wall_time", None)
+    if resolved["solver"].get("stop") == SolverConfig.stop:
+        resolved["solver"].pop("stop")
     if resolved["solver"]["method"] == "auto":
         resolved["solver"]["method"] = STEP_DEFAULT
     return resolved

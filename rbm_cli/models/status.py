@@ -19,6 +19,17 @@ FAILED_STEP, FAILED_NONFINITE = 9, 10
 OPENED = 11
 #: Loop turns (pieces, certified intervals) between two polls of the wall clock and Ctrl-C.
 POLL_PIECES = 64
+#: When a run may end before its motion does, as the loops read it: never (a recorded run),
+#: once no figure can change (solver.stop: figures), once the outcome cannot (outcome).
+STOP_NEVER, STOP_FIGURES, STOP_OUTCOME = 0, 1, 2
+
+
+def stop_level(early_stop: bool, solver) -> int:
+    """The loops' stop level of a run: STOP_NEVER unless early_stop, else as solver.stop
+    says (rbm_cli.config.types.STOPS)."""
+    if not early_stop:
+        return STOP_NEVER
+    return STOP_OUTCOME if solver.stop == "outcome" else STOP_FIGURES
 
 
 @jit

@@ -58,6 +58,7 @@ class ColumnArrays(NamedTuple):
     uplift_level: float  #: ground acceleration that uplifts a rigid monolith [m/s^2] (-1: none)
     rest_rate: float  #: rate below which a rigid monolith comes to rest after an impact [rad/s]
     barrier: float  #: energy barrier of the early stop [J] (NaN unless n = 1)
+    survival: float  #: energy below which free motion cannot collapse [J] (NaN: no such bound)
     families: np.ndarray  #: watched rows: arguments / theta_u, collapse ratios, top (2n + 1, n)
     gx: np.ndarray  #: the joints' law arguments over theta_u, argmap / tu (n, n)
     gc: np.ndarray  #: the collapse ratios, cmap (n, n); the step kernel's event rows are
@@ -91,6 +92,26 @@ def rest_levels(model: Model) -> tuple[float | None, float, float]:
     if model.n == 1:
         barrier = float(model.energy(model.collapse_ratio * tu, np.zeros(1))[0])
     return model.uplift_level, REST_RATE * model.rocking_p * float(tu.min()), barrier
+
+
+def survival_barrier(model: Model) -> float:
+    """Energy [J] below which a column in free motion cannot collapse; NaN where the model
+    gives no such bound.
+
+    For the `relative` formulation the energy is the kinetic energy plus the laws'
+    potentials F_i(x_i) = integral_0^x_i f_i, each a function of its own joint's argument.
+    A joint collapses where |x_i| reaches c theta_u,i (c <= 1), and on [0, theta_u] a law's
+    moment is >= 0, so F_i grows with |x_i| there and every F_j >= 0 before any joint
+    collapses: reaching the collapse of joint i takes an energy of at least F_i(c theta_u,i).
+    The barrier is the least of these. Free motion (no forcing, impacts with e <= 1, joint
+    damping >= 0) never gains energy, so a column below it survives whatever follows. Other
+    formulations: NaN (`geometric` adds gravity's potential, negative and coupling the
+    joints; `absolute` is not energy-conserving)."""
+    if model.formulation != "relative":
+        return math.nan
+    limit = model.collapse_ratio * model.column.rotation_capacity
+    return float(min(min(law.potential(x), law.potential(-x))
+                     for law, x in zip(model.laws, limit)))  # fmt: skip
 
 
 @jit
@@ -135,7 +156,7 @@ def column_arrays(model: Model) -> ColumnArrays:
         centre_map=model.centre_map.copy(), masses=col.masses.astype(float),
         normal_forces=col.normal_forces.astype(float), rigid_mono=uplift is not None,
         uplift_level=-1.0 if uplift is None else float(uplift), rest_rate=float(rest_rate),
-        barrier=float(barrier), families=np.vstack([args, cmap, top[None, :]]),
+        barrier=float(barrier), survival=survival_barrier(model), families=np.vstack([args, cmap, top[None, :]]),
         gx=np.ascontiguousarray(args, dtype=float), gc=np.ascontiguousarray(cmap, dtype=float),
         same=bool(same),
         md=md, mg=mg, track=track, es=es, slope_parts=np.stack(model.slope_parts),
@@ -144,4 +165,4 @@ def column_arrays(model: Model) -> ColumnArrays:
     )  # fmt: skip
 
 
-__all__ = ["REST_RATE", "ColumnArrays", "column_arrays", "rest_levels"]
+__all__ = ["REST_RATE", "ColumnArrays", "column_arrays", "rest_levels", "survival_barrier"]

@@ -14,6 +14,7 @@ import numpy as np
 
 from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC, LINEAR, ZERO
 from rbm_cli.models.rbm.exact.motion import check_exact
+from rbm_cli.models.status import stop_level
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -78,12 +79,14 @@ def run_settings(
     """(mo, se) of one run of a compiled closed-form loop: the motion
     mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and the settings
     se = [max_steps, max_events, deadline (monotonic clock, from solver.max_wall_time),
-    early_stop, record, output_dt, friction limit [-] (inf: none), until_open (the exact
+    stop level (models.status.stop_level), record, output_dt, friction limit [-] (inf:
+    none), until_open (the exact
     integrator: stop at the first event of a joint, rbm_cli.models.status.OPENED)]."""
     mo = np.array([1.0 if motion.is_pulse else 0.0, motion.amplitude, motion.omega,
                    motion.phase, motion.pulse_end, motion.t_end])  # fmt: skip
     deadline = time.monotonic() + float(solver.max_wall_time)
-    se = np.array([solver.max_steps, solver.max_events, deadline, float(early_stop),
+    se = np.array([solver.max_steps, solver.max_events, deadline,
+                   float(stop_level(early_stop, solver)),
                    float(record), output_dt, friction_limit, float(until_open)],
                   dtype=float)  # fmt: skip
     return mo, se

@@ -179,6 +179,17 @@ def energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes
     return e
 
 
+@jit
+def survives(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes, survival):
+    """Whether a state in free motion is certain to survive: its energy (:func:`energy`)
+    below the column's survival barrier [J] (physics.arrays.survival_barrier; NaN: never)
+    by more than 1e-9 of it."""
+    if not survival > 0.0:
+        return False
+    en = energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes)
+    return en < survival * (1.0 - 1e-9)
+
+
 @jit(inline=True)
 def friction_demand(ag, gam, centre_map, acc, masses, normal_forces, out):
     """Raise out (n) to the friction demand |T_i| / (N_i gam) [-] of each interface: T_i the

@@ -65,7 +65,7 @@ def _outcome(code, st, cnt, maxima, fric, solver, n: int) -> Outcome:
     if code == COLLAPSED:
         out.collapse(float(st[3]), int(cnt[5]))
     elif code == STOPPED_EARLY:
-        out.stopped_early()
+        out.stopped_early(solver.stop == "outcome")
     elif end_by_budget(out, code, solver):
         pass
     elif code != AT_REST_END and not math.isfinite(out.max_top):

@@ -47,6 +47,7 @@ from rbm_cli.models.rbm.pieces import (
     piece_bounds,
     restitute,
     silent_impact,
+    survives,
 )
 from rbm_cli.models.status import (
     AT_REST_END,
@@ -56,6 +57,8 @@ from rbm_cli.models.status import (
     GOING,
     OPENED,
     POLL_PIECES,
+    STOP_NEVER,
+    STOP_OUTCOME,
     STOPPED_EARLY,
     SURVIVED,
     guard_code,
@@ -134,6 +137,17 @@ def _passed_peak(mdl, pc, pts):
 
 
 @jit
+def _survives(mdl, pc, pts):
+    """solver.stop: outcome in free motion: the state at point 1 certain to survive
+    (pieces.survives)."""
+    n = pc.n
+    theta = pc.phi @ pts[1, 1 : 1 + n]
+    rate = pc.phi @ pts[1, 1 + n : 1 + 2 * n]
+    return survives(theta, rate, mdl.mass, mdl.argmap, mdl.gravity, mdl.edges, mdl.nedges,
+                    mdl.intercepts, mdl.slopes, mdl.survival)  # fmt: skip
+
+
+@jit
 def _budget(s, se):
     """A failure code when a budget is exceeded, else GOING."""
     if s.cnt[STEPS] > se[0]:
@@ -144,7 +158,7 @@ def _budget(s, se):
 
 
 @jit
-def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
+def _march(mdl, pc, wk, s, se, seg_end, can_stop, sure_stop, samples):
     """Advance through the piece to its first event or seg_end [s].
     Returns the event row, -1 at seg_end, or -(a terminal code)."""
     pts = wk.pts
@@ -174,6 +188,9 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, samples):
         if s.st[SLIP_IF] == 0.0:
             first_over(s.fric, se[6], pts[1, 0], s.st[T_SLIP : SLIP_IF + 1])
         if can_stop and _passed_peak(mdl, pc, pts):
+            s.st[T] = pts[1, 0]
+            return -STOPPED_EARLY
+        if sure_stop and _survives(mdl, pc, pts):
             s.st[T] = pts[1, 0]
             return -STOPPED_EARLY
         pts[0, :] = pts[1, :]
@@ -272,7 +289,7 @@ def _leave_rest(mdl, s, mo, seg_end, fc, samples, dt, mu):
 
 
 @jit
-def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
+def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, sure_stop, samples):
     """Run up to seg_end [s] under the forcing fc. Returns a code."""
     while s.st[T] < seg_end:
         if s.st[AT_REST] != 0.0:
@@ -283,7 +300,7 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, samples):
                 return GOING
         pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)
         set_point(pc, wk.pts, 0, s.st[T], pc.tom @ s.theta, pc.tom @ s.rate)
-        row = _march(mdl, pc, wk, s, se, seg_end, can_stop, samples)
+        row = _march(mdl, pc, wk, s, se, seg_end, can_stop, sure_stop, samples)
         if row < -1:
             return -row
         if row >= 0:
@@ -321,9 +338,11 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
         if not (i > 0 and int(seg_fc[i, 0]) == LINEAR and int(seg_fc[i - 1, 0]) == LINEAR):
             s.st[H] = min(s.st[H], FIRST_STEP)  # a record's next sample keeps its step
         free = int(seg_fc[i, 0]) == ZERO and seg_t[i, 0] >= mo[4]
-        can_stop = se[3] != 0.0 and free and mo[0] != 0.0
+        can_stop = se[3] != STOP_NEVER and free and mo[0] != 0.0
+        sure_stop = se[3] == STOP_OUTCOME and free  # solver.stop: outcome
         s.cnt[SEG] = i
-        code = _segment(mdl, cache, wk, s, mo, se, seg_fc[i], seg_t[i, 1], can_stop, samples)
+        code = _segment(mdl, cache, wk, s, mo, se, seg_fc[i], seg_t[i, 1], can_stop, sure_stop,
+                        samples)  # fmt: skip
         if code != GOING:
             break
     if code == GOING:

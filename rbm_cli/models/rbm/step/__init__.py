@@ -57,6 +57,7 @@ from rbm_cli.models.status import (
     FAILED_STEP,
     STOPPED_EARLY,
     end_by_budget,
+    stop_level,
 )
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
@@ -98,7 +99,8 @@ def integrate(
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)
     # a RunTask, as a plain tuple (step.inputs)
-    task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), bool(early_stop),
+    task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
+            stop_level(early_stop, solver),
             bool(record), float(output_dt), samples, float(friction_limit))  # fmt: skip
     armed = arm()  # Ctrl-C reaches the kernel through poll (rbm_cli.base.guard)
     try:
@@ -134,7 +136,7 @@ def _outcome(
     if code == COLLAPSED:
         out.collapse(float(t_col), int(c_if))
     elif code == STOPPED_EARLY:
-        out.stopped_early()
+        out.stopped_early(solver.stop == "outcome")
     elif code == FAILED_STEP:
         out.stop("failed", "integrator: Required step size is less than spacing between "
                  "numbers.", t_end)  # fmt: skip

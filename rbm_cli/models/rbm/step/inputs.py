@@ -78,7 +78,7 @@ class RunTask(NamedTuple):
 
     theta0: np.ndarray  #: initial drum rotations [rad] (n,)
     rate0: np.ndarray  #: initial rates [rad/s] (n,)
-    early_stop: bool  #: stop free motion below the collapse barrier
+    early_stop: int  #: when the run may stop early (models.status.stop_level)
     record: bool  #: write samples
     output_dt: float  #: sampling interval [s]
     samples: np.ndarray  #: output rows (t, theta, rate) (n_max, 1 + 2n), written in place

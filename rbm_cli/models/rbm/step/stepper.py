@@ -18,6 +18,7 @@ from rbm_cli.models.rbm.pieces import (
     friction_demand,
     locate,
     settle,
+    survives,
 )
 from rbm_cli.models.rbm.step.events import (
     CHECK_INTERVALS,
@@ -55,6 +56,8 @@ from rbm_cli.models.status import (
     FAILED_STEP,
     FAILED_STEPS,
     GOING,
+    STOP_NEVER,
+    STOP_OUTCOME,
     STOPPED_EARLY,
     SURVIVED,
     guard_code,
@@ -134,7 +137,7 @@ def run_kernel(model, motion, solver, task):
     damp, ground_load = model.damp, model.ground_load
     rigid, silent, tu, c_ratio = model.rigid, model.silent, model.tu, model.c_ratio
     centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
-    uplift_level, barrier = model.uplift_level, model.barrier
+    uplift_level, barrier, survival = model.uplift_level, model.barrier, model.survival
     amplitude, pulse_end, t_end = motion.amplitude, motion.pulse_end, motion.t_end
     knots, values, vertical, clipped = motion.knots, motion.values, motion.vertical, motion.clipped
     bounds, forced = motion.bounds, motion.forced
@@ -233,7 +236,11 @@ def run_kernel(model, motion, solver, task):
         free_seg = not forced[seg]
         gr = gr_free if free_seg else gr_full
         seg_gain = gr[1]
-        can_stop = early_stop and free_seg and motion.pulse and n == 1
+        can_stop = early_stop != STOP_NEVER and free_seg and motion.pulse and n == 1
+        # solver.stop: outcome: free motion from here to the end, below the survival barrier
+        sure_stop = early_stop == STOP_OUTCOME and not vert
+        for later in range(seg, bounds.size - 1):
+            sure_stop = sure_stop and not forced[later]
         h_carry = -1.0  # the step size proposed before an event, carried over it
         while t < seg_end:
             if at_rest:
@@ -394,6 +401,10 @@ def run_kernel(model, motion, solver, task):
                 f[:] = K[ns]
                 if event:
                     break
+                if sure_stop and survives(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
+                                          intercepts, slopes, survival):  # fmt: skip
+                    return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction, slip,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
                 if can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]:
                     en = energy(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
                                   intercepts, slopes)  # fmt: skip

@@ -41,8 +41,8 @@ from .paths import CONFIGS, RESULTS
 
 CI_BAND = CONFIGS / "ci" / "suite_multidrum_ci.yaml"
 STOPPED = re.compile(r"stopped at ([0-9.e+-]+) s \(solver\.stop: outcome\)")
-#: domain.csv columns a stop changes (the run's figures after its stop, its counts) and the
-#: ensemble's columns (the stored domain is an ensemble; these sweeps are single runs)
+#: the ensemble's columns of domain.csv (the stored domain is an ensemble; these sweeps are
+#: single runs), left out of the comparison
 ENSEMBLE = ("collapse_fraction", "robust")
 RECORD_S = 30.0  # the synthetic records' length [s]
 

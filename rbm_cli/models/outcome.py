@@ -98,12 +98,13 @@ class Outcome:
         """The run stopped early in free motion below the collapse barrier: at a peak, every
         figure final; with ``outcome_only`` (solver.stop: outcome) where its survival became
         certain, at t_end [s], the peaks those up to then."""
-        self.message = "free motion below the collapse barrier: stopped early"
         if outcome_only:
             self.message = (
                 f"free motion below every joint's collapse barrier: stopped at {self.t_end:.6g} s"
                 " (solver.stop: outcome), the peaks are those up to then"
             )
+        else:
+            self.message = "free motion below the collapse barrier: stopped early"
         return self
 
     def out_of_steps(self, solver, t: float) -> Outcome:

@@ -180,14 +180,16 @@ def energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes
 
 
 @jit
-def survives(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes, survival):
-    """Whether a state in free motion is certain to survive: its energy (:func:`energy`)
-    below the column's survival barrier [J] (physics.arrays.survival_barrier; NaN: never)
-    by more than 1e-9 of it."""
-    if not survival > 0.0:
+def below_barrier(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes,
+                  barrier):
+    """Whether a state's energy (:func:`energy`) is below an energy barrier [J] by more
+    than 1e-9 of it (NaN: no barrier, never): the test of both early stops of free motion,
+    a monolith's at a peak (physics.arrays.rest_levels) and a column's certain survival
+    (physics.arrays.survival_barrier)."""
+    if barrier != barrier:
         return False
     en = energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes)
-    return en < survival * (1.0 - 1e-9)
+    return en < barrier * (1.0 - 1e-9)
 
 
 @jit(inline=True)

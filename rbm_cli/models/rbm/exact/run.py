@@ -39,15 +39,14 @@ from rbm_cli.models.rbm.exact.search import SCRATCH, next_point
 from rbm_cli.models.rbm.pieces import (
     IMPACT,
     UPLIFT,
+    below_barrier,
     cross,
-    energy,
     first_over,
     friction_demand,
     locate,
     piece_bounds,
     restitute,
     silent_impact,
-    survives,
 )
 from rbm_cli.models.status import (
     AT_REST_END,
@@ -131,20 +130,19 @@ def _passed_peak(mdl, pc, pts):
     theta, rate = np.empty(1), np.empty(1)
     theta[0] = pc.phi[0, 0] * pts[1, 1]
     rate[0] = pc.phi[0, 0] * pts[1, 2]
-    en = energy(theta, rate, mdl.mass, mdl.argmap, mdl.gravity, mdl.edges, mdl.nedges,
-                mdl.intercepts, mdl.slopes)  # fmt: skip
-    return en < mdl.barrier * (1.0 - 1e-9)
+    return below_barrier(theta, rate, mdl.mass, mdl.argmap, mdl.gravity, mdl.edges,
+                         mdl.nedges, mdl.intercepts, mdl.slopes, mdl.barrier)  # fmt: skip
 
 
 @jit
 def _survives(mdl, pc, pts):
-    """solver.stop: outcome in free motion: the state at point 1 certain to survive
-    (pieces.survives)."""
+    """solver.stop: outcome in free motion: the state at point 1 certain to survive, below
+    the survival barrier (pieces.below_barrier)."""
     n = pc.n
     theta = pc.phi @ pts[1, 1 : 1 + n]
     rate = pc.phi @ pts[1, 1 + n : 1 + 2 * n]
-    return survives(theta, rate, mdl.mass, mdl.argmap, mdl.gravity, mdl.edges, mdl.nedges,
-                    mdl.intercepts, mdl.slopes, mdl.survival)  # fmt: skip
+    return below_barrier(theta, rate, mdl.mass, mdl.argmap, mdl.gravity, mdl.edges,
+                         mdl.nedges, mdl.intercepts, mdl.slopes, mdl.survival)  # fmt: skip
 
 
 @jit

@@ -12,13 +12,13 @@ from rbm_cli.config.types import G
 from rbm_cli.models.rbm.pieces import (
     IMPACT,
     UPLIFT,
+    below_barrier,
     bound_rows,
     energy,
     first_over,
     friction_demand,
     locate,
     settle,
-    survives,
 )
 from rbm_cli.models.rbm.step.events import (
     CHECK_INTERVALS,
@@ -229,6 +229,11 @@ def run_kernel(model, motion, solver, task):
                            slopes)  # fmt: skip
         ledger[1] = ledger[0]
 
+    last_forced = -1  # the last segment with forcing (solver.stop: outcome stops after it)
+    for seg in range(bounds.size - 1):
+        if forced[seg]:
+            last_forced = seg
+    outcome_bound = survival == survival and not vert  # a survival barrier that applies
     for seg in range(bounds.size - 1):
         seg_end = bounds[seg + 1]
         if t >= seg_end:
@@ -238,9 +243,7 @@ def run_kernel(model, motion, solver, task):
         seg_gain = gr[1]
         can_stop = early_stop != STOP_NEVER and free_seg and motion.pulse and n == 1
         # solver.stop: outcome: free motion from here to the end, below the survival barrier
-        sure_stop = early_stop == STOP_OUTCOME and not vert
-        for later in range(seg, bounds.size - 1):
-            sure_stop = sure_stop and not forced[later]
+        sure_stop = early_stop == STOP_OUTCOME and seg > last_forced and outcome_bound
         h_carry = -1.0  # the step size proposed before an event, carried over it
         while t < seg_end:
             if at_rest:
@@ -401,17 +404,14 @@ def run_kernel(model, motion, solver, task):
                 f[:] = K[ns]
                 if event:
                     break
-                if sure_stop and survives(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
-                                          intercepts, slopes, survival):  # fmt: skip
+                # free motion below a barrier: a column's survival certain (solver.stop:
+                # outcome), or a monolith past a peak (every figure final)
+                peak = can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]
+                if (sure_stop or peak) and below_barrier(
+                        y[:n], y[n:], mass, argmap, gravity, edges, nedges, intercepts, slopes,
+                        survival if sure_stop else barrier):  # fmt: skip
                     return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction, slip,
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-                if can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]:
-                    en = energy(y[:n], y[n:], mass, argmap, gravity, edges, nedges,
-                                  intercepts, slopes)  # fmt: skip
-                    if en < barrier * (1.0 - 1e-9):
-                        return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out,
-                                ledger)  # fmt: skip
             if not event:
                 t = seg_end if not running else t
                 continue

@@ -396,6 +396,12 @@ def _check_dimensions(config: Config) -> None:
             f" (got {fmt(excitation.angle)} deg): use a model in three dimensions ({three_d})"
             " or delete excitation.angle"
         )
+    if excitation.file_y is not None and excitation.motion is not None:
+        raise ConfigError(
+            f"motion {excitation.motion.name!r} is a pair (acceleration_y, a second horizontal"
+            f" component), and model {model} rocks in one plane: use a model in three"
+            f" dimensions ({three_d}) or give the motion without acceleration_y"
+        )
     if excitation.file_y is not None:
         raise ConfigError(
             "excitation.file_y is a second horizontal component (so is the y of a pair"

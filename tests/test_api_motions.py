@@ -155,6 +155,30 @@ def test_a_file_for_the_second_component_beside_a_motion_is_refused(
         assert "\n" not in message and words in message and "acceleration_y" in message
 
 
+def test_plot_domain_draws_a_sweep_of_motions_with_the_config_it_was_given():
+    """rbm.plot_domain(df, config=cfg) after rbm.sweep(cfg, motions=...): drawn with the
+    config swept (the motions from df.attrs), its uplift level B/H included; the config as
+    the sweep ran it draws the same figure."""
+    raw = {"name": "block", "column": {"height": 2.0, "base_width": 0.5},
+           "interface": {"stiffness": "rigid", "restitution": 0.9},
+           "grid": {"amplitudes": [0.1, 0.5, 2.0], "frequencies": [1.0]}}  # fmt: skip
+    cfg = rbm.load_config(raw)
+    t = np.linspace(0.0, 1.0, 401)
+    motions = [rbm.motion_from_arrays(t, s * np.sin(np.pi * t), name=f"m{s}") for s in (1, 2)]
+    df = rbm.sweep(cfg, motions=motions)
+    ax = rbm.plot_domain(df, config=cfg)
+    labels = [line.get_label() for line in ax.get_lines()]
+    ran = rbm.load_config({**raw, "excitation": {"type": "record", "file": motions[0]},
+                           "grid": {"amplitudes": [0.1, 0.5, 2.0],
+                                    "excitation.file": motions}})  # fmt: skip
+    same = rbm.plot_domain(df.copy(), config=ran)
+    assert labels == [line.get_label() for line in same.get_lines()]
+    texts = " ".join(labels + [t.get_text() for t in ax.texts])
+    assert "0.25" in texts or any(
+        np.allclose(line.get_ydata(), 0.25) for line in ax.get_lines() if len(line.get_ydata())
+    ), labels
+
+
 # --------------------------------------------------------------------------- pairs
 
 

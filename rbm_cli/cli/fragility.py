@@ -73,8 +73,12 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         rbm fragility results/suite_multidrum/domain.csv \
             --compare results/suite_monolithic/domain.csv -o docs/figures/suite
     """
-    from rbm_cli.api.fragility_curves import MAX_RESAMPLES, run_fragility
+    from rbm_cli.api.fragility_curves import MAX_RESAMPLES, check_intensity, run_fragility
 
+    try:
+        check_intensity(intensity_column, "--intensity")
+    except RbmError as exc:
+        raise UserError(one_line(exc)) from None
     if resamples > MAX_RESAMPLES:
         raise UserError(
             f"--resamples must be at most {MAX_RESAMPLES:,} (each is a refit), got {resamples:,}"

@@ -88,16 +88,19 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
     path = excitation.file_path or excitation.file
     if path is None:
         raise RbmError("excitation.file is required for type record")
+    rec_y = None
     if excitation.motion is not None:  # given as arrays: the same record, from memory
         motion = excitation.motion
-        path = f"motion {motion.name!r}"
+        path = path_y = f"motion {motion.name!r}"
         rec = Record(motion.time_s, motion.acceleration_m_s2, motion.name, "in memory")
         rec = rec.processed(excitation.processing)
+        if motion.is_pair:  # its y component, on the same times
+            rec_y = Record(motion.time_s, motion.acceleration_y_m_s2, motion.name, "in memory")
+            rec_y = rec_y.processed(excitation.processing)
     else:
         rec = processed_record(str(path), excitation.units, excitation.file_sha256,
                                excitation.processing)  # fmt: skip
-    rec_y = None
-    if excitation.file_y is not None:
+    if excitation.file_y is not None and excitation.motion is None:
         path_y = excitation.file_y_path or excitation.file_y
         rec_y = processed_record(str(path_y), excitation.units, excitation.file_y_sha256,
                                  excitation.processing)  # fmt: skip

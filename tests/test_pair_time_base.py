@@ -6,6 +6,8 @@ times) are then those of the motion run."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -93,3 +95,33 @@ def test_a_pair_on_one_time_base_is_run_as_read(tmp_path):
     motion = make_ground_motion(cfg.excitation, 0.3)
     assert motion.knots is not None and np.array_equal(motion.knots, TIMES_X)
     np.testing.assert_allclose(motion.values_y, VALUES_Y * G, rtol=1e-15)  # PGA 0.3 g as read
+
+
+def test_the_run_says_which_time_base_it_took(tmp_path):
+    """`rbm run` of the pair: its summary.json says the pair was put on the union of both
+    records' times; a pair on one time base says 'shared'."""
+    import json
+
+    import yaml
+    from click.testing import CliRunner
+
+    from rbm_cli.cli.main import cli
+
+    def run(file_y: str) -> dict:
+        name = f"pair_{Path(file_y).stem}"
+        config = tmp_path / f"{name}.yaml"
+        config.write_text(yaml.safe_dump({
+            "name": name, "model": "housner-3d", "column": dict(COLUMN),
+            "interface": {"stiffness": "rigid", "restitution": 0.9},
+            "excitation": {"type": "record", "units": "g", "free_time": 0.5,
+                           "file": write(tmp_path / "x.csv", TIMES_X, VALUES_X),
+                           "file_y": file_y},
+        }))  # fmt: skip
+        res = CliRunner().invoke(cli, ["run", str(config), "-a", "0.1", "-o", str(tmp_path)])
+        assert res.exit_code == 0, res.output
+        (summary,) = (tmp_path / name).glob("*/summary.json")
+        return json.loads(summary.read_text())["record"]
+
+    union = run(write(tmp_path / "y.csv", TIMES_Y, VALUES_Y))
+    shared = run(write(tmp_path / "y_same.csv", TIMES_X, VALUES_Y))
+    assert union["pair_times"] == "union" and shared["pair_times"] == "shared"

@@ -38,6 +38,7 @@ __all__ = [
     "load_record",
     "make_ground_motion",
     "merge_records",
+    "pair_times",
     "processed_record",
     "pulse_motion",
     "record_motion",
@@ -117,9 +118,8 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
                                excitation.processing)  # fmt: skip
         series.append((ver.t, _scaled(ver, factor, path)))
         end = max(end, ver.duration)
-    if len(series) == 1 or (
-        excitation.vertical is None and np.array_equal(series[1][0], series[0][0])
-    ):  # one time base already: the samples as read
+    if len(series) == 1 or (excitation.vertical is None and pair_times(excitation) == "shared"):
+        # one time base already: the samples as read
         knots, columns = series[0][0], [values for _, values in series]
     else:  # a vertical record, or a pair sampled at other times: on their union
         knots, *columns = common_knots(series)
@@ -145,6 +145,23 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
         vertical=vertical,
         values_y=values_y,
     )
+
+
+def pair_times(excitation: ExcitationConfig) -> str | None:
+    """How a pair of records (``excitation.file_y``) is put on one time base: ``shared``
+    when both have the same sample times (run as read), ``union`` when they differ (both
+    on the union of their times, each linear between its own samples:
+    :func:`common_knots`); None without a second component."""
+    if excitation.file_y is None:
+        return None
+    path = excitation.file_path or excitation.file
+    if excitation.motion is not None:
+        t = np.asarray(excitation.motion.time_s, dtype=float)
+    else:
+        t = load_record(str(path), excitation.units, excitation.file_sha256).t
+    path_y = excitation.file_y_path or excitation.file_y
+    t_y = load_record(str(path_y), excitation.units, excitation.file_y_sha256).t
+    return "shared" if np.array_equal(t, t_y) else "union"
 
 
 #: Largest peak acceleration of a scaled record [g]: the grid's largest amplitude.

@@ -114,6 +114,10 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         click.echo(f"median {median}, dispersion beta {beta}")
         if res.note:
             click.echo(f"note: {res.note}")
+        if res.fit_warning:
+            click.echo(f"warning: {res.fit_warning}")
+        if res.resamples_note:
+            click.echo(f"note: {res.resamples_note}")
     folder = made.paths[0].parent
     click.echo(f"output: {folder}/ " + ", ".join(p.name for p in made.paths))
 

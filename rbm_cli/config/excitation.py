@@ -9,6 +9,12 @@ Keys, by excitation type (a key of another type is refused, naming it):
   ``half-sine``, ``duration`` [s] is the maximum simulated time (default 20 s), the pulse
   then free motion; ``mavroeidis-papageorgiou`` also ``gamma`` (> 1, at most 20 [-]) and
   ``nu`` (in [-2 pi, 2 pi] [rad]), both required;
+- ``harmonic``, ``half-sine`` and the pulses: ``y: {amplitude_ratio, phase_deg}``, an
+  analytic second horizontal component at 90 degrees counter-clockwise from the motion's
+  direction, the same formula scaled by amplitude_ratio (in [0, 10] [-]) and shifted by
+  phase_deg (in [-360, 360] [deg], default 0; a Ricker wavelet has no phase: 0 or
+  +-180, its sign, or +-360) (:func:`second_component`; the loader refuses it for the
+  planar models);
 - ``record``: ``file`` (one PEER NGA ``.AT2`` or CSV file; a relative path is taken from the
   folder of the config file, or from the current directory for a config given as a
   mapping), ``units`` (``g``, default, or ``m/s2``: a CSV's values; an ``.AT2`` is in g),
@@ -64,6 +70,7 @@ from rbm_cli.config.types import (
     G,
     InitialConfig,
     ProcessingConfig,
+    SecondComponentConfig,
 )
 from rbm_cli.config.validate import (
     choice,
@@ -85,6 +92,7 @@ __all__ = [
     "processing_section",
     "record_file",
     "resolve_record_path",
+    "second_component",
     "with_record",
 ]
 
@@ -104,6 +112,7 @@ EXCITATION_KEYS = (
     "im_periods",
     "angle",
     "file_y",
+    "y",
 )
 PROCESSING_KEYS = ("baseline", "filter")
 FILTER_KEYS = ("low_hz", "high_hz", "order")
@@ -111,6 +120,13 @@ FILTER_KEYS = ("low_hz", "high_hz", "order")
 #: side, doubled by the forward and backward pass; strong-motion practice uses 2-8.
 FILTER_ORDER_MAX = 8
 INITIAL_KEYS = ("rotations", "velocities")
+#: Keys of excitation.y, the analytic second component.
+Y_KEYS = ("amplitude_ratio", "phase_deg")
+#: Largest excitation.y.amplitude_ratio [-]: a second component stronger than ten times
+#: the first is the first of the motion turned by 90 degrees (excitation.angle).
+Y_RATIO_MAX = 10.0
+#: Range of excitation.y.phase_deg [deg]: one turn either way.
+Y_PHASE_RANGE_DEG = (-360.0, 360.0)
 #: Default ``excitation.duration`` per type [s].
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
 DEFAULT_DURATION.update({kind: 20.0 for kind in PULSES})  # as the half-sine [assumption]
@@ -137,6 +153,7 @@ ONLY_FOR = {
     "file_y": ("record",),
     "processing": ("record",),
     "im_periods": ("record",),
+    "y": tuple(t for t in EXCITATIONS if t not in ("record", "free")),
 }
 #: Periods of the spectral accelerations a record's rows report (excitation.im_periods)
 #: [s], and how many a config may list.
@@ -344,6 +361,33 @@ def _initial(raw: Any, n: int, kind: str) -> InitialConfig:
     return InitialConfig(**values)
 
 
+def second_component(raw: Any, kind: str) -> SecondComponentConfig:
+    """The validated ``excitation.y`` of an excitation of type ``kind`` (a harmonic or a
+    pulse): ``amplitude_ratio`` r in [0, Y_RATIO_MAX] (required) and ``phase_deg`` phi in
+    Y_PHASE_RANGE_DEG (default 0); a Ricker wavelet, which has no phase, takes a multiple
+    of 180 degrees only (its sign).
+
+    Raises
+    ------
+    ConfigError  One line naming the key and its range.
+    """
+    path = "excitation.y"
+    y = mapping(raw, path, Y_KEYS, required=("amplitude_ratio",))
+    ratio = number(y["amplitude_ratio"], join(path, "amplitude_ratio"), "", 0.0, Y_RATIO_MAX,
+                   lo_open=False, hint="a larger second component is the first of the motion"
+                   " turned by 90 degrees: excitation.angle")  # fmt: skip
+    phase = number(y.get("phase_deg", 0.0), join(path, "phase_deg"), "deg")
+    phase = in_bounds(
+        phase, join(path, "phase_deg"), "deg", Y_PHASE_RANGE_DEG, "one turn either way"
+    )
+    if kind == "ricker" and phase % 180.0 != 0.0:
+        raise ConfigError(
+            f"{path}.phase_deg: a Ricker wavelet has no phase, so its second component is the"
+            f" same wavelet times r (phase_deg 0 or +-360) or -r (+-180), got {fmt(phase)}"
+        )
+    return SecondComponentConfig(float(ratio), float(phase))
+
+
 def _refuse_foreign_keys(e: dict, kind: str) -> None:
     """A key of another excitation type is an error that names it."""
     for key, kinds in ONLY_FOR.items():
@@ -353,6 +397,11 @@ def _refuse_foreign_keys(e: dict, kind: str) -> None:
                     "excitation.duration does not apply to type record: the run lasts the"
                     " record plus excitation.free_time [s] (default"
                     f" {fmt(DEFAULT_FREE_TIME)} s): delete it"
+                )
+            if key == "y" and kind == "record":
+                raise ConfigError(
+                    "excitation.y is the analytic second component of a harmonic or a pulse;"
+                    " a record's second component is a file: excitation.file_y"
                 )
             raise ConfigError(
                 f"excitation.{key} applies only to type {' or '.join(kinds)}"
@@ -575,5 +624,6 @@ def excitation_section(
         initial=_initial(e.get("initial"), n, kind),
         angle=angle,
         directed="angle" in e,
+        y=second_component(e["y"], kind) if "y" in e else None,
         **fields,
     )

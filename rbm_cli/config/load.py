@@ -372,7 +372,7 @@ def _check_stop(config: Config) -> None:
 def _check_dimensions(config: Config) -> None:
     """A model that moves in three dimensions (Config.three_d) takes a circular column only;
     a planar model takes a motion along its plane only (excitation.angle 0, no
-    excitation.file_y, so no suite of pairs either)."""
+    excitation.file_y, so no suite of pairs either, no excitation.y)."""
     model, excitation = config.model, config.excitation
     section = config.column.section
     if config.three_d:
@@ -402,6 +402,12 @@ def _check_dimensions(config: Config) -> None:
             f" {{x, y}} in excitation.file), and model {model} rocks in one plane: use a model"
             f" in three dimensions ({three_d}) or delete excitation.file_y (write"
             " excitation.file as files, not pairs)"
+        )
+    if excitation.y is not None:
+        raise ConfigError(
+            "excitation.y is a second horizontal component, and model"
+            f" {model} rocks in one plane: use a model in three dimensions ({three_d}) or"
+            " delete excitation.y"
         )
 
 

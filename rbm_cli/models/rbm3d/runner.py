@@ -101,7 +101,8 @@ def integrate3d(
     rows = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((rows, 3 + 3 * n))
     task = (y0, bool(record), float(output_dt), samples, float(friction_limit))
-    pair = (float(d[0]), float(d[1]), as_samples(motion.values_y))
+    pair = (float(d[0]), float(d[1]), as_samples(motion.values_y), motion.ground_y,
+            motion.knots_y)  # fmt: skip
     armed = arm()
     try:
         kernel = run3d if solver.implementation == "compiled" else plain(run3d)

@@ -292,6 +292,10 @@ def _ranges() -> dict[str, str]:
         f", distinct, at most {MAX_IM_PERIODS}",
         "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, one per drum",
         "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, one per drum",
+        "excitation.initial.rotations_across": f"within +-{fmt(INITIAL_MAX['rotations'])}, one"
+        " per drum; ``housner-3d``, ``rbm-3d``",
+        "excitation.initial.velocities_across": f"within +-{fmt(INITIAL_MAX['velocities'])}, one"
+        " per drum; ``housner-3d``, ``rbm-3d``",
         "excitation.y.amplitude_ratio": f"[0, {fmt(Y_RATIO_MAX)}]",
         "excitation.y.phase_deg": f"[{fmt(Y_PHASE_RANGE_DEG[0])}, {fmt(Y_PHASE_RANGE_DEG[1])}];"
         " ``ricker``: a multiple of 180",
@@ -448,8 +452,36 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "Default 0.",
     ),
     "excitation.initial": ("", "", "Initial state of the drums."),
-    "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),
-    "excitation.initial.velocities": ("rad/s", "", "Angular velocity of each drum at t = 0."),
+    "excitation.initial.rotations": (
+        "rad",
+        "",
+        "Absolute rotation of each drum at t = 0, in the motion's vertical plane (the x "
+        "plane of the planar models; ``excitation.angle``'s for the models in three "
+        "dimensions).",
+    ),
+    "excitation.initial.velocities": (
+        "rad/s",
+        "",
+        "Angular velocity of each drum at t = 0, in the motion's vertical plane.",
+    ),
+    "excitation.initial.rotations_across": (
+        "rad",
+        "",
+        "Models in three dimensions: each drum's rotation at t = 0 in the vertical plane "
+        "across the motion's (its direction turned by +90 degrees, a history's "
+        "``theta<i>_across_rad``): with ``rotations`` a rotation vector, rotations d + "
+        "rotations_across d'. ``housner-3d``: the column tilts by the vector's size toward "
+        "its direction. Refused by the planar models and ``bullet``. Default 0.",
+    ),
+    "excitation.initial.velocities_across": (
+        "rad/s",
+        "",
+        "Models in three dimensions: each drum's rate at t = 0 across the motion's plane; "
+        "the rates form a vector as the rotations do (the top moves along velocities d + "
+        "velocities_across d'). ``housner-3d``: its angular velocity is horizontal, no "
+        "spin about the vertical. A tilt in the plane with a rate across it starts a "
+        "wobble. Refused by the planar models and ``bullet``. Default 0.",
+    ),
     "excitation.y": (
         "",
         "a mapping",

@@ -2,7 +2,9 @@
 
 Keys, by excitation type (a key of another type is refused, naming it):
 
-- every type: ``type``, ``initial: {rotations, velocities}`` [rad, rad/s];
+- every type: ``type``, ``initial: {rotations, velocities}`` [rad, rad/s] (and, for the
+  models in three dimensions, ``rotations_across``, ``velocities_across``: the same across
+  the motion's plane; the loader refuses them for the others);
 - ``harmonic``, ``half-sine``, ``free``: ``duration`` [s]; ``harmonic``: ``phase`` [rad]
   (0 is accepted with any type);
 - pulses, ``one-sine``, ``cycloidal``, ``ricker``, ``mavroeidis-papageorgiou``: as
@@ -119,7 +121,7 @@ FILTER_KEYS = ("low_hz", "high_hz", "order")
 #: Largest order of each side of the band-pass [-]: the roll-off is 6 n dB an octave a
 #: side, doubled by the forward and backward pass; strong-motion practice uses 2-8.
 FILTER_ORDER_MAX = 8
-INITIAL_KEYS = ("rotations", "velocities")
+INITIAL_KEYS = ("rotations", "velocities", "rotations_across", "velocities_across")
 #: Keys of excitation.y, the analytic second component.
 Y_KEYS = ("amplitude_ratio", "phase_deg")
 #: Largest excitation.y.amplitude_ratio [-]: a second component stronger than ten times
@@ -342,18 +344,21 @@ def _initial(raw: Any, n: int, kind: str) -> InitialConfig:
     path = "excitation.initial"
     init = mapping(raw, path, INITIAL_KEYS)
     per = f"one value per drum ({n})"
-    values = {
-        key: tuple(
-            in_bounds(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
-            for i, x in enumerate(
-                number_list(init[key], join(path, key), unit, length=n, length_text=per)
+    units = {"rotations": "rad", "velocities": "rad/s"}
+    values = {}
+    for key in INITIAL_KEYS:
+        unit, bound = units[key.removesuffix("_across")], INITIAL_MAX[key.removesuffix("_across")]
+        values[key] = (
+            tuple(
+                in_bounds(x, join(join(path, key), i), unit, (-bound, bound))
+                for i, x in enumerate(
+                    number_list(init[key], join(path, key), unit, length=n, length_text=per)
+                )
             )
+            if key in init
+            else ()
         )
-        if key in init
-        else ()
-        for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
-    }
-    if kind == "free" and not any(values["rotations"]) and not any(values["velocities"]):
+    if kind == "free" and not any(any(v) for v in values.values()):
         raise ConfigError(
             f"{path}: excitation type free needs a non-zero initial rotation or velocity"
             f" ({path}.rotations or .velocities); with none the column stays at rest"

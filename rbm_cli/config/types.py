@@ -196,11 +196,25 @@ class InterfaceConfig:
 class InitialConfig:
     """Initial absolute drum rotations [rad] and rates [rad/s], bottom first.
 
+    rotations, velocities : tuple of float  In the motion's vertical plane (the plane of
+        the planar models; for the models in three dimensions, the vertical plane of
+        excitation.angle)
+    rotations_across, velocities_across : tuple of float  Models in three dimensions
+        only: the same in the vertical plane across it (the motion's direction turned by
+        +90 degrees in plan), as a history's ``rotations_across``
+
     Empty tuples mean zero.
     """
 
     rotations: tuple[float, ...] = ()
     velocities: tuple[float, ...] = ()
+    rotations_across: tuple[float, ...] = ()
+    velocities_across: tuple[float, ...] = ()
+
+    @property
+    def across(self) -> bool:
+        """Whether a rotation or rate across the motion's plane is given (not all 0)."""
+        return any(self.rotations_across) or any(self.velocities_across)
 
 
 @dataclass(frozen=True)
@@ -356,6 +370,9 @@ class ExcitationConfig:
             drop.append("y")
         for key in drop:
             out.pop(key)
+        for key in ("rotations_across", "velocities_across"):  # none: as before they existed
+            if not out["initial"][key]:
+                del out["initial"][key]
         return out
 
 

@@ -146,6 +146,7 @@ def config_keys() -> list[str]:
         FILTER_KEYS,
         INITIAL_KEYS,
         PROCESSING_KEYS,
+        Y_KEYS,
     )
     from rbm_cli.config.grid import EXCITATION_AXES, LINKED, VIRTUAL_PATHS
     from rbm_cli.config.interface import INTERFACE_KEYS, STIFFNESS_KEYS
@@ -169,6 +170,7 @@ def config_keys() -> list[str]:
     sub = {
         "interface.stiffness": STIFFNESS_KEYS,
         "excitation.initial": INITIAL_KEYS,
+        "excitation.y": Y_KEYS,
         "excitation.processing": PROCESSING_KEYS,
         "excitation.processing.filter": FILTER_KEYS,
         "column.capital": CAPITAL_KEYS,
@@ -201,6 +203,7 @@ def _defaults() -> dict[str, str]:
         "interface": t.InterfaceConfig,
         "excitation": t.ExcitationConfig,
         "excitation.initial": t.InitialConfig,
+        "excitation.y": t.SecondComponentConfig,
         "excitation.processing": t.ProcessingConfig,
         "excitation.processing.filter": t.FilterConfig,
         "collapse": t.CollapseConfig,
@@ -231,6 +234,8 @@ def _ranges() -> dict[str, str]:
         MAX_DURATION,
         MAX_IM_PERIODS,
         PHASE_MAX,
+        Y_PHASE_RANGE_DEG,
+        Y_RATIO_MAX,
     )
     from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, MAX_CELLS
     from rbm_cli.config.interface import FRICTION_MAX, NORMAL_RANGE, ROTATIONAL_RANGE
@@ -288,6 +293,13 @@ def _ranges() -> dict[str, str]:
         f", distinct, at most {MAX_IM_PERIODS}",
         "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, one per drum",
         "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, one per drum",
+        "excitation.initial.rotations_across": f"within +-{fmt(INITIAL_MAX['rotations'])}, one"
+        " per drum; ``housner-3d``, ``rbm-3d``",
+        "excitation.initial.velocities_across": f"within +-{fmt(INITIAL_MAX['velocities'])}, one"
+        " per drum; ``housner-3d``, ``rbm-3d``",
+        "excitation.y.amplitude_ratio": f"[0, {fmt(Y_RATIO_MAX)}]",
+        "excitation.y.phase_deg": f"[{fmt(Y_PHASE_RANGE_DEG[0])}, {fmt(Y_PHASE_RANGE_DEG[1])}];"
+        " ``ricker``: a multiple of 180",
         "grid.amplitudes": f"[{fmt(AMPLITUDE_RANGE_G[0])}, {fmt(AMPLITUDE_RANGE_G[1])}]",
         "grid.frequencies": f"[{fmt(FREQUENCY_RANGE_HZ[0])}, {fmt(FREQUENCY_RANGE_HZ[1])}]",
         "grid.<key path>": f"at most {MAX_CELLS:,} cells in all",
@@ -448,8 +460,57 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "Default 0.",
     ),
     "excitation.initial": ("", "", "Initial state of the drums."),
-    "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),
-    "excitation.initial.velocities": ("rad/s", "", "Angular velocity of each drum at t = 0."),
+    "excitation.initial.rotations": (
+        "rad",
+        "",
+        "Absolute rotation of each drum at t = 0, in the motion's vertical plane (the x "
+        "plane of the planar models; ``excitation.angle``'s for the models in three "
+        "dimensions).",
+    ),
+    "excitation.initial.velocities": (
+        "rad/s",
+        "",
+        "Angular velocity of each drum at t = 0, in the motion's vertical plane.",
+    ),
+    "excitation.initial.rotations_across": (
+        "rad",
+        "",
+        "Models in three dimensions: each drum's rotation at t = 0 in the vertical plane "
+        "across the motion's (its direction turned by +90 degrees, a history's "
+        "``theta<i>_across_rad``): with ``rotations`` a rotation vector, rotations d + "
+        "rotations_across d'. ``housner-3d``: the column tilts by the vector's size toward "
+        "its direction. Refused by the planar models and ``bullet``. Default 0.",
+    ),
+    "excitation.initial.velocities_across": (
+        "rad/s",
+        "",
+        "Models in three dimensions: each drum's rate at t = 0 across the motion's plane; "
+        "the rates form a vector as the rotations do (the top moves along velocities d + "
+        "velocities_across d'). ``housner-3d``: its angular velocity is horizontal, no "
+        "spin about the vertical. A tilt in the plane with a rate across it starts a "
+        "wobble. Refused by the planar models and ``bullet``. Default 0.",
+    ),
+    "excitation.y": (
+        "",
+        "a mapping",
+        "``harmonic``, ``half-sine`` and the pulses, models in three dimensions: an "
+        "analytic second horizontal component at 90 degrees counter-clockwise from the "
+        "motion's direction (``excitation.angle`` turns both, as a record pair), the "
+        "same formula times ``amplitude_ratio`` r, its phase led by ``phase_deg`` phi: a "
+        "harmonic's a_y = r A sin(omega t + phase + phi); a sine pulse's the same on the "
+        "pulse (the cycloidal's phase is 90 degrees); ``mavroeidis-papageorgiou``'s the "
+        "pulse with nu + phi and r times its velocity amplitude; ``ricker``'s the wavelet "
+        "times r (phi 0 or 360) or -r (phi 180). r = 1, phi = 90 is a circular motion; the "
+        "grid's amplitude is the first component's. r = 0 is the motion of one component. "
+        "Refused for records (their second component is ``file_y``), free motion and "
+        "the planar models.",
+    ),
+    "excitation.y.amplitude_ratio": (
+        "",
+        "",
+        "Required. r: the second component's multiplier over the first's.",
+    ),
+    "excitation.y.phase_deg": ("deg", "", "phi: the second component's phase lead."),
     "excitation.file": (
         "",
         "a file, a list of files, a folder, a glob, or a list of ``{x: FILE, y: FILE}``",

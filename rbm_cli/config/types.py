@@ -196,11 +196,40 @@ class InterfaceConfig:
 class InitialConfig:
     """Initial absolute drum rotations [rad] and rates [rad/s], bottom first.
 
+    rotations, velocities : tuple of float  In the motion's vertical plane (the plane of
+        the planar models; for the models in three dimensions, the vertical plane of
+        excitation.angle)
+    rotations_across, velocities_across : tuple of float  Models in three dimensions
+        only: the same in the vertical plane across it (the motion's direction turned by
+        +90 degrees in plan), as a history's ``rotations_across``
+
     Empty tuples mean zero.
     """
 
     rotations: tuple[float, ...] = ()
     velocities: tuple[float, ...] = ()
+    rotations_across: tuple[float, ...] = ()
+    velocities_across: tuple[float, ...] = ()
+
+    @property
+    def across(self) -> bool:
+        """Whether a rotation or rate across the motion's plane is given (not all 0)."""
+        return any(self.rotations_across) or any(self.velocities_across)
+
+
+@dataclass(frozen=True)
+class SecondComponentConfig:
+    """An analytic second horizontal component (excitation.y) of a harmonic or a pulse,
+    acting at 90 degrees counter-clockwise from the motion's direction: the same formula
+    scaled by amplitude_ratio and shifted in phase by phase_deg (a_y = r A sin(omega t +
+    phase + phi) for a harmonic; rbm_cli.physics.excitation says it for each pulse).
+
+    amplitude_ratio : float  r = the second component's multiplier over the first's [-]
+    phase_deg : float  phi, its phase lead [deg]
+    """
+
+    amplitude_ratio: float
+    phase_deg: float = 0.0
 
 
 #: ExcitationConfig fields of type 'record' only, and those never in Config.resolved()
@@ -283,6 +312,9 @@ class ExcitationConfig:
     directed : bool  excitation.angle was written (0 included): a model that moves in three
         dimensions when its motion is given a direction does so (ModelEntry.any_direction);
         never in :meth:`resolved` (Config.resolved says the dimensions instead)
+    y : SecondComponentConfig or None  A harmonic's or a pulse's analytic second
+        horizontal component, at 90 degrees counter-clockwise from the motion's direction
+        (models in three dimensions only); left out of :meth:`resolved` when None
     processing : ProcessingConfig or None  Record: its baseline correction and band-pass,
         applied to the record (and the vertical record) before scaling; None: the record
         as read (also for a processing that changes nothing, so the config's hash is the
@@ -312,6 +344,7 @@ class ExcitationConfig:
     file_y: str | None = None
     file_y_sha256: str | None = None
     file_y_path: str | None = field(default=None, compare=False)
+    y: SecondComponentConfig | None = None
 
     def resolved(self) -> dict:
         """The settings that define the motion, as plain data: the fields of other
@@ -333,8 +366,13 @@ class ExcitationConfig:
             drop.append("im_periods")
         if self.angle == 0.0:
             drop.append("angle")
+        if self.y is None:
+            drop.append("y")
         for key in drop:
             out.pop(key)
+        for key in ("rotations_across", "velocities_across"):  # none: as before they existed
+            if not out["initial"][key]:
+                del out["initial"][key]
         return out
 
 
@@ -481,7 +519,8 @@ class Config:
         dimensions (ModelEntry.three_d); for a model that takes any direction
         (ModelEntry.any_direction), when the motion is given a direction
         (``excitation.angle`` written, 0 included, or an axis over it) or a second
-        horizontal component (``excitation.file_y``, or an axis over it: a suite of pairs)."""
+        horizontal component (``excitation.file_y`` or ``excitation.y``, or an axis over
+        either: a suite of pairs)."""
         entry = MODELS[self.model]
         if entry.three_d:
             return True
@@ -493,8 +532,10 @@ class Config:
             e.directed
             or e.angle != 0.0
             or e.file_y is not None
+            or e.y is not None
             or "excitation.angle" in paths
             or "excitation.file_y" in paths
+            or any(p == "excitation.y" or p.startswith("excitation.y.") for p in paths)
         )
 
     def record_files(self) -> tuple[tuple[str, str, str], ...]:

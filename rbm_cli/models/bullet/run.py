@@ -22,7 +22,8 @@ angular damping (PyBullet's defaults are not 0), collision margin 0, split
 impulse on, erp 0.2.
 
 In three dimensions (Config.three_d: the motion given a direction, ``excitation.angle``,
-or a second horizontal component, ``excitation.file_y``; circular drums), the drums are
+or a second horizontal component, ``excitation.file_y`` or ``excitation.y``; circular
+drums), the drums are
 the engine's cylinders (:func:`rbm_cli.models.bullet.scene.cylinder_shape`) and nothing
 holds them in a plane: they rock, roll on their rims, slide and twist as the contacts
 let them, the gravity vector (-a_x(t), -a_y(t), -(g + a_v(t))); the joints are read by
@@ -127,6 +128,8 @@ def ground_friction_demand(motion: GroundMotion) -> float:
     resultant). With a vertical record both are linear between the same knots (a pair's
     resultant convex), so the ratio is at most its value at an end of each interval and
     its maximum is at a knot."""
+    if motion.second is not None:  # an analytic second component (no vertical record)
+        return motion.horizontal_peak / G
     horizontal = None
     if motion.values_y is not None:  # a pair: the resultant, convex on each interval
         horizontal = np.hypot(motion.values, motion.values_y)

@@ -98,6 +98,7 @@ def cylinder_run(
     early_stop: bool = True,
     events: list | None = None,
     state: np.ndarray | None = None,
+    across: tuple[float, float] = (0.0, 0.0),
 ) -> Outcome:
     """One run of the rigid cylinder in three dimensions (the module's rules).
 
@@ -111,6 +112,11 @@ def cylinder_run(
         [rad/s] and h alpha [m]), step and event budgets
     record : bool  Keep samples every output_dt [s] (the module's history angle)
     initial : (float, float)  Initial tilt [rad] and its rate [rad/s] in the motion's plane
+    across : (float, float)  The same across it (the motion's direction d turned by +90
+        degrees in plan, d'): the column starts tilted by |(theta, theta')| toward theta d
+        + theta' d' (theta the first of ``initial``, theta' the first of ``across``), its
+        angular velocity horizontal, rate (e_z x d) + rate' (e_z x d') (the top moving
+        along rate d + rate' d'), no spin about the vertical
     early_stop : bool  Stop at rest after the motion
     events : list or None  If a list, (t [s], kind) is appended for every 'uplift',
         'impact', 'rest' and 'collapse'
@@ -139,6 +145,8 @@ def cylinder_run(
     run.c = side * d
     run.y[0:2] = math.sin(abs(theta0)) * run.c
     run.y[2:4] = rate0 * np.array([-d[1], d[0]])  # about the horizontal normal to d
+    if across[0] != 0.0 or across[1] != 0.0:
+        run.y, run.c = _initial_state(d, theta0, rate0, float(across[0]), float(across[1]))
     if state is not None:
         run.y = np.array(state, dtype=float)
         run.c = lean_direction(run.y[0:2], run.c)
@@ -166,6 +174,25 @@ def cylinder_run(
         if stop is not None:
             return stop
     return _finish(run)
+
+
+def _initial_state(d: np.ndarray, theta: float, rate: float, theta_across: float,
+                   rate_across: float) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The state (7,) and the contact direction of a column tilted by theta along d and
+    theta_across across it (d' = d turned by +90 degrees), turning at rate and rate_across
+    (cylinder_run's ``across``): the lean q = sin|v| v / |v|, v = theta d + theta_across d',
+    the angular velocity rate (e_z x d) + rate_across (e_z x d'); the contact toward v, or
+    toward where the top moves when upright."""
+    across = np.array([-d[1], d[0]])
+    v = theta * d + theta_across * across
+    size = math.hypot(v[0], v[1])
+    moving = rate * d + rate_across * across
+    speed = math.hypot(moving[0], moving[1])
+    c = v / size if size > 0.0 else (moving / speed if speed > 0.0 else d)
+    y = np.zeros(STATE_SIZE)
+    y[0:2] = math.sin(size) * c
+    y[2:4] = rate * np.array([-d[1], d[0]]) + rate_across * np.array([-across[1], across[0]])
+    return y, c
 
 
 def _finish(run: _Run3d, status: str = "survived", message: str = "") -> Outcome:
@@ -366,6 +393,11 @@ class Housner3dRunner(BlockRunner):
     def __init__(self, config) -> None:
         super().__init__(config)
         self.cylinder = cylinder_geometry(config.column)
+        init = config.excitation.initial
+        self.across = (
+            float(init.rotations_across[0]) if init.rotations_across else 0.0,
+            float(init.velocities_across[0]) if init.velocities_across else 0.0,
+        )
         methods.resolve(config)  # an explicit method that does not apply: refused
 
     def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
@@ -378,6 +410,7 @@ class Housner3dRunner(BlockRunner):
             collapse_ratio=self.config.collapse.ratio,
             solver=solver,
             initial=self.initial,
+            across=self.across,
             **options,
         )
         out.method = solver.method

@@ -45,10 +45,11 @@ from rbm_cli.models.status import (
 from rbm_cli.physics.arrays import ColumnArrays
 from rbm_cli.physics.beam3d import CS_PER_JOINT, ES_EXTRA, horizontal, pack_pieces
 from rbm_cli.physics.ground import (
+    LINE,
     gravity_factor,
     ground_at,
     next_uplift,
-    pair_exceedance,
+    pair_uplift,
     record_piece,
 )
 
@@ -383,7 +384,8 @@ def run3d(col, motion, solver, task, pair):
     solver : SolverSettings  atol of 4n entries
     task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 3n), friction_limit); y0
         is the state, changed in place: the state where the run ended
-    pair : tuple  (d0, d1, values_y: the second record's samples, or empty)
+    pair : tuple  (d0, d1, values_y: a second record's samples, or empty; gy: the second
+        component's ground tuple, physics.ground, gain 0 for none; knots_y: its knots)
 
     Returns
     -------
@@ -393,7 +395,7 @@ def run3d(col, motion, solver, task, pair):
     """
     col = ColumnArrays(*col)
     y0, record, output_dt, samples, mu = task
-    d0, d1, values_y = pair
+    d0, d1, values_y, gy, knots_y = pair
     mc, rtol, atol = solver[0], solver[1], solver[2]
     max_steps, max_events, deadline = solver[3], solver[4], solver[5]
     form, gain, center, gamma = motion[6], motion[7], motion[8], motion[9]
@@ -401,7 +403,8 @@ def run3d(col, motion, solver, task, pair):
     bounds, forced, pulse_end, t_end = motion[14], motion[15], motion[4], motion[5]
     gr_full = (form, gain, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
     gr_free = (form, 0.0, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
-    pair_on = values_y.size > 0
+    pair_on = values_y.size > 0 or gy[1] != 0.0
+    formula_y = values_y.size == 0 and gy[1] != 0.0  # an analytic second component
     n = col.tu.size
     m4 = 4 * n
     nrow_max = 5 * n
@@ -417,6 +420,7 @@ def run3d(col, motion, solver, task, pair):
     es[:n] = col.es
     es[n], es[n + 1] = d0, d1
     es[n + 8] = 1.0 if np.any(col.mg != 0.0) else 0.0
+    es[n + 9] = LINE if values_y.size > 0 else gy[0]
 
     k = np.zeros(n, dtype=np.int64)
     pending = np.zeros(n, dtype=np.bool_)
@@ -492,6 +496,9 @@ def run3d(col, motion, solver, task, pair):
         free_seg = not forced[seg]
         gr = gr_free if free_seg else gr_full
         seg_gain = gr[1]
+        if formula_y:  # its formula in es, 0 on a free segment
+            es[n + 2], es[n + 3], es[n + 4] = 1.0, 0.0 if free_seg else gy[1], gy[2]
+            es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
         h_carry = -1.0
         while t < seg_end:
             if at_rest:
@@ -503,8 +510,8 @@ def run3d(col, motion, solver, task, pair):
                             n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
                 last = min(pulse_end, t_end)
                 if pair_on:
-                    t_up = pair_exceedance(t, col.uplift_level / G, min(last, seg_end), knots,
-                                           values, values_y, vertical)  # fmt: skip
+                    t_up = pair_uplift(t, col.uplift_level / G, min(last, seg_end), gr_full, gy,
+                                       knots, values, values_y, knots_y, vertical)  # fmt: skip
                 else:
                     t_up = next_uplift(t, col.uplift_level, motion[1], gr_full, knots, values,
                                        vertical, last)  # fmt: skip
@@ -520,7 +527,7 @@ def run3d(col, motion, solver, task, pair):
                 t = t_up
                 y[:] = 0.0
                 a_d = ground_at(t, gr_full, knots, values)
-                a_y = ground_at(t, gr_full, knots, values_y) if pair_on else 0.0
+                a_y = ground_at(t, gy, knots, values_y) if pair_on else 0.0
                 ax, ay = a_d * d0 - a_y * d1, a_d * d1 + a_y * d0
                 size = math.sqrt(ax * ax + ay * ay)
                 c[0, 0], c[0, 1] = -ax / size, -ay / size

@@ -66,6 +66,7 @@ def integrate3d(
     prepared=None,
     state: np.ndarray | None = None,
     end: list | None = None,
+    across: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Outcome:
     """One run of a column's RBM in two directions (the module's rules).
 
@@ -75,6 +76,8 @@ def integrate3d(
     motion : GroundMotion  The ground motion, in any direction, one or two components
     theta0, rate0 : (n,)  Initial drum rotations [rad] and rates [rad/s] in the motion's
         vertical plane
+    across : ((n,), (n,)) or None  Those in the vertical plane across it (the motion's
+        direction turned by +90 degrees in plan); None: 0
     solver : SolverConfig  Runge-Kutta pair, rtol, atol (scaled by theta_u and 10 theta_u
         per second, as the planar step kernel), budgets, implementation
     record, output_dt : as the planar integrators
@@ -93,6 +96,10 @@ def integrate3d(
     if state is None:
         theta0, rate0 = np.asarray(theta0, float), np.asarray(rate0, float)
         y0 = np.concatenate([theta0 * d[0], theta0 * d[1], rate0 * d[0], rate0 * d[1]])
+        if across is not None:  # theta d + theta_across (-d1, d0), and so the rates
+            tc, rc = np.asarray(across[0], float), np.asarray(across[1], float)
+            y0 = np.concatenate([theta0 * d[0] - tc * d[1], theta0 * d[1] + tc * d[0],
+                                 rate0 * d[0] - rc * d[1], rate0 * d[1] + rc * d[0]])  # fmt: skip
     else:
         y0 = np.array(state, dtype=float)
     scale = np.concatenate([prepared.atol_scale[:n], prepared.atol_scale[:n],
@@ -101,7 +108,8 @@ def integrate3d(
     rows = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((rows, 3 + 3 * n))
     task = (y0, bool(record), float(output_dt), samples, float(friction_limit))
-    pair = (float(d[0]), float(d[1]), as_samples(motion.values_y))
+    pair = (float(d[0]), float(d[1]), as_samples(motion.values_y), motion.ground_y,
+            motion.knots_y)  # fmt: skip
     armed = arm()
     try:
         kernel = run3d if solver.implementation == "compiled" else plain(run3d)
@@ -163,12 +171,18 @@ class Rbm3dRunner(RbmRunner):
     the Rigid Beam Model, in two horizontal directions."""
 
     def integrator_of(self, method):
-        """The integrator of every method that runs `rbm-3d` (a step pair): this module's."""
+        """The integrator of every method that runs `rbm-3d` (a step pair): this module's,
+        from the config's initial state in the motion's plane and across it."""
         prepared = prepare_kernel(self.model)
+        init, n = self.config.excitation.initial, self.model.n
+        across = None
+        if init.rotations_across or init.velocities_across:
+            across = tuple(np.asarray(v, float) if v else np.zeros(n)
+                           for v in (init.rotations_across, init.velocities_across))  # fmt: skip
 
         def run(model, motion, theta0, rate0, solver, **options):
             return integrate3d(model, motion, theta0, rate0, solver, prepared=prepared,
-                               **options)  # fmt: skip
+                               across=across, **options)  # fmt: skip
 
         return run
 

@@ -157,13 +157,12 @@ def pair_times(excitation: ExcitationConfig) -> str | None:
     when both have the same sample times (run as read), ``union`` when they differ (both
     on the union of their times, each linear between its own samples:
     :func:`common_knots`); None without a second component."""
+    if excitation.motion is not None:  # given as arrays: a pair has one time base
+        return "shared" if excitation.motion.is_pair else None
     if excitation.file_y is None:
         return None
     path = excitation.file_path or excitation.file
-    if excitation.motion is not None:
-        t = np.asarray(excitation.motion.time_s, dtype=float)
-    else:
-        t = load_record(str(path), excitation.units, excitation.file_sha256).t
+    t = load_record(str(path), excitation.units, excitation.file_sha256).t
     path_y = excitation.file_y_path or excitation.file_y
     t_y = load_record(str(path_y), excitation.units, excitation.file_y_sha256).t
     return "shared" if np.array_equal(t, t_y) else "union"

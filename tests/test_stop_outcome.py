@@ -204,7 +204,12 @@ def _check_domain(fresh: dict, stored: dict, at_least: int) -> int:
         found = STOPPED.search(row["message"])
         if found is None:
             for col, value in old.items():  # the stored columns (made before some existed)
-                if col not in ENSEMBLE:
+                if col in ENSEMBLE:
+                    continue
+                if col == "n_uplifts":  # stored when a joint that opened again before it
+                    # closed (e = 1) was a second uplift: now a subset of those is counted
+                    assert int(row[col]) <= int(value), (key, col)
+                else:
                     assert row[col] == value, (key, col)
             continue
         stopped += 1

@@ -175,7 +175,7 @@ class InterfaceConfig:
     friction : float  Coulomb friction coefficient of the joints and the base
         (model bullet's contacts; the RBM and the reference models do not slide) [-]
     friction_limit : float or None  The friction coefficient the RBM's friction demand
-        max |T_i / N_i| is checked against (interface.friction given for model rbm): a run
+        max |T_i / N_i| is checked against (interface.friction given for rbm or rbm-3d): a run
         says where the demand first exceeds it and a domain marks the cells it does
         (``slides``); None: not checked [-]
     damping : float  Ratio zeta of critical damping of the column's first elastic mode,

@@ -16,6 +16,12 @@ import numpy as np
 
 from rbm_cli.models.history import History
 
+#: A joint's lean is wobbling (Outcome.turns counts its direction's turning) while it is at
+#: least this fraction of the joint's collapse limit [-]: nearer closure the direction of a
+#: small rotation, which turns round at every pass near zero, says nothing of a rolling
+#: column [assumption; the contact engine's reading of its joints uses the same fraction].
+WOBBLE_LEVEL = 0.1
+
 
 class EnergyAccount(NamedTuple):
     """The energy account of a run [J], relative to the ground (Model.energy: kinetic, the
@@ -67,7 +73,8 @@ class Outcome:
     method: str = ""  # the method that ran (solver.method, `auto` resolved), set by the runner
     energy: EnergyAccount | None = None  # a recorded run's energy account, where kept
     #: a model in three dimensions: where its lean pointed at collapse [rad from x], and
-    #: the angle its lean's direction swept while it rolled, in turns [-]
+    #: the angle its lean's direction swept while it leant by WOBBLE_LEVEL of its collapse
+    #: limit or more (a wobble), in turns [-] (the largest over the joints)
     azimuth: float = math.nan
     turns: float = math.nan
     top_plan: np.ndarray | None = None  # a recorded 3D run: the top in plan per sample [m]

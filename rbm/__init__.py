@@ -12,7 +12,8 @@ docstring with its units and an example (``help(rbm.run)``).
   with ``.status``, ``.t_collapse_s`` [s], ``.history`` (a pandas DataFrame) and
   ``.result`` (a :class:`CellResult`, a read-only mapping of every figure of the run)
 - :func:`motion_from_arrays` a ground motion given as arrays (times [s], acceleration in g
-  or m/s^2), checked as a record file is: a :class:`Motion` to run or sweep as a record
+  or m/s^2; a second horizontal component on the same times, ``acceleration_y``, for a
+  pair), checked as a record file is: a :class:`Motion` to run or sweep as a record
 - :func:`sweep` a config's grid (or a suite of motions, ``motions=[...]``): a DataFrame
   with the rows of domain.csv; :func:`read_domain` reads a stored one
 - :func:`compare` two domains, as ``rbm compare`` (a :class:`DomainComparison`);

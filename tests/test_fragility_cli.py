@@ -327,7 +327,7 @@ def test_bad_domain_is_refused_in_one_line(tmp_path, make, needles):
 @pytest.mark.parametrize(
     ("args", "needles"),
     [
-        (("--intensity-column", "pga"), ("missing column 'pga'",)),
+        (("--intensity-column", "pga"), ("--intensity must be an intensity measure, got 'pga'",)),
         (("--seed", "-1"), ("--seed",)),
         (("--resamples", "-5"), ("--resamples",)),
         (("--ci", "95", "5"), ("ci_percentiles",)),

@@ -307,8 +307,9 @@ def test_a_non_numeric_axis_at_one_frequency_is_named_on_the_ticks():
     view = domain_view(df)
     assert view.layout == "single" and view.line == "excitation.file"
     (ax,) = domain_figure(df, None).axes
-    assert [t.get_text() for t in ax.get_xticklabels()] == ["a.csv", "b.csv"]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["a", "b"]  # the records' names
     np.testing.assert_array_equal(one(ax, "boundary").get_ydata(), [0.5, np.nan])
+    assert one(ax, "boundary").get_linestyle() == "None"  # a bar per record, no line
 
 
 # --------------------------------------------------------------------------- the API

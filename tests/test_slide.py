@@ -31,7 +31,6 @@ from rbm_cli.base.errors import ConfigError  # noqa: E402
 from rbm_cli.cli.main import cli  # noqa: E402
 from rbm_cli.report.domain_figure import domain_figure  # noqa: E402
 from rbm_cli.report.plot_domain import (  # noqa: E402
-    BASE_JOINT_LABEL,
     SLIDES_LABEL,
     UPPER_JOINT_LABEL,
     plot_domain,
@@ -199,7 +198,9 @@ def test_cells_are_marked_by_mechanism_and_slides():
     assert upper.get_marker() != _gid(ax, "unsafe")[0].get_marker()
     (slides,) = _gid(ax, "slides")
     assert len(slides.get_xdata()) == int(df["slides"].sum()) == 8
-    assert {UPPER_JOINT_LABEL, BASE_JOINT_LABEL, SLIDES_LABEL} <= set(_legend(ax))
+    assert {UPPER_JOINT_LABEL, SLIDES_LABEL} <= set(_legend(ax))
+    assert "cross alone" in UPPER_JOINT_LABEL  # a collapse at the base is the plain cross:
+    assert sum(t == "unsafe (collapsed)" or "base joint" in t for t in _legend(ax)) == 1  # once
     # a domain without the columns draws none of these marks
     plain = plot_domain(df.drop(columns=["collapse_interface", "slides"]))
     assert not any(_gid(plain, g) for g in ("upper-joint", "slides", "base-joint"))

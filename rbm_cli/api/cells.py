@@ -10,9 +10,10 @@ from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rbm_cli.api.configs import as_config, check_cell, check_output_dt
+from rbm_cli.api.configs import as_config, check_cell, check_flag, check_output_dt
 from rbm_cli.api.motions import Motion, motion_config
 from rbm_cli.base.errors import ConfigError, RbmError
+from rbm_cli.config.load import shown as shown_value
 from rbm_cli.config.types import Config
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import history_frame, vertical_history
@@ -179,15 +180,20 @@ def run(
     config : Config, path or mapping  The config (else loaded with :func:`load_config`)
     amplitude_g : float  Peak ground acceleration [g], in [0, 1000] (not used by `free`);
         of a record or a ``motion``: its PGA after scaling (``excitation.scale: pga``, the
-        default) or a plain scale factor [-] (``scale: factor``)
-    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by `free`,
-        a record or a ``motion``)
+        default; of a pair, the larger of its two components') or a plain scale factor
+        [-] (``scale: factor``)
+    frequency_hz : float  Excitation frequency [Hz], in [0.001, 1000] (not used by
+        `free`; refused for a record or a ``motion``, which have none)
     motion : Motion, optional  A ground motion given as arrays
-        (:func:`motion_from_arrays`), run as a record of the config would be: scaled as
-        the config's record excitation says (another excitation: scale pga, 5 s of free
-        motion after the last sample)
-    record : bool  Keep the history, as ``rbm run`` (the run goes on to the end of the
-        motion or to collapse); False: as a sweep, stop once the outcome cannot change
+        (:func:`motion_from_arrays`, a pair with ``acceleration_y``), run as a record of
+        the config would be: in its place, with every other key of the config's
+        excitation (a record config's scale, free time, vertical record, processing,
+        im_periods; any config's angle and initial conditions); another excitation's form
+        is replaced (scale pga, 5 s of free motion after the last sample). A config's
+        ``excitation.file_y`` is refused beside it (a pair as arrays: ``acceleration_y``)
+    record : bool  True or False: keep the history, as ``rbm run`` (the run goes on to
+        the end of the motion or to collapse); False: as a sweep, stop once the outcome
+        cannot change
     output_dt : float, optional  Sampling interval of the history [s]; default 0.002 s
 
     Returns
@@ -196,7 +202,8 @@ def run(
 
     Raises
     ------
-    RbmError  A missing or out-of-range amplitude or frequency, a bad config (one line)
+    RbmError  A missing or out-of-range amplitude or frequency, a frequency for a record
+        or a motion, a ``record`` that is not a boolean, a bad config (one line)
 
     Examples
     --------
@@ -211,12 +218,19 @@ def run(
     'collapsed'
     """
     cfg = as_config(config)
+    check_flag(record, "record")
     if motion is not None:
         if not isinstance(motion, Motion):
             raise ConfigError(
                 f"motion must be a motion (rbm.motion_from_arrays), got {type(motion).__name__}"
             )
         cfg = motion_config(cfg, [motion], axis=False)
+    if frequency_hz is not None and cfg.excitation.type == "record":
+        what = "a motion given as arrays" if motion is not None else "a record"
+        raise RbmError(
+            f"frequency_hz does not apply to {what} (its samples are the motion), got"
+            f" {shown_value(frequency_hz)}: leave it out"
+        )
     amplitude_g, frequency_hz = check_cell(cfg, amplitude_g, frequency_hz)
     output_dt = check_output_dt(cfg, output_dt)
     result = simulate(cfg, amplitude_g, frequency_hz, record=record, output_dt=output_dt)

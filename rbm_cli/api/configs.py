@@ -22,6 +22,8 @@ __all__ = [
     "Config",
     "as_config",
     "check_cell",
+    "check_config",
+    "check_flag",
     "check_options",
     "check_output_dt",
     "load_config",
@@ -71,7 +73,27 @@ def load_config(source: str | os.PathLike | Mapping[str, Any]) -> Config:
 
 
 def as_config(config: Config | str | os.PathLike | Mapping[str, Any]) -> Config:
+    """``config`` itself, or loaded (:func:`load_config`) from a path or a mapping."""
     return config if isinstance(config, Config) else load_config(config)
+
+
+def check_config(config: Any, where: str) -> Config:
+    """``config``, checked to be a Config (a ConfigError naming ``where`` otherwise)."""
+    if not isinstance(config, Config):
+        raise ConfigError(
+            f"{where}: config must be a Config (from rbm.load_config), got {type(config).__name__}"
+        )
+    return config
+
+
+def check_flag(value: Any, name: str) -> bool:
+    """``value``, checked to be True or False (a numpy boolean too): a string such as "no"
+    or a number is not taken for one (RbmError naming ``name``)."""
+    import numpy as np
+
+    if not isinstance(value, bool | np.bool_):
+        raise RbmError(f"{name} must be True or False, got {shown(value)}")
+    return bool(value)
 
 
 def with_values(config: Config, changes: Mapping[str, Any]) -> Config:
@@ -92,7 +114,8 @@ def with_values(config: Config, changes: Mapping[str, Any]) -> Config:
 
     Raises
     ------
-    ConfigError  A malformed path, or a bad value (one line naming its key path)
+    ConfigError  A config that is not a Config, changes that are not a mapping, a
+        malformed path, or a bad value (one line naming its key path)
 
     Examples
     --------
@@ -102,6 +125,7 @@ def with_values(config: Config, changes: Mapping[str, Any]) -> Config:
     >>> taller.column.height, taller.interface.restitution, cfg.column.height
     (4.0, 0.9, 2.0)
     """
+    check_config(config, "with_values")
     if config.written is None:
         raise ConfigError(f"config {config.name} keeps no written mapping: use rbm.load_config")
     if not isinstance(changes, Mapping):
@@ -134,7 +158,8 @@ def with_value(config: Config, path: str, value: Any) -> Config:
 
     Raises
     ------
-    ConfigError  A malformed path, or a bad value (one line naming its key path)
+    ConfigError  A config that is not a Config, a path that is not a string, a malformed
+        path, or a bad value (one line naming its key path)
 
     Examples
     --------
@@ -147,6 +172,13 @@ def with_value(config: Config, path: str, value: Any) -> Config:
     ...
     rbm_cli.base.errors.ConfigError: block with column.height = -1: column.height must be a number > 0 [m], got -1
     """  # noqa: E501
+    check_config(config, "with_value")
+    if not isinstance(path, str):
+        raise ConfigError(
+            f"{config.name}: with_value takes one key path (a string such as"
+            f" 'column.height'), got {type(path).__name__}; several changes:"
+            " rbm.with_values(config, {path: value, ...})"
+        )
     return with_values(config, {path: value})
 
 

@@ -10,10 +10,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rbm_cli.api.configs import as_config
+from rbm_cli.api.motions import motion_config
+from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
-from rbm_cli.study.domain import axis_columns, domain_config
+from rbm_cli.study.domain import REQUIRED, axis_columns, domain_config
 from rbm_cli.study.domain import compare as compare_domains
 from rbm_cli.study.domain import read_domain as _read_domain
+from rbm_cli.study.result import STATUSES
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -72,7 +75,9 @@ def plot_domain(
     df : pandas.DataFrame  A domain: :func:`sweep`'s or :func:`read_domain`'s
     ax : matplotlib Axes, optional  None: a new Figure, not held by pyplot
     config : Config, path or mapping, optional  The config swept: adds the level [g] where
-        the column starts to rock (B/H for a rigid monolith) and the closed forms that apply
+        the column starts to rock (B/H for a rigid monolith) and the closed forms that apply.
+        For the domain of ``rbm.sweep(cfg, motions=[...])`` the config given to it
+        (``cfg``): the motions it was swept with are read from ``df.attrs["motions"]``
     dimensionless : bool  Axes omega / p and A / (g tan alpha) instead (read from the domain's
         scale columns, or computed from ``config`` for domains written before them)
     layout : str  A domain over more axes than amplitude and frequency: 'panels' (one per
@@ -104,6 +109,9 @@ def plot_domain(
     from rbm_cli.report.domain_figure import draw_domain_on  # matplotlib, pandas: when drawn
 
     cfg = None if config is None else as_config(config)
+    motions = getattr(df, "attrs", {}).get("motions")
+    if cfg is not None and motions and "excitation.file" not in cfg.grid.axis_paths:
+        cfg = motion_config(cfg, motions, axis=True)  # the config with them, as swept
     return draw_domain_on(df, ax, cfg, dimensionless=dimensionless, layout=layout, **options)
 
 
@@ -163,7 +171,9 @@ def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.Path
 
     Raises
     ------
-    RbmError  A domain that cannot be read (one line)
+    RbmError  A domain that cannot be read, or that is not a domain: a value that is not
+        a DataFrame or a path, a frame without amplitude_g, frequency_hz or status, a bad
+        value in them (one line naming the argument, ``a`` or ``b``, and the row)
 
     Examples
     --------
@@ -175,7 +185,7 @@ def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.Path
     >>> c.n_common, c.n_differ, round(c.max_shift_g, 6)  # the boundary moves up 0.1 g
     (3, 1, 0.1)
     """
-    frames = [read_domain(x) if isinstance(x, str | os.PathLike) else x for x in (a, b)]
+    frames = [_domain_frame(x, which) for x, which in ((a, "a"), (b, "b"))]
     for k, df in enumerate(frames):
         if "collapsed" not in df.columns:
             frames[k] = df.assign(collapsed=(df["status"] == "collapsed").astype(int))
@@ -184,6 +194,51 @@ def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.Path
     return DomainComparison(n_common=cmp.n_common, n_differ=cmp.n_differ, fraction=cmp.fraction,
                             only_a=cmp.only_a, only_b=cmp.only_b, max_shift_g=cmp.max_shift_g,
                             shifts=cmp.shifts, regression=rule)  # fmt: skip
+
+
+def _domain_frame(value: Any, which: str) -> pd.DataFrame:
+    """A domain for :func:`compare`: read from a path, or a DataFrame checked to hold a
+    domain's cells (amplitude_g >= 0 [g], frequency_hz > 0 [Hz] or empty on every row,
+    status one of STATUSES); an RbmError naming the argument and the row otherwise."""
+    import numpy as np
+    import pandas as pd
+
+    if isinstance(value, str | os.PathLike):
+        return read_domain(value)
+    where = f"compare: {which}"
+    if not isinstance(value, pd.DataFrame):
+        raise RbmError(
+            f"{where} must be a domain (a DataFrame of rbm.sweep or rbm.read_domain, or the"
+            f" path of a domain.csv), got {type(value).__name__}"
+        )
+    missing = [c for c in REQUIRED if c not in value.columns]
+    if missing:
+        raise RbmError(
+            f"{where} is not a domain: no column {', '.join(map(repr, missing))} (a domain's"
+            " rows have amplitude_g [g], frequency_hz [Hz] and status)"
+        )
+    if value.empty:
+        raise RbmError(f"{where} has no rows")
+    for col, unit, positive in (("amplitude_g", "g", False), ("frequency_hz", "Hz", True)):
+        x = pd.to_numeric(value[col], errors="coerce").to_numpy(float)
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isfinite(x) | ((x <= 0.0) if positive else (x < 0.0))
+        if positive and np.isnan(x).all():
+            bad[:] = False  # no frequency at all: a record's domain
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise RbmError(
+                f"{where}: row {i}: {col} must be a finite number {'> 0' if positive else '>= 0'}"
+                f" [{unit}], got {value[col].iloc[i]!r}"
+            )
+    bad = ~value["status"].isin(STATUSES).to_numpy()
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RbmError(
+            f"{where}: row {i}: status must be one of {', '.join(STATUSES)}, got"
+            f" {value['status'].iloc[i]!r}"
+        )
+    return value
 
 
 def read_domain(path: str | os.PathLike) -> pd.DataFrame:

@@ -13,7 +13,87 @@ if TYPE_CHECKING:
 
     from rbm_cli.study.fragility import FragilityResult
 
-__all__ = ["MAX_RESAMPLES", "fragility", "run_fragility"]  # noqa: F822 (read on first use)
+__all__ = [
+    "MAX_RESAMPLES",  # noqa: F822 (read on first use)
+    "check_intensity",
+    "check_members",
+    "fragility",
+    "intensity_names",
+    "run_fragility",  # noqa: F822 (read on first use)
+]
+
+#: A record's measures that are not intensities: its column's elastic period and its
+#: significant duration (neither grows with the record's scale).
+NOT_INTENSITIES = ("t1_s", "d5_95_s")
+
+
+def intensity_names() -> tuple[str, ...]:
+    """The columns a fragility may be fitted on: the amplitude's
+    (rbm_cli.study.outcomes.INTENSITY_COLUMNS, the first present by default), then a
+    record's measures that grow with its scale (rbm_cli.study.intensities), the spectral
+    accelerations at ``excitation.im_periods`` written ``sa_<T>s_g``."""
+    from rbm_cli.study.intensities import BASE_FIELDS, ROCKING_FIELDS
+    from rbm_cli.study.outcomes import INTENSITY_COLUMNS
+
+    measures = tuple(f for f in BASE_FIELDS + ROCKING_FIELDS if f not in NOT_INTENSITIES)
+    return INTENSITY_COLUMNS + measures + ("sa_<T>s_g",)
+
+
+def check_intensity(name, where: str = "intensity") -> str | None:
+    """``name`` (None: the default), checked to be an intensity measure's column
+    (:func:`intensity_names`): a count, a time or another result is not one.
+
+    Raises
+    ------
+    RbmError  One line naming ``where`` and the measures there are
+    """
+    from rbm_cli.base.errors import RbmError
+    from rbm_cli.study.intensities import sa_field
+
+    if name is None:
+        return None
+    ok = isinstance(name, str) and (name in intensity_names() or _is_sa(name, sa_field))
+    if not ok:
+        shown = repr(name) if isinstance(name, str) else type(name).__name__
+        raise RbmError(
+            f"{where} must be an intensity measure, got {shown} (one of"
+            f" {', '.join(intensity_names())})"
+        )
+    return name
+
+
+def _is_sa(name: str, sa_field) -> bool:
+    """Whether ``name`` is the column of a spectral acceleration, ``sa_<T>s_g`` with T > 0
+    [s] written as sa_field writes it."""
+    if not (name.startswith("sa_") and name.endswith("s_g")):
+        return False
+    try:
+        period = float(name[3:-3].replace("p", "."))
+    except ValueError:
+        return False
+    return period > 0.0 and sa_field(period) == name
+
+
+def check_members(n_members) -> int | None:
+    """n_members: None (unknown) or a whole number >= 1 (not a boolean, a string or nan).
+
+    Raises
+    ------
+    RbmError  One line naming it
+    """
+    import numbers
+
+    from rbm_cli.base.errors import RbmError
+
+    if n_members is None:
+        return None
+    if isinstance(n_members, bool) or not isinstance(n_members, numbers.Integral) \
+            or n_members < 1:  # fmt: skip
+        raise RbmError(
+            "fragility: n_members must be a whole number >= 1 (the members per cell of an"
+            f" ensemble domain) or None, got {n_members!r}"
+        )
+    return int(n_members)
 
 
 def __getattr__(name: str):
@@ -63,7 +143,7 @@ def fragility(
         ``majority`` (a cell collapses when most members did) or ``member0`` (the row's
         own run); ``result.outcome`` says which
     n_members : int, optional  Members per cell of an ensemble domain given as a
-        DataFrame (a domain.csv's meta.json says it for a path)
+        DataFrame, a whole number >= 1 (a domain.csv's meta.json says it for a path)
 
     Returns
     -------
@@ -77,6 +157,8 @@ def fragility(
     Raises
     ------
     RbmError  One line: not a suite domain (no ``record`` column), bad rows or options
+        (an intensity that is not a measure, such as ``n_rhs``; n_members not a whole
+        number >= 1)
 
     Examples
     --------
@@ -96,6 +178,9 @@ def fragility(
     from rbm_cli.study.outcomes import prepare_outcomes, read_suite_domain
 
     check_options(n_resamples, seed, ci_percentiles)
+    n_members = check_members(n_members)
+    check_intensity(intensity, "fragility: intensity")
+    check_intensity(intensity_column, "fragility: intensity_column")
     if intensity is not None and intensity_column is not None and intensity != intensity_column:
         raise RbmError(f"fragility: intensity {intensity!r} and intensity_column "
                        f"{intensity_column!r} name two columns: give one")  # fmt: skip

@@ -8,7 +8,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rbm_cli.api.configs import as_config
+from rbm_cli.api.configs import as_config, check_flag
 from rbm_cli.api.motions import Motion, motion_config
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
@@ -32,6 +32,10 @@ __all__ = [
 
 #: The settings of a sweep in memory (rbm_cli.study.sweep.sweep_rows) besides jobs.
 IN_MEMORY_OPTIONS = ("backend", "scheduler", "ensemble", "force", "progress", "notify")
+#: The settings only a sweep into a folder takes (rbm_cli.study.sweep.run_sweep).
+FOLDER_OPTIONS = ("resume", "stop_after", "resume_command", "figure", "figure_process")
+#: The settings that are True or False.
+FLAGS = ("force", "resume")
 
 
 def run_sweep(
@@ -75,20 +79,26 @@ def sweep(
         the motion's name in the ``record`` and ``excitation.file`` columns. They replace
         the config's ground motion (a record config keeps its scale, free time and
         vertical record). Their samples' SHA-256 is in the config's hash: a folder sweep
-        (``output``) does not resume over other arrays under the same names
+        (``output``) does not resume over other arrays under the same names. Every other
+        key of the config's excitation is kept (:func:`run`'s ``motion``); pairs
+        (``acceleration_y``) and motions of one component are not mixed
     **options  Other settings of rbm_cli.study.sweep.run_sweep (resume, force, ensemble...);
         without an output folder those of sweep_rows (backend, scheduler, ensemble, force,
-        progress, notify)
+        progress, notify). ``ensemble`` K runs each cell K times: the cells times K are
+        the runs counted against the grid's limits (more than 100,000 need
+        ``force=True``, more than 1,000,000 are refused)
 
     Returns
     -------
     pandas.DataFrame  The rows of domain.csv, one per cell (amplitude_g [g], frequency_hz
         [Hz], status, collapsed, t_collapse_s [s], ...); ``attrs["folder"]``: the folder
-        (None without an output folder)
+        (None without an output folder); with ``motions``, ``attrs["motions"]``: them
+        (:func:`plot_domain` draws the domain with the config they were swept with)
 
     Raises
     ------
-    RbmError  Bad arguments (one line); an option that needs an output folder without one
+    RbmError  Bad arguments (one line): an unknown option, a flag that is not a boolean,
+        an option that needs an output folder without one, too many runs
 
     Examples
     --------
@@ -99,6 +109,16 @@ def sweep(
     >>> df[["amplitude_g", "frequency_hz", "status"]].values.tolist()
     [[0.1, 0.5, 'survived'], [2.5, 0.5, 'collapsed'], [0.1, 1.0, 'survived'], [2.5, 1.0, 'collapsed']]
     """  # noqa: E501
+    unknown = sorted(set(options) - set(IN_MEMORY_OPTIONS) - set(FOLDER_OPTIONS))
+    if unknown:
+        raise RbmError(
+            f"sweep: unknown option {', '.join(map(repr, unknown))} (allowed: jobs, motions,"
+            f" {', '.join(IN_MEMORY_OPTIONS)}; with an output folder also"
+            f" {', '.join(FOLDER_OPTIONS)})"
+        )
+    for name in FLAGS:
+        if name in options:
+            check_flag(options[name], name)
     cfg = as_config(config)
     if motions is not None:
         cfg = motion_config(cfg, motions, axis=True)
@@ -107,9 +127,12 @@ def sweep(
         if folder_only:
             raise RbmError(f"{', '.join(folder_only)}: needs an output folder (output=...)")
         df = sweep_rows(cfg, jobs=jobs, **options).frame()
-        df.attrs["folder"] = None
-        return df
-    summary = run_sweep(cfg, output, jobs=jobs, **options)
-    df = read_domain(Path(summary.folder) / "domain.csv")
-    df.attrs["folder"] = str(summary.folder)
+        folder = None
+    else:
+        summary = run_sweep(cfg, output, jobs=jobs, **options)
+        df = read_domain(Path(summary.folder) / "domain.csv")
+        folder = str(summary.folder)
+    df.attrs["folder"] = folder
+    if motions is not None:  # plot_domain(df, config=...) runs the config with them again
+        df.attrs["motions"] = tuple(motions)
     return df

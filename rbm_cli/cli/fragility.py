@@ -73,8 +73,12 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         rbm fragility results/suite_multidrum/domain.csv \
             --compare results/suite_monolithic/domain.csv -o docs/figures/suite
     """
-    from rbm_cli.api.fragility_curves import MAX_RESAMPLES, run_fragility
+    from rbm_cli.api.fragility_curves import MAX_RESAMPLES, check_intensity, run_fragility
 
+    try:
+        check_intensity(intensity_column, "--intensity")
+    except RbmError as exc:
+        raise UserError(one_line(exc)) from None
     if resamples > MAX_RESAMPLES:
         raise UserError(
             f"--resamples must be at most {MAX_RESAMPLES:,} (each is a refit), got {resamples:,}"
@@ -110,6 +114,10 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         click.echo(f"median {median}, dispersion beta {beta}")
         if res.note:
             click.echo(f"note: {res.note}")
+        if res.fit_warning:
+            click.echo(f"warning: {res.fit_warning}")
+        if res.resamples_note:
+            click.echo(f"note: {res.resamples_note}")
     folder = made.paths[0].parent
     click.echo(f"output: {folder}/ " + ", ".join(p.name for p in made.paths))
 

@@ -47,8 +47,9 @@ from rbm_cli.cli.common import (
 @click.option(
     "--force",
     is_flag=True,
-    help="Allow grids of more than 100,000 cells; set aside (to superseded/, never deleted) "
-    "an unfinished journal or another config's result in the folder, and start again.",
+    help="Allow grids of more than 100,000 runs (cells x --ensemble; at most 1,000,000); "
+    "set aside (to superseded/, never deleted) an unfinished journal or another config's "
+    "result in the folder, and start again.",
 )
 @click.option(
     "--ensemble",
@@ -57,7 +58,8 @@ from rbm_cli.cli.common import (
     show_default=True,
     metavar="K",
     help="Run each cell K times, phase and amplitude perturbed by up to 1e-6 (rad, "
-    "relative), and add the collapse_fraction column: which cells are robust.",
+    "relative), and add the collapse_fraction column: which cells are robust. The runs "
+    "(cells x K) count against the grid's limits (see --force).",
 )
 @click.option("-q", "--quiet", is_flag=True, help="No progress output and no notes.")
 def sweep(

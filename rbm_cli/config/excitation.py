@@ -27,7 +27,10 @@ Keys, by excitation type (a key of another type is refused, naming it):
   sets ``ExcitationConfig.duration`` to that. A mapping made in Python may give a motion
   (:class:`rbm_cli.config.motions.Motion`, arrays checked when it was made) in the place
   of the file, here or among the values of a grid axis over ``excitation.file``: its name
-  stands for the file as written, the SHA-256 of its samples for the file's.
+  stands for the file as written, the SHA-256 of its samples for the file's. A motion with a
+  second horizontal component (``acceleration_y``) is a pair on one time base: it sets
+  ``file_y`` to its name and ``file_y_sha256`` to the digest of its y samples, as
+  ``excitation.file_y`` would (which it then refuses).
 
 The record file is read and checked when the config is loaded: a missing or malformed file
 is a one-line :class:`~rbm_cli.base.errors.ConfigError` naming the key, the file and the
@@ -392,6 +395,8 @@ def _record_fields(e: dict, base_dir: str | os.PathLike | None) -> dict:
         rec_y = record_file(e["file_y"], "excitation.file_y", base_dir, units)
         _check_pair(rec, rec_y)
         fields.update(file_y=rec_y.written, file_y_sha256=rec_y.sha256, file_y_path=rec_y.path)
+    elif rec.motion is not None and rec.motion.is_pair:  # its y component, on its times
+        fields.update(file_y=rec.written, file_y_sha256=rec.motion.sha256_y)
     if "processing" in e:
         records = [("excitation.file", rec)]
         if "file_y" in e:
@@ -414,7 +419,8 @@ def _check_pair(rec: RecordFile, rec_y: RecordFile) -> None:
     number of samples, step and last time (a station's two components are)."""
     if rec.motion is not None or rec_y.motion is not None:
         raise ConfigError(
-            "excitation.file_y pairs two record files; a motion given as arrays has one component"
+            "excitation.file_y pairs two record files; a motion given as arrays takes its y"
+            " component from its own arrays (rbm.motion_from_arrays(..., acceleration_y=...))"
         )
     if (rec.samples, rec.step, rec.end) != (rec_y.samples, rec_y.step, rec_y.end):
         raise ConfigError(

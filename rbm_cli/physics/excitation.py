@@ -34,9 +34,11 @@ __all__ = [
     "PULSE_KINDS",
     "SAMPLES_PER_PERIOD",
     "GroundMotion",
+    "common_knots",
     "load_record",
     "make_ground_motion",
     "merge_records",
+    "pair_times",
     "processed_record",
     "pulse_motion",
     "record_motion",
@@ -88,16 +90,19 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
     path = excitation.file_path or excitation.file
     if path is None:
         raise RbmError("excitation.file is required for type record")
+    rec_y = None
     if excitation.motion is not None:  # given as arrays: the same record, from memory
         motion = excitation.motion
-        path = f"motion {motion.name!r}"
+        path = path_y = f"motion {motion.name!r}"
         rec = Record(motion.time_s, motion.acceleration_m_s2, motion.name, "in memory")
         rec = rec.processed(excitation.processing)
+        if motion.is_pair:  # its y component, on the same times
+            rec_y = Record(motion.time_s, motion.acceleration_y_m_s2, motion.name, "in memory")
+            rec_y = rec_y.processed(excitation.processing)
     else:
         rec = processed_record(str(path), excitation.units, excitation.file_sha256,
                                excitation.processing)  # fmt: skip
-    rec_y = None
-    if excitation.file_y is not None:
+    if excitation.file_y is not None and excitation.motion is None:
         path_y = excitation.file_y_path or excitation.file_y
         rec_y = processed_record(str(path_y), excitation.units, excitation.file_y_sha256,
                                  excitation.processing)  # fmt: skip
@@ -106,22 +111,28 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
             factor = amplitude_g * G / max(rec.pga, 0.0 if rec_y is None else rec_y.pga)
         else:
             factor = float(amplitude_g)
-        knots, values, vertical = rec.t, _scaled(rec, factor, path), None
-        values_y = None if rec_y is None else _scaled(rec_y, factor, path_y)
-    end = rec.duration
+        series = [(rec.t, _scaled(rec, factor, path))]
+        if rec_y is not None:
+            series.append((rec_y.t, _scaled(rec_y, factor, path_y)))
+    end = max(float(t[-1]) for t, _ in series)  # the records' last samples, from t = 0
     if excitation.vertical is not None:
         path = excitation.vertical_path or excitation.vertical
         ver = processed_record(str(path), excitation.units, excitation.vertical_sha256,
                                excitation.processing)  # fmt: skip
-        merged = merge_records(rec.t, values, ver.t, _scaled(ver, factor, path), values_y)
-        knots, values, vertical = merged[:3]
-        values_y = merged[3] if values_y is not None else None
+        series.append((ver.t, _scaled(ver, factor, path)))
         end = max(end, ver.duration)
-        vertical.setflags(write=False)
-    values.setflags(write=False)
+    if len(series) == 1 or (excitation.vertical is None and pair_times(excitation) == "shared"):
+        # one time base already: the samples as read
+        knots, columns = series[0][0], [values for _, values in series]
+    else:  # a vertical record, or a pair sampled at other times: on their union
+        knots, *columns = common_knots(series)
+    values = columns[0]
+    values_y = columns[1] if rec_y is not None else None
+    vertical = columns[-1] if excitation.vertical is not None else None
+    for column in columns:
+        column.setflags(write=False)
     peak = float(np.max(np.abs(values)))
     if values_y is not None:
-        values_y.setflags(write=False)
         peak = float(np.max(np.hypot(values, values_y)))
     return GroundMotion(
         "record",
@@ -137,6 +148,23 @@ def record_motion(excitation: ExcitationConfig, amplitude_g: float) -> GroundMot
         vertical=vertical,
         values_y=values_y,
     )
+
+
+def pair_times(excitation: ExcitationConfig) -> str | None:
+    """How a pair of records (``excitation.file_y``) is put on one time base: ``shared``
+    when both have the same sample times (run as read), ``union`` when they differ (both
+    on the union of their times, each linear between its own samples:
+    :func:`common_knots`); None without a second component."""
+    if excitation.file_y is None:
+        return None
+    path = excitation.file_path or excitation.file
+    if excitation.motion is not None:
+        t = np.asarray(excitation.motion.time_s, dtype=float)
+    else:
+        t = load_record(str(path), excitation.units, excitation.file_sha256).t
+    path_y = excitation.file_y_path or excitation.file_y
+    t_y = load_record(str(path_y), excitation.units, excitation.file_y_sha256).t
+    return "shared" if np.array_equal(t, t_y) else "union"
 
 
 #: Largest peak acceleration of a scaled record [g]: the grid's largest amplitude.
@@ -159,41 +187,52 @@ def _scaled(record: Record, factor: float, path) -> np.ndarray:
     return values
 
 
-def _limits(t: float, ts: np.ndarray, vs: np.ndarray) -> tuple[float, float]:
-    """(value just before t, value just after t) of a record (ts [s], vs), linear
-    between its samples and 0 outside them."""
-    inside = float(np.interp(t, ts, vs))
-    before = inside if ts[0] < t <= ts[-1] else 0.0
-    after = inside if ts[0] <= t < ts[-1] else 0.0
+def _limits(t: np.ndarray, ts: np.ndarray, vs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(values just before, values just after) the times t [s] of a record (ts [s], vs),
+    linear between its samples and 0 outside them."""
+    inside = np.interp(t, ts, vs)
+    before = np.where((ts[0] < t) & (t <= ts[-1]), inside, 0.0)
+    after = np.where((ts[0] <= t) & (t < ts[-1]), inside, 0.0)
     return before, after
+
+
+def common_knots(series) -> tuple[np.ndarray, ...]:
+    """Records given as (times [s], values), each linear between its own samples and 0
+    outside them, on one set of knots: (knots, the values of each record at them, in the
+    order given). The knots are the union of all their sample times, so every record is
+    linear between consecutive knots and its values there are its own (at its samples) or
+    its linear interpolation (between them): the motion each record describes, exactly,
+    with no sample lost. Where any record jumps (its first or last value not 0, inside
+    the run) the time is written twice, the values before then after. At the first knot
+    the values after it are kept (the ground rests before), at the last those before it."""
+    times = np.unique(np.concatenate([np.asarray(t, dtype=float) for t, _ in series]))
+    limits = [_limits(times, np.asarray(ts, dtype=float), np.asarray(vs, dtype=float))
+              for ts, vs in series]  # fmt: skip
+    jump = np.zeros(times.size, dtype=bool)
+    for before, after in limits:
+        jump |= before != after
+    jump[[0, -1]] = False
+    counts = 1 + jump.astype(np.int64)
+    at = np.repeat(np.arange(times.size), counts)
+    first = (np.cumsum(counts) - counts)[jump]  # the first of each time written twice
+    columns = []
+    for before, after in limits:
+        after = after.copy()
+        after[-1] = before[-1]
+        column = after[at]
+        column[first] = before[jump]
+        columns.append(column)
+    return (times[at], *columns)
 
 
 def merge_records(
     th: np.ndarray, ah: np.ndarray, tv: np.ndarray, av: np.ndarray, ay: np.ndarray | None = None
 ) -> tuple[np.ndarray, ...]:
-    """Two records (times [s], values), each linear between its samples and 0 outside them,
-    on one set of knots: (knots, horizontal, vertical), and the second horizontal
-    component ay (on the times th) after them when given. All are linear between the union
-    of their sample times; where any jumps (its first or last value not 0, inside the run)
-    the time is written twice, the values before then after. At the first knot the values
-    after it are kept (the ground rests before), at the last those before it."""
-    times = np.union1d(th, tv)
+    """A horizontal record (th [s], ah) and a vertical one (tv, av) on one set of knots
+    (:func:`common_knots`): (knots, horizontal, vertical), and the second horizontal
+    component ay (at the times th) after them when given."""
     series = [(th, ah), (tv, av)] + ([] if ay is None else [(th, ay)])
-    knots: list[float] = []
-    columns: list[list[float]] = [[] for _ in series]
-    for i, t in enumerate(times):
-        limits = [_limits(t, ts, vs) for ts, vs in series]
-        if i == len(times) - 1:
-            limits = [(b, b) for b, _ in limits]
-        if 0 < i < len(times) - 1 and any(b != a for b, a in limits):
-            knots += [t, t]
-            for col, (b, a) in zip(columns, limits, strict=True):
-                col += [b, a]
-        else:
-            knots.append(t)
-            for col, (_, a) in zip(columns, limits, strict=True):
-                col.append(a)
-    return (np.array(knots), *(np.array(col) for col in columns))
+    return common_knots(series)
 
 
 def pulse_motion(excitation: ExcitationConfig, amplitude: float, frequency_hz: float):

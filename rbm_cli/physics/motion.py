@@ -71,7 +71,8 @@ class GroundMotion:
         plane and take 0 only; the models in three dimensions take any.
     values_y : ndarray or None  A record's second horizontal component at the knots
         [m/s^2], acting along (-sin angle, cos angle) (excitation.file_y; models in three
-        dimensions only)
+        dimensions only). Sampled at other times than the record, both are on the union
+        of their samples' times (each linear between its own samples, as read)
     """
 
     kind: str

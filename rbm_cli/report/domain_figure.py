@@ -261,7 +261,8 @@ def domain_figure(
                            where=where, colorbar=False)  # fmt: skip
     name = config.name if config is not None else (labels[0] if labels else "")
     kind = f" ({config.excitation.type})" if config is not None else ""
-    title = f"{name}: safe-unsafe domain{kind}" + (", dimensionless" if dimensionless else "")
+    title = (f"{name}: " if name else "") + f"safe-unsafe domain{kind}" + (
+        ", dimensionless" if dimensionless else "")  # fmt: skip
     freqs = df["frequency_hz"].dropna().unique()
     if view.line != "frequency_hz" and len(freqs) == 1:
         title += f", at {freqs[0]:g} Hz"

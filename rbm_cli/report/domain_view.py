@@ -20,6 +20,13 @@ values go one to one, count as one axis) and the frequencies decide:
   frequency back on the line (each point then a panel, or one mark per frequency);
   a domain without axes over config keys has no points and refuses both.
 
+A record axis (``excitation.file``, ``excitation.file_y`` or ``excitation.vertical``: a
+suite) is named by its records, not their paths: the ``record`` column of domain.csv (the
+file's stem, or a motion's name), or the file's stem, with as many of its folders as tell
+two records of one stem apart (:func:`record_names`). On x it is a categorical axis
+("record"), along which a boundary is one mark per record, never a line joining unrelated
+records (rbm_cli.report.plot_axes); as a point, a panel is titled ``record rdk_01``.
+
 In dimensionless axes x is omega / p whatever the line variable: a size axis at one
 frequency spreads along omega / p (p falls as the size grows) in one plane, and an overlay
 of a size sweep over several frequencies puts every size's boundary on one curve. The
@@ -28,12 +35,15 @@ sweep's domain.png follows the same rule (rbm_cli.report.domain_figure).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from pathlib import PurePath
 
 import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.grid import RECORD_PATHS
 from rbm_cli.config.types import Config
 from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
 from rbm_cli.study.cells import grid_points
@@ -53,6 +63,9 @@ UNITS = {
 }  # fmt: skip
 #: Axis labels of the dimensionless plane.
 DIMENSIONLESS_LABELS = (r"$\omega / p$ [-]", r"$A / (g \tan\alpha)$ [-]")
+#: What the records of a record axis are called in a panel's title.
+RECORD_WORDS = {"excitation.file": "record", "excitation.file_y": "y record",
+                "excitation.vertical": "vertical record"}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -72,8 +85,9 @@ class DomainView:
     """How to draw a domain (module docstring): ``layout`` 'single', 'panels' or 'overlay';
     ``line`` the column along a boundary line (frequency_hz or an axis path), ``x`` and
     ``y`` the columns on the axes; ``log_x`` for a log axis, ``categories`` the tick labels
-    of a non-numeric axis (x then holds their positions); ``points`` in grid order, each
-    a value of the columns ``point_paths``."""
+    of a non-numeric axis (x then holds their positions, ``category_of`` the position of
+    each value, by its text) and ``category_word`` what one category is ("record" on a
+    record axis); ``points`` in grid order, each a value of the columns ``point_paths``."""
 
     layout: str
     dimensionless: bool
@@ -85,6 +99,8 @@ class DomainView:
     categories: tuple[str, ...] | None
     points: list[Point]
     point_paths: tuple[str, ...] = ()
+    category_of: dict = field(default_factory=dict)
+    category_word: str = "value"
 
     def at_point(self, other: pd.DataFrame, point: Point, where: str) -> pd.DataFrame:
         """The rows of another domain at ``point`` (matched on the point's columns)."""
@@ -101,8 +117,8 @@ class DomainView:
         frequency_hz, y in amplitude_g (the axis and scale columns dropped)."""
         out = rows.drop(columns=[*axis_columns(rows.columns), "frequency_hz", "amplitude_g"])
         x = rows[self.x]
-        if self.categories is not None:
-            x = x.map(lambda v: self.categories.index(value_text(v)))
+        if self.categories is not None:  # a value no category holds (another domain's): nan
+            x = x.map(lambda v: self.category_of.get(str(v), math.nan))
         out.insert(0, "frequency_hz", pd.to_numeric(x).to_numpy(float))
         out.insert(0, "amplitude_g", rows[self.y].to_numpy(float))
         return out
@@ -116,6 +132,46 @@ def value_text(value, path: str = "") -> str:
         text = str(value)
     unit = UNITS.get(path)
     return f"{text} {unit}" if unit else text
+
+
+def record_names(values, names=None) -> dict[str, str]:
+    """{value as text: its name} of a record axis's values (file paths, or motions' names),
+    in the order met: ``names`` (a mapping from the value's text, e.g. domain.csv's
+    ``record`` column) or the file's stem; where two values share a name, each is named
+    by the end of its path, as many folders as tell them apart (``x/rdk_01``,
+    ``y/rdk_01``), and by its whole text where nothing shorter does."""
+    keys = list(dict.fromkeys(str(v) for v in values))
+    names = dict(names or {})
+    labels = {k: str(names.get(k) or PurePath(k).stem or k) for k in keys}
+    if len(set(labels.values())) == len(keys):
+        return labels
+    parts = {k: PurePath(k).parent.parts + (PurePath(k).stem,) for k in keys}
+    for depth in range(2, max(len(p) for p in parts.values()) + 1):
+        labels = {k: "/".join(parts[k][-depth:]) for k in keys}
+        if len(set(labels.values())) == len(keys):
+            return labels
+    return {k: k for k in keys}
+
+
+def axis_names(df: pd.DataFrame) -> dict[str, dict[str, str]]:
+    """The names of the records of each record axis of a domain (:func:`record_names`):
+    {path: {value as text: name}}; ``excitation.file`` named by the ``record`` column."""
+    out = {}
+    for path in RECORD_PATHS:
+        if path in df.columns:
+            named = None
+            if path == "excitation.file" and "record" in df.columns:
+                named = dict(zip(df[path].astype(str), df["record"].astype(str), strict=True))
+            out[path] = record_names(df[path], named)
+    return out
+
+
+def _point_text(path: str, value, names: dict) -> str:
+    """A point's value as a panel's title or a legend shows it: ``record rdk_01`` on a
+    record axis, else ``path = value unit``."""
+    if path in names:
+        return f"{RECORD_WORDS[path]} {names[path][str(value)]}"
+    return f"{path} = {value_text(value, path)}"
 
 
 def point_key(values) -> tuple[str, ...]:
@@ -228,14 +284,23 @@ def _log_axis(values, path: str, config: Config | None) -> bool:
     return bool(np.ptp(ratio) < 1e-6 * abs(ratio.mean()) and np.ptp(step) > 1e-6 * step.mean())
 
 
-def _coordinates(df, line, dimensionless, config) -> dict:
-    """x, y, axis labels, log x and categories of the view."""
+def _coordinates(df, line, dimensionless, config, group=(), names=None) -> dict:
+    """x, y, axis labels, log x and categories of the view (``group``: the linked paths of
+    the line's axis; ``names``: the records' names of the record axes)."""
     if dimensionless:
         return dict(x="omega_over_p", y="a_over_g_alpha", labels=DIMENSIONLESS_LABELS,
                     log_x=False, categories=None)  # fmt: skip
     if line == "frequency_hz":
         return dict(x=line, y="amplitude_g", labels=("frequency [Hz]", "amplitude [g]"),
                     log_x=False, categories=None)  # fmt: skip
+    names = names or {}
+    if line in names:  # a suite: its records by name, one category each
+        words = "record pair (x record)" if "excitation.file_y" in group else RECORD_WORDS[line]
+        keys = list(names[line])
+        categories = tuple(names[line][k] for k in keys)
+        return dict(x=line, y="amplitude_g", labels=(words, "amplitude [g]"), log_x=False,
+                    categories=categories, category_of={k: i for i, k in enumerate(keys)},
+                    category_word="record")  # fmt: skip
     unit = UNITS.get(line)
     label = f"{line} [{unit}]" if unit else line
     numeric = pd.to_numeric(df[line], errors="coerce")
@@ -244,8 +309,9 @@ def _coordinates(df, line, dimensionless, config) -> dict:
         return dict(x=line, y="amplitude_g", labels=(label, "amplitude [g]"), log_x=log,
                     categories=None)  # fmt: skip
     categories = tuple(dict.fromkeys(value_text(v) for v in df[line]))
+    category_of = {str(v): categories.index(value_text(v)) for v in df[line]}
     return dict(x=line, y="amplitude_g", labels=(label, "amplitude [g]"), log_x=False,
-                categories=categories)  # fmt: skip
+                categories=categories, category_of=category_of)  # fmt: skip
 
 
 def domain_view(
@@ -274,14 +340,13 @@ def domain_view(
     line, rest = _split(df, groups, layout, where)
     paths = [p for g in rest for p in g]
     configs = point_configs(df, config)
+    names = axis_names(df)
     if paths:
         grouped = df.groupby(paths, sort=False, dropna=False)
         points = []
         for values, rows in grouped:
             values = values if isinstance(values, tuple) else (values,)
-            label = ", ".join(
-                f"{p} = {value_text(v, p)}" for p, v in zip(paths, values, strict=True)
-            )
+            label = ", ".join(_point_text(p, v, names) for p, v in zip(paths, values, strict=True))
             points.append(Point(label, rows, configs, values))
     else:
         points = [Point("", df, configs)]
@@ -293,7 +358,8 @@ def domain_view(
             f"panels: {where} has {len(points)} points, too many panels (at most"
             f" {MAX_PANELS}): use overlay"
         )
-    coordinates = _coordinates(df, line, dimensionless, config)
+    group = next((g for g in groups if line in g), ())
+    coordinates = _coordinates(df, line, dimensionless, config, group, names)
     return DomainView(layout=layout, dimensionless=dimensionless, line=line, points=points,
                       point_paths=tuple(paths), **coordinates)  # fmt: skip
 
@@ -310,10 +376,13 @@ __all__ = [
     "LAYOUTS",
     "DomainView",
     "Point",
+    "RECORD_WORDS",
     "axis_groups",
+    "axis_names",
     "domain_view",
     "point_configs",
     "point_key",
+    "record_names",
     "row_configs",
     "value_text",
     "with_scales",

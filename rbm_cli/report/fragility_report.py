@@ -59,6 +59,9 @@ def fragility_summary(result: FragilityResult) -> dict:
             for x, n in zip(result.table["intensity_g"], result.table["n_failed"], strict=True)
         ],
         "warning": result.warning,
+        "fit_warning": result.fit_warning,
+        "resamples_dropped": dict(result.resamples_dropped),
+        "resamples_note": result.resamples_note,
     }
 
 
@@ -143,7 +146,10 @@ def plot_fragility(
     -------
     matplotlib.axes.Axes
         The axes: points (marker "o", gid "observed"), fitted curve (gid "fitted"), band
-        (a PolyCollection, gid "band"); the legend says which is which
+        (a PolyCollection, gid "band"); the legend says which is which. Under the axes,
+        notes: why there is no fit or no band (gid "note", "few-records"), an
+        extrapolated fit (gid "fit-warning", in red) and the bootstrap resamples left out
+        and why (gid "resamples-note")
     """
     ax = ax if ax is not None else _new_axes()
     prefix = f"{label}: " if label else ""
@@ -159,6 +165,10 @@ def plot_fragility(
         _note(ax, f"{prefix}no fit: {result.note}", "note")
     elif result.note and result.n_records >= MIN_BAND_RECORDS:
         _note(ax, f"{prefix}{result.note}", "note")
+    if result.fit_warning:
+        _note(ax, f"{prefix}{result.fit_warning}", "fit-warning", "tab:red")
+    if result.resamples_note:
+        _note(ax, f"{prefix}{result.resamples_note}", "resamples-note")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("probability of collapse [-]")
     ax.set_ylim(-0.03, 1.03)
@@ -168,11 +178,20 @@ def plot_fragility(
     return ax
 
 
+#: The gids of the notes under a fragility figure's axes.
+NOTE_GIDS = ("note", "few-records", "fit-warning", "resamples-note")
+#: Characters of a note's line under the axes (a longer note is wrapped).
+NOTE_WIDTH = 120
+
+
 def _note(ax, text: str, gid: str, color: str = "black") -> None:
-    """A note under the axes (off the points and the legend), one line below the last."""
-    below = sum(t.get_gid() in ("note", "few-records") for t in ax.texts)
-    ax.text(0.0, -0.14 - 0.06 * below, text, transform=ax.transAxes, fontsize=7, va="top",
-            color=color, gid=gid)  # fmt: skip
+    """A note under the axes (off the points and the legend), below the last one, wrapped
+    at NOTE_WIDTH characters."""
+    import textwrap
+
+    lines = sum(t.get_text().count("\n") + 1 for t in ax.texts if t.get_gid() in NOTE_GIDS)
+    ax.text(0.0, -0.14 - 0.04 * lines, textwrap.fill(text, NOTE_WIDTH), transform=ax.transAxes,
+            fontsize=7, va="top", color=color, gid=gid)  # fmt: skip
 
 
 #: Most points labelled with their counts: beyond, the labels cover each other (a suite

@@ -2,6 +2,10 @@
 point, or an overlay of the points' boundaries; in physical or dimensionless axes, with the
 uplift level and the closed forms where they apply.
 
+Over a categorical x (the records of a suite, or any named values) nothing joins one x to
+the next: a boundary is a bar per category (plot_domain.py), an overlaid point's boundary
+its marks alone, and the categories are the ticks, turned upright when they would overlap.
+
 Every artist carries a gid, as in plot_domain.py: 'safe', 'unsafe', 'failed', 'boundary'
 (one per panel), 'boundary-member0' (an ensemble's member 0, one per panel),
 'boundary-<k>' (the k-th point's line of an overlay), 'member0-<k>' (its member 0's line
@@ -52,6 +56,7 @@ FAINT = 0.22
 #: An overlaid ensemble's member 0 boundary: thin, no marks (the majority's: marks "o").
 OVERLAY_MEMBER0 = dict(linewidth=0.9, linestyle=(0, (3, 1, 1, 1, 1, 1)), zorder=4)
 OVERLAY_MEMBER0_LABEL = "member 0's boundary of each point (thin, no marks)"
+OVERLAY_MEMBER0_MARKS = "member 0's lowest collapsed amplitude of each point (bars)"
 #: Styles of the level and curves (as plot_domain.py draws them against frequency).
 STATIC = dict(color="0.3", linestyle="--", linewidth=1.0)
 HOUSNER = dict(color="tab:purple", linestyle="-.", linewidth=1.3)
@@ -187,8 +192,17 @@ def _x_range(plane: pd.DataFrame) -> tuple[float, float]:
     return (float(x.min()), float(x.max())) if x.size else (0.0, 1.0)
 
 
-def _finish_x(ax, view: DomainView) -> None:
-    """A log x axis labelled 1, 2, 5, 10, ... in plain numbers; category names as ticks."""
+#: Most category names on an axis: beyond, every k-th is named (the ticks stay).
+MAX_CATEGORY_TICKS = 60
+#: Width of a tick label's character, in its font size (a mean over names in sans-serif).
+CHAR_WIDTH = 0.6
+
+
+def _finish_x(ax, view: DomainView) -> float:
+    """A log x axis labelled 1, 2, 5, 10, ... in plain numbers; category names as ticks,
+    upright when side by side they would not fit the axes' width, every k-th named
+    beyond MAX_CATEGORY_TICKS, and half a category of margin at either end. Returns the
+    height the upright names take beyond one line of text [points] (0 otherwise)."""
     if view.log_x:
         from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
@@ -197,7 +211,20 @@ def _finish_x(ax, view: DomainView) -> None:
         ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.xaxis.set_minor_formatter(NullFormatter())
     if view.categories is not None:
-        ax.set_xticks(range(len(view.categories)), view.categories)
+        from matplotlib.font_manager import FontProperties
+
+        n = len(view.categories)
+        every = math.ceil(n / MAX_CATEGORY_TICKS)
+        names = [name if k % every == 0 else "" for k, name in enumerate(view.categories)]
+        size = FontProperties(size="small").get_size_in_points()
+        width = ax.get_position().width * ax.figure.get_size_inches()[0] * 72.0  # [points]
+        needed = sum(CHAR_WIDTH * size * (len(name) + 2) for name in names)
+        upright = needed > width
+        ax.set_xticks(range(n), names, fontsize="small", rotation=90 if upright else 0)
+        ax.set_xlim(-0.5, n - 0.5)
+        if upright:
+            return CHAR_WIDTH * size * max(len(name) for name in names) - size
+    return 0.0
 
 
 def draw_plane(ax, view: DomainView, point: Point, compare=(), labels=None, colorbar=True,
@@ -207,10 +234,14 @@ def draw_plane(ax, view: DomainView, point: Point, compare=(), labels=None, colo
     plane = view.plane(point.rows)
     others = [view.plane(c) for c in compare]
     size = LOG_MARKER if view.log_x else None
-    proxies = draw_domain(ax, plane, others, labels, colorbar, size)
+    bars = view.category_word if view.categories is not None else None
+    proxies = draw_domain(ax, plane, others, labels, False, size, bars)
     top = draw_levels(ax, view, point, _x_range(plane))
     finish_axes(ax, [plane, *others], top, proxies, view.labels, legend)
-    _finish_x(ax, view)
+    names = _finish_x(ax, view)
+    if colorbar and is_ensemble(plane):  # below the x axis's names, however tall they stand
+        height = ax.get_position().height * ax.figure.get_size_inches()[1] * 72.0  # [points]
+        fraction_colorbar(ax.figure, ax, pad=0.16 + names / height)
     return proxies
 
 
@@ -237,17 +268,22 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
         artist.set_alpha(FAINT)
     colours = point_colours(len(view.points), numeric)
     ensemble = is_ensemble(rows)
+    joined = view.categories is None  # over categories, marks alone: no line between them
     for k, (point, colour) in enumerate(zip(view.points, colours, strict=True)):
         bnd = boundary(view.plane(point.rows))
         f = bnd["frequency_hz"].to_numpy(float)
+        style = ("-", "--", "-.")[k // 10 % 3] if not numeric else "-"
         ax.plot(f, bnd["lowest_unsafe_g"].to_numpy(float),
                 color=colour, linewidth=1.5, marker="o", markersize=3.5, label=point.label,
-                linestyle=("-", "--", "-.")[k // 10 % 3] if not numeric else "-",
-                gid=f"boundary-{k}", zorder=4)  # fmt: skip
+                linestyle=style if joined else "none", gid=f"boundary-{k}",
+                zorder=4)  # fmt: skip
         if ensemble:
+            member0 = dict(OVERLAY_MEMBER0) if joined else dict(
+                linestyle="none", marker="_", markersize=7.0, zorder=4)  # fmt: skip
             ax.plot(f, bnd["member0_lowest_unsafe_g"].to_numpy(float), color=colour,
-                    label=OVERLAY_MEMBER0_LABEL if k == 0 else "_", gid=f"member0-{k}",
-                    **OVERLAY_MEMBER0)  # fmt: skip
+                    label=OVERLAY_MEMBER0_LABEL if k == 0 and joined
+                    else OVERLAY_MEMBER0_MARKS if k == 0 else "_",
+                    gid=f"member0-{k}", **member0)  # fmt: skip
     tops = [
         _overlay_levels(ax, view, point, k, colour)
         for k, (point, colour) in enumerate(zip(view.points, colours, strict=True))
@@ -264,8 +300,10 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
         from matplotlib.lines import Line2D
 
         handles, _ = ax.get_legend_handles_labels()
+        what = "lines with marks" if joined else "marks"
         majority = Line2D([], [], color="0.2", linewidth=1.5, marker="o", markersize=3.5,
-                          label=f"lines with marks: each point's {MAJORITY_LABEL}")  # fmt: skip
+                          linestyle="-" if joined else "none",
+                          label=f"{what}: each point's {MAJORITY_LABEL}")  # fmt: skip
         handles = [majority, *handles]
     legend_beside(ax, handles=handles)
 

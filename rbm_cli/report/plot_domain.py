@@ -3,11 +3,16 @@
 A pure plot function: it takes ``ax=None`` (a new figure is made if omitted)
 and returns the axes; it never saves or shows (the CLI and the sweep do).
 Every artist it draws carries a ``gid`` ('safe', 'unsafe', 'failed', 'upper-joint',
-'base-joint', 'slides', 'boundary', 'boundary-member0', 'compare-<k>', 'static',
-'housner', 'linear'), so
+'slides', 'boundary', 'boundary-member0', 'compare-<k>', 'static', 'housner', 'linear'), so
 callers and tests can find them. In an ensemble domain (a collapse_fraction column)
 'boundary' is the majority's and 'boundary-member0' member 0's
-(:func:`rbm_cli.study.domain.boundary`).
+(:func:`rbm_cli.study.domain.boundary`), drawn where it differs from the majority's.
+
+The legend lists what is drawn, each mark once: a boundary with no point (nothing
+collapsed) is not listed, nor member 0's where it is the majority's everywhere. Over a
+categorical x (the records of a suite, rbm_cli.report.domain_view) the boundary is not a
+line, which would join unrelated records, but a bar per record at its lowest collapsed
+amplitude (:data:`BAR_LABEL`).
 """
 
 from __future__ import annotations
@@ -22,6 +27,9 @@ from rbm_cli.physics.column import Column
 from rbm_cli.study.domain import MAJORITY, boundary
 
 __all__ = [
+    "BAR_LABEL",
+    "BAR_MAJORITY_LABEL",
+    "BAR_MEMBER0_LABEL",
     "MAJORITY_LABEL",
     "MEMBER0_LABEL",
     "boundary",
@@ -52,11 +60,19 @@ MAJORITY_LABEL = f"boundary of the majority (collapse fraction >= {MAJORITY:g})"
 MEMBER0_LABEL = "member 0's boundary (its own outcome)"
 #: Style of member 0's boundary line (the majority's is solid).
 MEMBER0_STYLE = dict(linestyle=":", linewidth=1.6)
+#: Labels of the boundary over a categorical x: a bar per category (``{}``: what one
+#: category is, e.g. "record"), the majority's and member 0's of an ensemble.
+BAR_LABEL = "boundary (lowest collapsed amplitude), a bar per {}"
+BAR_MAJORITY_LABEL = "boundary of the majority (fraction >= {:g}), a bar per {}"
+BAR_MEMBER0_LABEL = "member 0's boundary where it differs (grey bar)"
+#: Style of those bars (member 0's thinner, in grey), their width in cell marker sizes.
+BAR_STYLE = dict(linestyle="none", marker="_", markeredgewidth=2.0)
+BAR_MEMBER0_STYLE = dict(linestyle="none", marker="_", markeredgewidth=1.4, color="0.55")
+BAR_WIDTH = 3.0
 #: The column of domain.csv marking cells whose friction demand exceeds interface.friction.
 SLIDES = "slides"
 #: Legend labels of the marks over the cells (mark_cells).
-UPPER_JOINT_LABEL = "collapsed at an upper joint (cross in a triangle)"
-BASE_JOINT_LABEL = "collapsed at the base joint (cross alone)"
+UPPER_JOINT_LABEL = "collapsed at an upper joint (in a triangle; a cross alone: at the base)"
 SLIDES_LABEL = "slides: max |T/N| > interface.friction"
 #: Marker size range [points] and its share of the grid spacing on screen.
 MARKER_MAX, MARKER_MIN, MARKER_SHARE = 5.0, 1.5, 0.75
@@ -165,9 +181,9 @@ def _plot_fraction_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None)
     return handles
 
 
-def fraction_colorbar(fig, axes, cax=None) -> None:
+def fraction_colorbar(fig, axes, cax=None, pad: float = 0.16) -> None:
     """The colour bar of the collapse fraction, below ``axes`` (one or a list; the legend
-    sits beside them), or in ``cax``."""
+    sits beside them; ``pad``: the gap, in the axes' height), or in ``cax``."""
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
 
@@ -175,7 +191,7 @@ def fraction_colorbar(fig, axes, cax=None) -> None:
     if cax is not None:
         fig.colorbar(mappable, cax=cax, label=FRACTION_LABEL, orientation="horizontal")
         return
-    fig.colorbar(mappable, ax=axes, label=FRACTION_LABEL, location="bottom", pad=0.16,
+    fig.colorbar(mappable, ax=axes, label=FRACTION_LABEL, location="bottom", pad=pad,
                  fraction=0.06, aspect=40)  # fmt: skip
 
 
@@ -184,16 +200,37 @@ def is_ensemble(df: pd.DataFrame) -> bool:
     return "collapse_fraction" in df.columns
 
 
-def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str, member0=None) -> None:
-    """The boundary as a line under the cells (no markers of its own); ``member0``: the
-    label of member 0's boundary of an ensemble, drawn dotted beside the majority's."""
+def _listed(label: str, y: np.ndarray) -> str:
+    """A legend label for a mark with values ``y``, hidden ('_' first) when none is finite:
+    the legend lists only what is drawn."""
+    return label if np.isfinite(y).any() else f"_{label}"
+
+
+def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str, member0=None,
+                   bars: float | None = None) -> None:  # fmt: skip
+    """The boundary under the cells: a line (no markers of its own), or with ``bars`` (a
+    categorical x: the bar's width [points]) a bar at each x, nothing joining them.
+    ``member0``: the label of member 0's boundary of an ensemble, drawn dotted (grey bars)
+    beside the majority's where the two differ, and not at all where they never do."""
     bnd = boundary(df)
     f = bnd["frequency_hz"].to_numpy(float)
-    ax.plot(f, bnd["lowest_unsafe_g"].to_numpy(float), color=colour, linewidth=1.4,
-            label=label, gid=gid, zorder=2)  # fmt: skip
-    if member0 is not None and "member0_lowest_unsafe_g" in bnd.columns:
-        ax.plot(f, bnd["member0_lowest_unsafe_g"].to_numpy(float), color=colour,
-                label=member0, gid=f"{gid}-member0", zorder=2, **MEMBER0_STYLE)  # fmt: skip
+    y = bnd["lowest_unsafe_g"].to_numpy(float)
+    style = dict(color=colour, linewidth=1.4) if bars is None else dict(
+        color=colour, markersize=bars, **BAR_STYLE)  # fmt: skip
+    ax.plot(f, y, label=_listed(label, y), gid=gid, zorder=2, **style)
+    if member0 is None or "member0_lowest_unsafe_g" not in bnd.columns:
+        return
+    y0 = bnd["member0_lowest_unsafe_g"].to_numpy(float)
+    differs = ~((y0 == y) | (np.isnan(y0) & np.isnan(y)))
+    if not differs.any():
+        return  # the same boundary: one line, one legend entry
+    if bars is None:
+        ax.plot(f, y0, color=colour, label=member0, gid=f"{gid}-member0", zorder=2,
+                **MEMBER0_STYLE)  # fmt: skip
+    else:
+        y0 = np.where(differs, y0, np.nan)
+        ax.plot(f, y0, markersize=bars, label=_listed(member0, y0), gid=f"{gid}-member0",
+                zorder=2, **BAR_MEMBER0_STYLE)  # fmt: skip
 
 
 def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
@@ -220,13 +257,29 @@ def _plot_closed_forms(ax, column: Column, frequencies_hz: np.ndarray) -> None:
     )
 
 
-def _labels(labels: Sequence[str] | None, domains: list[pd.DataFrame]) -> tuple[list, str]:
+def _labels(labels: Sequence[str] | None, domains: list[pd.DataFrame],
+            bars: str | None = None) -> tuple[list, str]:  # fmt: skip
     """The legend labels of the boundaries (the domain's, then one per compared domain),
     and of member 0's boundary of an ensemble domain.
 
     Alone, the domain's line is the BOUNDARY_LABEL (what the line is; the figure's title
     names the study), or for an ensemble the MAJORITY_LABEL. With compared domains each
-    line is '<name>: boundary', '<name>: boundary of the majority' for an ensemble."""
+    line is '<name>: boundary', '<name>: boundary of the majority' for an ensemble. With
+    ``bars`` (what one category of a categorical x is) the boundary is a bar per category:
+    BAR_LABEL, BAR_MAJORITY_LABEL and BAR_MEMBER0_LABEL say so."""
+    if bars is not None:
+        alone = [BAR_MAJORITY_LABEL.format(MAJORITY, bars) if is_ensemble(d)
+                 else BAR_LABEL.format(bars) for d in domains]  # fmt: skip
+        if len(domains) == 1:
+            return alone, BAR_MEMBER0_LABEL
+        names = list(labels) if labels else [f"domain {k + 1}" for k in range(len(domains))]
+        if len(names) != len(domains):
+            raise ValueError(
+                f"labels needs {len(domains)} entries (the domain, then one per compared "
+                f"domain), got {len(names)}"
+            )
+        return ([f"{name}: {text}" for name, text in zip(names, alone, strict=True)],
+                f"{names[0]}: {BAR_MEMBER0_LABEL}")  # fmt: skip
     n_compare = len(domains) - 1
     if labels is None:
         labels = ["domain 1"] + [f"domain {k + 2}" for k in range(n_compare)]
@@ -334,7 +387,8 @@ def _flag(df: pd.DataFrame, column: str) -> np.ndarray:
 def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
     """Marks over the cells: the mechanism of a collapse, where the domain says which
     interface collapsed (collapse_interface, 1 at the ground: a cross alone is a collapse
-    at the base joint, a cross in a triangle at an upper joint; gid 'upper-joint'), and
+    at the base joint, a cross in a triangle at an upper joint; gid 'upper-joint', whose
+    legend entry says both), and
     the cells whose friction demand exceeds interface.friction (slides = 1: an open
     diamond around the cell; gid 'slides')."""
     f = df["frequency_hz"].to_numpy(float)
@@ -344,11 +398,9 @@ def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
     if "collapse_interface" in df.columns and unsafe.any():
         where = pd.to_numeric(df["collapse_interface"], errors="coerce").to_numpy(float)
         upper = unsafe & (where > 1)
-        if upper.any():
+        if upper.any():  # (a cross alone is the collapse's own entry: not listed twice)
             ax.plot(f[upper], a[upper], marker="^", color="tab:red", markersize=1.5 * size,
                     label=UPPER_JOINT_LABEL, gid="upper-joint", **style)  # fmt: skip
-            ax.plot([], [], marker="x", linestyle="none", color="tab:red",
-                    label=BASE_JOINT_LABEL, gid="base-joint")  # fmt: skip
     if SLIDES in df.columns:
         slides = _flag(df, SLIDES)
         if slides.any():
@@ -358,17 +410,23 @@ def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
 
 
 def draw_domain(
-    ax, df: pd.DataFrame, compare=(), labels=None, colorbar: bool = True, size=None
-) -> list:
+    ax, df: pd.DataFrame, compare=(), labels=None, colorbar: bool = True, size=None,
+    bars: str | None = None,
+) -> list:  # fmt: skip
     """Cells of ``df`` and the boundaries of it and of ``compare`` (see :func:`plot_domain`),
-    from its amplitude_g and frequency_hz columns; returns the ensemble's legend proxies."""
+    from its amplitude_g and frequency_hz columns; returns the ensemble's legend proxies.
+    ``bars``: x is categorical, each category one ``bars`` ("record"): the boundaries are
+    bars, one per category, not lines."""
     compare = list(compare)
-    texts, member0 = _labels(labels, [df, *compare])
+    texts, member0 = _labels(labels, [df, *compare], bars)
+    size = marker_size(ax, df) if size is None else size
     proxies = draw_cells(ax, df, colorbar, size)
-    _plot_boundary(ax, df, "black", texts[0], "boundary", member0 if is_ensemble(df) else None)
+    width = BAR_WIDTH * size if bars is not None else None
+    _plot_boundary(ax, df, "black", texts[0], "boundary", member0 if is_ensemble(df) else None,
+                   width)  # fmt: skip
     for k, (other, label) in enumerate(zip(compare, texts[1:], strict=True)):
         colour = COMPARE_COLOURS[k % len(COMPARE_COLOURS)]
-        _plot_boundary(ax, other, colour, label, f"compare-{k}")
+        _plot_boundary(ax, other, colour, label, f"compare-{k}", bars=width)
     return proxies
 
 
@@ -427,9 +485,10 @@ def plot_domain(
     Alone, the domain's line is labelled "boundary (lowest collapsed amplitude)";
     with compared domains each line is "<label>: boundary". The boundary is the
     lowest collapsed amplitude per frequency (:func:`rbm_cli.study.domain.boundary`;
-    gaps where nothing collapses). In an ensemble domain it is the majority's (a cell
-    collapsed where collapse_fraction >= 0.5), labelled so, and member 0's boundary is
-    drawn beside it, dotted in the same colour, labelled "member 0's boundary". The
+    gaps where nothing collapses; not listed in the legend when nothing does). In an
+    ensemble domain it is the majority's (a cell collapsed where collapse_fraction >=
+    0.5), labelled so, and member 0's boundary is drawn beside it, dotted in the same
+    colour, labelled "member 0's boundary", where the two differ anywhere. The
     closed forms use the mapping of the RBM's rigid monolith to the linear block
     (:func:`rbm_cli.physics.closed_forms.linear_rocking_parameters`): the rigid RBM
     monolith is the piecewise-linear block with alpha = B_1/H.

@@ -136,10 +136,12 @@ def record_of_run(config, amplitude_g: float) -> dict | None:
     """What a record run ran, for its summary.json and its figures' titles: the record's
     name, its peak acceleration as scaled [g] (the amplitude with ``scale: pga``; the
     factor times the processed record's PGA with ``scale: factor``; a pair's: the larger
-    component's, with ``record_y`` the second record's name), and the vertical record's
-    name and scaled peak [g] (None without one); None for another excitation."""
+    component's, with ``record_y`` the second record's name and ``pair_times`` how the two
+    were put on one time base: ``shared`` (the same sample times) or ``union`` (the union
+    of both records' times, each linear between its own samples)), and the vertical
+    record's name and scaled peak [g] (None without one); None for another excitation."""
     from rbm_cli.config.types import G
-    from rbm_cli.physics.excitation import make_ground_motion
+    from rbm_cli.physics.excitation import make_ground_motion, pair_times
 
     excitation = config.excitation
     if excitation.type != "record":
@@ -149,6 +151,7 @@ def record_of_run(config, amplitude_g: float) -> dict | None:
             "scale": excitation.scale, "vertical": None, "vertical_peak_g": None}  # fmt: skip
     if motion.values_y is not None:  # a pair: its PGA is the larger component's
         info["record_y"] = Path(str(excitation.file_y)).stem
+        info["pair_times"] = pair_times(excitation)
         info["pga_g"] = max(info["pga_g"], float(np.max(np.abs(motion.values_y))) / G)
     if motion.vertical is not None:
         info["vertical"] = Path(str(excitation.vertical)).stem

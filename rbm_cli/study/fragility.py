@@ -15,13 +15,22 @@ The bootstrap draws whole records with replacement (a record's runs at all inten
 stay together, so the correlation between its outcomes is kept), refits, and takes
 percentiles of theta, beta and P(x) at each grid intensity (Efron and Tibshirani's
 percentile interval). Resamples with no fit (e.g. no collapse drawn) are skipped and
-counted. A suite of one record has no bootstrap (every resample would be that record: a
-band of zero width, as if the fit were certain): its fit has no band and no intervals, and
-its note says why. At most :data:`MAX_RESAMPLES` resamples (each one a refit, about 1-3
-ms). Percentile intervals of a dispersion are somewhat narrow at small samples: on 80
-simulated suites of 40 records (capacities lognormal, theta 0.4 g, beta 0.35, 20 levels)
-the 5-95 % intervals covered theta in 89 % and beta in 83 % of the suites (nominal 90 %);
-the MLE of beta was 2 % low on average, as the sample standard deviation of 40 values is.
+counted by why (:data:`~rbm_cli.study.fragility_fit.NO_FIT_REASONS`), and a note says how
+many and why: the draws left out are a suite's extremes (no collapse: a median above every
+intensity), so the band of the others is narrower than the data's uncertainty. A suite of
+one record has no bootstrap (every resample would be that record: a band of zero width, as
+if the fit were certain): its fit has no band and no intervals, and its note says why. At
+most :data:`MAX_RESAMPLES` resamples (each one a refit, about 1-3 ms). Percentile
+intervals of a dispersion are somewhat narrow at small samples: on 80 simulated suites of
+40 records (capacities lognormal, theta 0.4 g, beta 0.35, 20 levels) the 5-95 % intervals
+covered theta in 89 % and beta in 83 % of the suites (nominal 90 %); the MLE of beta was
+2 % low on average, as the sample standard deviation of 40 values is.
+
+A fit that rests on extrapolation is flagged (``fit_warning``): a median outside the
+intensities tested (the runs then hold one side of the curve only), or a curve whose rise
+from 16 % to 84 % (theta e^-beta to theta e^beta, a factor e^(2 beta) in intensity) is
+wider than the span of the intensities tested (its dispersion is then read from a part of
+the curve the runs do not reach).
 
 References
 ----------
@@ -36,14 +45,16 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.study.fragility_fit import (
+    NO_FIT_REASONS,
     LognormalFit,
+    NoFit,
     collapse_probability,
     fit_counts,
     fit_lognormal,
@@ -90,6 +101,10 @@ class FragilityResult:
     outcome : what a trial is, one line (each run; an ensemble's members or majority)
     ensemble_outcome : members, majority or member0 for an ensemble domain, else None
     warning : one line when failed runs concentrate at the high intensities, else ""
+    fit_warning : one line when the fit is extrapolated (module docstring), else ""
+    resamples_dropped : (what the resample held, count) of the bootstrap resamples with no
+        fit, the most frequent first (empty when none was dropped)
+    resamples_note : one line saying how many resamples were dropped and why, else ""
     """
 
     table: pd.DataFrame
@@ -109,6 +124,9 @@ class FragilityResult:
     outcome: str = "each run a trial"
     ensemble_outcome: str | None = None
     warning: str = ""
+    fit_warning: str = ""
+    resamples_dropped: tuple[tuple[str, int], ...] = ()
+    resamples_note: str = ""
 
     @property
     def intensity_unit(self) -> str:
@@ -138,13 +156,15 @@ def _record_matrices(rows: pd.DataFrame, levels: np.ndarray):
 
 
 def _bootstrap(runs, hits, log_levels, start, n_resamples, seed, grid, progress=None):
-    """Refit on records drawn with replacement; degenerate resamples are skipped.
+    """Refit on records drawn with replacement; degenerate resamples are skipped and
+    counted by their reason ({NO_FIT_REASONS key: count}, the fourth value returned).
     ``progress(done, total)`` is called after each resample."""
     rng = np.random.default_rng(seed)
     n_rec = runs.shape[0]
     thetas, betas = np.empty(n_resamples), np.empty(n_resamples)
     curves = np.empty((n_resamples, grid.size))  # filled in place: no list of arrays copied
     used_fits = 0
+    dropped: dict[str, int] = {}
     for done in range(1, n_resamples + 1):
         weights = np.bincount(rng.integers(0, n_rec, n_rec), minlength=n_rec).astype(float)
         n = weights @ runs
@@ -152,15 +172,16 @@ def _bootstrap(runs, hits, log_levels, start, n_resamples, seed, grid, progress=
         used = n > 0
         try:
             fit = fit_counts(log_levels[used], n[used], k[used], start=start)
-        except RbmError:
+        except NoFit as exc:
             fit = None
+            dropped[exc.reason] = dropped.get(exc.reason, 0) + 1
         if fit is not None:
             thetas[used_fits], betas[used_fits] = fit.median_g, fit.beta
             curves[used_fits] = collapse_probability(grid, fit.median_g, fit.beta)
             used_fits += 1
         if progress is not None:
             progress(done, n_resamples)
-    return thetas[:used_fits], betas[:used_fits], curves[:used_fits]
+    return thetas[:used_fits], betas[:used_fits], curves[:used_fits], dropped
 
 
 def fragility(
@@ -238,6 +259,8 @@ def fragility(
     band = _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, [lo_pct, hi_pct], progress)
     curve = _curve(grid, fit, band)
     _add_fitted(table, grid, fit, band)
+    dropped = tuple(sorted(((NO_FIT_REASONS[r], c) for r, c in band.dropped.items()),
+                           key=lambda item: -item[1]))  # fmt: skip
     return FragilityResult(
         table=table,
         curve=curve,
@@ -256,6 +279,9 @@ def fragility(
         outcome=_outcome(ensemble, ensemble_outcome, n_members),
         ensemble_outcome=ensemble_outcome if ensemble else None,
         warning=failed_warning(table),
+        fit_warning=fit_warning(fit, table, intensity_unit(column)),
+        resamples_dropped=dropped,
+        resamples_note=resamples_note(n_resamples if fit is not None else 0, dropped),
     )
 
 
@@ -288,6 +314,69 @@ def failed_warning(table: pd.DataFrame) -> str:
         f"{top} of the {total} failed runs are at the upper third of the intensities "
         f"(from {low:.4g}): left out of the fit, they may hide collapses, so the median may "
         "be too high"
+    )
+
+
+def fit_warning(fit: LognormalFit | None, table: pd.DataFrame, unit: str = "g") -> str:
+    """One line when the fit rests on extrapolation (module docstring), else "": its median
+    outside the intensities tested (those with runs that did not fail), or its rise from
+    16 % to 84 % wider than their span (e^(2 beta) > highest / lowest)."""
+    if fit is None:
+        return ""
+    trials = table["n_trials"] if "n_trials" in table.columns else table["n_records"]
+    tested = table[trials.to_numpy() > 0]
+    if tested.empty:
+        return ""
+    x = tested["intensity_g"].to_numpy(float)
+    lo, hi = float(x.min()), float(x.max())
+    median, beta = fit.median_g, fit.beta
+    curve = f"median {median:.4g} {unit}, beta {beta:.3g}"
+
+    def observed(at: float) -> str:
+        row = tested.loc[tested["intensity_g"] == at].iloc[0]
+        return f"{float(row['fraction']):.2g} collapsed there"
+
+    if median > hi:
+        return (
+            f"extrapolated fit ({curve}): the median lies above the highest intensity tested"
+            f" ({hi:.4g} {unit}, {observed(hi)}), so the runs hold only the curve's lower"
+            " part; test higher intensities"
+        )
+    if median < lo:
+        return (
+            f"extrapolated fit ({curve}): the median lies below the lowest intensity tested"
+            f" ({lo:.4g} {unit}, {observed(lo)}), so the runs hold only the curve's upper"
+            " part; test lower intensities"
+        )
+    if 2.0 * beta > math.log(hi / lo):
+        p16, p84 = median * math.exp(-beta), median * math.exp(beta)
+        return (
+            f"extrapolated dispersion ({curve}): the curve rises from 16 % to 84 % over a"
+            f" factor e^(2 beta) = {math.exp(2.0 * beta):.3g} in intensity ({p16:.4g} to"
+            f" {p84:.4g} {unit}), more than the intensities tested span (a factor"
+            f" {hi / lo:.3g}: {lo:.4g} to {hi:.4g} {unit}), so beta is read from a part of"
+            " the curve the runs do not reach"
+        )
+    return ""
+
+
+def resamples_note(n_resamples: int, dropped) -> str:
+    """One line: how many of the bootstrap's resamples had no fit and why (``dropped``:
+    (what they held, count) pairs), and what that does to the band; "" when none."""
+    total = sum(count for _, count in dropped)
+    if n_resamples <= 0 or total == 0:
+        return ""
+    why = ", ".join(f"{count} drew {what}" for what, count in dropped)
+    if total == n_resamples:
+        return (
+            f"all {n_resamples} bootstrap resamples of the records have no fit ({why}):"
+            " no band and no intervals"
+        )
+    return (
+        f"{total} of {n_resamples} bootstrap resamples of the records have no fit and are"
+        f" left out ({why}): the band and intervals are the other {n_resamples - total}'s,"
+        " and as the draws left out are the suite's extremes, they understate the"
+        " uncertainty"
     )
 
 
@@ -354,29 +443,32 @@ def _fit_table(rows: pd.DataFrame, levels: np.ndarray, n_records: int, n_resampl
 @dataclass(frozen=True)
 class _Band:
     """Bootstrap result: percentile band of the curve on the grid (lower, upper [-], nan
-    without resamples), intervals of theta [g] and beta [-], resamples with a fit."""
+    without resamples), intervals of theta [g] and beta [-], resamples with a fit, and
+    those without one by reason ({NO_FIT_REASONS key: count})."""
 
     lower: np.ndarray
     upper: np.ndarray
     median_ci_g: tuple[float, float]
     beta_ci: tuple[float, float]
     n_used: int
+    dropped: dict = field(default_factory=dict)
 
 
 def _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, pct, progress=None) -> _Band:
     """The bootstrap over records around `fit` (none without a fit or resamples)."""
     thetas = betas = np.array([])
     curves = np.empty((0, grid.size))
+    dropped: dict = {}
     if fit is not None and n_resamples > 0:
         _, runs, hits = _record_matrices(rows, levels)
         start = (math.log(fit.median_g), math.log(fit.beta))
-        thetas, betas, curves = _bootstrap(
+        thetas, betas, curves, dropped = _bootstrap(
             runs, hits, np.log(levels), start, n_resamples, seed, grid, progress
         )
     if curves.shape[0] == 0:
         nan_pair = (math.nan, math.nan)
         lower, upper = np.full((2, grid.size), np.nan)
-        return _Band(lower, upper, nan_pair, nan_pair, int(thetas.size))
+        return _Band(lower, upper, nan_pair, nan_pair, int(thetas.size), dropped)
     lower, upper = np.percentile(curves, pct, axis=0, overwrite_input=True)  # no sorted copy
     return _Band(
         lower,
@@ -384,6 +476,7 @@ def _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, pct, progress=No
         tuple(np.percentile(thetas, pct)),
         tuple(np.percentile(betas, pct)),
         int(thetas.size),
+        dropped,
     )
 
 
@@ -417,5 +510,7 @@ __all__ = [
     "collapse_probability",
     "failed_warning",
     "fit_lognormal",
+    "fit_warning",
+    "resamples_note",
     "fragility",
 ]

@@ -25,6 +25,27 @@ from scipy.special import log_ndtr, ndtr, ndtri
 from rbm_cli.base.errors import RbmError
 
 
+class NoFit(RbmError):
+    """The outcomes allow no lognormal fit; ``reason`` says why, as a key of
+    :data:`NO_FIT_REASONS` (the message says it in full, one line)."""
+
+    def __init__(self, message: str, reason: str) -> None:
+        super().__init__(message)
+        self.reason = reason
+
+
+#: Why outcomes allow no fit: the key a NoFit carries -> what the outcomes held, as a
+#: phrase (a bootstrap counts its resamples with no fit by these).
+NO_FIT_REASONS = {
+    "no-runs": "no runs",
+    "no-collapse": "no collapse",
+    "all-collapse": "only collapses",
+    "one-intensity": "runs at one intensity only",
+    "separated": "outcomes separated by intensity (no finite dispersion)",
+    "not-increasing": "outcomes that no increasing curve fits",
+}
+
+
 @dataclass(frozen=True)
 class LognormalFit:
     """A fitted lognormal fragility.
@@ -80,42 +101,62 @@ def _start(log_x, n, k) -> np.ndarray:
 def fit_counts(log_x, n, k, start=None, unit: str = "g") -> LognormalFit:
     """MLE from counts per level: ln of each intensity [ln g], runs and collapses there
     (``start``: the (ln theta, ln beta) to start from; ``unit``: the intensity's, for the
-    messages); RbmError, one line, when no finite, increasing fit exists (no collapse, only
-    collapses, one intensity, separated outcomes)."""
+    messages); :class:`NoFit` (an RbmError, one line, with its reason) when no finite,
+    increasing fit exists (no collapse, only collapses, one intensity, separated or
+    quasi-separated outcomes, collapse not rising with intensity)."""
     total_k, total_n = float(np.sum(k)), float(np.sum(n))
     if total_n == 0:
-        raise RbmError("fragility: no runs to fit")
+        raise NoFit("fragility: no runs to fit", "no-runs")
     if total_k == 0:
-        raise RbmError(
-            "fragility: no record collapsed at any intensity: the median lies above them"
+        raise NoFit(
+            "fragility: no record collapsed at any intensity: the median lies above them",
+            "no-collapse",
         )
     if total_k == total_n:
-        raise RbmError(
-            "fragility: every record collapsed at every intensity: the median lies below them"
+        raise NoFit(
+            "fragility: every record collapsed at every intensity: the median lies below them",
+            "all-collapse",
         )
     if np.unique(log_x[n > 0]).size < 2:
         x = math.exp(float(np.max(log_x[n > 0])))
-        raise RbmError(
+        raise NoFit(
             f"fragility: all runs are at one intensity ({x:.6g} {unit}, {total_k:.6g} of "
-            f"{total_n:.6g} collapsed): a lognormal curve needs runs at two intensities or more"
+            f"{total_n:.6g} collapsed): a lognormal curve needs runs at two intensities or more",
+            "one-intensity",
         )
     survived, collapsed = n - k > 0, k > 0
-    if np.max(log_x[survived]) <= np.min(log_x[collapsed]):
-        raise RbmError(
+    top_safe, low_unsafe = np.max(log_x[survived]), np.min(log_x[collapsed])
+    if top_safe < low_unsafe:
+        raise NoFit(
             f"fragility: outcomes are separated (all runs survive up to "
-            f"{math.exp(np.max(log_x[survived])):.6g} {unit} and collapse from "
-            f"{math.exp(np.min(log_x[collapsed])):.6g} {unit}): the dispersion has no finite "
-            "estimate"
+            f"{math.exp(top_safe):.6g} {unit} and collapse from "
+            f"{math.exp(low_unsafe):.6g} {unit}): the dispersion has no finite estimate",
+            "separated",
+        )
+    if top_safe == low_unsafe:  # one intensity with mixed outcomes, none mixed elsewhere
+        j = int(np.flatnonzero(log_x == top_safe)[0])
+        below, above = bool(np.any(log_x < top_safe)), bool(np.any(log_x > top_safe))
+        sides = " and ".join(
+            [*(["every run below it survives"] if below else []),
+             *(["every run above it collapses"] if above else [])]
+        )  # fmt: skip
+        raise NoFit(
+            f"fragility: outcomes are quasi-separated, mixed at one intensity only"
+            f" ({math.exp(top_safe):.6g} {unit}: {k[j]:.6g} of {n[j]:.6g} collapsed; {sides}):"
+            " the curve may rise there as steeply as it likes, so the dispersion has no"
+            " finite estimate",
+            "separated",
         )
     x0 = _start(log_x, n, k) if start is None else np.asarray(start, dtype=float)
-    res = minimize(
-        _neg_log_likelihood,
-        x0,
-        args=(log_x, n, k),
-        jac=True,
-        method="BFGS",
-        options={"gtol": 1e-9, "maxiter": 500},
-    )
+    with np.errstate(all="ignore"):  # a trial step far out overflows; the result is checked
+        res = minimize(
+            _neg_log_likelihood,
+            x0,
+            args=(log_x, n, k),
+            jac=True,
+            method="BFGS",
+            options={"gtol": 1e-9, "maxiter": 500},
+        )
     log_theta, log_beta = res.x
     spread = np.max(log_x) - np.min(log_x)
     if (
@@ -124,9 +165,10 @@ def fit_counts(log_x, n, k, start=None, unit: str = "g") -> LognormalFit:
         or log_beta > math.log(50.0)
         or np.max(np.abs(res.jac)) > 1e-4 * max(total_n, 1.0)
     ):
-        raise RbmError(
+        raise NoFit(
             "fragility: no increasing lognormal curve fits these outcomes "
-            "(collapse does not become more frequent with intensity)"
+            "(collapse does not become more frequent with intensity)",
+            "not-increasing",
         )
     return LognormalFit(math.exp(log_theta), math.exp(log_beta), -float(res.fun))
 

@@ -92,18 +92,19 @@ def column_period(config: Config) -> float | None:
 
 def _record(config: Config, second: bool = False):
     """(times [s], accelerations [m/s^2]) of a record config's record (its second
-    horizontal component, ``excitation.file_y``, if second), as the run reads it:
+    horizontal component, ``excitation.file_y`` or a motion's ``acceleration_y``, if
+    second), as the run reads it:
     processed as ``excitation.processing`` says (rbm_cli.physics.records.process)."""
     from rbm_cli.physics.excitation import load_record
     from rbm_cli.physics.records import process
 
     exc = config.excitation
-    if second:
+    if exc.motion is not None:  # given as arrays (a pair: its y component if second)
+        t, name = exc.motion.time_s, exc.motion.name
+        a = exc.motion.acceleration_y_m_s2 if second else exc.motion.acceleration_m_s2
+    elif second:
         rec = load_record(str(exc.file_y_path or exc.file_y), exc.units, exc.file_y_sha256)
         t, a, name = rec.t, rec.acceleration, rec.name
-    elif exc.motion is not None:
-        t, a = exc.motion.time_s, exc.motion.acceleration_m_s2
-        name = exc.motion.name
     else:
         rec = load_record(str(exc.file_path or exc.file), exc.units, exc.file_sha256)
         t, a, name = rec.t, rec.acceleration, rec.name

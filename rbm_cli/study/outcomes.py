@@ -25,8 +25,10 @@ members, rbm_cli.study.robustness; its row is member 0's) is counted by
   majority's boundary of the domain figure);
 - ``member0``: the cell is its row, member 0's run, one trial.
 
-A cell whose members all failed (collapse_fraction empty) is a failed run under
-``members`` and ``majority``.
+A row whose ``status`` is ``failed`` never enters a fit, however it is counted: under
+``members`` and ``majority`` it is left out even when its ``collapse_fraction`` holds the
+fraction of the other members (member 0's run, the row's, failed), and so is a cell whose
+members all failed (collapse_fraction empty).
 """
 
 from __future__ import annotations
@@ -147,15 +149,16 @@ def prepare_outcomes(
 
 
 def _ensemble_trials(rows: pd.DataFrame, df: pd.DataFrame, outcome: str, n_members) -> None:
-    """The trials and hits of an ensemble domain's rows, in place (module docstring); a
-    cell whose members all failed (no fraction) is a failed row."""
+    """The trials and hits of an ensemble domain's rows, in place (module docstring): a
+    failed row (its status) stays failed, and a cell whose members all failed (no
+    fraction) is one too."""
     fraction = pd.to_numeric(df["collapse_fraction"], errors="coerce").to_numpy(dtype=float)
     bad = ~np.isnan(fraction) & ((fraction < 0.0) | (fraction > 1.0))
     if bad.any():
         i = int(np.argmax(bad))
         raise RbmError(f"fragility: row {i + 1}: collapse_fraction must be in [0, 1], "
                        f"got {df['collapse_fraction'].iat[i]!r}")  # fmt: skip
-    failed = np.isnan(fraction)
+    failed = np.isnan(fraction) | rows["failed"].to_numpy(dtype=bool)
     if outcome == "majority":
         trials, hits = np.ones(len(df)), (fraction >= 0.5).astype(float)
     else:

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.grid import MAX_CELLS as GRID_MAX_CELLS
 from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import MODELS, Config, hash_form
 from rbm_cli.models.methods import compiled_codes
@@ -66,8 +67,12 @@ if TYPE_CHECKING:
     import pandas as pd
     from matplotlib.figure import Figure
 
-#: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s).
+#: Grids larger than this need force=True (a 10 s cell takes ~0.01-10 s); an ensemble's
+#: members count as cells.
 MAX_CELLS = 100_000
+#: Most runs (cells x ensemble members) a sweep takes, with force too: the grid's limit
+#: (rbm_cli.config.grid.MAX_CELLS).
+MAX_RUNS = GRID_MAX_CELLS
 BACKENDS = ("loky", "threading", "sequential", "dask")
 #: Columns an ensemble sweep adds to domain.csv (rbm_cli.study.robustness).
 ENSEMBLE_FIELDS = ("collapse_fraction", "robust", "sensitive_to")
@@ -289,13 +294,21 @@ def _check_request(
             raise RbmError("the config has no grid: give grid.amplitudes (the records' PGA [g])")
     elif not n_cells or not config.grid.frequencies_hz:
         raise RbmError("the config has no grid: give grid.amplitudes and grid.frequencies")
-    if n_cells > MAX_CELLS and not force:
-        raise RbmError(
-            f"the grid has {n_cells:,} cells (more than {MAX_CELLS:,}); use --force to run it"
-        )
     for name, value in (("jobs", jobs), ("ensemble", ensemble)):
         if not (_is_int(value) and value >= 1):
             raise RbmError(f"--{name} must be a whole number >= 1, got {value!r}")
+    # an ensemble's members are runs as cells are: counted against the same limits
+    runs = n_cells * int(ensemble)
+    cells = f"{n_cells:,} cell{'s' if n_cells != 1 else ''}"
+    what = f"the grid has {cells}" if ensemble == 1 else \
+        f"the sweep has {cells} x {int(ensemble):,} ensemble members = {runs:,} runs"  # fmt: skip
+    if runs > MAX_RUNS:
+        raise RbmError(
+            f"{what}, more than the {MAX_RUNS:,} a sweep can run: split the grid"
+            + (" or lower --ensemble" if ensemble > 1 else "")
+        )
+    if runs > MAX_CELLS and not force:
+        raise RbmError(f"{what} (more than {MAX_CELLS:,}); use --force to run it")
     if not isinstance(backend, str) or backend not in BACKENDS:
         raise RbmError(f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
     if backend == "dask":

@@ -39,7 +39,7 @@ from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.housner.state import BlockRun
 from rbm_cli.models.methods import step_method
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import Outcome, budget_message
 from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.cylinder import (
     STATE_SIZE,
@@ -124,6 +124,7 @@ def cylinder_run(
     """
     if not 0.0 < restitution <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
+    solver = solver.for_run(motion.t_end, 1)
     alpha, p = geo.slenderness, geo.block.frequency_parameter
     limit = collapse_ratio * alpha
     d = motion.direction
@@ -206,7 +207,7 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
             run.c = motion.uplift_direction(run.t)
             run.y, run.phase = np.zeros(STATE_SIZE), LEAVING
             if out.n_uplifts + out.n_impacts > solver.max_events:
-                return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+                return _fail(run, budget_message("event", solver.max_events))
         c0, pinned = run.c.copy(), run.phase != FREE
 
         def rhs(t, y, c0=c0, pinned=pinned):
@@ -245,7 +246,7 @@ def _steps(run, integ, k, solver, d):
             return _fail(run, f"integrator: {msg} at t={run.t:.6g} s")
         out.n_steps += 1
         if out.n_steps > solver.max_steps:
-            return _fail(run, f"step budget exceeded ({solver.max_steps} steps)")
+            return _fail(run, budget_message("step", solver.max_steps))
         dense = integ.dense_output()
 
         def rows(ts, dense=dense):
@@ -307,7 +308,7 @@ def _impact(run, k, solver) -> Outcome | None:
     out.n_impacts += 1
     run.note((run.t, "impact"))
     if out.n_uplifts + out.n_impacts > solver.max_events:
-        return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+        return _fail(run, budget_message("event", solver.max_events))
     y = run.y.copy()
     y[0:2] = 0.0
     y[2:4] *= k["e"]

@@ -97,6 +97,7 @@ def integrate3d(
         y0 = np.array(state, dtype=float)
     scale = np.concatenate([prepared.atol_scale[:n], prepared.atol_scale[:n],
                             prepared.atol_scale[n:], prepared.atol_scale[n:]])  # fmt: skip
+    solver = solver.for_run(motion.t_end, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     rows = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((rows, 3 + 3 * n))

@@ -304,8 +304,12 @@ def _ranges() -> dict[str, str]:
         "grid.frequencies": f"[{fmt(FREQUENCY_RANGE_HZ[0])}, {fmt(FREQUENCY_RANGE_HZ[1])}]",
         "grid.<key path>": f"at most {MAX_CELLS:,} cells in all",
         "solver.method": one_of(t.METHODS),
-        "solver.max_steps": f"at most {MAX_BUDGET:,}",
-        "solver.max_events": f"at most {MAX_BUDGET:,}",
+        "solver.max_steps": f"auto ({t.BUDGET_PER_JOINT_SECOND['max_steps']:,} a second of "
+        f"motion and a joint, at least {t.BUDGET_FLOOR['max_steps']:,}), or an integer "
+        f"1,000-{MAX_BUDGET:,}",
+        "solver.max_events": f"auto ({t.BUDGET_PER_JOINT_SECOND['max_events']:,} a second of "
+        f"motion and a joint, at least {t.BUDGET_FLOOR['max_events']:,}), or an integer "
+        f"100-{MAX_BUDGET:,}",
         "solver.time_step": f"[{fmt(TIME_STEP_RANGE[0])}, {fmt(TIME_STEP_RANGE[1])}]",
         "solver.max_wall_time": f"({fmt(WALL_TIME_RANGE[0])}, {fmt(WALL_TIME_RANGE[1])}]",
         "solver.implementation": one_of(t.IMPLEMENTATIONS),
@@ -652,8 +656,20 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "(0, 1e-3]",
         "Absolute tolerance, relative to theta_u (rates: 10 theta_u).",
     ),
-    "solver.max_steps": ("", "", "Step budget of one run: beyond it the run is ``failed``."),
-    "solver.max_events": ("", "", "Event budget of one run: beyond it the run is ``failed``."),
+    "solver.max_steps": (
+        "",
+        "",
+        "Step budget of one run: beyond it the run is ``failed`` and its message names the "
+        "budget to raise. Default ``auto``: it grows with the motion's duration (its free "
+        "time included) and the column's joints, so a tall column under a long record runs.",
+    ),
+    "solver.max_events": (
+        "",
+        "",
+        "Event budget of one run (uplifts, impacts, kinks): beyond it the run is ``failed`` "
+        "and its message names the budget to raise. Default ``auto``: it grows with the "
+        "motion's duration and the column's joints.",
+    ),
     "solver.time_step": ("s", "", "The contact engine's fixed step (``model: bullet``)."),
     "solver.implementation": (
         "",

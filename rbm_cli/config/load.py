@@ -585,6 +585,14 @@ def _drums(value: Any, height: float) -> tuple[float, ...]:
     return heights
 
 
+def _budget(value: Any, path: str, lo: int) -> int | None:
+    """A run's budget: `auto` (None: it scales with the run, SolverConfig.for_run) or an
+    integer in lo..MAX_BUDGET."""
+    if value == "auto":
+        return None
+    return integer(value, path, lo, MAX_BUDGET, " or auto")
+
+
 def _solver(raw: Any) -> SolverConfig:
     s = mapping(raw, "solver", SOLVER_KEYS)
     default = SolverConfig()
@@ -592,12 +600,8 @@ def _solver(raw: Any) -> SolverConfig:
         method=choice(s.get("method", default.method), "solver.method", METHODS),
         rtol=number(s.get("rtol", default.rtol), "solver.rtol", "", 1e-13, 1e-3, lo_open=False),
         atol=number(s.get("atol", default.atol), "solver.atol", "", 0.0, 1e-3),
-        max_steps=integer(
-            s.get("max_steps", default.max_steps), "solver.max_steps", 1000, MAX_BUDGET
-        ),
-        max_events=integer(
-            s.get("max_events", default.max_events), "solver.max_events", 100, MAX_BUDGET
-        ),
+        max_steps=_budget(s.get("max_steps", "auto"), "solver.max_steps", 1000),
+        max_events=_budget(s.get("max_events", "auto"), "solver.max_events", 100),
         time_step=number(
             s.get("time_step", default.time_step),
             "solver.time_step",

@@ -48,6 +48,15 @@ class EnergyAccount(NamedTuple):
                 "impacts_J": self.impacts, "residual_J": self.residual}  # fmt: skip
 
 
+def budget_message(kind: str, budget: int) -> str:
+    """The message of a run that used up its step or event budget (kind: 'step' or
+    'event'): which budget, its size and how to raise it."""
+    return (
+        f"{kind} budget exceeded ({budget:,} {kind}s; raise solver.max_{kind}s, by default"
+        " auto: it scales with the motion's duration and the joints)"
+    )
+
+
 @dataclass
 class Outcome:
     """Raw outcome of an integration (simulate() turns it into a RunResult)."""
@@ -116,11 +125,11 @@ class Outcome:
 
     def out_of_steps(self, solver, t: float) -> Outcome:
         """The run ended 'failed' at t [s]: more steps than solver.max_steps."""
-        return self.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+        return self.stop("failed", budget_message("step", solver.max_steps), t)
 
     def out_of_events(self, solver, t: float) -> Outcome:
         """The run ended 'failed' at t [s]: more events than solver.max_events."""
-        return self.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
+        return self.stop("failed", budget_message("event", solver.max_events), t)
 
     def out_of_time(self, solver, t: float) -> Outcome:
         """The run ended 'failed' at t [s]: past its wall-clock budget."""

@@ -46,7 +46,7 @@ from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.housner.state import BlockRun
 from rbm_cli.models.methods import step_method
-from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome
+from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome, budget_message
 from rbm_cli.models.plan import from_ground, to_ground, wrapped
 from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.cylinder import (
@@ -142,6 +142,7 @@ def cylinder_run(
     """
     if not 0.0 < restitution <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
+    solver = solver.for_run(motion.t_end, 1)
     alpha, p = geo.slenderness, geo.block.frequency_parameter
     limit = collapse_ratio * alpha
     angle = wrapped(motion.angle)  # the motion's frame (rbm_cli.models.plan)
@@ -261,7 +262,7 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
             run.c = motion.uplift_direction(run.t)
             run.y, run.phase = np.zeros(STATE_SIZE), LEAVING
             if out.n_uplifts + out.n_impacts > solver.max_events:
-                return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+                return _fail(run, budget_message("event", solver.max_events))
         c0, pinned = run.c.copy(), run.phase != FREE
         # a peak of free motion may end the run (as `housner`'s): in the plane, below the
         # collapse barrier (its energy is constant up to the next impact)
@@ -305,7 +306,7 @@ def _steps(run, integ, k, solver, d, stop_ok=False):
             return _fail(run, f"integrator: {msg} at t={run.t:.6g} s")
         out.n_steps += 1
         if out.n_steps > solver.max_steps:
-            return _fail(run, f"step budget exceeded ({solver.max_steps} steps)")
+            return _fail(run, budget_message("step", solver.max_steps))
         dense = integ.dense_output()
 
         def rows(ts, dense=dense):
@@ -373,7 +374,7 @@ def _impact(run, k, solver) -> Outcome | None:
     out.n_impacts += 1
     run.note((run.t, "impact"))
     if out.n_uplifts + out.n_impacts > solver.max_events:
-        return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+        return _fail(run, budget_message("event", solver.max_events))
     y = run.y.copy()
     y[0:2] = 0.0
     y[2:4] *= k["e"]

@@ -134,6 +134,7 @@ def integrate3d(
             y0[part : part + n], y0[part + n : part + 2 * n] = pairs[:, 0], pairs[:, 1]
     scale = np.concatenate([prepared.atol_scale[:n], prepared.atol_scale[:n],
                             prepared.atol_scale[n:], prepared.atol_scale[n:]])  # fmt: skip
+    solver = solver.for_run(motion.t_end, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     rows = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((rows, 3 + 3 * n))

@@ -45,7 +45,9 @@ class CellResult(Mapping):
     ``max_top_displacement_m`` [m], for a run in three dimensions (as domain.csv)
     ``collapse_azimuth_deg`` [deg from x, in (-180, 180]; nan if it did not collapse] and
     ``wobble_turns`` [-], then ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs`` (int),
-    ``message``, then ``friction_demand`` (per interface, max |T/N| [-]),
+    ``message``, then ``friction_demand`` (per interface, the largest |T/N| held for
+    ``friction_duration_s``, 0.03 s [-]), ``friction_demand_peak`` (per interface, its
+    instantaneous peak [-]; empty for the models without the RBM's joints),
     ``wall_time_s`` [s], ``method`` (the method that ran), ``friction_limit`` (the
     interface.friction of a model with the RBM's joints, rbm and rbm-3d, the coefficient
     the demand is checked against; None: not checked), ``slip`` ((t [s], interface) where
@@ -81,6 +83,7 @@ class CellResult(Mapping):
                   "wall_time_s"):  # fmt: skip
             values[k] = float(values[k])
         values["friction_demand"] = tuple(float(v) for v in values["friction_demand"])
+        values["friction_demand_peak"] = tuple(float(v) for v in values["friction_demand_peak"])
         object.__setattr__(self, "_run", run)
         object.__setattr__(self, "_values", values)
 
@@ -116,6 +119,7 @@ class CellResult(Mapping):
 #: status == 'collapsed'), then figures a domain does not keep.
 FIELDS = tuple(k for k in CSV_FIELDS if k not in ("collapsed", "friction_demand")) + (
     "friction_demand",
+    "friction_demand_peak",
     "wall_time_s",
     "method",
     "friction_limit",

@@ -44,8 +44,23 @@ def _slide_lines(result) -> list[tuple[str, str]]:
     if result.slip is None:
         return [("slides", f"no: |T/N| stays <= interface.friction {mu:.4g}")]
     t, where = result.slip
+    tau = result.friction_duration_s
+    if tau:
+        return [("slides", f"|T/N| > interface.friction {mu:.4g} held for {tau:.4g} s from"
+                           f" t = {t:.6g} s, interface {where}")]  # fmt: skip
     return [("slides", f"|T/N| > interface.friction {mu:.4g} first at t = {t:.6g} s, interface"
                        f" {where}")]  # fmt: skip
+
+
+def _demand_text(result) -> str:
+    """The friction demand: held for its duration, with the instantaneous peak apart."""
+    if not math.isfinite(result.max_friction_demand):
+        return "- (not computed by this model)"
+    text = f"max |T/N| = {result.max_friction_demand:.4g}"
+    tau = result.friction_duration_s
+    if tau:
+        text += f" held for {tau:.4g} s (instantaneous peak {result.max_friction_demand_peak:.4g})"
+    return text
 
 
 def _print_summary(result, folder: Path) -> None:
@@ -56,12 +71,7 @@ def _print_summary(result, folder: Path) -> None:
     lines += [
         ("max rotation ratio", f"{result.max_rotation_ratio:.4g}"),
         ("max top displacement", f"{result.max_top_displacement_m:.4g} m (relative to base)"),
-        (
-            "friction demand",
-            f"max |T/N| = {result.max_friction_demand:.4g}"
-            if math.isfinite(result.max_friction_demand)
-            else "- (not computed by this model)",
-        ),
+        ("friction demand", _demand_text(result)),
         *_slide_lines(result),
         ("uplifts / impacts", f"{result.n_uplifts} / {result.n_impacts}"),
     ]

@@ -46,7 +46,8 @@ class Integrator(Protocol):
     """What a method prepares for one RBM column: one run from an initial state [rad,
     rad/s] under a motion, with a run's solver settings, to an Outcome (with
     friction_limit [-], inf for none: where the friction demand first exceeded it,
-    Outcome.slip)."""
+    Outcome.slip; friction_duration [s]: the duration the demand is held for,
+    Outcome.friction, 0 for its peak)."""
 
     def __call__(
         self,
@@ -60,6 +61,7 @@ class Integrator(Protocol):
         output_dt: float,
         early_stop: bool,
         friction_limit: float = ...,
+        friction_duration: float = ...,
     ) -> Outcome: ...
 
 

@@ -69,6 +69,9 @@ class Outcome:
     max_ratio: np.ndarray | None = None
     max_top: float = 0.0
     friction: np.ndarray | None = None
+    #: the instantaneous peak of |T_i / N_i| per interface [-] (friction: the demand held
+    #: for the run's duration, models.rbm.pieces; the same without one)
+    friction_peak: np.ndarray | None = None
     #: where the friction demand first exceeded the run's friction limit: (t [s], interface
     #: from 1); None: it did not, or no limit was given
     slip: tuple[float, int] | None = None

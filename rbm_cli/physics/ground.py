@@ -252,6 +252,13 @@ def rest_demand(t0, t1, gr, knots, values, vertical):
 
 
 @jit
+def rest_shear(t, gr, knots, values, vertical):
+    """The shear ratio T / N = a_g / (g + a_v) [-] of a column at rest on the ground at t
+    [s], with its sign (T = m a_g, N = m (g + a_v)): a sample of its held friction demand."""
+    return ground_at(t, gr, knots, values) / (G * vertical_factor(t, knots, vertical))
+
+
+@jit
 def _solve_piece(gr, tl, tr, target):
     """Bisection for a_g = target on [tl, tr], a_g monotone with s (a_g(tl) - target) <= 0 <
     s (a_g(tr) - target), s = sign(target): the earliest float past the crossing."""

@@ -53,9 +53,16 @@ class RunResult:
     n_impacts : int  Zero crossings of a law argument after an excursion
         beyond its elastic branch (every crossing for a rigid law)
     n_steps, n_rhs : int  Accepted integrator steps, right-hand-side evaluations
-    friction_demand : tuple of float  max over time of |T_i / N_i| per interface (domain.csv
-        keeps their largest, for model rbm; empty for the models that do not compute it or,
-        as bullet's contacts, slide for real: their |T / N| is capped by Coulomb)
+    friction_demand : tuple of float  The largest |T_i / N_i| held in one direction for
+        friction_duration_s, per interface (domain.csv keeps their largest, for models rbm
+        and rbm-3d; empty for the models that do not compute it or, as bullet's contacts,
+        slide for real: their |T / N| is capped by Coulomb)
+    friction_demand_peak : tuple of float  Its instantaneous peak, max over time of
+        |T_i / N_i| per interface (the joints' elastic phases and the drums' rattles
+        included; empty where not computed; not in domain.csv)
+    friction_duration_s : float or None  The duration friction_demand is held for [s] for
+        a model with the RBM's joints (models.rbm.pieces.FRICTION_DURATION), None for the
+        others
     wall_time_s : float  Wall time of the run [s]
     method : str  The method that ran (solver.method, `auto` resolved; not in domain.csv)
     model : str  The model that ran (config.model)
@@ -97,6 +104,8 @@ class RunResult:
     collapse_azimuth_deg: float = float("nan")
     wobble_turns: float = float("nan")
     three_d: bool = False
+    friction_demand_peak: tuple[float, ...] = ()
+    friction_duration_s: float | None = None
 
     @property
     def collapsed(self) -> bool:
@@ -105,6 +114,11 @@ class RunResult:
     @property
     def max_friction_demand(self) -> float:
         finite = [v for v in self.friction_demand if np.isfinite(v)]
+        return max(finite) if finite else float("nan")
+
+    @property
+    def max_friction_demand_peak(self) -> float:
+        finite = [v for v in self.friction_demand_peak if np.isfinite(v)]
         return max(finite) if finite else float("nan")
 
     @property
@@ -135,11 +149,17 @@ class RunResult:
         return out
 
     def summary(self) -> dict:
-        """The domain.csv fields plus friction demand per interface, the first exceedance
-        of the friction coefficient (when checked) and wall time (JSON-ready)."""
+        """The domain.csv fields plus friction demand per interface (for a model with the
+        RBM's joints also the duration it is held for and its instantaneous peak), the first
+        exceedance of the friction coefficient (when checked) and wall time (JSON-ready)."""
         out = self.row()
         out["friction_demand"] = [v if np.isfinite(v) else None for v in self.friction_demand]
         out["max_friction_demand"] = self.max_friction_demand
+        if self.friction_duration_s is not None:
+            out["friction_duration_s"] = self.friction_duration_s
+            out["friction_demand_peak"] = [v if np.isfinite(v) else None
+                                           for v in self.friction_demand_peak]  # fmt: skip
+            out["max_friction_demand_peak"] = self.max_friction_demand_peak
         if self.friction_limit is not None:
             out["friction_limit"] = self.friction_limit
             out["slip_interface"] = None if self.slip is None else self.slip[1]

@@ -15,6 +15,7 @@ import numpy as np
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import MODELS, Config
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT, Runner
+from rbm_cli.models.rbm.pieces import FRICTION_DURATION
 from rbm_cli.models.registry import make_runner
 from rbm_cli.physics.assembly import check_derived, model_from_config
 from rbm_cli.physics.excitation import make_ground_motion
@@ -103,4 +104,10 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         collapse_azimuth_deg=math.degrees(math.remainder(out.azimuth, 2.0 * math.pi)),
         wobble_turns=float(out.turns),
         three_d=config.three_d,
+        friction_demand_peak=()
+        if out.friction_peak is None
+        else tuple(float(v) for v in out.friction_peak),
+        friction_duration_s=FRICTION_DURATION
+        if MODELS[config.model].beam
+        else None,
     )

@@ -54,6 +54,7 @@ from rbm_cli.models.methods import model_why_not
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.modal import LINEAR
 from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings, sine_arrays
+from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.physics.arrays import REST_RATE, rest_levels
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
@@ -184,11 +185,14 @@ def run_closed_form(
     seg: tuple | None = None,
     events: list | None = None,
     friction_limit: float = math.inf,
+    friction_duration: float = FRICTION_DURATION,
 ) -> Outcome:
     """One run of a block (Block) from (theta0 [rad], rate0 [rad/s]).
 
     friction_limit : float  A friction coefficient [-]: the outcome says where the RBM
-        block's |T / N| first exceeded it (Outcome.slip; exact); inf: none.
+        block's |T / N| first exceeded it (Outcome.slip; exact for the peak); inf: none.
+    friction_duration : float  The duration the RBM block's friction demand is held for
+        [s] (Outcome.friction; its peak, exact: Outcome.friction_peak); 0: the peak.
 
     seg : (seg_t, seg_fc, seg_v), optional  The motion's forcing segments
         (block_segments); made here from the motion when None (a vertical record taken
@@ -209,10 +213,12 @@ def run_closed_form(
     rows = 0 if events is None else LOG_ROWS
     while True:
         log = np.zeros((rows, 2))
+        held = held_array(1, float(friction_duration) if block.rbm else 0.0,
+                          float(friction_limit))  # fmt: skip
         armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
         try:
             code, st, cnt = run(block.params, seg_t, seg_fc, seg_v, mo, se, float(theta0),
-                                float(rate0), samples, log)  # fmt: skip
+                                float(rate0), samples, log, held)  # fmt: skip
         finally:
             disarm(armed)
         if int(st[N_LOG]) < rows or events is None:
@@ -222,9 +228,12 @@ def run_closed_form(
         events.extend((float(t), _LOG_KINDS[int(k)]) for t, k in log[: int(st[N_LOG])])
     out = Outcome(t_end=float(st[0]), t_collapse=float(st[9]), max_top=block.height * st[5])
     out.max_ratio = np.array([st[5] / block.ratio_scale])
-    out.friction = np.array([st[6] if block.rbm else math.nan])
-    if block.rbm and not math.isnan(st[T_SLIP]):
-        out.slip = (float(st[T_SLIP]), 1)
+    out.friction_peak = np.array([st[6] if block.rbm else math.nan])
+    if block.rbm:
+        slip = (st[T_SLIP], 0.0 if math.isnan(st[T_SLIP]) else 1.0)
+        out.friction, out.slip = held_result(held, out.friction_peak, slip)
+    else:
+        out.friction = out.friction_peak.copy()
     out.n_uplifts, out.n_impacts, out.n_steps, out.n_rhs = (int(x) for x in cnt[:4])
     out.n_events = int(cnt[4]) if block.rbm else out.n_uplifts + out.n_impacts
     _messages(block, code, out, solver)
@@ -321,13 +330,15 @@ def integrate_closed_form(
     early_stop: bool = True,
     block: Block | None = None,
     friction_limit: float = math.inf,
+    friction_duration: float = FRICTION_DURATION,
 ) -> Outcome:
     """The RBM integrators' signature (rbm.kernel.integrate) for a rigid monolith:
     block is rbm_block(model), made once by a caller that runs one model many times."""
     block = rbm_block(model) if block is None else block
     return run_closed_form(block, motion, float(theta0[0]), float(rate0[0]), solver,
                            record=record, output_dt=output_dt, early_stop=early_stop,
-                           friction_limit=friction_limit)  # fmt: skip
+                           friction_limit=friction_limit,
+                           friction_duration=friction_duration)  # fmt: skip
 
 
 def prepare(model: Model):

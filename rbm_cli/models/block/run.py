@@ -17,7 +17,9 @@ The friction demand |T / N| of the RBM block (block.closed_form.rbm_block derive
 exact: at rest |a_g| / (g + a_v) over the rest (T = m a_g, N = m (g + a_v); a harmonic's
 crest or a line's ends), in motion the piece's largest |demand| (block.piece._friction),
 and so is its first exceedance of the limit (the exceedance of |a_g| at rest, Brent on the
-piece's demand in motion).
+piece's demand in motion): its peak. The demand held for a duration
+(models.rbm.pieces.held_push, the step and exact integrators' too) takes its samples from
+a_g at rest and from the piece's closed form in motion (block.piece.point).
 
 A vertical record makes the weights act as under g + a_v: on a piece the block obeys
 theta'' = p^2 gam (theta - s alpha) + e a_g with gam = (g + a_v) / g taken at the middle
@@ -67,6 +69,7 @@ from rbm_cli.models.rbm.exact.modal import (
     f_peak_on,
     linear_exceedance,
 )
+from rbm_cli.models.rbm.pieces import held_push, held_time
 from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
@@ -146,6 +149,20 @@ def _emit(pc, st, samples, t_stop, dt, rest):
 
 
 @jit
+def _held_rest(fc, fv, t1, held, hw):
+    """The held demand's samples due up to t1 [s] of the block at rest: a_g / (g + a_v)
+    (0 where no forcing acts). hw: the sample's shear ratios (x, y) and a peak they raise,
+    one value each."""
+    while held_time(held) <= t1:
+        t_k = held_time(held)
+        a = 0.0 if int(fc[0]) == ZERO else f_accel(fc, t_k)
+        if fv.size > 0:
+            a /= gravity_factor(fc, fv, t_k)
+        hw[0] = a / G
+        held_push(held, hw[0:1], hw[1:2], hw[2:3])
+
+
+@jit
 def _rest_friction(st, fc, fv, t0, t1, mu):
     """The friction demand of the block at rest on [t0, t1] [s], |a_g| / (g + a_v) (a_g
     and a_v straight on a record's piece: their ratio is monotone, its ends hold the
@@ -165,7 +182,7 @@ def _rest_friction(st, fc, fv, t0, t1, mu):
 
 
 @jit
-def _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, dt, log, mu):
+def _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, dt, log, mu, held, hw):
     """The block at rest: 0 no ground motion left (rests to the end), 1 the segment ends
     first, 2 it lifts (a harmonic's exceedance from its formula, a line's from the line,
     under a vertical record (fv: its line, else empty) against the level times
@@ -190,6 +207,7 @@ def _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, dt, log, mu):
             kind, t_stop = 2, t_up
     if not math.isnan(blk[B_FA]) and kind_fc != ZERO:
         _rest_friction(st, fc, fv, t, t_stop, mu)
+    _held_rest(fc, fv, t_stop, held, hw)
     _emit(pc, st, samples, t_stop - (1e-15 if kind == 2 else 0.0), dt, True)
     st[T] = t_stop
     if kind != 2:
@@ -222,10 +240,11 @@ def _event(blk, st, cnt, kind, se, log):
 
 
 @jit
-def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log):
+def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log, held, hw):
     """One piece from the current state up to its first event, a peak of free motion
     below the barrier (can_stop) or seg_end [s]; under a vertical record (fv not empty) and
-    a linear forcing, with gam = (g + a_v) / g at the piece's middle. Returns a code."""
+    a linear forcing, with gam = (g + a_v) / g at the piece's middle; the held demand's
+    samples on it (hw: as _held_rest's). Returns a code."""
     t = st[T]
     gam = 1.0
     if fv.size > 0 and int(fc[0]) == LINEAR:
@@ -246,6 +265,10 @@ def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log):
     t_new = seg_end if (kind == NONE and not stop_here) else t + tau_end
     if se[4] != 0.0:
         _emit(pc, st, samples, t_new, se[5], False)
+    while held_time(held) <= t_new:
+        _, _, _, _, d_k, _, _ = point(pc, held_time(held) - t)
+        hw[0] = d_k
+        held_push(held, hw[0:1], hw[1:2], hw[2:3])
     f, g, _, _, _, _, _ = point(pc, tau_end)
     st[THETA], st[RATE], st[T] = pc[1] * f, pc[1] * g, t_new
     st[PEAK], st[FRICTION] = max(st[PEAK], acc[A_PEAK]), acc[A_FRICTION]
@@ -259,13 +282,13 @@ def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log):
 
 
 @jit
-def _segment(blk, st, cnt, mo, se, fc, fv, seg_end, can_stop, samples, pc, acc, log):
+def _segment(blk, st, cnt, mo, se, fc, fv, seg_end, can_stop, samples, pc, acc, log, held, hw):
     """Run up to seg_end [s] under the forcing fc (and the upward line fv). Returns a
     code."""
     while st[T] < seg_end:
         if st[AT_REST] != 0.0:
             kind = _leave_rest(blk, st, cnt, mo, seg_end, fc, fv, pc, samples, se[5], log,
-                               se[6])  # fmt: skip
+                               se[6], held, hw)  # fmt: skip
             if kind == 0:
                 return AT_REST_END
             if kind == 1:
@@ -276,17 +299,19 @@ def _segment(blk, st, cnt, mo, se, fc, fv, seg_end, can_stop, samples, pc, acc, 
             code = guard_code(se[2])
             if code != GOING:
                 return code
-        code = _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log)
+        code = _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log,
+                      held, hw)  # fmt: skip
         if code != GOING:
             return code
     return GOING
 
 
 @jit
-def run_block(blk, seg_t, seg_fc, seg_v, mo, se, theta0, rate0, samples, log):
+def run_block(blk, seg_t, seg_fc, seg_v, mo, se, theta0, rate0, samples, log, held):
     """One run from (theta0 [rad], rate0 [rad/s]) at t = 0: samples (rows t, theta, rate)
     written when se asks for them, events (rows t [s], kind LOG_*) logged while log has
-    rows. Returns (code, st, cnt)."""
+    rows, the held friction demand's samples taken into held (models.rbm.pieces.held_array;
+    one with no window takes none). Returns (code, st, cnt)."""
     side = 1.0 if theta0 > 0.0 else -1.0 if theta0 < 0.0 else (-1.0 if rate0 < 0.0 else 1.0)
     at_rest = 1.0 if theta0 == 0.0 and rate0 == 0.0 else 0.0
     st = np.array([0.0, theta0, rate0, side, at_rest, abs(theta0), 0.0, 0.0, 0.0, math.nan,
@@ -294,6 +319,7 @@ def run_block(blk, seg_t, seg_fc, seg_v, mo, se, theta0, rate0, samples, log):
     no_v = np.zeros(0)
     cnt = np.zeros(5, dtype=np.int64)
     pc, acc = np.zeros(PIECE_SIZE), np.zeros(ACC_SIZE)
+    hw = np.zeros(3)  # a held demand's sample (x, y) and the peak it raises (not the block's)
     if abs(theta0) >= blk[B_LIMIT]:
         st[T_COLLAPSE] = 0.0
         return COLLAPSED, st, cnt
@@ -305,7 +331,7 @@ def run_block(blk, seg_t, seg_fc, seg_v, mo, se, theta0, rate0, samples, log):
         can_stop = se[3] != 0.0 and free and mo[0] != 0.0
         fv = seg_v[i] if seg_v.shape[0] > 0 else no_v
         code = _segment(blk, st, cnt, mo, se, seg_fc[i], fv, seg_t[i, 1], can_stop, samples,
-                        pc, acc, log)  # fmt: skip
+                        pc, acc, log, held, hw)  # fmt: skip
         if code != GOING:
             break
     if code == GOING:

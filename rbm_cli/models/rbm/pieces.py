@@ -2,7 +2,9 @@
 them: which piece of its moment-rotation law each interface is on, the piece's bounds and
 event rows, locating the pieces of a state and crossing to the next piece (uplift, kink,
 impact), the silent impacts, and what both integrators compute from the pieces (an impact's
-loss of rate, a law's potential and a state's energy, the friction demand).
+loss of rate, a law's potential and a state's energy, the friction demand: its peak and
+the demand held for a duration, which the block's closed form and rbm-3d's kernel take
+too).
 
 A law is odd and piecewise linear (rbm_cli.physics.law): on x >= 0 its piece k is
 f = a_k + b_k x on [x_k, x_{k+1}), the edges x_1 < x_2 < ... padded with inf
@@ -18,6 +20,8 @@ tests/piece_oracle.py writes the same bookkeeping from the laws' objects, as a c
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -185,8 +189,7 @@ def energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes
 
 
 @jit
-def below_barrier(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes,
-                  barrier):
+def below_barrier(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes, barrier):
     """Whether a state's energy (:func:`energy`) is below an energy barrier [J] by more
     than 1e-9 of it (NaN: no barrier, never): the test of both early stops of free motion,
     a monolith's at a peak (physics.arrays.rest_levels) and a column's certain survival
@@ -198,21 +201,30 @@ def below_barrier(theta, rate, mass, argmap, gravity, edges, nedges, intercepts,
 
 
 @jit(inline=True)
-def friction_demand(ag, gam, centre_map, acc, masses, normal_forces, out):
-    """Raise out (n) to the friction demand |T_i| / (N_i gam) [-] of each interface: T_i the
-    shear [N] of the drums above it, from their absolute accelerations ag [m/s^2] (the
-    ground's) + centre_map @ acc (acc the drums' theta'' [rad/s^2]), masses [kg]; N_i the
-    normal force [N] at rest, gam = (g + a_v) / g [-] (1 without vertical motion)."""
+def shear_ratios(ag, ag_y, gam, centre_map, acc, acc_y, masses, normal_forces, rx, ry, peak):
+    """The friction demand of each interface at one instant: rx, ry (n) get the shear
+    T_i / (N_i gam) [-] (its x and y components; ry 0 in the plane), peak (n) is raised to
+    its magnitude |T_i| / (N_i gam). T_i [N] is the shear of the drums above interface i,
+    from their absolute horizontal accelerations: the ground's (ag, ag_y) [m/s^2] +
+    centre_map @ (acc, acc_y) (acc the drums' theta'' [rad/s^2]; acc_y empty in the
+    plane), masses [kg]; N_i the normal force [N] at rest, gam = (g + a_v) / g [-] (1
+    without vertical motion)."""
     n = acc.size
-    shear = 0.0
+    three = acc_y.size > 0
+    sx, sy = 0.0, 0.0
     for i in range(n - 1, -1, -1):
-        a_abs = ag
+        bx, by = ag, ag_y
         for j in range(n):
-            a_abs += centre_map[i, j] * acc[j]
-        shear += a_abs * masses[i]
-        fr = abs(shear) / (normal_forces[i] * gam)
-        if fr > out[i]:
-            out[i] = fr
+            bx += centre_map[i, j] * acc[j]
+            if three:
+                by += centre_map[i, j] * acc_y[j]
+        sx += bx * masses[i]
+        sy += by * masses[i]
+        w = normal_forces[i] * gam
+        rx[i], ry[i] = sx / w, sy / w
+        d = math.sqrt(sx * sx + sy * sy) / w if three else abs(sx) / w
+        if d > peak[i]:
+            peak[i] = d
 
 
 @jit(inline=True)
@@ -226,6 +238,121 @@ def first_over(friction, mu, t, slip):
             slip[0], slip[1] = t, i + 1.0
 
 
+# ---- the friction demand held for a duration
+#
+# The RBM's normal force N_i is the weight above the joint: it has no vertical motion. That
+# is the mean of the true normal force over times long against the joints' elastic
+# periods, not its value at an instant of a joint's elastic phase or of a rattle of the
+# drums (many joints open at once, in alternate directions): there the model's own
+# kinematics lift the drums above an open joint at up to tens of g, and |T_i| / N_i (its
+# largest, the peak) compares a shear of that instant with the weight. The demand a domain
+# reports is the largest level |T_i| / N_i stays above, without its direction reversing,
+# at every sample of a window of FRICTION_DURATION [s]: samples at
+# t_k = k duration / HELD_SAMPLES, taken by every integrator at the same times (the step
+# integrators on their steps' quintic Hermite interpolants of theta, the exact integrator
+# and the block's closed form from their closed forms, a block at rest from a_g).
+
+#: The duration [s] a friction demand of the RBM's joints is held for: longer than a
+#: joint's elastic phase or a rattle of the drums (a few ms at k_n 5e9 Pa/m), a tenth of
+#: the period of a 3.3 Hz shaking. The integrators take it as their default.
+FRICTION_DURATION = 0.03
+#: Sample intervals in a window of the held demand [-].
+HELD_SAMPLES = 60
+#: Columns of a held array's interface rows: the largest level held [-], the index of the
+#: last sample whose shear reversed against the one before it, the last sample's shear
+#: components [-], then the ring of the window's magnitudes (HELD_SAMPLES + 1).
+HELD_LEVEL, HELD_REV, HELD_X, HELD_Y, HELD_RING = 0, 1, 2, 3, 4
+#: Columns of its last row: the next sample's index and time [s], the sample spacing [s],
+#: the window in samples (0: no held demand), the friction limit mu [-] and where the held
+#: demand first exceeded it: the start of that window [s] and the interface (from 1; 0:
+#: not).
+HELD_NEXT, HELD_T_NEXT, HELD_DT, HELD_K, HELD_MU, HELD_T_SLIP, HELD_SLIP_IF = range(7)
+
+
+def held_array(n: int, duration: float, mu: float = math.inf) -> np.ndarray:
+    """A held demand's state for n interfaces, a window of duration [s] (0: none, the
+    demand is the peak) and a friction limit mu [-] (inf: none); the integrators change it
+    in place (:func:`held_push`)."""
+    k = HELD_SAMPLES if duration > 0.0 else 0
+    held = np.zeros((n + 1, max(HELD_RING + k + 1, 7)))
+    last = held[n]
+    last[HELD_T_NEXT] = 0.0 if k else math.inf
+    last[HELD_DT] = duration / k if k else math.inf
+    last[HELD_K] = k
+    last[HELD_MU] = mu
+    last[HELD_T_SLIP] = math.nan
+    return held
+
+
+@jit(inline=True)
+def held_time(held):
+    """The time of the next sample of a held demand [s] (inf: it takes none)."""
+    return held[held.shape[0] - 1, HELD_T_NEXT]
+
+
+@jit
+def held_push(held, rx, ry, peak):
+    """Take the sample due (at :func:`held_time`): rx, ry (n) the shear ratios of each
+    interface there (:func:`shear_ratios`). Each interface's held level is raised to the
+    least magnitude over the window of the last HELD_SAMPLES + 1 samples where the shear
+    did not reverse in it (no two consecutive samples with a dot product <= 0), peak (n)
+    to the magnitude; the first window held above mu notes where it started."""
+    n = held.shape[0] - 1
+    last = held[n]
+    k = last[HELD_NEXT]
+    window = int(last[HELD_K])
+    slot = HELD_RING + int(k) % (window + 1)
+    best, where = last[HELD_MU], -1
+    for i in range(n):
+        row = held[i]
+        x, y = rx[i], ry[i]
+        if x * row[HELD_X] + y * row[HELD_Y] <= 0.0:
+            row[HELD_REV] = k
+        row[HELD_X], row[HELD_Y] = x, y
+        size = abs(x) if y == 0.0 else math.sqrt(x * x + y * y)
+        row[slot] = size
+        if size > peak[i]:
+            peak[i] = size
+        if k - row[HELD_REV] >= window:
+            level = row[HELD_RING]
+            for j in range(1, window + 1):
+                level = min(level, row[HELD_RING + j])
+            if level > row[HELD_LEVEL]:
+                row[HELD_LEVEL] = level
+            if level > best:
+                best, where = level, i
+    if where >= 0 and last[HELD_SLIP_IF] == 0.0:
+        last[HELD_T_SLIP] = (k - window) * last[HELD_DT]
+        last[HELD_SLIP_IF] = where + 1.0
+    last[HELD_NEXT] = k + 1.0
+    last[HELD_T_NEXT] = (k + 1.0) * last[HELD_DT]
+
+
+@jit(inline=True)
+def hermite_accel(s, h, x0, v0, a0, x1, v1, a1):
+    """x''(t0 + s h) [per s^2] of the quintic through x, x', x'' given at t0 (x0, v0, a0)
+    and t0 + h (x1, v1, a1), 0 <= s <= 1, h > 0 [s]."""
+    s2 = s * s
+    s3 = s2 * s
+    return (((x1 - x0) * (60.0 * s - 180.0 * s2 + 120.0 * s3)
+             + h * (v0 * (-36.0 * s + 96.0 * s2 - 60.0 * s3)
+                    + v1 * (-24.0 * s + 84.0 * s2 - 60.0 * s3))) / (h * h)
+            + a0 * (1.0 - 9.0 * s + 18.0 * s2 - 10.0 * s3)
+            + a1 * (3.0 * s - 12.0 * s2 + 10.0 * s3))  # fmt: skip
+
+
+def held_result(held: np.ndarray, peak: np.ndarray, slip) -> tuple[np.ndarray, tuple | None]:
+    """The friction demand (n) and its first exceedance of the limit ((t [s], interface)
+    or None) a run reports: the held demand's with a window, else the peak's (slip: the
+    integrator's (t, interface), interface 0 for none)."""
+    n = held.shape[0] - 1
+    last = held[n]
+    if last[HELD_K] == 0.0:
+        return peak.copy(), ((float(slip[0]), int(slip[1])) if slip[1] > 0 else None)
+    where = int(last[HELD_SLIP_IF])
+    return held[:n, HELD_LEVEL].copy(), ((float(last[HELD_T_SLIP]), where) if where else None)
+
+
 __all__ = [
     "IMPACT",
     "KINK",
@@ -234,13 +361,18 @@ __all__ = [
     "cross",
     "energy",
     "first_over",
-    "friction_demand",
+    "held_array",
+    "held_push",
+    "held_result",
+    "held_time",
+    "hermite_accel",
     "law_potential",
     "locate",
     "n_below",
     "piece_bounds",
     "restitute",
     "settle",
+    "shear_ratios",
     "silent_impact",
     "zero_active",
 ]

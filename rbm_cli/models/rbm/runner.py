@@ -97,6 +97,7 @@ class RbmRunner:
             out = Outcome(status="failed", message=f"numerical failure: {exc}")
             out.max_ratio = np.full(n, np.nan)
             out.friction = np.full(n, np.nan)
+            out.friction_peak = np.full(n, np.nan)
         if record:
             out.history = history_from_samples(self.model.node_map, motion, out.samples)
         out.method = out.method or method.name  # exact-first says which of its two ran

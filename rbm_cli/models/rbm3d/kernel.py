@@ -21,7 +21,14 @@ from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.models.outcome import WOBBLE_LEVEL
-from rbm_cli.models.rbm.pieces import below_barrier, law_potential
+from rbm_cli.models.rbm.pieces import (
+    below_barrier,
+    held_push,
+    held_time,
+    hermite_accel,
+    law_potential,
+    shear_ratios,
+)
 from rbm_cli.models.rbm.step.rk import (
     NS_MAX,
     STEP_TAKEN,
@@ -57,6 +64,7 @@ from rbm_cli.physics.ground import (
     pair_uplift,
     record_piece,
     rest_demand,
+    rest_shear,
     vertical_factor,
 )
 
@@ -321,22 +329,15 @@ def _move(i, y, n, arg_inv, dx, dy):
 
 
 @jit
-def _friction(t, y, f, n, col, es, gr, friction):
-    """Raise friction to |T_i| / (N_i gam) of y' = f at (t, y); return the largest."""
+def _friction(t, f, n, col, es, gr, friction, rx, ry):
+    """The shear ratios (rx, ry: pieces.shear_ratios) of y' = f at t [s], the peak friction
+    raised to their magnitudes |T_i| / (N_i gam); returns the largest of those."""
     ax, ay = horizontal(t, es, n, gr)
-    gam = gravity_factor(t, gr)
-    sx, sy, top = 0.0, 0.0, 0.0
-    for i in range(n - 1, -1, -1):
-        bx, by = ax, ay
-        for j in range(n):
-            bx += col.centre_map[i, j] * f[2 * n + j]
-            by += col.centre_map[i, j] * f[3 * n + j]
-        sx += bx * col.masses[i]
-        sy += by * col.masses[i]
-        d = math.sqrt(sx * sx + sy * sy) / (col.normal_forces[i] * gam)
-        if d > friction[i]:
-            friction[i] = d
-        top = max(top, d)
+    shear_ratios(ax, ay, gravity_factor(t, gr), col.centre_map, f[2 * n : 3 * n],
+                 f[3 * n : 4 * n], col.masses, col.normal_forces, rx, ry, friction)  # fmt: skip
+    top = 0.0
+    for i in range(n):
+        top = max(top, math.sqrt(rx[i] * rx[i] + ry[i] * ry[i]))
     return top
 
 
@@ -477,8 +478,9 @@ def run3d(col, motion, solver, task, pair):
     motion : Excitation  The motion along its direction (step.inputs)
     solver : SolverSettings  atol of 4n entries
     task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 3n), friction_limit,
-        early stop (models.status.stop_level)); y0 is the state, changed in place: the
-        state where the run ended
+        early stop (models.status.stop_level), held: the held friction demand,
+        pieces.held_array); y0 and held are changed in place: the state where the run
+        ended, the samples of the demand held
     pair : tuple  (d0, d1, values_y: a second record's samples, or empty; gy: the second
         component's ground tuple, physics.ground, gain 0 for none; knots_y: its knots)
 
@@ -492,7 +494,7 @@ def run3d(col, motion, solver, task, pair):
         the energy the joints' damping and the impacts took.
     """
     col = ColumnArrays(*col)
-    y0, record, output_dt, samples, mu, stop = task
+    y0, record, output_dt, samples, mu, stop, held = task
     d0, d1, values_y, gy, knots_y = pair
     mc, rtol, atol = solver[0], solver[1], solver[2]
     max_steps, max_events, deadline = solver[3], solver[4], solver[5]
@@ -536,6 +538,7 @@ def run3d(col, motion, solver, task, pair):
     D, R = np.empty((nrow_max, CHECK_INTERVALS + 1)), np.empty((nrow_max, CHECK_INTERVALS + 1))
     max_ratio, friction, swept = np.zeros(n), np.zeros(n), np.zeros(n)
     slip = np.array([np.nan, 0.0])
+    rx, ry, acc_k = np.zeros(n), np.zeros(n), np.zeros(2 * n)  # a held demand's sample
     max_top, azimuth = 0.0, np.nan
     n_upl, n_imp, n_steps, n_rhs, n_ev, n_out = 0, 0, 0, 0, 0, 0
     next_out = 0.0
@@ -633,6 +636,11 @@ def run3d(col, motion, solver, task, pair):
                     d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
                 if d_rest > friction[0]:
                     friction[0] = d_rest
+                while held_time(held) <= t_rest:
+                    t_k = held_time(held)
+                    rx[0] = rest_shear(t_k, gr_full, knots, values, vertical)
+                    ry[0] = rest_shear(t_k, gy, knots, values_y, vertical) if pair_on else 0.0
+                    held_push(held, rx, ry, friction)
                 if slip[1] == 0.0 and d_rest > mu:
                     if pair_on:
                         slip[0] = pair_uplift(t, mu, t_rest, gr_full, gy, knots, values,
@@ -726,16 +734,31 @@ def run3d(col, motion, solver, task, pair):
                     event = True
                     rhs(t_new, y_new, n, As, cs, es, gr, work)
                     n_rhs += 1
-                    fr = _friction(t_new, y_new, work, n, col, es, gr, friction)
+                    fr = _friction(t_new, work, n, col, es, gr, friction, rx, ry)
                 else:
                     y_new[:] = ynew
-                    fr = _friction(t_new, y_new, K[ns], n, col, es, gr, friction)
+                    fr = _friction(t_new, K[ns], n, col, es, gr, friction, rx, ry)
                 if slip[1] == 0.0 and fr > mu:
                     best = 0
                     for i in range(n):
                         if friction[i] > friction[best]:
                             best = i
                     slip[0], slip[1] = t_new, best + 1.0
+                # the held demand's samples in (t_old, t_new]: theta'' on the step's quintic
+                f_new = work if hit >= 0 else K[ns]
+                while held_time(held) <= t_new:
+                    t_k = held_time(held)
+                    h_k = t_new - t_old
+                    for j in range(2 * n):
+                        q = 2 * n + j
+                        acc_k[j] = f_new[q] if h_k <= 0.0 else hermite_accel(
+                            (t_k - t_old) / h_k, h_k, y[j], y[q], f[q], y_new[j], y_new[q],
+                            f_new[q])  # fmt: skip
+                    ax_k, ay_k = horizontal(t_k, es, n, gr)
+                    shear_ratios(ax_k, ay_k, gravity_factor(t_k, gr), col.centre_map,
+                                 acc_k[:n], acc_k[n:], col.masses, col.normal_forces, rx, ry,
+                                 friction)  # fmt: skip
+                    held_push(held, rx, ry, friction)
                 if record:
                     n_out, next_out = _emit(mc, t_new, t_old, h, y, F, yq, samples, n_out,
                                             next_out, output_dt, n, d0, d1, col)  # fmt: skip

@@ -62,6 +62,7 @@ from rbm_cli.base.jit import plain
 from rbm_cli.config.types import SolverConfig
 from rbm_cli.models.outcome import EnergyAccount, Outcome
 from rbm_cli.models.plan import from_ground, to_ground, wrapped
+from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.models.rbm.step.inputs import excitation, prepare_kernel, solver_settings
 from rbm_cli.models.rbm3d.kernel import AT_REST, run3d
@@ -88,6 +89,7 @@ def integrate3d(
     output_dt: float = 0.002,
     early_stop: bool = True,
     friction_limit: float = math.inf,
+    friction_duration: float = FRICTION_DURATION,
     prepared=None,
     state: np.ndarray | None = None,
     end: list | None = None,
@@ -110,6 +112,8 @@ def integrate3d(
         motion's plane below its collapse barrier (solver.stop; the module's notes); a
         run also stops at rest after the motion (a rigid monolith)
     friction_limit : float  Outcome.slip where |T_i| / N_i first exceeds it (inf: none)
+    friction_duration : float  The duration the friction demand is held for [s]
+        (Outcome.friction; its peak: Outcome.friction_peak); 0: the peak
     prepared : PreparedModel, optional  prepare_kernel(model), made once by a caller
     state : (4n,) array, optional  A whole initial state (theta_x, theta_y, their rates, in
         the ground's axes) in place of theta0, rate0
@@ -138,8 +142,9 @@ def integrate3d(
     deadline = time.monotonic() + float(solver.max_wall_time)
     rows = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((rows, 3 + 3 * n))
+    held = held_array(n, float(friction_duration), float(friction_limit))
     task = (y0, bool(record), float(output_dt), samples, float(friction_limit),
-            stop_level(early_stop, solver))  # fmt: skip
+            stop_level(early_stop, solver), held)  # fmt: skip
     pair = (1.0, 0.0, as_samples(own.values_y), own.ground_y, own.knots_y)
     armed = arm()
     try:
@@ -157,10 +162,11 @@ def integrate3d(
                                        1), angle)  # fmt: skip
             y_end[part : part + n], y_end[part + n : part + 2 * n] = pairs[:, 0], pairs[:, 1]
         end.append(y_end)
+    demand, first = held_result(held, friction, slip)
     out = Outcome(
-        t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=friction,
-        n_uplifts=int(n_upl), n_impacts=int(n_imp), n_steps=int(n_steps), n_rhs=int(n_rhs),
-        n_events=int(n_ev), slip=(float(slip[0]), int(slip[1])) if slip[1] > 0 else None,
+        t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=demand,
+        friction_peak=friction, n_uplifts=int(n_upl), n_impacts=int(n_imp),
+        n_steps=int(n_steps), n_rhs=int(n_rhs), n_events=int(n_ev), slip=first,
         azimuth=float(azimuth) + angle, turns=float(swept.max()) / (2.0 * math.pi),
     )  # fmt: skip
     if record:

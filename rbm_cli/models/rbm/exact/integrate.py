@@ -22,6 +22,7 @@ from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.rbm.exact.piece import new_cache
 from rbm_cli.models.rbm.exact.run import run_exact
 from rbm_cli.models.rbm.forcing_arrays import motion_arrays, run_settings
+from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.models.status import (
     AT_REST_END,
     COLLAPSED,
@@ -52,14 +53,13 @@ def prepare_exact(model: Model) -> PreparedExact:
     return PreparedExact(column_arrays(model), new_cache(model.n))
 
 
-def _outcome(code, st, cnt, maxima, fric, solver, n: int) -> Outcome:
+def _outcome(code, st, cnt, maxima, fric, solver, n: int, held: np.ndarray) -> Outcome:
     out = Outcome()
     out.t_end = float(st[0])
     out.max_ratio = maxima[:n].copy()
     out.max_top = float(maxima[n])
-    out.friction = fric.copy()
-    if st[7] > 0.0:  # run.SLIP_IF
-        out.slip = (float(st[6]), int(st[7]))
+    out.friction_peak = fric.copy()
+    out.friction, out.slip = held_result(held, fric, st[6:8])  # run.T_SLIP, run.SLIP_IF
     out.n_uplifts, out.n_impacts, out.n_steps, out.n_rhs, out.n_events = (int(x) for x in cnt[:5])
     t = out.t_end
     if code == COLLAPSED:
@@ -85,6 +85,7 @@ def integrate_exact(
     prepared: PreparedExact | None = None,
     friction_limit: float = math.inf,
     until_open: bool = False,
+    friction_duration: float = FRICTION_DURATION,
 ) -> Outcome | None:
     """Integrate one motion of a model from the initial state (theta0 [rad], rate0
     [rad/s]) exactly, piece by piece (rbm_cli.models.rbm.exact): compiled, or its
@@ -104,6 +105,8 @@ def integrate_exact(
         runs one model many times (a sweep); made here when None.
     friction_limit : float  A friction coefficient [-]: the outcome says where |T / N|
         first exceeded it (Outcome.slip); inf: none.
+    friction_duration : float  The duration the friction demand is held for [s]
+        (Outcome.friction; its peak: Outcome.friction_peak); 0: the peak.
     until_open : bool  Stop at the first event of a joint (its law argument reaching the
         end of its piece: an uplift from the elastic branch) and return None; the outcome
         otherwise (the run never met one).
@@ -115,18 +118,20 @@ def integrate_exact(
     solver = solver.for_run(motion.t_end, n)
     mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit, until_open)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
+    held = held_array(n, float(friction_duration), float(friction_limit))
     armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
     try:
         run = run_exact if solver.implementation == "compiled" else plain(run_exact)
         code, st, cnt, maxima, fric = run(
             prepared.arrays, prepared.cache, seg_t, seg_fc, mo, se,
             np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float), samples, POOL, STACK,
+            held,
         )  # fmt: skip
     finally:
         disarm(armed)
     if code == OPENED:
         return None
-    out = _outcome(code, st, cnt, maxima, fric, solver, n)
+    out = _outcome(code, st, cnt, maxima, fric, solver, n, held)
     if record:
         out.samples = sample_rows(samples, int(st[5]), n)
     return out

@@ -10,10 +10,12 @@ is mo = [pulse or record (0/1), amplitude, omega, phase, pulse_end, t_end] and i
 se = [max_steps, max_events, deadline, early_stop, record, output_dt, friction limit,
 until_open] (until_open: stop at the first event of a joint, with status.OPENED).
 
-The friction demand is the largest |T_i / N_i| at the points of the march (the step
+The friction demand's peak is the largest |T_i / N_i| at the points of the march (the step
 integrators' step ends) and, at rest, over the rest (exact: the forcing's crest or ends,
 T = m a_g, N = m g); its first exceedance of the limit is the point where the running
-maximum first passes it, at rest the time |a_g| reaches limit g.
+maximum first passes it, at rest the time |a_g| reaches limit g. The held demand
+(models.rbm.pieces.held_push) takes its samples from the pieces' closed form, at rest from
+a_g.
 """
 
 from __future__ import annotations
@@ -42,10 +44,12 @@ from rbm_cli.models.rbm.pieces import (
     below_barrier,
     cross,
     first_over,
-    friction_demand,
+    held_push,
+    held_time,
     locate,
     piece_bounds,
     restitute,
+    shear_ratios,
     silent_impact,
 )
 from rbm_cli.models.status import (
@@ -74,8 +78,9 @@ FIRST_STEP = 1e-3
 #: reference counts, free list and stack, and the noted intervals (exact.peaks).
 Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes")
 #: The moving state: rotations, rates, law pieces (side, k, pending, awaiting), maxima of
-#: the tracked quantities, friction demand.
-State = namedtuple("State", "theta rate side k pending awaiting maxima fric st cnt")
+#: the tracked quantities, friction demand (its peak; the held demand, pieces.held_array,
+#: and the shear ratios of a sample).
+State = namedtuple("State", "theta rate side k pending awaiting maxima fric st cnt held rx ry")
 
 
 @jit
@@ -104,15 +109,27 @@ def _emit_rest(s, samples, t_stop, dt):
 
 
 @jit
-def _accel_and_friction(mdl, pc, pts, i, fric):
-    """Friction demand at point i (the step integrators' step ends)."""
+def _accel_and_friction(mdl, pc, pts, i, s):
+    """The shear ratios (s.rx) of the state at point i (at its time pts[i, 0]); the peak
+    s.fric raised to them."""
     n = pc.n
     from_modes = np.empty(n)
     ag = f_accel(pc.fc, pts[i, 0])
     for j in range(n):
         from_modes[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
-    friction_demand(ag, 1.0, mdl.centre_map, pc.phi @ from_modes, mdl.masses, mdl.normal_forces,
-                    fric)  # fmt: skip
+    shear_ratios(ag, 0.0, 1.0, mdl.centre_map, pc.phi @ from_modes, s.ry[:0], mdl.masses,
+                 mdl.normal_forces, s.rx, s.ry, s.fric)  # fmt: skip
+
+
+@jit
+def _held_samples(mdl, pc, pts, s):
+    """The held demand's samples due up to point 1, from the piece's closed form at point 0."""
+    while held_time(s.held) <= pts[1, 0]:
+        t_k = held_time(s.held)
+        eval_point(pc, pts, 0, t_k - pts[0, 0], SCRATCH)
+        pts[SCRATCH, 0] = t_k
+        _accel_and_friction(mdl, pc, pts, SCRATCH, s)
+        held_push(s.held, s.rx, s.ry, s.fric)
 
 
 @jit
@@ -182,9 +199,10 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, sure_stop, samples):
         s.cnt[RHS_PEAKS] += ev
         if se[4] != 0.0:
             _emit(pc, pts, s, samples, pts[1, 0], se[5])
-        _accel_and_friction(mdl, pc, pts, 1, s.fric)
+        _accel_and_friction(mdl, pc, pts, 1, s)
         if s.st[SLIP_IF] == 0.0:
             first_over(s.fric, se[6], pts[1, 0], s.st[T_SLIP : SLIP_IF + 1])
+        _held_samples(mdl, pc, pts, s)
         if can_stop and _passed_peak(mdl, pc, pts):
             s.st[T] = pts[1, 0]
             return -STOPPED_EARLY
@@ -249,6 +267,9 @@ def _rest_friction(s, fc, t0, t1, mu):
     if s.st[SLIP_IF] == 0.0 and d > mu:
         s.st[T_SLIP] = f_exceedance(fc, t0, mu * G, t1)
         s.st[SLIP_IF] = 1.0
+    while held_time(s.held) <= t1:
+        s.rx[0] = f_accel(fc, held_time(s.held)) / G
+        held_push(s.held, s.rx, s.ry, s.fric)
 
 
 @jit
@@ -309,8 +330,10 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, sure_stop, sample
 
 
 @jit
-def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, stack):
-    """One run (exact.integrate.integrate_exact). Returns (code, st, cnt, maxima, friction)."""
+def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, stack, held):
+    """One run (exact.integrate.integrate_exact); held: the held friction demand
+    (pieces.held_array), changed in place. Returns (code, st, cnt, maxima, friction: its
+    peak)."""
     n = theta0.size
     side = np.ones(n, dtype=np.int64)
     k = np.zeros(n, dtype=np.int64)
@@ -323,7 +346,7 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
         st[AT_REST] = 1.0
     s = State(theta, rate, side, k, pending, awaiting, np.zeros(n + 1), np.zeros(n), st,
-              np.zeros(8, dtype=np.int64))  # fmt: skip
+              np.zeros(8, dtype=np.int64), held, np.zeros(n), np.zeros(n))  # fmt: skip
     nf = 2 * n + 1
     wk = Work(np.zeros((pool, 1 + 2 * n + 3 * nf)), np.zeros((9, n)), np.zeros((8, nf)),
               np.zeros(pool, dtype=np.int64), np.zeros(pool - 3, dtype=np.int64),

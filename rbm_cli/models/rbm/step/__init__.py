@@ -44,6 +44,7 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm, poll
 from rbm_cli.base.jit import plain
 from rbm_cli.models.outcome import EnergyAccount, Outcome, sample_buffer, sample_rows
+from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.models.rbm.step.inputs import (
     PreparedModel,
     excitation,
@@ -74,6 +75,7 @@ def integrate(
     early_stop: bool = True,
     prepared: PreparedModel | None = None,
     friction_limit: float = math.inf,
+    friction_duration: float = FRICTION_DURATION,
 ) -> Outcome:
     """Integrate one motion of a model from the initial state (theta0 [rad], rate0
     [rad/s]) with the step kernel: compiled, or its uncompiled version (the same source,
@@ -91,6 +93,8 @@ def integrate(
         that runs one model many times (a sweep); made here when None.
     friction_limit : float  A friction coefficient [-]: the outcome says where |T / N|
         first exceeded it (Outcome.slip); inf: none.
+    friction_duration : float  The duration the friction demand is held for [s]
+        (Outcome.friction; its instantaneous peak: Outcome.friction_peak); 0: the peak.
     """
     if prepared is None:
         prepared = prepare_kernel(model)
@@ -99,17 +103,19 @@ def integrate(
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)
+    held = held_array(n, float(friction_duration), float(friction_limit))
     # a RunTask, as a plain tuple (step.inputs)
     task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
             stop_level(early_stop, solver),
-            bool(record), float(output_dt), samples, float(friction_limit))  # fmt: skip
+            bool(record), float(output_dt), samples, float(friction_limit), held)  # fmt: skip
     armed = arm()  # Ctrl-C reaches the kernel through poll (rbm_cli.base.guard)
     try:
         kernel = run_kernel if solver.implementation == "compiled" else plain(run_kernel)
         res = kernel(prepared.packed, excitation(motion), settings, task)
     finally:
         disarm(armed)
-    return _outcome(res, samples, n, record, solver, account=motion.vertical is None)
+    return _outcome(res, samples, n, record, solver, account=motion.vertical is None,
+                    held=held)  # fmt: skip
 
 
 def prepare(model: Model):
@@ -119,16 +125,24 @@ def prepare(model: Model):
 
 
 def _outcome(
-    res: tuple, samples: np.ndarray, n: int, record: bool, solver, account: bool
+    res: tuple,
+    samples: np.ndarray,
+    n: int,
+    record: bool,
+    solver,
+    account: bool,
+    held: np.ndarray,
 ) -> Outcome:
     """The Outcome of what run_kernel returned (samples: its output rows; account: its
-    energy account is kept, a recorded run without a vertical record)."""
+    energy account is kept, a recorded run without a vertical record; held: the held
+    friction demand it took, pieces.held_array)."""
     (code, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
      n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger) = res  # fmt: skip
+    demand, first = held_result(held, friction, slip)
     out = Outcome(
-        t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=friction,
-        n_uplifts=int(n_upl), n_impacts=int(n_imp), n_steps=int(n_steps), n_rhs=int(n_rhs),
-        n_events=int(n_ev), slip=(float(slip[0]), int(slip[1])) if slip[1] > 0 else None,
+        t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=demand,
+        friction_peak=friction, n_uplifts=int(n_upl), n_impacts=int(n_imp),
+        n_steps=int(n_steps), n_rhs=int(n_rhs), n_events=int(n_ev), slip=first,
     )  # fmt: skip
     if record:
         out.samples = sample_rows(samples, n_out, n)

@@ -83,6 +83,7 @@ class RunTask(NamedTuple):
     output_dt: float  #: sampling interval [s]
     samples: np.ndarray  #: output rows (t, theta, rate) (n_max, 1 + 2n), written in place
     friction_limit: float  #: a friction coefficient [-]: where |T / N| first exceeds it (inf: none)
+    held: np.ndarray  #: the held friction demand's state (pieces.held_array), in place
 
 
 @dataclass(frozen=True)

@@ -16,9 +16,12 @@ from rbm_cli.models.rbm.pieces import (
     bound_rows,
     energy,
     first_over,
-    friction_demand,
+    held_push,
+    held_time,
+    hermite_accel,
     locate,
     settle,
+    shear_ratios,
 )
 from rbm_cli.models.rbm.step.events import (
     CHECK_INTERVALS,
@@ -63,7 +66,15 @@ from rbm_cli.models.status import (
     guard_code,
 )
 from rbm_cli.physics.arrays import ColumnArrays
-from rbm_cli.physics.ground import ground, ground_at, next_uplift, record_piece, rest_demand
+from rbm_cli.physics.ground import (
+    gravity_factor,
+    ground,
+    ground_at,
+    next_uplift,
+    record_piece,
+    rest_demand,
+    rest_shear,
+)
 
 #: Gauss-Legendre nodes on [0, 1] and weights (5 points: exact for polynomials of degree 9).
 GL_NODES = np.array([0.04691007703066802, 0.23076534494715845, 0.5, 0.7692346550528415,
@@ -118,8 +129,10 @@ def run_kernel(model, motion, solver, task):
     tuple  (status code (rbm_cli.models.status), t_end [s], t_collapse [s], collapsed interface,
         max_ratio (n,), max_top, friction (n,), slip (2,), n_uplifts, n_impacts, n_steps,
         n_rhs, n_events, n_samples, ledger). friction: the largest |T_i / N_i| of each
-        interface [-], at rest (physics.ground.rest_demand, exact) and at step ends in
-        motion; slip: where it first exceeded task.friction_limit, (t [s], interface from 1),
+        interface [-] (its peak), at rest (physics.ground.rest_demand, exact), at step ends
+        in motion and at the samples of the held demand (task.held, changed in place:
+        pieces.held_push); slip: where the peak first exceeded task.friction_limit,
+        (t [s], interface from 1),
         (nan, 0) if not: at rest the exceedance time itself (physics.ground.next_uplift at the
         limit), in motion the end of the first step whose demand exceeds it. ledger: the
         energy account of a recorded run without a vertical record [J] (zeros otherwise): the
@@ -152,6 +165,7 @@ def run_kernel(model, motion, solver, task):
     theta0, rate0, early_stop = task.theta0, task.rate0, task.early_stop
     record, output_dt, samples = task.record, task.output_dt, task.samples
     mu = task.friction_limit
+    held = task.held
 
     n = theta0.size
     n_out = 0
@@ -206,6 +220,8 @@ def run_kernel(model, motion, solver, task):
     z_old, z_new, z_prev = np.empty(nt), np.empty(nt), np.empty(nt)
     dz_old, dz_new, dz_prev = np.empty(nt), np.empty(nt), np.empty(nt)
     acc = np.empty(n)
+    acc_old, acc_k = np.empty(n), np.empty(n)  # theta'' at a step's start, at a sample
+    rx, ry = np.zeros(n), np.zeros(n)  # the shear ratios at a sample of the held demand
     no_offset = np.empty(0)
     y_new = np.empty(m)
     est_order = TAB_EST[mc]
@@ -259,6 +275,9 @@ def run_kernel(model, motion, solver, task):
                 d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
                 if d_rest > friction[0]:
                     friction[0] = d_rest
+                while held_time(held) <= t_rest:
+                    rx[0] = rest_shear(held_time(held), gr_full, knots, values, vertical)
+                    held_push(held, rx, ry, friction)
                 if slip[1] == 0.0 and d_rest > mu:
                     slip[0] = next_uplift(t, mu * G, amplitude, gr_full, knots, values,
                                           vertical, t_rest)  # fmt: skip
@@ -330,6 +349,7 @@ def run_kernel(model, motion, solver, task):
                 y_old = y
                 y_new[:] = ynew
                 dense_ready = False
+                acc_old[:] = acc
                 g_new, gam_new = acc_of(t_new, y_new, n, As, cs, es, gr, acc)
                 surfaces(gx, gc, same, y_new, acc, h0, d_new, dd_new, d2_new, t_new, gr, mv_e,
                           mv_w)  # fmt: skip
@@ -391,9 +411,22 @@ def run_kernel(model, motion, solver, task):
                         max_ratio[i] = peaks[i]
                 if peaks[n] > max_top:
                     max_top = peaks[n]
-                friction_demand(g_new, gam_new, centre_map, acc, masses, normal_forces, friction)
+                shear_ratios(g_new, 0.0, gam_new, centre_map, acc, no_offset, masses,
+                             normal_forces, rx, ry, friction)  # fmt: skip
                 if slip[1] == 0.0:
                     first_over(friction, mu, t_new, slip)
+                # the held demand's samples in (t_old, t_new]: theta'' on the step's quintic
+                while held_time(held) <= t_new:
+                    t_k = held_time(held)
+                    h_k = t_new - t_old
+                    for j in range(n):
+                        acc_k[j] = acc[j] if h_k <= 0.0 else hermite_accel(
+                            (t_k - t_old) / h_k, h_k, y_old[j], y_old[n + j], acc_old[j],
+                            y_new[j], y_new[n + j], acc[j])  # fmt: skip
+                    shear_ratios(ground(t_k, gr), 0.0, gravity_factor(t_k, gr), centre_map,
+                                 acc_k, no_offset, masses, normal_forces, rx, ry,
+                                 friction)  # fmt: skip
+                    held_push(held, rx, ry, friction)
                 z_prev, z_old, z_new = z_old, z_new, z_prev
                 dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
                 d_old, d_new = d_new, d_old

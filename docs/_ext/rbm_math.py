@@ -7,7 +7,9 @@ holds MathJax 3.2.2's files; conf.py points ``mathjax_path`` at ``mathjax/tex-ch
 and this extension copies, once the HTML is written, the parts a page loads: the TeX to
 CommonHTML component, the TeX extensions it loads when a formula needs them (autoload:
 ``\\boldsymbol``, ``\\cancel``...), the fonts of its output, and the modules of its
-right-click menu and accessibility (about 4 MB of the package's 24 MB).
+right-click menu and accessibility (about 4 MB of the package's 24 MB). An equation wider
+than the page's text scrolls sideways instead of being cut at the text's edge
+(``_static/rbm_math.css``).
 """
 
 from __future__ import annotations
@@ -30,6 +32,18 @@ PARTS = (
     "sre/mathmaps/base.json",
     "sre/mathmaps/en.json",
 )
+
+
+#: The site's style of displayed equations: one wider than the text scrolls.
+CSS = "rbm_math.css"
+CSS_TEXT = """\
+/* an equation wider than the text scrolls sideways (docs/_ext/rbm_math.py) */
+mjx-container[jax="CHTML"][display="true"] {
+  overflow-x: auto;
+  overflow-y: hidden;
+  max-width: 100%;
+}
+"""
 
 
 def mathjax_folder() -> Path:
@@ -68,11 +82,14 @@ def _check_config(app, config) -> None:
 
 def _copy(app, exc) -> None:
     if exc is None and app.builder.format == "html":
-        copy_mathjax(mathjax_folder(), Path(app.outdir) / "_static")
+        static = Path(app.outdir) / "_static"
+        copy_mathjax(mathjax_folder(), static)
+        (static / CSS).write_text(CSS_TEXT)
 
 
 def setup(app):  # pragma: no cover - exercised by the docs build
     app.setup_extension("sphinx.ext.mathjax")
     app.connect("config-inited", _check_config)
     app.connect("build-finished", _copy)
+    app.add_css_file(CSS)
     return {"parallel_read_safe": True, "parallel_write_safe": True}

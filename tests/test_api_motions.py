@@ -320,9 +320,9 @@ def test_a_motion_refuses_the_analytic_second_component_it_would_drop():
     """A harmonic config's excitation.y is a second component of the harmonic: arrays that
     replace the harmonic would run without it, silently. Refused in one line that says where
     a second component of arrays goes."""
+    second = {"amplitude_ratio": 0.5, "phase_deg": 90}
     cfg = rbm.load_config({"name": "c", "model": "housner-3d", "column": dict(CYLINDER),
-                           "excitation": {"type": "harmonic",
-                                          "y": {"amplitude_ratio": 0.5, "phase_deg": 90}}})  # fmt: skip
+                           "excitation": {"type": "harmonic", "y": second}})  # fmt: skip
     motion = rbm.motion_from_arrays(T, AX, name="x")
     for call in (lambda: rbm.run(cfg, 0.3, motion=motion),
                  lambda: rbm.sweep(cfg, motions=[motion])):  # fmt: skip

@@ -278,7 +278,8 @@ def read_domain(path: str | os.PathLike) -> pd.DataFrame:
 def migrate(folder: str | os.PathLike) -> str:
     """Bring a domain stored by an earlier rbm (its meta.json under an earlier schema of the
     config hash) to this version's hash, so that this version resumes, compares and keeps
-    it as its own; its rows and figures are not touched. It checks first that the domain
+    it as its own; its rows (amplitudes [g], frequencies [Hz], ...) and figures are not
+    touched. It checks first that the domain
     is the one this version makes of its config (the same settings, no cell that ran out of
     a budget, the method that ran: docs/guide/reproducibility.md) and refuses otherwise.
 

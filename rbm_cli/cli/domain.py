@@ -234,6 +234,11 @@ def migrate_cmd(folders: tuple[str, ...]) -> None:
     the same config (the same settings, no cell that ran out of a budget, the method that
     ran); its rows and figures are not touched. A folder that does not pass is left as it
     is, named in one line (re-make it), and the exit status is 2.
+
+    \b
+    Example:
+        rbm migrate results/*/
+        rbm migrate old_results/slender old_results/thick
     """
     from rbm_cli.api import migrate
 

@@ -17,6 +17,8 @@ import pytest
 
 from tests.paths import TOOLS
 
+pytestmark = pytest.mark.slow
+
 SCRIPT = TOOLS / "make_validation.py"
 HEADINGS = (
     "# Validation report",

@@ -375,7 +375,6 @@ def test_a_write_that_fails_leaves_the_folder_as_it_was(tmp_path):
     assert {p.name: p.read_bytes() for p in (tmp_path / "s").iterdir()} == before
 
 
-@pytest.mark.slow
 def test_compare_draws_each_domain_fitted_in_one_figure(tmp_path, figures):
     """--compare: a second suite (capacities twice as large) is fitted with the same options
     and drawn in fragility.png beside the first, each fitted curve the closed form of its own

@@ -185,7 +185,9 @@ def test_plot_domain_draws_a_sweep_of_motions_with_the_config_it_was_given():
 # --------------------------------------------------------------------------- pairs
 
 
-@pytest.mark.parametrize("model", ["housner-3d", "rbm-3d", "bullet"])
+@pytest.mark.parametrize(
+    "model", ["housner-3d", "rbm-3d", pytest.param("bullet", marks=pytest.mark.slow)]
+)
 def test_a_pair_given_as_arrays_runs_as_the_same_pair_of_record_files(records, model):
     """rbm.motion_from_arrays(t, ax, acceleration_y=ay) swept by each model in three
     dimensions gives the rows of excitation.file with excitation.file_y holding the same

@@ -79,7 +79,10 @@ def half_sines(tmp_path_factory):
     return {f: _half_sine_files(folder, f) for f in FREQUENCIES}
 
 
-@pytest.mark.parametrize("model, impl", MODELS)
+@pytest.mark.parametrize(
+    "model, impl",
+    [pytest.param(*m, marks=pytest.mark.slow) if m == ("rbm", "python") else m for m in MODELS],
+)
 def test_half_sine_record_equals_the_analytic_half_sine(half_sines, model, impl):
     """On a whole grid (below uplift, survived, collapsed): the same outcome, the collapse
     time within 1e-3 s (found: ~1e-6 s) and the peak ratio within 1e-4, for the .AT2, the
@@ -116,7 +119,7 @@ def test_half_sine_record_equals_the_analytic_half_sine(half_sines, model, impl)
 
 @pytest.mark.parametrize(
     "drums, stiffness, amplitude, moved",
-    [(8, {"normal": 5e9}, 0.1, 1e-4), (1, "rigid", 0.5, 0.5)],
+    [pytest.param(8, {"normal": 5e9}, 0.1, 1e-4, marks=pytest.mark.slow), (1, "rigid", 0.5, 0.5)],
 )
 def test_record_kernel_matches_python_loop(half_sines, drums, stiffness, amplitude, moved):
     """The compiled kernel and the Python loop take the same steps under a record (an

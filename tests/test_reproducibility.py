@@ -37,10 +37,6 @@ from rbm_cli.study.regression import check, sensitive_bound
 
 from .paths import CONFIGS, RESULTS, ROOT
 
-#: Slow (whole domains re-made, processes killed, contact-engine runs):
-#: `pytest -m 'not slow'` leaves this file out.
-pytestmark = pytest.mark.slow
-
 CI_CONFIG = CONFIGS / "ci" / "harmonic_multidrum_ci.yaml"
 CI_STORED = RESULTS / "harmonic_multidrum_ci" / "domain.csv"
 
@@ -85,6 +81,7 @@ def here(tmp_path_factory) -> bytes:
     return (run_sweep(load_config(CI_CONFIG), folder, jobs=1).folder / "domain.csv").read_bytes()
 
 
+@pytest.mark.slow  # the CI band re-made three times, once by a generic compile
 @needs_x86_linux
 @pytest.mark.may_skip(reason="the variants are x86-64 settings: another Linux machine skips")
 @pytest.mark.parametrize("name", sorted(_variants()))

@@ -893,6 +893,7 @@ def _wait_rows(journal: Path, n: int, proc: subprocess.Popen, limit: float = 90)
 
 
 @pytest.mark.timeout(240)
+@pytest.mark.slow
 def test_case15_ctrl_c_says_what_is_kept_and_how_to_resume(tmp_path, compiled):
     """Defect: Ctrl-C printed only 'Aborted!' and left loky's 'leaked semlock' warnings;
     workers outlived the sweep; Ctrl-C pressed again during the stop could cut short the

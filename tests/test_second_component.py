@@ -210,7 +210,11 @@ def _sampled_pair(tmp_path, motion, per_period=4000):
 
 @pytest.mark.parametrize(
     ("model", "drums", "interface"),
-    [("housner-3d", 1, None), ("rbm-3d", 1, None), ("rbm-3d", 3, ELASTIC)],
+    [
+        pytest.param("housner-3d", 1, None, marks=pytest.mark.slow),
+        ("rbm-3d", 1, None),
+        ("rbm-3d", 3, ELASTIC),
+    ],
 )
 def test_the_formula_is_the_pair_of_records_sampled_from_it(tmp_path, model, drums, interface):
     """A harmonic and a Mavroeidis-Papageorgiou pulse with their second components,

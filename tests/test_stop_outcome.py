@@ -223,6 +223,7 @@ def _check_domain(fresh: dict, stored: dict, at_least: int) -> int:
     return stopped
 
 
+@pytest.mark.slow
 def test_the_ci_band_keeps_every_outcome(tmp_path):
     """The 40 runs of the 8-drum band (the step kernel) against the stored domain, whose
     member 0 is the plain run: 24 collapse, none in the free tail; of the 16 survivors,
@@ -245,6 +246,7 @@ def test_a_collapse_in_the_free_tail_is_kept():
         assert f"{res['t_collapse_s']:.12g}" == stored["t_collapse_s"]
 
 
+@pytest.mark.slow
 def test_the_exact_integrator_keeps_every_outcome(tmp_path):
     """One record's ten levels with the exact integrator: stopped and not, against its own
     full runs."""

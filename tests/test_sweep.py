@@ -152,6 +152,7 @@ def test_boundary_from_rows_without_pandas():
     assert boundary(read)["lowest_unsafe_g"].tolist() == [0.3]
 
 
+@pytest.mark.slow
 def test_sweep_killed_with_sigkill_then_resumed(tmp_path):
     """A real kill: `rbm sweep` in a subprocess, SIGKILL once the journal holds
     some rows, then --resume: same bytes as a straight run, no complete-looking

@@ -185,4 +185,4 @@ print(differ[["record", "amplitude_g", "collapsed_3d", "collapsed_2d", "wobble_t
 # %%
 # The same study from the command line: ``rbm sweep configs/suite_pairs.yaml`` and
 # ``rbm sweep configs/suite_pairs_planar.yaml`` (1 and 8 drums, 10 levels), then
-# ``python docs/make_pairs_study.py`` for the two fragility curves of each drum count.
+# ``python tools/make_pairs_study.py`` for the two fragility curves of each drum count.

@@ -4,4 +4,4 @@ Baraldi, Milani and Sarhosis, "A simple and effective Rigid Beam Model for
 studying the dynamic behaviour of freestanding columns".
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"

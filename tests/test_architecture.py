@@ -189,3 +189,109 @@ def test_the_check_sees_a_private_import(tmp_path, monkeypatch):
         ("rbm_cli.physics.x", "rbm_cli.base.files", "_fsync"),
         ("rbm_cli.physics.x", "rbm_cli.physics.law", "_piece"),
     }
+
+
+# ------------------------------------------------------ tools beside the package, not in it
+
+ROOT = PACKAGE.parent
+TOOLS = ROOT / "tools"
+#: Modules of rbm_cli that no entry point reaches, read only by a tool: developer tooling
+#: still inside the package. The list may only shrink (a module listed that is reached, or
+#: gone, fails too).
+NOT_REACHED = {
+    "rbm_cli.models.bullet.convergence",  # tools/make_engine.py's step-convergence tables
+    "rbm_cli.models.bullet.normals",  # tools/make_engine.py's census of contact normals
+}
+
+
+def entry_points() -> set[str]:
+    """The modules a user starts from: the console scripts (pyproject.toml), what
+    `import rbm` imports, `python -m rbm_cli` and every module with a main guard (run as
+    `python -m`)."""
+    import tomllib
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    found = {target.split(":")[0] for target in project["scripts"].values()}
+    found |= {m for m in imports(ROOT / "rbm" / "__init__.py", "rbm", set(modules()))}
+    for module, path in modules().items():
+        if path.name == "__main__.py" or '__name__ == "__main__"' in path.read_text():
+            found.add(module)
+    return found
+
+
+def named_modules(path: Path, known: set[str]) -> set[str]:
+    """Modules of rbm_cli a file names in a string to import later ("rbm_cli.a.b" or
+    "rbm_cli.a.b:function": the model registry, the method table, the compiled targets)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            name = node.value.split(":")[0]
+            if name in known and name.startswith("rbm_cli."):
+                found.add(name)
+    return found
+
+
+def unreached(roots: set[str], graph: dict[str, set[str]], named: dict[str, set[str]]) -> set:
+    """The modules of graph that no import (or name in a string) leads to from roots; a
+    module imported imports its packages too."""
+    seen, stack = set(), list(roots)
+    while stack:
+        module = stack.pop()
+        if module in seen:
+            continue
+        seen.add(module)
+        for dep in graph.get(module, set()) | named.get(module, set()):
+            parts = dep.split(".")
+            stack += [".".join(parts[:k]) for k in range(1, len(parts) + 1)]
+    return set(graph) - seen
+
+
+def test_every_module_is_reached_from_an_entry_point():
+    """A module of rbm_cli that no user's entry point reaches is run only by a developer's
+    tool: it belongs in tools/ (docs/architecture.md), beside the scripts that read it."""
+    mods = modules()
+    named = {m: named_modules(p, set(mods)) for m, p in mods.items()}
+    left = unreached(entry_points(), graph(), named)
+    assert not left - NOT_REACHED, "reached by no entry point (tools/ holds these):\n" + "\n".join(
+        sorted(left - NOT_REACHED)
+    )
+    assert not NOT_REACHED - left, "reached now, or gone: delete from NOT_REACHED:\n" + "\n".join(
+        sorted(NOT_REACHED - left)
+    )
+
+
+def test_the_check_sees_a_module_no_entry_point_reaches(tmp_path):
+    """The checker itself: a module that only a tool imports is left over, one named in a
+    string (as the registry names its runners) is reached."""
+    graph = {"rbm_cli.cli.main": {"rbm_cli.api"}, "rbm_cli.api": set(), "rbm_cli.models.x": set(),
+             "rbm_cli.study.tooling": set(), "rbm_cli": set()}  # fmt: skip
+    path = tmp_path / "x.py"
+    path.write_text('RUNNERS = {"x": "rbm_cli.models.x:run"}\n')
+    named = {"rbm_cli.api": named_modules(path, set(graph))}
+    assert unreached({"rbm_cli.cli.main"}, graph, named) == {"rbm_cli.study.tooling"}
+
+
+def test_nothing_of_the_package_imports_a_tool():
+    """tools/ is not installed with the package: no module of rbm_cli imports one."""
+    tools = {path.stem for path in TOOLS.glob("*.py")}
+    found = []
+    for module, path in modules().items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and not node.level:
+                names = [node.module or ""]
+            else:
+                continue
+            found += [
+                f"{module} imports {n}" for n in names if n.split(".")[0] in tools | {"tools"}
+            ]
+    assert not found, "\n".join(found)
+
+
+def test_docs_holds_the_site_and_no_script():
+    """The scripts that make the docs' figures and measurements are in tools/: the only
+    Python directly in docs/ is the site's configuration (its extensions are in docs/_ext,
+    the tutorials and the API example are run by the build and the tests)."""
+    assert sorted(p.name for p in (ROOT / "docs").glob("*.py")) == ["conf.py"]
+    assert (TOOLS / "make_validation.py").is_file()

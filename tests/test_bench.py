@@ -10,10 +10,6 @@ from click.testing import CliRunner
 from rbm_cli.cli.main import cli
 from rbm_cli.study.bench import PEAK_TARGET, check_targets, errors
 
-#: Slow (whole domains re-made, processes killed, contact-engine runs):
-#: `pytest -m 'not slow'` leaves this file out.
-pytestmark = pytest.mark.slow
-
 
 def frame(rows):
     df = pd.DataFrame(rows, columns=["amplitude_g", "frequency_hz", "collapsed",
@@ -57,6 +53,7 @@ def test_targets_fail_when_the_default_misses_them():
     assert check_targets(pd.DataFrame([other])) == []
 
 
+@pytest.mark.slow  # the four problems by every method against their references
 def test_quick_bench_meets_the_accuracy_targets(tmp_path):
     res = CliRunner().invoke(cli, ["bench", "--quick", "-o", str(tmp_path)])
     assert res.exit_code == 0, res.output

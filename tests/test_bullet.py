@@ -6,7 +6,7 @@ corner inertia from the independent polynomial integrals of `housner`
 impact formula e = 1 - 1.5 sin^2(alpha) written here, the statics of a rigid
 block (no motion below tan(alpha) g), and Housner's model itself run with the
 engine's measured impact loss. CI runs the study's 6 x 5 grid with 3 s of
-excitation per cell (docs/make_engine.py runs it for 10 s).
+excitation per cell (tools/make_engine.py runs it for 10 s).
 """
 
 from __future__ import annotations
@@ -251,7 +251,7 @@ def test_same_cell_same_answer():
 
 # ------------------------------------------------------------ against Housner
 
-#: The study's 6 x 5 harmonic grid (the one docs/make_engine.py runs for 10 s).
+#: The study's 6 x 5 harmonic grid (the one tools/make_engine.py runs for 10 s).
 GRID_AMPLITUDES = (0.3, 0.5, 0.7, 0.9, 1.1, 1.3)  # g
 GRID_FREQUENCIES = (0.5, 1.0, 1.5, 2.0, 2.5)  # Hz
 #: CI runs it with 3 s of excitation instead of 10 s (both models see the same motion).

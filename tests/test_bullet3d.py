@@ -46,7 +46,7 @@ from rbm_cli.study.result import THREE_D_FIELDS
 from rbm_cli.study.simulate import simulate
 from rbm_cli.study.sweep import config_hash
 
-from .paths import docs_script
+from .paths import tool_script
 
 #: Contact-engine runs: `pytest -m 'not slow'` leaves this file out.
 pytestmark = pytest.mark.slow
@@ -162,9 +162,9 @@ def test_the_engines_cylinders_keep_a_steady_wobble(theta):
     cylinder (the centre of mass at rest, the axis at a tilt theta precessing at Omega;
     Omega^2 = m g R (R cos - h sin) / (sin (I_t R cos - I_a h sin)), derived in the
     housner-3d tests): over three of its turns the engine's tilt stays within 1 % of
-    theta and its lean turns three times within 1 % (docs/engine_shapes.py's run, which
+    theta and its lean turns three times within 1 % (tools/engine_shapes.py's run, which
     also measures polygonal prisms: they do not)."""
-    turns, off = docs_script("engine_shapes").wobble("cylinders", theta)
+    turns, off = tool_script("engine_shapes").wobble("cylinders", theta)
     assert off < 0.01
     assert turns == pytest.approx(3.0, rel=0.01)
 

@@ -1,7 +1,7 @@
 """`model: bullet`'s library pieces beside the run: the physics client a run is
 given or opens, the per-step probe (`observe`) and the contact-normal census, the
 engine's e for `housner`, the time-step agreement summaries, and what
-docs/make_engine.py computes through them.
+tools/make_engine.py computes through them.
 
 Expected values come from statics (a block at rest carries its weight on the
 ground's normal), from hand-built outcome tables, and from runs of the same cell
@@ -10,7 +10,6 @@ made the other way (own client against a given one, probed against not).
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import subprocess
 import sys
@@ -34,7 +33,7 @@ from rbm_cli.models.bullet.normals import NormalCensus
 from rbm_cli.models.bullet.run import bullet_run
 from rbm_cli.models.bullet.settings import EngineSettings, settings_from_config
 from rbm_cli.physics.excitation import GroundMotion
-from tests.paths import ROOT
+from tests.paths import tool_script
 
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}
 TAPER = {"height": 5.0, "base_width": 0.96, "top_width": 0.66}
@@ -202,14 +201,11 @@ def test_ensemble_agreement_keeps_chaotic_cells_apart():
     assert out["chaotic_engine_housner"] == {"0.7 1.0": (0.5, 1.0), "0.9 1.0": (1.0, 0.25)}
 
 
-# ---------------------------------------------------------- docs/make_engine.py
+# ---------------------------------------------------------- tools/make_engine.py
 
 
 def make_engine():
-    spec = importlib.util.spec_from_file_location("make_engine", ROOT / "docs" / "make_engine.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return tool_script("make_engine")
 
 
 def test_make_engine_boundaries_come_from_the_domain_library():

@@ -63,7 +63,9 @@ PAIRS = [
 ]
 
 
-@pytest.mark.parametrize("planar_model, model, interface", PAIRS)
+@pytest.mark.parametrize(
+    "planar_model, model, interface", [pytest.param(*PAIRS[0], marks=pytest.mark.slow), *PAIRS[1:]]
+)
 def test_along_x_a_sweep_counts_the_planar_models_impacts_and_uplifts(
     planar_model, model, interface
 ):

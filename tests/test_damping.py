@@ -175,7 +175,7 @@ def test_zero_damping_is_the_undamped_column():
     del undamped["interface"]["damping"]
     zero = _config(0.0)
     assert load_config(zero).resolved() == load_config(undamped).resolved()
-    assert "damping" not in load_config(zero).resolved()["interface"]
+    assert load_config(zero).resolved()["interface"]["damping"] == 0.0
 
 
 def test_auto_runs_a_damped_column_with_a_method_that_damps():
@@ -212,6 +212,7 @@ def test_the_exact_method_refuses_damping_in_one_line():
         run(cfg, amplitude_g=0.1, frequency_hz=2.0)
 
 
+@pytest.mark.slow
 def test_the_stored_damped_study_is_reproduced(tmp_path):
     """The stored damped 8-drum study (results/harmonic_multidrum_damped, an ensemble of 16)
     on a sub-grid of 6 cells across its boundary: the same outcome on its robust cells, the

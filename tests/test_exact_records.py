@@ -32,7 +32,7 @@ from rbm_cli.study.simulate import simulate
 
 from .paths import CONFIGS
 
-pytestmark = [pytest.mark.slow, pytest.mark.timeout(900)]
+pytestmark = pytest.mark.timeout(900)
 
 RECORD = CONFIGS / "records" / "synthetic" / "rdk_01.AT2"
 #: The paper's tapered column, 8 drums and monolithic (rigid).
@@ -98,7 +98,7 @@ def _assert_same(step, exact, cell):
 
 
 @pytest.mark.parametrize("kind", ["one-sine", "cycloidal"])
-@pytest.mark.parametrize("drums", [1, 8])
+@pytest.mark.parametrize("drums", [1, pytest.param(8, marks=pytest.mark.slow)])
 def test_sine_pulses_agree_with_the_step_kernel(kind, drums):
     interface = ELASTIC if drums > 1 else None
     excitation = {"type": kind, "duration": 4.0}
@@ -109,7 +109,7 @@ def test_sine_pulses_agree_with_the_step_kernel(kind, drums):
     assert _check(drums, excitation, cells, interface) >= 2
 
 
-@pytest.mark.parametrize("drums", [1, 8])
+@pytest.mark.parametrize("drums", [1, pytest.param(8, marks=pytest.mark.slow)])
 def test_a_record_agrees_with_the_step_kernel(drums):
     """A synthetic record (rdk_01, 0.01 s samples), scaled to three PGAs."""
     interface = ELASTIC if drums > 1 else None

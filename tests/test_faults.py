@@ -21,7 +21,7 @@ between the publication's renames); every row seen in the journal before the fau
 still there and valid (less the rows the fault itself damaged); the resume keeps them
 all ("N resumed"); no process of the sweep is left; the last resume gives the reference.
 
-    pytest tests/test_faults.py                          # small: ~30 s, in the default run
+    pytest -m slow tests/test_faults.py                  # small: ~30 s, in the slow tier
     RBM_FAULT_TRIALS=120 pytest -m stress tests/test_faults.py -s   # the large version
     (RBM_FAULT_LOG=file appends a running tally a trial; RBM_FAULT_SEED another draw)
 

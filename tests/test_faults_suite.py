@@ -16,7 +16,7 @@ After every step every domain.csv in the folder and in superseded/ must be the d
 one version of the records, byte for byte (a straight sweep's): a file that mixes the two
 versions, or a resume that ran over a changed record, counts as ``mixed`` and must stay 0.
 
-    pytest tests/test_faults_suite.py                                  # small: ~15 s
+    pytest -m slow tests/test_faults_suite.py                          # small: ~15 s
     RBM_SUITE_FAULT_TRIALS=60 pytest -m stress tests/test_faults_suite.py -s  # large
 
 The figures of the last large run are in docs/stability.md.

@@ -254,7 +254,11 @@ grid: {amplitudes: [0.2, 0.5, 1.2], frequencies: [0.5, 2.0]}
 PARENT_MODULES = parent_modules("pandas", "rbm_cli.study.sweep")
 
 
-@pytest.mark.parametrize("extra", [[], ["--ensemble", "2"]], ids=["plain", "ensemble"])
+@pytest.mark.parametrize(
+    "extra",
+    [[], pytest.param(["--ensemble", "2"], marks=pytest.mark.slow)],
+    ids=["plain", "ensemble"],
+)
 def test_the_sweep_process_never_imports_pandas(tmp_path, extra):
     """`rbm sweep` writes domain.csv and boundary.csv from its rows and sends them to the
     figure's child, which builds the DataFrame: pandas is not imported in the
@@ -294,7 +298,11 @@ def _rows(journal: Path) -> int:
 
 
 @pytest.mark.timeout(300)
-@pytest.mark.parametrize("rows", [0, 40], ids=["workers-starting", "workers-at-work"])
+@pytest.mark.parametrize(
+    "rows",
+    [0, pytest.param(40, marks=pytest.mark.slow)],
+    ids=["workers-starting", "workers-at-work"],
+)
 def test_ctrl_c_on_a_pool_keeps_the_cells_and_leaves_no_process(tmp_path, rows):
     """400 cells of an 8-drum elastic column (~10 s of work at the least) go to a pool; a
     Ctrl-C to the whole group (a terminal's), as soon as the workers exist (still

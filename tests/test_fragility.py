@@ -79,6 +79,7 @@ def test_mle_is_the_maximum_and_consistent():
         assert other < ll
 
 
+@pytest.mark.slow
 def test_bootstrap_interval_covers_the_generating_lognormal():
     """40 records (a realistic suite): the 5-95 % intervals contain theta and beta."""
     df = _ida(40, 0.4, 0.35, seed=3)

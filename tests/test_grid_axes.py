@@ -231,6 +231,7 @@ def test_a_journal_row_of_another_point_is_not_trusted(tmp_path):
     assert any("not in the config's grid" in n for n in notes), notes
 
 
+@pytest.mark.slow
 def test_dask_sweeps_axes_as_the_local_workers_do(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     cfg = config({"frequencies": [1.0], "column.slenderness": [3.0, 5.0]})

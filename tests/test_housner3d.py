@@ -276,6 +276,7 @@ def test_a_pair_with_a_zero_second_record_is_the_one_component_run(pair_dir):
         assert one.n_impacts > 20
 
 
+@pytest.mark.slow
 def test_swapping_the_components_with_the_angle_turned_gives_the_same_run(pair_dir):
     """(x, y) = (rdk_01, rdk_02) against (rdk_02, rdk_01) turned by 90 degrees (rdk_01
     then acts along -x: the mirror image): the same outcome, impacts, peak and collapse

@@ -62,7 +62,7 @@ def _solver(cfg, implementation, **kw):
     [
         ("spanos_koh_slender", 0.5, 2.0, "DOP853"),  # a rigid block: rest, uplift, impacts
         ("harmonic_monolithic", 0.5, 2.0, "RK45"),  # an elastic monolith
-        ("harmonic_multidrum", 0.15, 2.0, "DOP853"),  # 8 elastic drums
+        pytest.param("harmonic_multidrum", 0.15, 2.0, "DOP853", marks=pytest.mark.slow),  # 8 drums
     ],
 )
 def test_the_kernel_uncompiled_gives_the_same_bits(study, amplitude, frequency, method):

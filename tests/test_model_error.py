@@ -11,7 +11,7 @@ and nothing else changed; tests/test_regression.py re-makes them with the others
 - the small-rotation limit: the RBM is the linearised exact block (sin(alpha - theta) ->
   alpha - theta, alpha = atan(B/H) -> B/H, its p -> the block's), so for a slender block
   (20 m x 1 m, alpha = 0.05) the two domains agree but for a few boundary cells;
-- rbm_cli.study.model_error says which side a differing cell is on.
+- tools/model_error.py says which side a differing cell is on.
 """
 
 from __future__ import annotations
@@ -26,10 +26,13 @@ from rbm_cli.config.load import load_config, parse_config
 from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.column import build_column
 from rbm_cli.study.domain import domain_config, read_domain
-from rbm_cli.study.model_error import CONSERVATIVE, UNCONSERVATIVE, model_error
 from rbm_cli.study.simulate import simulate
 
-from .paths import CONFIGS, RESULTS
+from .paths import CONFIGS, RESULTS, tool_script
+
+_MODEL_ERROR = tool_script("model_error")
+CONSERVATIVE, UNCONSERVATIVE = _MODEL_ERROR.CONSERVATIVE, _MODEL_ERROR.UNCONSERVATIVE
+model_error = _MODEL_ERROR.model_error
 
 #: The monolithic rigid RBM studies, each with its exact-block twin `<study>_housner`.
 STUDIES = ("spanos_koh_slender", "spanos_koh_thick", "spanos_koh_thick_housner_e",
@@ -167,6 +170,7 @@ def next_to_boundary(df: pd.DataFrame, a: float, f: float) -> bool:
     return any(col.collapsed[j] != col.collapsed[i] for j in (i - 1, i + 1) if 0 <= j < len(col))
 
 
+@pytest.mark.slow
 def test_a_slender_block_converges_to_the_exact_block(tmp_path):
     """The small-rotation limit: at alpha = 0.05 (sin(alpha - theta) = alpha - theta to
     alpha^3 / 6 = 2e-5, atan(B/H) = B/H to 4e-5 rad) the RBM and the exact block agree on
@@ -226,18 +230,12 @@ def test_model_error_calls_a_cell_robust_only_when_robust_in_both():
 
 
 def test_the_figure_draws_each_pair_and_its_sides():
-    """docs/make_model_error.py: per panel, the exact block's boundary is that of the stored
+    """tools/make_model_error.py: per panel, the exact block's boundary is that of the stored
     housner domain, the marked cells are the differing cells by side, and the title's
     percentage is the fraction of the table above."""
-    import importlib.util
-
     from rbm_cli.study.domain import boundary
 
-    spec = importlib.util.spec_from_file_location(
-        "make_model_error", CONFIGS.parent / "docs" / "make_model_error.py"
-    )
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
+    script = tool_script("make_model_error")
     fig, errors = script.make_figure()
     assert list(errors) == list(script.STUDIES) and set(script.STUDIES) == set(STUDIES)
     for ax, study in zip(fig.axes, script.STUDIES, strict=False):

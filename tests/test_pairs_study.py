@@ -1,4 +1,4 @@
-"""docs/make_pairs_study.py: the planar assessment of a pair is the worse of its two
+"""tools/make_pairs_study.py: the planar assessment of a pair is the worse of its two
 components, a cell's outcome its members' majority (tables set by hand), and the figure of
 the stored studies is drawn."""
 
@@ -7,12 +7,12 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from .paths import RESULTS, docs_script
+from .paths import RESULTS, tool_script
 
 
 @pytest.fixture(scope="module")
 def study():
-    return docs_script("make_pairs_study")
+    return tool_script("make_pairs_study")
 
 
 def test_a_cell_collapses_when_most_of_its_members_did(study):
@@ -53,11 +53,11 @@ def test_the_figure_of_the_stored_studies(study, tmp_path, monkeypatch, capsys):
 
 @pytest.fixture(scope="module")
 def engine_study():
-    return docs_script("make_pairs_engine")
+    return tool_script("make_pairs_engine")
 
 
 def test_the_engine_is_compared_on_robust_cells_only(engine_study):
-    """docs/make_pairs_engine.py: an 8-drum rbm-3d cell is robust or not by its members;
+    """tools/make_pairs_engine.py: an 8-drum rbm-3d cell is robust or not by its members;
     only robust cells count for agreement, and a difference is put down to the side that
     collapsed (a table set by hand; the 1-drum cells and a failed run left out)."""
     beam = pd.DataFrame({

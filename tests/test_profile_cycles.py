@@ -1,19 +1,14 @@
-"""docs/profile_cycles.py finds every part it counts in today's run loops: its anchors occur
+"""tools/profile_cycles.py finds every part it counts in today's run loops: its anchors occur
 once each, and the instrumented copies are valid Python that reads the counter (the script
 itself compiles two integrators, minutes: it is run by hand, docs/performance.md)."""
 
 import ast
-import importlib.util
 
-from tests.paths import ROOT
+from tests.paths import ROOT, tool_script
 
 
 def _script():
-    path = ROOT / "docs" / "profile_cycles.py"
-    spec = importlib.util.spec_from_file_location("profile_cycles", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return tool_script("profile_cycles")
 
 
 def test_the_counters_go_into_todays_run_loops(tmp_path):

@@ -83,6 +83,7 @@ def test_parallel_folders_pair_in_sorted_order(folder):
     assert list(axis.points) == [(f"x/{x}", f"y/{y}") for x, y in PAIRS]
 
 
+@pytest.mark.slow
 def test_a_sweep_of_pairs_gives_the_linked_axis_rows(folder):
     """Two pairs x two amplitudes: the rows of the pairs {x, y} and of the parallel globs
     are those of the linked axis, every column; each pair is named as its x record."""

@@ -43,7 +43,7 @@ CI_BAND = CONFIGS / "ci" / "suite_multidrum_ci.yaml"
 STOPPED = re.compile(r"stopped at ([0-9.e+-]+) s \(solver\.stop: outcome\)")
 #: the ensemble's columns of domain.csv (the stored domain is an ensemble; these sweeps are
 #: single runs), left out of the comparison
-ENSEMBLE = ("collapse_fraction", "robust")
+ENSEMBLE = ("collapse_fraction", "robust", "sensitive_to")
 RECORD_S = 30.0  # the synthetic records' length [s]
 
 
@@ -51,7 +51,8 @@ def _raw(path=CI_BAND) -> dict:
     """The config file as a mapping (for the keys a Config cannot change)."""
     raw = yaml.safe_load(path.read_text())
     raw["interface"]["stiffness"]["normal"] = float(raw["interface"]["stiffness"]["normal"])
-    raw["excitation"]["file"] = [str((path.parent / f).resolve()) for f in raw["excitation"]["file"]]
+    files = raw["excitation"]["file"]
+    raw["excitation"]["file"] = [str((path.parent / f).resolve()) for f in files]
     return raw
 
 
@@ -76,9 +77,9 @@ def test_the_barrier_is_the_least_potential_of_a_joint_at_collapse(xi, ratio):
     raw["collapse"] = {"ratio": ratio}
     model = model_from_config(load_config(raw))
     by_quad = []
-    for law, tu in zip(model.laws, model.column.rotation_capacity):
+    for law, tu in zip(model.laws, model.column.rotation_capacity, strict=True):
         edges = [e for e in law.edges if e < ratio * tu]  # the kinks: quad's breakpoints
-        value, err = quad(lambda x: float(law(x)), 0.0, ratio * tu, points=edges or None,
+        value, err = quad(lambda x, law=law: float(law(x)), 0.0, ratio * tu, points=edges or None,
                           limit=200, epsabs=0.0, epsrel=1e-12)  # fmt: skip
         by_quad.append(value)
     assert survival_barrier(model) == pytest.approx(min(by_quad), rel=1e-9)
@@ -222,6 +223,7 @@ def _check_domain(fresh: dict, stored: dict, at_least: int) -> int:
     return stopped
 
 
+@pytest.mark.slow
 def test_the_ci_band_keeps_every_outcome(tmp_path):
     """The 40 runs of the 8-drum band (the step kernel) against the stored domain, whose
     member 0 is the plain run: 24 collapse, none in the free tail; of the 16 survivors,
@@ -244,6 +246,7 @@ def test_a_collapse_in_the_free_tail_is_kept():
         assert f"{res['t_collapse_s']:.12g}" == stored["t_collapse_s"]
 
 
+@pytest.mark.slow
 def test_the_exact_integrator_keeps_every_outcome(tmp_path):
     """One record's ten levels with the exact integrator: stopped and not, against its own
     full runs."""

@@ -322,6 +322,7 @@ def test_impact_energy_reproducer(formulation):
 # Joint 4 integrated ~2 ms with the moment of the wrong sign.
 
 
+@pytest.mark.slow
 def test_energy_jump_reproducer():
     """Guards against a missed first event when another row crosses later in the step
     (energy jump 5e-4 before the fix; the limit is 1e-6). Runs the step kernel's source

@@ -1,4 +1,4 @@
-"""docs/make_validation.py --quick runs, writes every section of validation.md, and the
+"""tools/make_validation.py --quick runs, writes every section of validation.md, and the
 numbers it writes agree with closed forms computed here (not with the script's own code).
 
 The closed forms used, for the slender block of the report (rectangle H = 4 m, B = 1 m):
@@ -15,9 +15,11 @@ import sys
 
 import pytest
 
-from tests.paths import ROOT
+from tests.paths import TOOLS
 
-SCRIPT = ROOT / "docs" / "make_validation.py"
+pytestmark = pytest.mark.slow
+
+SCRIPT = TOOLS / "make_validation.py"
 HEADINGS = (
     "# Validation report",
     "## 1. RBM n = 1 vs the closed-form linear solution",

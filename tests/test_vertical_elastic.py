@@ -74,8 +74,8 @@ def _run(cfg, amplitude, **kw):
 
 
 CASES = [(name, "compiled") for name in COLUMNS] + [
-    ("two-drum-trilinear", "python"),
-    ("monolith-bilinear", "python"),
+    pytest.param("two-drum-trilinear", "python", marks=pytest.mark.slow),
+    pytest.param("monolith-bilinear", "python", marks=pytest.mark.slow),
 ]
 
 

@@ -4,7 +4,7 @@ Pure functions on outcomes already computed (no engine): they summarise a study
 that runs the same cells under several engine variants (time steps), or as
 ensembles, against a reference. A cell is chaotic under a variant when that
 variant's own runs of it (the same cell nudged within 1e-6) disagree; only the
-cells robust under both can be said to agree or differ. docs/make_engine.py
+cells robust under both can be said to agree or differ. tools/make_engine.py
 (parts timestep and converge) prints them for docs/engine.md.
 """
 

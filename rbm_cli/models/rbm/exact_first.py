@@ -7,7 +7,7 @@ closed form and takes no steps for their vibration, where the step kernel's step
 the highest elastic mode (some 20 steps a cycle at the default tolerance). Once a joint
 opens, the exact integrator costs more than the step kernel (its certified search at every
 event). Measured on the 40 record runs of the stored 8-drum suite's CI band
-(`python docs/profile_methods.py`): the exact integrator takes 0.16 of the step kernel's
+(`python tools/profile_methods.py`): the exact integrator takes 0.16 of the step kernel's
 time on the run where no joint opens, 1.1-2.3 times it on the 39 where one does.
 
 So a run starts with the exact integrator asked to stop at the first event of a joint

@@ -1,4 +1,4 @@
-"""Measurements the validation report makes (docs/make_validation.py), as library functions.
+"""Measurements the validation report makes (tools/make_validation.py), as functions.
 
 - :func:`zero_crossings` and :func:`period_from_crossings`: the rocking period of a
   recorded history (t, theta, theta'), from its zero crossings on the cubic Hermite

@@ -1,7 +1,7 @@
 """Where a record run's time goes inside the compiled integrators: the processor's cycles
 per part of the run loop, per event (docs/performance.md, "Record suites: inside an event").
 
-    python docs/profile_cycles.py           # the 40 runs, both integrators: ~5 min
+    python tools/profile_cycles.py           # the 40 runs, both integrators: ~5 min
 
 The compiled code cannot be profiled by Python's profilers, and the uncompiled code spends
 its time elsewhere. So this script copies the package to a temporary folder, adds a read of
@@ -167,7 +167,7 @@ def _child(method: str) -> None:
     """Run the 40 runs with the method (in the instrumented copy: the counters print)."""
     import dataclasses
 
-    sys.path.insert(0, str(ROOT / "docs"))
+    sys.path.insert(0, str(ROOT / "tools"))
     from profile_records import CONFIG, points
 
     from rbm_cli.config.load import load_config

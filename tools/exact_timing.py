@@ -1,9 +1,9 @@
 """Time per cell of the step kernel (DOP853, the config's rtol) and of the exact method
 (compiled), as in docs/architecture.md, "The exact integrator".
 
-    python docs/exact_timing.py cells        # 64 cells of the 8-drum domain (10 s)
-    python docs/exact_timing.py kn           # 6 cells, k_n 5e7 .. 5e11 Pa/m
-    python docs/exact_timing.py drums 1 2 4 8 16
+    python tools/exact_timing.py cells        # 64 cells of the 8-drum domain (10 s)
+    python tools/exact_timing.py kn           # 6 cells, k_n 5e7 .. 5e11 Pa/m
+    python tools/exact_timing.py drums 1 2 4 8 16
 
 Each line: the case, then per method the median and mean time per cell [ms], the total [s],
 the cells that collapse, mean steps and right-hand sides (closed-form evaluations for the

@@ -1,8 +1,8 @@
 """Regenerate docs/validation.md and its figures (the validation report).
 
-    python docs/make_validation.py            # full report into docs/ (< 10 min on 2 cores)
-    python docs/make_validation.py --quick    # smaller grids, shorter runs (< 60 s)
-    python docs/make_validation.py --quick --out /tmp/val
+    python tools/make_validation.py            # full report into docs/ (< 10 min on 2 cores)
+    python tools/make_validation.py --quick    # smaller grids, shorter runs (< 60 s)
+    python tools/make_validation.py --quick --out /tmp/val
 
 Everything goes through the library API (no CLI calls); every number written
 into validation.md is printed as it is measured. Sweeps write into a
@@ -30,6 +30,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
+from validation_measures import (  # noqa: E402  (the module beside this script)
+    differing_cells,
+    linear_domain,
+    period_from_crossings,
+    zero_crossings,
+)
 
 from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
@@ -46,12 +52,6 @@ from rbm_cli.physics.excitation import make_ground_motion  # noqa: E402
 from rbm_cli.report.plot_domain import plot_domain  # noqa: E402
 from rbm_cli.study.domain import boundary, compare, read_domain  # noqa: E402
 from rbm_cli.study.simulate import model_from_config, simulate  # noqa: E402
-from rbm_cli.study.validation import (  # noqa: E402
-    differing_cells,
-    linear_domain,
-    period_from_crossings,
-    zero_crossings,
-)
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIGS = ROOT / "configs"
@@ -63,7 +63,7 @@ RESULTS = ROOT / "results"
 
 #: The line under every figure of the report: what made it, when, where.
 FIGURE_NOTE = (
-    f"*Made by `python docs/make_validation.py` on "
+    f"*Made by `python tools/make_validation.py` on "
     f"{_dt.datetime.now().astimezone().strftime('%Y-%m-%d')}, {platform.machine()}, "
     f"{os.cpu_count()} cores.*"
 )
@@ -815,7 +815,7 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--out",
         type=Path,
-        default=Path(__file__).resolve().parent,
+        default=ROOT / "docs",
         help="folder for validation.md and figures/ (default docs/)",
     )
     parser.add_argument("--jobs", type=int, default=2, help="sweep workers (default 2)")
@@ -843,7 +843,7 @@ def main(argv=None) -> int:
             walls.append(time.perf_counter() - t0)
             bodies.append((title, rep.lines))
     total = time.perf_counter() - start
-    cmd = "python docs/make_validation.py" + (" --quick" if args.quick else "")
+    cmd = "python tools/make_validation.py" + (" --quick" if args.quick else "")
     head = [
         "# Validation report",
         "",

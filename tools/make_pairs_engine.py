@@ -1,7 +1,7 @@
 """rbm-3d against the contact engine in three dimensions: the paper's column in 8 circular
 drums under record pairs, cell by cell.
 
-    python docs/make_pairs_engine.py      # prints a Markdown table and the agreement
+    python tools/make_pairs_engine.py      # prints a Markdown table and the agreement
 
 Reads the stored domains results/suite_pairs (model rbm-3d, made by `rbm sweep
 configs/suite_pairs.yaml -o results --ensemble 16`; its 8-drum cells) and

@@ -1,8 +1,8 @@
 """Which method a record run of the 8-drum column wants, and what its events cost
 (docs/performance.md, "Record suites: the method and the events").
 
-    python docs/profile_methods.py            # the 40 runs, both methods: ~2 min
-    python docs/profile_methods.py --events   # first steps after each kind of event: ~1 min
+    python tools/profile_methods.py            # the 40 runs, both methods: ~2 min
+    python tools/profile_methods.py --events   # first steps after each kind of event: ~1 min
 
 The runs of `configs/ci/suite_multidrum_ci.yaml` (the paper's column in 8 drums, k_n 5e9
 Pa/m, the first 4 synthetic records of 30 s plus 5 s of free motion, PGA 0.1-1.0 g), one

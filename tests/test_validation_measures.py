@@ -1,4 +1,4 @@
-"""rbm_cli.study.validation: the measurements of the validation report, against closed
+"""tools/validation_measures.py: the measurements of the validation report, against closed
 forms and hand-made cases."""
 
 from __future__ import annotations
@@ -15,14 +15,14 @@ from rbm_cli.config.types import GridConfig
 from rbm_cli.physics.closed_forms import linear_rocking_parameters
 from rbm_cli.physics.column import build_column
 from rbm_cli.study.domain import read_domain
-from rbm_cli.study.validation import (
-    differing_cells,
-    linear_domain,
-    period_from_crossings,
-    zero_crossings,
-)
 
-from .paths import CONFIGS, RESULTS
+from .paths import CONFIGS, RESULTS, tool_script
+
+_MEASURES = tool_script("validation_measures")
+differing_cells = _MEASURES.differing_cells
+linear_domain = _MEASURES.linear_domain
+period_from_crossings = _MEASURES.period_from_crossings
+zero_crossings = _MEASURES.zero_crossings
 
 
 def test_crossing_of_a_sampled_cubic_is_its_root():

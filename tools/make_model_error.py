@@ -1,11 +1,11 @@
 """The RBM against the exact block (`housner`) on the shipped monolithic rigid studies.
 
-    python docs/make_model_error.py                 # docs/figures/rbm_vs_housner.png
-    python docs/make_model_error.py --out /tmp/fig.png
+    python tools/make_model_error.py                 # docs/figures/rbm_vs_housner.png
+    python tools/make_model_error.py --out /tmp/fig.png
 
 Reads the stored domains of the STUDIES below (results/<study>/domain.csv and
 results/<study>_housner/domain.csv, made by `rbm sweep configs/<study>.yaml -o results
---ensemble 16`), prints for each pair its ModelError (rbm_cli.study.model_error: the
+--ensemble 16`), prints for each pair its ModelError (tools/model_error.py: the
 fraction that differs, the cells by side, the boundary shifts) and the cells where the RBM
 is unconservative, and draws one panel per study: the RBM's cells and boundary, the exact
 block's boundary, the differing cells by side, and the two uplift levels. Runs nothing;
@@ -19,12 +19,12 @@ import math
 from pathlib import Path
 
 from matplotlib.figure import Figure
+from model_error import CONSERVATIVE, UNCONSERVATIVE, ModelError, model_error  # beside this
 
 from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.column import build_column
 from rbm_cli.report.plot_domain import plot_domain
 from rbm_cli.study.domain import domain_config, read_domain
-from rbm_cli.study.model_error import CONSERVATIVE, UNCONSERVATIVE, ModelError, model_error
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "results"

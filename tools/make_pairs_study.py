@@ -1,7 +1,7 @@
 """Planar against three-dimensional fragility: the paper's column in circular drums.
 
-    python docs/make_pairs_study.py                 # docs/figures/pairs_fragility.png
-    python docs/make_pairs_study.py --out /tmp/fig.png
+    python tools/make_pairs_study.py                 # docs/figures/pairs_fragility.png
+    python tools/make_pairs_study.py --out /tmp/fig.png
 
 Reads the stored domains results/suite_pairs (model rbm-3d: ten pairs of synthetic records,
 each pair scaled by one factor, its larger PGA to the amplitude) and

@@ -17,7 +17,7 @@ the run's settings (step 1e-4 s, 100 iterations, friction 1), collided as prisms
   the centre of their normal forces: its largest distance across the motion's plane, in
   radii (0 for contact forces that leave the rocking in its plane).
 
-    python docs/engine_shapes.py     # about 15 s on one core; prints two Markdown tables
+    python tools/engine_shapes.py     # about 15 s on one core; prints two Markdown tables
 """
 
 from __future__ import annotations

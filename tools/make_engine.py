@@ -1,20 +1,20 @@
 """Measure the numbers and draw the figures of docs/engine.md (`model: bullet`).
 
-    python docs/make_engine.py impact      # the engine's impact loss vs Housner's e (~1 min)
-    python docs/make_engine.py grid        # 6 x 5 grid, engine vs housner, 3 time steps (~5 min)
-    python docs/make_engine.py timestep    # 24 8-drum cells at 3 time steps, each run twice
+    python tools/make_engine.py impact      # the engine's impact loss vs Housner's e (~1 min)
+    python tools/make_engine.py grid        # 6 x 5 grid, engine vs housner, 3 time steps (~5 min)
+    python tools/make_engine.py timestep    # 24 8-drum cells at 3 time steps, each run twice
                                            # (amplitude x (1 + 1e-6)) (~25 min)
-    python docs/make_engine.py cost        # CPU of 10 s 8-drum cells at 1e-4 s, 3 runs each
-    python docs/make_engine.py emap        # housner's outcome against e in the knife-edge cells
-    python docs/make_engine.py fine        # the 6 x 5 grid at 5e-5 s, engine vs housner (~3 min)
-    python docs/make_engine.py converge    # the 6 x 5 grid as ensembles of 4 at 1e-4, 5e-5
+    python tools/make_engine.py cost        # CPU of 10 s 8-drum cells at 1e-4 s, 3 runs each
+    python tools/make_engine.py emap        # housner's outcome against e in the knife-edge cells
+    python tools/make_engine.py fine        # the 6 x 5 grid at 5e-5 s, engine vs housner (~3 min)
+    python tools/make_engine.py converge    # the 6 x 5 grid as ensembles of 4 at 1e-4, 5e-5
                                            # and 2.5e-5 s, engine vs housner (~15 min, 2 jobs)
-    python docs/make_engine.py chaos       # one chaotic 8-drum cell, K = 4, 2 time steps
-    python docs/make_engine.py monolithic  # the monolithic study: RBM, housner, engine (~2 min)
-    python docs/make_engine.py rbm_e       # 8-drum RBM with e < 1 vs engine; friction demand
-    python docs/make_engine.py normals     # the engine's contact normals at the 8-drum joints
+    python tools/make_engine.py chaos       # one chaotic 8-drum cell, K = 4, 2 time steps
+    python tools/make_engine.py monolithic  # the monolithic study: RBM, housner, engine (~2 min)
+    python tools/make_engine.py rbm_e       # 8-drum RBM with e < 1 vs engine; friction demand
+    python tools/make_engine.py normals     # the engine's contact normals at the 8-drum joints
                                            # against the faces', with the friction demand
-    python docs/make_engine.py multidrum   # RBM formulations vs engine fractions (figure;
+    python tools/make_engine.py multidrum   # RBM formulations vs engine fractions (figure;
                                            # runs the RBM on the engine's grid)
 
 Everything goes through the library API. Each part prints what it measures and

@@ -1,7 +1,7 @@
 """Where a record run's time goes: the 8-drum column of the stored record suite, run by
 run (docs/performance.md, "Record suites: where the time goes").
 
-    python docs/profile_records.py            # 4 records x 10 levels, one process: ~2 min
+    python tools/profile_records.py            # 4 records x 10 levels, one process: ~2 min
 
 The runs of `configs/ci/suite_multidrum_ci.yaml` (the paper's column in 8 drums, k_n 5e9
 Pa/m, the first 4 synthetic records of 30 s plus 5 s of free motion, PGA 0.1-1.0 g), each

@@ -539,6 +539,7 @@ def run3d(col, motion, solver, task, pair):
     max_ratio, friction, swept = np.zeros(n), np.zeros(n), np.zeros(n)
     slip = np.array([np.nan, 0.0])
     rx, ry, acc_k = np.zeros(n), np.zeros(n), np.zeros(2 * n)  # a held demand's sample
+    between = np.zeros(n)  # its peak between step ends (interpolated: not the run's peak)
     max_top, azimuth = 0.0, np.nan
     n_upl, n_imp, n_steps, n_rhs, n_ev, n_out = 0, 0, 0, 0, 0, 0
     next_out = 0.0
@@ -757,8 +758,8 @@ def run3d(col, motion, solver, task, pair):
                     ax_k, ay_k = horizontal(t_k, es, n, gr)
                     shear_ratios(ax_k, ay_k, gravity_factor(t_k, gr), col.centre_map,
                                  acc_k[:n], acc_k[n:], col.masses, col.normal_forces, rx, ry,
-                                 friction)  # fmt: skip
-                    held_push(held, rx, ry, friction)
+                                 between)  # fmt: skip
+                    held_push(held, rx, ry, between)
                 if record:
                     n_out, next_out = _emit(mc, t_new, t_old, h, y, F, yq, samples, n_out,
                                             next_out, output_dt, n, d0, d1, col)  # fmt: skip

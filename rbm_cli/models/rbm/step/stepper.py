@@ -129,10 +129,10 @@ def run_kernel(model, motion, solver, task):
     tuple  (status code (rbm_cli.models.status), t_end [s], t_collapse [s], collapsed interface,
         max_ratio (n,), max_top, friction (n,), slip (2,), n_uplifts, n_impacts, n_steps,
         n_rhs, n_events, n_samples, ledger). friction: the largest |T_i / N_i| of each
-        interface [-] (its peak), at rest (physics.ground.rest_demand, exact), at step ends
-        in motion and at the samples of the held demand (task.held, changed in place:
-        pieces.held_push); slip: where the peak first exceeded task.friction_limit,
-        (t [s], interface from 1),
+        interface [-] (its peak), at rest (physics.ground.rest_demand, exact) and at step
+        ends in motion (the held demand's samples between them, on the step's interpolant,
+        go to task.held only, changed in place: pieces.held_push); slip: where the peak
+        first exceeded task.friction_limit, (t [s], interface from 1),
         (nan, 0) if not: at rest the exceedance time itself (physics.ground.next_uplift at the
         limit), in motion the end of the first step whose demand exceeds it. ledger: the
         energy account of a recorded run without a vertical record [J] (zeros otherwise): the
@@ -222,6 +222,7 @@ def run_kernel(model, motion, solver, task):
     acc = np.empty(n)
     acc_old, acc_k = np.empty(n), np.empty(n)  # theta'' at a step's start, at a sample
     rx, ry = np.zeros(n), np.zeros(n)  # the shear ratios at a sample of the held demand
+    between = np.zeros(n)  # their peak between step ends (interpolated: not the run's peak)
     no_offset = np.empty(0)
     y_new = np.empty(m)
     est_order = TAB_EST[mc]
@@ -425,8 +426,8 @@ def run_kernel(model, motion, solver, task):
                             y_new[j], y_new[n + j], acc[j])  # fmt: skip
                     shear_ratios(ground(t_k, gr), 0.0, gravity_factor(t_k, gr), centre_map,
                                  acc_k, no_offset, masses, normal_forces, rx, ry,
-                                 friction)  # fmt: skip
-                    held_push(held, rx, ry, friction)
+                                 between)  # fmt: skip
+                    held_push(held, rx, ry, between)
                 z_prev, z_old, z_new = z_old, z_new, z_prev
                 dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
                 d_old, d_new = d_new, d_old

@@ -126,24 +126,29 @@ def test_law_potential_is_the_laws_potential(name):
             assert plain(compiled.law_potential)(i, x, edges, nedges, intercepts, slopes) == got
 
 
-def test_friction_demand_is_the_models_shear_ratio():
-    """The friction demand raises its maxima to Model.shear_ratios (gam = 1) and to the
-    ratios over gam under vertical motion."""
+def test_shear_ratios_are_the_models_shear_ratio():
+    """The shear ratios of an instant are Model.shear_ratios (gam = 1), over gam under
+    vertical motion; they raise the peak to their magnitudes."""
     model = MODELS["8 drums, bilinear"]()
     rng = np.random.default_rng(5)
     col = model.column
     out = np.zeros(model.n)
+    rx, ry, none = np.zeros(model.n), np.zeros(model.n), np.zeros(0)
     for _ in range(20):
         acc, ag = rng.normal(size=model.n), float(rng.normal())
         want = model.shear_ratios(acc[None, :], np.array([ag]))[0]
         before = out.copy()
-        compiled.friction_demand(ag, 1.0, model.centre_map, acc, col.masses, col.normal_forces,
-                                 out)  # fmt: skip
-        np.testing.assert_allclose(out, np.maximum(before, want), rtol=1e-12, atol=1e-15)
+        compiled.shear_ratios(ag, 0.0, 1.0, model.centre_map, acc, none, col.masses,
+                              col.normal_forces, rx, ry, out)  # fmt: skip
+        np.testing.assert_allclose(out, np.maximum(before, np.abs(want)), rtol=1e-12,
+                                   atol=1e-15)  # fmt: skip
+        np.testing.assert_allclose(np.abs(rx), want, rtol=1e-12, atol=1e-15)
+        assert np.all(ry == 0.0)
     under = np.zeros(model.n)
-    compiled.friction_demand(ag, 1.25, model.centre_map, acc, col.masses, col.normal_forces,
-                             under)  # fmt: skip
-    np.testing.assert_allclose(under, want / 1.25, rtol=1e-12)
+    compiled.shear_ratios(ag, 0.0, 1.25, model.centre_map, acc, none, col.masses,
+                          col.normal_forces, rx, ry, under)  # fmt: skip
+    np.testing.assert_allclose(under, np.abs(want) / 1.25, rtol=1e-12)
+    np.testing.assert_allclose(np.abs(rx), np.abs(want) / 1.25, rtol=1e-12)
 
 
 def test_rest_levels():

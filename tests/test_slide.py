@@ -1,10 +1,15 @@
 """Sliding demand of model rbm against a friction coefficient, and the domain figure's marks.
 
 Independent reasons: a rigid block at rest on the ground carries T = m a_g on N = m g, so
-under a harmonic A sin(omega t) below its uplift level (A < g B / H) its friction demand
-max |T / N| is A / g exactly and first exceeds mu < A / g at t = asin(mu g / A) / omega;
-above the uplift level the demand is at least the uplift level B / H (it equals it at
-uplift). Hence on a grid with mu below B / H a cell slides exactly where A / g > mu.
+under a harmonic A sin(omega t) below its uplift level (A < g B / H) the instantaneous
+peak of |T / N| is A / g exactly. The friction demand is |T / N| held in one direction for
+tau = 0.03 s, sampled every tau / 60 from t = 0: at rest it lies within
+[(A / g) cos(omega (tau / 2 + tau / 120)), (A / g) cos(omega tau / 2)] (a window of samples
+about a crest) and is first held above mu < A / g from the first sample at or after
+t* = asin(mu g / A) / omega. Above the uplift level the peak is at least B / H (it equals
+it at uplift) and the demand at least the least a_g / g of the window ending at uplift,
+(A / g) sin(omega (t_u - tau - tau / 60)), t_u = asin(g B / (H A)) / omega (a_g rises on
+it). Hence on a grid with mu below every such level a cell slides exactly where A / g > mu.
 The figures are read back from their artists (gids, point counts, legend texts) and
 checked against the domain's own columns and the column's static multiplier computed
 from its geometry (tan alpha = B / H of a rectangular monolith).
@@ -29,6 +34,7 @@ from click.testing import CliRunner  # noqa: E402
 import rbm  # noqa: E402
 from rbm_cli.base.errors import ConfigError  # noqa: E402
 from rbm_cli.cli.main import cli  # noqa: E402
+from rbm_cli.models.rbm.pieces import FRICTION_DURATION as TAU  # noqa: E402
 from rbm_cli.report.domain_figure import domain_figure  # noqa: E402
 from rbm_cli.report.plot_domain import (  # noqa: E402
     SLIDES_LABEL,
@@ -68,11 +74,15 @@ def test_block_at_rest_has_demand_a_over_g_and_slips_at_the_closed_form_time(met
     for a in (0.05, 0.15, 0.2, 0.24):
         r = simulate(block(mu, method), a, FREQ)
         assert r.method == method and r.n_uplifts == 0 and r.status == "survived"
-        errors.append(abs(r.friction_demand[0] - a))
+        errors.append(abs(r.friction_demand_peak[0] - a))
+        om = 2 * math.pi * FREQ
+        held = (a * math.cos(om * (TAU / 2 + TAU / 120)), a * math.cos(om * TAU / 2))
+        assert held[0] - 1e-12 <= r.friction_demand[0] <= held[1] + 1e-12
         if a > mu:  # a_g = a g sin(omega t) first reaches mu g at asin(mu / a) / omega
             t_slip, where = r.slip
+            t_first = math.asin(mu / a) / om
             assert where == 1
-            assert t_slip == pytest.approx(math.asin(mu / a) / (2 * math.pi * FREQ), abs=1e-9)
+            assert t_first - 1e-12 <= t_slip <= t_first + TAU / 60 + 1e-12
             assert r.slides == 1
         else:
             assert r.slip is None and r.slides == 0
@@ -83,8 +93,16 @@ def test_block_at_rest_has_demand_a_over_g_and_slips_at_the_closed_form_time(met
 def test_a_rocking_block_demands_at_least_its_uplift_level(method):
     r = simulate(block(None, method), 0.5, FREQ)
     assert r.n_uplifts >= 1 and r.friction_limit is None and r.slip is None
-    assert r.friction_demand[0] >= B / H - 1e-9
+    assert r.friction_demand_peak[0] >= B / H - 1e-9
+    assert r.friction_demand[0] >= _held_before_uplift(0.5, FREQ) - 1e-12
     assert "slides" not in r.row() and math.isfinite(r.row()["friction_demand"])
+
+
+def _held_before_uplift(a, freq):
+    """The least a_g / g of the last window of samples before the block's uplift."""
+    om = 2 * math.pi * freq
+    t_u = math.asin(B / H / a) / om
+    return max(0.0, a * math.sin(om * (t_u - TAU - TAU / 60)))
 
 
 def test_slides_exactly_where_a_over_g_exceeds_mu_on_a_grid():
@@ -98,9 +116,14 @@ def test_slides_exactly_where_a_over_g_exceeds_mu_on_a_grid():
     assert len(df) == 72 and (df["status"] != "failed").all()
     np.testing.assert_array_equal(df["slides"], (df["amplitude_g"] > mu).astype(int))
     below = df["amplitude_g"] < B / H
-    np.testing.assert_allclose(df.loc[below, "friction_demand"], df.loc[below, "amplitude_g"],
-                               rtol=0, atol=1e-9)  # fmt: skip
-    assert (df.loc[~below, "friction_demand"] >= B / H - 1e-9).all()
+    om = 2 * math.pi * df["frequency_hz"]
+    a = df["amplitude_g"]
+    lo, hi = a * np.cos(om * (TAU / 2 + TAU / 120)), a * np.cos(om * TAU / 2)
+    d = df["friction_demand"]
+    assert ((d >= lo - 1e-12) & (d <= hi + 1e-12))[below].all()
+    f = df["frequency_hz"]
+    rocks = [_held_before_uplift(x, y) for x, y in zip(a[~below], f[~below], strict=True)]
+    assert (d[~below] >= np.array(rocks) - 1e-12).all()
 
 
 def test_no_friction_no_slides_column_and_stored_hashes_unchanged():
@@ -150,7 +173,8 @@ def test_a_bullet_domain_keeps_no_demand_and_no_slides():
     assert cfg.interface.friction == 0.4 and cfg.interface.friction_limit is None
     assert "slides" not in sweep_fields(cfg)
     engine = dataclasses.replace(simulate(block(), 0.1, FREQ), model="bullet")
-    assert engine.max_friction_demand == pytest.approx(0.1)
+    assert engine.max_friction_demand_peak == pytest.approx(0.1)
+    assert 0.09 < engine.max_friction_demand <= engine.max_friction_demand_peak
     assert math.isnan(engine.row()["friction_demand"]) and engine.slides is None
 
 
@@ -163,16 +187,17 @@ def test_run_summary_says_where_the_demand_first_exceeded_mu(tmp_path):
     res = CliRunner().invoke(cli, ["run", str(cfg_path), "-a", "0.2", "-f", str(FREQ), "-o",
                                    str(tmp_path / "out")])  # fmt: skip
     assert res.exit_code == 0, res.output
-    t_want = math.asin(0.1 / 0.2) / (2 * math.pi * FREQ)
+    t_want = math.asin(0.1 / 0.2) / (2 * math.pi * FREQ)  # the first sample at or after it
     line = next(ln for ln in res.output.splitlines() if ln.startswith("slides:"))
-    assert f"first at t = {t_want:.6g} s, interface 1" in line
+    assert line.endswith(", interface 1") and f"held for {TAU:.4g} s from t = " in line
     summary = json.loads(next((tmp_path / "out").rglob("summary.json")).read_text())
     assert summary["slip_interface"] == 1 and summary["slides"] == 1
-    assert summary["t_slip_s"] == pytest.approx(t_want, abs=1e-9)
+    assert t_want - 1e-12 <= summary["t_slip_s"] <= t_want + TAU / 60 + 1e-12
+    assert f"from t = {summary['t_slip_s']:.6g} s" in line
     result = rbm.run(rbm.load_config(cfg_path), amplitude_g=0.2, frequency_hz=FREQ,
                      record=False).result  # fmt: skip
     assert result["friction_limit"] == 0.1 and result.slip[1] == 1
-    assert result.slip[0] == pytest.approx(t_want, abs=1e-9)
+    assert result.slip[0] == summary["t_slip_s"]
 
 
 # ---- the domain figure

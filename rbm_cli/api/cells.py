@@ -45,13 +45,14 @@ class CellResult(Mapping):
     ``max_top_displacement_m`` [m], for a run in three dimensions (as domain.csv)
     ``collapse_azimuth_deg`` [deg from x, in (-180, 180]; nan if it did not collapse] and
     ``wobble_turns`` [-], then ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs`` (int),
-    ``message``, then ``friction_demand`` (per interface, the largest |T/N| held for
-    ``friction_duration_s``, 0.03 s [-]), ``friction_demand_peak`` (per interface, its
+    ``message``, then ``friction_demand`` (per interface, the largest |T/N| held in
+    one direction for 0.03 s [-]), ``friction_demand_peak`` (per interface, its
     instantaneous peak [-]; empty for the models without the RBM's joints),
     ``wall_time_s`` [s], ``method`` (the method that ran), ``friction_limit`` (the
     interface.friction of a model with the RBM's joints, rbm and rbm-3d, the coefficient
     the demand is checked against; None: not checked), ``slip`` ((t [s], interface) where
-    the demand first exceeded it; None: it did not, or no check) and ``energy`` (a recorded
+    the demand was first held above it, the start of its 0.03 s; None: it did not, or no
+    check) and ``energy`` (a recorded
     run's energy account [J] where its method keeps one: ``initial_J``, ``final_J``,
     ``ground_work_J``, ``damping_J``, ``impacts_J``, ``residual_J``; else None). Whole
     numbers are ints, real numbers floats. The outputs reference defines the counts.

@@ -37,7 +37,7 @@ def _check_excitation(cfg, amplitude: float | None, frequency: float | None):
 
 
 def _slide_lines(result) -> list[tuple[str, str]]:
-    """Where model rbm's friction demand first exceeded interface.friction (given)."""
+    """Where model rbm's friction demand was first held above interface.friction (given)."""
     mu = result.friction_limit
     if mu is None:
         return []

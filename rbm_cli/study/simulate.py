@@ -104,10 +104,8 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         collapse_azimuth_deg=math.degrees(math.remainder(out.azimuth, 2.0 * math.pi)),
         wobble_turns=float(out.turns),
         three_d=config.three_d,
-        friction_demand_peak=()
-        if out.friction_peak is None
-        else tuple(float(v) for v in out.friction_peak),
-        friction_duration_s=FRICTION_DURATION
-        if MODELS[config.model].beam
-        else None,
+        friction_demand_peak=tuple(float(v) for v in out.friction_peak)
+        if out.friction_peak is not None and MODELS[config.model].beam
+        else (),
+        friction_duration_s=FRICTION_DURATION if MODELS[config.model].beam else None,
     )

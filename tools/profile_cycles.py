@@ -91,9 +91,9 @@ ANCHORS = [
     (STEPPER, "                if any_silent:\n",
      f"                prof[5] += {TICK}\n                c0 = cycles()\n"
      "                if any_silent:\n"),
-    (STEPPER, "                friction_demand(g_new,",
+    (STEPPER, "                shear_ratios(g_new,",
      f"                prof[6] += {TICK}\n                c0 = cycles()\n"
-     "                friction_demand(g_new,"),
+     "                shear_ratios(g_new,"),
     (STEPPER, "                z_prev, z_old, z_new = z_old, z_new, z_prev\n",
      f"                prof[7] += {TICK}\n"
      "                z_prev, z_old, z_new = z_old, z_new, z_prev\n"),
@@ -135,8 +135,10 @@ ANCHORS = [
     (EXACT_RUN, "            code = _handle(mdl, pc, row, s, se)\n",
      "            c0 = cycles()\n            code = _handle(mdl, pc, row, s, se)\n"
      "            s.cnt[12] += cycles() - c0\n"),
-    (EXACT_RUN, "              np.zeros(8, dtype=np.int64))  # fmt: skip\n",
-     "              np.zeros(14, dtype=np.int64))  # fmt: skip\n    c_all = cycles()\n"),
+    (EXACT_RUN, "              np.zeros(8, dtype=np.int64), held, np.zeros(n), np.zeros(n))"
+     "  # fmt: skip\n",
+     "              np.zeros(14, dtype=np.int64), held, np.zeros(n), np.zeros(n))"
+     "  # fmt: skip\n    c_all = cycles()\n"),
     (EXACT_RUN, "        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n",
      "        c0 = cycles()\n"
      "        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n"

@@ -54,6 +54,7 @@ from rbm_cli.physics.ground import (
     gravity_factor,
     ground_at,
     next_uplift,
+    pair_exceedance,
     pair_uplift,
     record_piece,
     rest_demand,

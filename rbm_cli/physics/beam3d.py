@@ -24,9 +24,11 @@ elastic branch (Model.joint_damping). On the elastic branch f = K_M |phi| and th
 -K_M phi: the column is linear and the two directions do not meet at all.
 
 Near a closed joint of a rigid law (f jumps at 0: a rigid monolith) the direction of phi is
-round-off; there the law reads the component x = phi . c of phi along a pinned direction c
-(the side the joint rocks onto), as a base flat to that side, and m = -f(x) c
-(rbm_cli.models.rbm3d says when).
+not defined at phi = 0 and turns without bound as phi passes closure ever nearer; within a
+pinned distance of closure the law reads the component x = phi . c of phi along a pinned
+direction c (the side the joint rocks onto), as a base flat to that side, and m = -f(x) c
+(rbm_cli.models.rbm3d says when: that distance is the integrator's absolute tolerance of
+the rotation, solver.atol theta_u).
 
 The equations are compiled (numba) as the planar kernel's are, into the same slots of its
 right-hand side (rbm_cli.models.rbm.step.rk.rhs: a state of 4n values is this model's):
@@ -125,8 +127,8 @@ def beam_rates(t, y, n, As, cs, es, gr, out):
 @jit
 def pack_pieces(k, pinned, c, intercepts, weight, elastic, damp, rigid, cs):
     """cs's pieces (beam_rates) of joints on pieces k (n,) of their laws, pinned (n,) bool
-    along c (n, 2): each piece's intercept and slopes, the damping of an elastic joint on
-    its elastic branch."""
+    along c (n, 2 or more: the direction in its first two columns): each piece's intercept
+    and slopes, the damping of an elastic joint on its elastic branch."""
     n = k.size
     for i in range(n):
         q = k[i]

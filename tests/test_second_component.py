@@ -17,6 +17,7 @@ Checked against what does not follow its code:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -113,24 +114,34 @@ def test_an_elliptic_motion_turned_by_90_degrees_is_its_components_swapped(model
 def test_two_components_in_phase_are_one_turned_motion(model, drums, interface, amplitude,
                                                        kind, phi):  # fmt: skip
     """phi = 0 (or 180: -r): the motion is a line at atan(+-r) from x, of amplitude
-    A sqrt(1 + r^2): the run of that one component turned there, peaks within 1e-8 (on
-    columns that stay in their plane: not a rigid monolith of the RBM, whose planar
-    rocking leaves its plane on round-off, docs/guide/models.md), the same impacts for the
-    cylinder (the elastic drums' chattering closures, 80-280 here, are counted to
-    round-off, as the planar model's at two tolerances). A half-sine pulse, positive
-    first, that overturns the column does so away from it, at the azimuth atan(+-r) + 180
-    degrees (so the second component acts at +90 degrees from the first,
-    counter-clockwise)."""
+    A sqrt(1 + r^2): the run of that one component turned there. Whole runs (recorded: no
+    early stop, which a run in its motion's plane may take and a pair's may not). The
+    cylinder: the same impacts, peaks within 1e-8. The elastic drums (on columns that stay
+    in their plane: not a rigid monolith of the RBM, whose planar rocking leaves its plane
+    on round-off, docs/guide/models.md): their chattering closures, 80-280 here, amplify
+    round-off, and the line runs in its own frame while the pair runs at atan(r) to it, so
+    the two round differently; their peaks agree within ten times what the line's own peak
+    moves between rtol 1e-10 and 1e-11 (the integration's own error), and at least 1e-8.
+    A half-sine pulse, positive first, that overturns the column does so away from it, at
+    the azimuth atan(+-r) + 180 degrees (so the second component acts at +90 degrees from
+    the first, counter-clockwise)."""
     r = 0.75
     sign = 1.0 if phi == 0.0 else -1.0
     angle = math.degrees(math.atan2(sign * r, 1.0))
     kw = dict(drums=drums, interface=interface)
     for frequency in (1.0, 2.0):
         pair = simulate(config(model, kind, y={"amplitude_ratio": r, "phase_deg": phi}, **kw),
-                        amplitude, frequency)  # fmt: skip
-        line = simulate(config(model, kind, angle=angle, **kw),
-                        amplitude * math.hypot(1.0, r), frequency)  # fmt: skip
-        same_run(line, pair, 1e-8, events=model == "housner-3d")
+                        amplitude, frequency, record=True)  # fmt: skip
+        line_cfg = config(model, kind, angle=angle, **kw)
+        line = simulate(line_cfg, amplitude * math.hypot(1.0, r), frequency, record=True)
+        rel = 1e-8
+        if model == "rbm-3d":
+            tight = dataclasses.replace(line_cfg, solver=dataclasses.replace(
+                line_cfg.solver, rtol=1e-11))  # fmt: skip
+            other = simulate(tight, amplitude * math.hypot(1.0, r), frequency, record=True)
+            moved = abs(other.max_rotation_ratio / line.max_rotation_ratio - 1.0)
+            rel = max(rel, 10.0 * moved)
+        same_run(line, pair, rel, events=model == "housner-3d")
         assert pair.n_uplifts > 0
     if kind == "half-sine":
         strong = simulate(config(model, kind, y={"amplitude_ratio": r, "phase_deg": phi}, **kw),

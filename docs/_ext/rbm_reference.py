@@ -3,8 +3,9 @@
 Two directives:
 
 - ``.. rbm-cli::`` every command of the click group ``rbm_cli.cli.main:main``'s ``cli``
-  with its usage, its help text as ``rbm COMMAND --help`` prints it, and a table of its
-  arguments and options (flags, type, default, help);
+  with its usage, its help text (as ``rbm COMMAND --help`` prints it, once: its options are
+  in the table, not repeated above it) and a table of its arguments and options (the
+  flags; the help, the type and the default);
 - ``.. rbm-config::`` every key of the config: the key paths are read from the loader's key
   tuples (``rbm_cli.config.load.TOP_KEYS`` ...), the defaults from the config dataclasses
   (``rbm_cli.config.types``), the choices and most ranges from the loader's constants; the
@@ -18,6 +19,9 @@ Two directives:
 from __future__ import annotations
 
 import dataclasses
+import inspect
+import re
+import textwrap
 from collections.abc import Iterator
 
 import click
@@ -89,52 +93,122 @@ def _type_text(param: click.Parameter) -> str:
     return {"text": "text", "integer": "integer", "float": "number"}.get(name, name)
 
 
+def _metavar(param: click.Option) -> str:
+    """The word after an option's flag: its metavar, its name for a choice (the choices
+    are listed in the table's meaning), nothing for a flag."""
+    if param.is_flag:
+        return ""
+    if param.metavar:
+        return param.metavar
+    if isinstance(param.type, click.Choice):
+        return param.name.upper()
+    return param.type.get_metavar(param, click.Context(click.Command("x"))) or param.name.upper()
+
+
+def _default_text(param: click.Option) -> str:
+    default = param.default
+    unset = "sentinel" in type(default).__name__.lower()  # click's UNSET: no default
+    if unset or param.is_flag or default is None or callable(default) or default == ():
+        return ""
+    return lit(default if not isinstance(default, tuple | list) else
+               " ".join(str(d) for d in default))  # fmt: skip
+
+
 def _option_row(param: click.Parameter) -> list[str]:
+    """[the flags, the meaning]: its help, then its type and default in a line of their
+    own. The choices of a choice are listed there, not beside the flag (a long
+    ``[a|b|c]`` made the column too wide for the page)."""
     if isinstance(param, click.Argument):
         flags = lit(param.make_metavar(click.Context(click.Command("x"))))
-        meaning = "argument" + (" (required)" if param.required else "")
-        return [flags, esc(_type_text(param)), "\\-", esc(meaning)]
+        meaning = "Argument" + (" (required)." if param.required else ".")
+        return [flags, meaning + "\n\n" + esc(_type_text(param))]
     assert isinstance(param, click.Option)
+    metavar = _metavar(param)
     names = list(param.opts) + list(param.secondary_opts)
-    metavar = ""
-    if not param.is_flag:
-        metavar = " " + (param.metavar or param.type.get_metavar(param, click.Context(
-            click.Command("x"))) or param.name.upper())  # fmt: skip
-    flags = ", ".join(lit(n + metavar) for n in names)
+    flags = ", ".join(lit(n + (" " + metavar if metavar else "")) for n in names)
     if param.nargs and param.nargs > 1:
         flags += f" (takes {param.nargs} values)"
     if param.multiple:
         flags += " (repeatable)"
-    default = param.default
-    unset = "sentinel" in type(default).__name__.lower()  # click's UNSET: no default
-    if unset or param.is_flag or default is None or callable(default) or default == ():
-        default_text = "\\-"
+    kind = _type_text(param)
+    if isinstance(param.type, click.Choice):
+        kind = "one of " + ", ".join(lit(c) for c in param.type.choices)
     else:
-        default_text = lit(default if not isinstance(default, tuple | list) else
-                           " ".join(str(d) for d in default))  # fmt: skip
-    return [flags, esc(_type_text(param)), default_text, esc(param.help or "")]
+        kind = esc(kind)
+    default = _default_text(param)
+    facts = f"*{kind}*" if not isinstance(param.type, click.Choice) else kind
+    if default:
+        facts += f"; default {default}"
+    return [flags, esc(param.help or "") + "\n\n" + facts]
+
+
+def help_rst(text: str) -> list[str]:
+    """A click help text as reStructuredText: its paragraphs as text, each paragraph that
+    click prints as written (one that starts with ``\\b``: examples, lists) as a literal
+    block; what follows a ``\\f`` is not help."""
+    text = inspect.cleandoc(text or "").split("\f")[0]
+    lines: list[str] = []
+    for para in re.split(r"\n\s*\n", text):
+        if not para.strip():
+            continue
+        if para.lstrip().startswith("\b"):
+            body = textwrap.dedent(para.lstrip()[1:].strip("\n"))
+            lines += ["::", ""] + ["   " + line for line in body.splitlines()] + [""]
+        else:
+            lines += [esc(para), ""]
+    return lines
+
+
+def _cell(text: str, first: bool) -> list[str]:
+    """A list-table cell whose text may hold paragraphs (split at blank lines)."""
+    head = "   * - " if first else "     - "
+    paras = text.split("\n\n") if text else ["\\-"]
+    out = [head + paras[0]]
+    for para in paras[1:]:
+        out += ["", "       " + para]
+    return out
+
+
+def option_table(rows: list[list[str]], header: str = "option") -> list[str]:
+    """The two-column table of a command's arguments and options (of the group's
+    commands with ``header="command or option"``)."""
+    lines = [
+        ".. list-table::",
+        "   :header-rows: 1",
+        "   :widths: 32 68",
+        "   :class: rbm-reference rbm-options",
+        "",
+    ]
+    for row in [[header, "meaning"], *rows]:
+        for k, cell in enumerate(row):
+            lines += _cell(cell, k == 0)
+    lines.append("")
+    return lines
 
 
 def cli_rst() -> str:
-    """reStructuredText of every command: usage, help, and a table of its parameters."""
+    """reStructuredText of every command: its usage, its help text once, and a table of its
+    arguments and options (the options' help is in the table, not repeated above it)."""
     group = cli_group()
     lines: list[str] = []
-    top = click.Context(
-        group, info_name="rbm", terminal_width=80, max_content_width=80, **group.context_settings
-    )
+    top = click.Context(group, info_name="rbm", **group.context_settings)
     lines += ["The ``rbm`` command", "-" * 19, "", ".. code-block:: text", ""]
-    lines += ["   " + line for line in group.get_help(top).splitlines()]
-    lines.append("")
+    lines += ["   " + group.get_usage(top), ""]
+    lines += help_rst(group.help)
+    rows = [[lit(f"rbm {name}"), esc(cmd.get_short_help_str(limit=200))]
+            for name, cmd in commands()]  # fmt: skip
+    rows.append([lit("--version"), "Show the version and exit."])
+    rows.append([lit("-h") + ", " + lit("--help"), "Show the help and exit."])
+    lines += option_table(rows, header="command or option")
     for name, cmd in commands():
         ctx = click.Context(cmd, info_name=name, parent=top, **cmd.context_settings)
         title = f"rbm {name}"
         lines += [f".. _cli-{name}:", "", title, "-" * len(title), ""]
-        lines += [esc(cmd.get_short_help_str(limit=200)), "", ".. code-block:: text", ""]
-        lines += ["   " + line for line in cmd.get_help(ctx).splitlines()]
-        lines.append("")
+        lines += [".. code-block:: text", "", "   " + cmd.get_usage(ctx), ""]
+        lines += help_rst(cmd.help)
         rows = [_option_row(p) for p in cmd.params]
-        rows.append([lit("-h") + ", " + lit("--help"), "flag", "\\-", "Show the help and exit."])
-        lines += list_table(["option", "type", "default", "meaning"], rows, [30, 14, 10, 46])
+        rows.append([lit("-h") + ", " + lit("--help"), "Show the help and exit."])
+        lines += option_table(rows)
     return "\n".join(lines) + "\n"
 
 

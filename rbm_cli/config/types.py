@@ -482,8 +482,8 @@ class SolverConfig:
         budgets = {}
         for key in ("max_steps", "max_events"):
             written = getattr(self, key)
-            budgets[key] = (written if written is not None else
-                            max(BUDGET_FLOOR[key], math.ceil(BUDGET_PER_JOINT_SECOND[key] * scale)))  # fmt: skip
+            scaled = math.ceil(BUDGET_PER_JOINT_SECOND[key] * scale)
+            budgets[key] = written if written is not None else max(BUDGET_FLOOR[key], scaled)
         return replace(self, **budgets)
 
 

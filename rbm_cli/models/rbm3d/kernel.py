@@ -423,13 +423,29 @@ def account_step3d(mc, t_old, t_new, h, y_old, F, yq, n, col, k, es, gr, ledger)
 
 
 @jit
-def pair_rest_demand(t0, t1, gr, knots, values, values_y, vertical):
-    """The friction demand max |a_h| / (g + a_v) [-] of a column at rest under a pair of
-    records over [t0, t1] [s], a_h = (a_x, a_y): both components and a_v are straight
+def pair_rest_demand(t0, t1, gr, gy, knots, values, values_y, knots_y, vertical):
+    """The friction demand max |a_h| / (g + a_v) [-] of a column at rest under a pair over
+    [t0, t1] [s], a_h = (a_x, a_y). A pair of records: both components and a_v are straight
     between samples, where |a_h| / (g + a_v) has no interior maximum (its sublevel sets
-    are convex), so the ends and the samples between them hold it."""
+    are convex), so the ends and the samples between them hold it. A formula and its
+    second component (gy): the largest ratio that physics.ground.pair_uplift finds
+    exceeded on [t0, t1), by halving to the last bit (closed-form exceedance times)."""
     if gr[1] == 0.0 or t1 < t0:
         return 0.0
+    if values_y.size == 0:
+        lo, hi = 0.0, 1.0
+        while pair_uplift(t0, hi, t1, gr, gy, knots, values, values_y, knots_y, vertical) >= 0.0:
+            lo, hi = hi, 2.0 * hi
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if mid <= lo or mid >= hi:
+                break
+            if pair_uplift(t0, mid, t1, gr, gy, knots, values, values_y, knots_y,
+                           vertical) >= 0.0:  # fmt: skip
+                lo = mid
+            else:
+                hi = mid
+        return lo
     best = 0.0
     for j in range(knots.size + 2):
         tt = t0 if j == 0 else (t1 if j == 1 else knots[j - 2])
@@ -614,16 +630,16 @@ def run3d(col, motion, solver, task, pair):
                 # exceeds the limit
                 t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
                 if pair_on:
-                    d_rest = pair_rest_demand(t, t_rest, gr_full, knots, values, values_y,
-                                              vertical)  # fmt: skip
+                    d_rest = pair_rest_demand(t, t_rest, gr_full, gy, knots, values, values_y,
+                                              knots_y, vertical)  # fmt: skip
                 else:
                     d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
                 if d_rest > friction[0]:
                     friction[0] = d_rest
                 if slip[1] == 0.0 and d_rest > mu:
                     if pair_on:
-                        slip[0] = pair_exceedance(t, mu, t_rest, knots, values, values_y,
-                                                  vertical)  # fmt: skip
+                        slip[0] = pair_uplift(t, mu, t_rest, gr_full, gy, knots, values,
+                                              values_y, knots_y, vertical)  # fmt: skip
                     else:
                         slip[0] = next_uplift(t, mu * G, motion[1], gr_full, knots, values,
                                               vertical, t_rest)  # fmt: skip

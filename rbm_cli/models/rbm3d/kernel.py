@@ -54,7 +54,6 @@ from rbm_cli.physics.ground import (
     gravity_factor,
     ground_at,
     next_uplift,
-    pair_exceedance,
     pair_uplift,
     record_piece,
     rest_demand,

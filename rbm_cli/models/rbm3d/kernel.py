@@ -528,6 +528,8 @@ def run3d(col, motion, solver, task, pair):
     k = np.zeros(n, dtype=np.int64)
     pending = np.zeros(n, dtype=np.bool_)
     phase = np.zeros(n, dtype=np.int64)
+    # leaving closure from phi = 0 exactly (an uplift from rest): pinned at phi = 0 alone
+    rising = np.zeros(n, dtype=np.bool_)
     c = np.zeros((n, 3))  # per joint: the pinned direction (x, y), the pinned distance [rad]
     for i in range(n):
         c[i, 0], c[i, 1], c[i, 2] = d0, d1, pin * col.tu[i]
@@ -659,15 +661,16 @@ def run3d(col, motion, solver, task, pair):
                 ax, ay = a_d * d0 - a_y * d1, a_d * d1 + a_y * d0
                 size = math.sqrt(ax * ax + ay * ay)
                 c[0, 0], c[0, 1] = -ax / size, -ay / size
-                phase[0] = LEAVING
+                phase[0], rising[0] = LEAVING, True
                 at_rest = False
                 n_upl += 1
                 h_carry = -1.0
 
             # a new stepper from (t, y), its pieces packed
-            pinned = np.zeros(n, dtype=np.bool_)
+            pinned = np.zeros(n, dtype=np.int64)  # beam3d.pack_pieces
             for i in range(n):
-                pinned[i] = phase[i] != FREE and col.rigid[i]
+                if phase[i] != FREE and col.rigid[i]:
+                    pinned[i] = 2 if rising[i] else 1
             pack_pieces(k, pinned, c, col.intercepts, weight, elastic, col.damp, col.rigid, cs)
             m = watch(n, k, phase, pending, col, kinds, joints)
             t_bound = seg_end
@@ -850,8 +853,9 @@ def run3d(col, motion, solver, task, pair):
                 phase[i] = APPROACH
                 c[i, 0], c[i, 1] = px / r, py / r
             elif kind == LEFT:
-                phase[i] = FREE
+                phase[i], rising[i] = FREE, False
             else:  # ACROSS or TURNED: the joint closes
+                rising[i] = False
                 cx, cy = c[i, 0], c[i, 1]
                 if col.rigid[i]:
                     _move(i, y, n, col.arg_inv, -px, -py)

@@ -14,7 +14,11 @@ RK45, RK23) in a compiled run of its own (kernel.py; its source uncompiled with
   a joint that passes closure that near cannot be told from one through it, and its
   direction there is not what the steps control; as `housner-3d` pins its contact), and
   closes there (crossing the line, or turning away); after the impact it rocks on toward
-  where it moves, pinned until |phi| is LEAVE_FACTOR times that distance. A joint that
+  where it moves, pinned until |phi| is LEAVE_FACTOR times that distance (its phi is
+  round-off there). A monolith lifting from rest (phi = 0 exactly, growing from it) is
+  pinned at phi = 0 alone, and follows its own direction from there: pinned while it
+  leans slowly off the vertical, as the motion turns, its peak moved by about the square
+  root of that distance (1e-3 at atol 1e-12 just above the uplift level). A joint that
   passes farther from closure rolls round it (a wobble), and a passage within that
   distance is found wherever it falls in a step (the square of |phi| is watched, smooth
   through closure). 100 times smaller tolerances take that distance 100 times nearer

@@ -36,9 +36,9 @@ at a distance delta turns the contact point round the rim at a rate |q'| / delta
 the vertical the column's contact direction is therefore held at a given c0 (the side it
 lifts to or rocks onto, or the direction it leaned as it came within that lean): the base
 strikes or leaves the ground as a whole there. That lean is a numerical one, not a
-flatness of the stone: rbm_cli.models.housner3d takes it from the integrator's absolute
-tolerance of the lean (atol alpha), so that the answer is the rigid cylinder's, converged
-as the tolerances shrink.
+flatness of the stone: rbm_cli.models.housner3d ties it to the integrator's absolute
+tolerance of the lean (solver.atol alpha; housner3d.runner.pinned_lean), so that the
+answer is the rigid cylinder's, converged as the tolerances shrink.
 
 References
 ----------

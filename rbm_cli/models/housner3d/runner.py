@@ -3,14 +3,16 @@ under a ground motion in any horizontal direction, integrated by scipy's DOP853 
 RK23) step by step like `housner`, the events located on each step's dense output:
 
 - **uplift** when |a_g| exceeds (g + a_v) tan(alpha), onto the rim's point away from a_g;
-- **impact** where the lean crosses the vertical. Within UPRIGHT_LEAN sin(alpha) of it
-  the contact is pinned: a lean that comes that near is followed, its contact held where
-  it leaned as it came in, until it crosses the line across that direction (theta = 0
-  exactly in a plane) or turns away. The horizontal angular velocity then becomes e times
-  itself, the spin about the axis is kept, the lean is set upright, and the column rocks
-  on toward where its axis moves, pinned until its lean is LEAVE_FACTOR times that
-  distance out. A lean that passes farther from the vertical rolls round it (Srinivasan
-  and Ruina 2008). In a plane this is Housner's impact (theta' <- e theta');
+- **impact** where the lean crosses the vertical. Within the pinned lean of it
+  (pinned_lean: 1000 solver.atol alpha, solver.atol alpha from an uplift from rest up to
+  the next impact) the contact is pinned: a lean that comes that near is followed, its
+  contact held where it leaned as it came in, until it crosses the line across that
+  direction (theta = 0 exactly in a plane) or turns away. The horizontal angular velocity
+  then becomes e times itself, the spin about the axis is kept, the lean is set upright,
+  and the column rocks on toward where its axis moves, pinned until its lean is
+  LEAVE_FACTOR times that distance out. A lean that passes farther from the vertical rolls
+  round it (Srinivasan and Ruina 2008). In a plane this is Housner's impact
+  (theta' <- e theta');
 - **collapse** at a tilt of collapse.ratio alpha (Outcome.azimuth: where it leaned);
   Outcome.turns is the angle the lean's direction swept while the tilt was WOBBLE_LEVEL
   alpha or more at both ends of a step (a wobble), in turns;

@@ -19,6 +19,8 @@ docstring with its units and an example (``help(rbm.run)``).
 - :func:`compare` two domains, as ``rbm compare`` (a :class:`DomainComparison`);
   :func:`fragility` the lognormal fragility of a suite's domain with its bootstrap band,
   as ``rbm fragility`` fits it (no files)
+- :func:`migrate` brings a domain stored by an earlier rbm to this version's config hash,
+  once it has checked that the domain is the one this version makes
 - :func:`plot_domain`, :func:`plot_history` draw on a matplotlib axes and return it
 - :class:`Config`, :class:`ConfigError`, :class:`RbmError`, :class:`SweepInterrupted`,
   ``__version__``
@@ -51,6 +53,7 @@ from rbm_cli.api import (
     fragility,
     info,
     load_config,
+    migrate,
     motion_from_arrays,
     plot_domain,
     plot_history,
@@ -75,6 +78,7 @@ __all__ = [
     "fragility",
     "info",
     "load_config",
+    "migrate",
     "motion_from_arrays",
     "plot_domain",
     "plot_history",

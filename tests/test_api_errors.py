@@ -207,7 +207,7 @@ def test_the_smallest_capital_runs_and_a_smaller_one_is_refused():
                            "interface": stiff})  # fmt: skip
     cell = rbm.run(cfg, 0.1, 1.0, record=False)
     assert cell.status == "survived", cell.result.message
-    assert cell.result.n_steps < cfg.solver.max_steps
+    assert cell.result.n_steps < cfg.solver.for_run(10.0, 2).max_steps  # its budget
     for key in ("height", "width", "depth"):
         capital = {**smallest, key: 0.0999}
         one_line(lambda capital=capital: rbm.load_config(

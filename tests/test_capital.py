@@ -122,8 +122,9 @@ def test_bad_capital_or_top_mass_is_refused_in_one_line(column, top, match):
 
 
 def test_without_them_the_config_resolves_as_before():
-    """No capital and no top mass: the resolved form (and so the hash) has no such keys."""
-    assert not {"capital", "top_mass"} & set(_cfg({}).resolved()["column"])
+    """No capital and no top mass: the resolved form holds their default, none."""
+    column = _cfg({}).resolved()["column"]
+    assert column["capital"] is None and column["top_mass"] is None
     assert (
         "capital"
         in _cfg(

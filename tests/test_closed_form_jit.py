@@ -288,7 +288,9 @@ def test_auto_resolves_and_an_explicit_method_is_kept():
     out, kernel = simulate(cfg, 0.5, 1.0), simulate(step, 0.5, 1.0)
     assert (out.method, kernel.method) == ("closed-form", "DOP853")
     assert kernel.n_steps > 10 * out.n_steps  # steps of the kernel, pieces of the closed form
-    assert config_hash(cfg) == config_hash(step)  # auto hashes as the former default
+    # the hash holds the method that runs: auto's closed form, not the step kernel
+    assert config_hash(cfg) == config_hash(_with(cfg, method="closed-form"))
+    assert config_hash(cfg) != config_hash(step)
     assert resolve_method(_with(cfg, implementation="python")) == "DOP853"
     for other in ("harmonic_monolithic", "harmonic_multidrum"):  # elastic joints
         assert resolve_method(load_config(CONFIGS / f"{other}.yaml")) == "DOP853"

@@ -175,7 +175,7 @@ def test_zero_damping_is_the_undamped_column():
     del undamped["interface"]["damping"]
     zero = _config(0.0)
     assert load_config(zero).resolved() == load_config(undamped).resolved()
-    assert "damping" not in load_config(zero).resolved()["interface"]
+    assert load_config(zero).resolved()["interface"]["damping"] == 0.0
 
 
 def test_auto_runs_a_damped_column_with_a_method_that_damps():

@@ -185,7 +185,7 @@ def test_with_no_state_across_the_run_is_unchanged():
         a, b = simulate(plain, 0.4, 1.0), simulate(zeros, 0.4, 1.0)
         assert (a.status, a.n_impacts, a.max_rotation_ratio) == (
             b.status, b.n_impacts, b.max_rotation_ratio)  # fmt: skip
-        assert "rotations_across" not in plain.resolved()["excitation"]["initial"]
+        assert plain.resolved()["excitation"]["initial"]["rotations_across"] == ()
         assert config_hash(plain) != config_hash(zeros)
 
 

@@ -233,14 +233,17 @@ def test_docs_state_each_studys_sensitive_cells():
     rows = {}
     for line in section.splitlines():
         cells = [c.strip(" `") for c in line.strip().strip("|").split("|")]
-        if len(cells) == 4 and cells[1].isdigit():
-            rows[cells[0]] = tuple(int(c) for c in cells[1:])
+        if len(cells) == 5 and cells[1].isdigit():
+            solver, both = (int(c) for c in cells[4].split("/"))
+            rows[cells[0]] = (*(int(c) for c in cells[1:4]), solver, both)
     assert set(rows) == set(STUDIES)
-    for name, (n_cells, members, sensitive) in rows.items():
+    for name, (n_cells, members, sensitive, solver, both) in rows.items():
         df = read_domain(RESULTS / name / "domain.csv")
         meta = json.loads((RESULTS / name / "meta.json").read_text())
+        why = df["sensitive_to"].value_counts()
         assert (len(df), meta["ensemble"]["members"], int((df["robust"] != 1).sum())) == (
             n_cells, members, sensitive), name  # fmt: skip
+        assert (why.get("solver", 0), why.get("both", 0)) == (solver, both), name
 
 
 def test_cli_compare_applies_the_rule_to_a_stored_ensemble(tmp_path):

@@ -132,19 +132,27 @@ def test_case01_a_finished_domain_of_another_config_is_never_replaced_quietly(sm
     assert (kept / "domain.csv").read_bytes() == before
 
 
-def test_case01_a_domain_made_before_a_new_config_key_is_this_configs(small, tmp_path):
-    """A finished domain whose meta.json predates a config key (another hash, a key
-    missing, the same settings otherwise) is recognised: --resume does nothing."""
+def test_case01_a_domain_stored_under_the_earlier_hash_is_this_configs(small, tmp_path):
+    """A finished domain whose meta.json is rbm 0.1's (schema 1: no schema written, the
+    settings that came later left out at their defaults, the hash of that form) and holds
+    this config's settings is recognised: --resume does nothing. With a setting that
+    differs it is another config's."""
+    from .test_fingerprint import schema1_digest
+
     out = tmp_path / "out"
     assert invoke("sweep", small, "-o", out, "--jobs", "1", "--quiet").exit_code == 0
     meta_path = out / "small" / "meta.json"
     meta = json.loads(meta_path.read_text())
-    meta["config_hash"] = "made-by-an-older-rbm"
-    del meta["config"]["solver"]["max_wall_time"], meta["config"]["interface"]["friction"]
+    del meta["schema"], meta["config"]["dimensions"]
+    for section, key in [("column", "capital"), ("column", "top_mass"),
+                         ("interface", "friction_limit"), ("interface", "damping")]:  # fmt: skip
+        del meta["config"][section][key]
+    meta["config_hash"] = schema1_digest(meta["config"])
     meta_path.write_text(json.dumps(meta))
     res = invoke("sweep", small, "-o", out, "--jobs", "1", "--resume")
     assert res.exit_code == 0 and "already finished" in res.output, res.output
     meta["config"]["excitation"]["duration"] = 5.0  # a setting that differs: another config
+    meta["config_hash"] = schema1_digest(meta["config"])
     meta_path.write_text(json.dumps(meta))
     one_line_error(invoke("sweep", small, "-o", out, "--resume"), "another config")
 

@@ -389,12 +389,13 @@ def test_a_planar_model_refuses_a_second_component(model, tmp_path):
 
 
 def test_a_config_without_it_keeps_its_hash():
-    """excitation.y absent: the config's resolved form (and hash) has no trace of it; with
-    it, the hash changes with r and phi."""
+    """excitation.y absent: the config's resolved form holds its default, none (and a
+    motion without a second component hashes as before it existed: rbm migrate); with it,
+    the hash changes with r and phi."""
     from rbm_cli.study.sweep import config_hash
 
     plain = config()
-    assert "y" not in plain.resolved()["excitation"]
+    assert plain.resolved()["excitation"]["y"] is None
     hashes = {config_hash(plain)}
     for y in ({"amplitude_ratio": 0.0}, {"amplitude_ratio": 1.0},
               {"amplitude_ratio": 1.0, "phase_deg": 90.0}):  # fmt: skip

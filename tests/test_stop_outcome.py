@@ -43,7 +43,7 @@ CI_BAND = CONFIGS / "ci" / "suite_multidrum_ci.yaml"
 STOPPED = re.compile(r"stopped at ([0-9.e+-]+) s \(solver\.stop: outcome\)")
 #: the ensemble's columns of domain.csv (the stored domain is an ensemble; these sweeps are
 #: single runs), left out of the comparison
-ENSEMBLE = ("collapse_fraction", "robust")
+ENSEMBLE = ("collapse_fraction", "robust", "sensitive_to")
 RECORD_S = 30.0  # the synthetic records' length [s]
 
 

@@ -169,4 +169,4 @@ def test_vertical_in_the_resolved_config(tmp_path):
     assert cfg.excitation.duration == pytest.approx(3.0 + 5.0)  # the longer record + 5 s
     del exc["vertical"]
     cfg = parse_config({"name": "v", "column": COLUMN, "excitation": exc}, "c", tmp_path)
-    assert "vertical" not in cfg.resolved()["excitation"]
+    assert cfg.resolved()["excitation"]["vertical"] is None

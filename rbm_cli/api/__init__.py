@@ -26,7 +26,7 @@ _HOME = {
     "check_output_dt": "configs", "load_config": "configs", "parse_config": "configs",
     "with_value": "configs", "with_values": "configs",
     "DomainComparison": "domains", "compare": "domains", "plot_domain": "domains",
-    "read_domain": "domains",
+    "migrate": "domains", "read_domain": "domains",
     "ConfigError": "errors", "RbmError": "errors",
     "fragility": "fragility_curves", "info": "column_info",
     "Motion": "motions", "motion_from_arrays": "motions",

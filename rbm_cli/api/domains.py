@@ -16,6 +16,7 @@ from rbm_cli.config.types import Config
 from rbm_cli.study.domain import REQUIRED, axis_columns, domain_config
 from rbm_cli.study.domain import compare as compare_domains
 from rbm_cli.study.domain import read_domain as _read_domain
+from rbm_cli.study.fingerprint import migrate as _migrate
 from rbm_cli.study.result import STATUSES
 
 if TYPE_CHECKING:
@@ -29,6 +30,7 @@ __all__ = [
     "compare_domains",
     "domain_config",
     "draw_domain",
+    "migrate",
     "plot_domain",
     "read_domain",
     "save_figure",
@@ -271,3 +273,22 @@ def read_domain(path: str | os.PathLike) -> pd.DataFrame:
     >>> df = rbm.read_domain("out/block/domain.csv")  # doctest: +SKIP
     """
     return _read_domain(path)
+
+
+def migrate(folder: str | os.PathLike) -> str:
+    """Bring a domain stored by an earlier rbm (its meta.json under an earlier schema of the
+    config hash) to this version's hash, so that this version resumes, compares and keeps
+    it as its own; its rows (amplitudes [g], frequencies [Hz], ...) and figures are not
+    touched. It checks first that the domain
+    is the one this version makes of its config (the same settings, no cell that ran out of
+    a budget, the method that ran: docs/guide/reproducibility.md) and refuses otherwise.
+
+    Returns a one-line note; RbmError (one line) when it cannot (re-make the domain).
+
+    Examples
+    --------
+    >>> import rbm
+    >>> rbm.migrate("results/suite_multidrum")  # doctest: +SKIP
+    'results/suite_multidrum: schema 1 -> 2, hash b3ff6eec901ab719-ensemble16 -> ...'
+    """
+    return _migrate(folder)

@@ -8,11 +8,10 @@ import copy
 from collections.abc import Sequence
 
 from rbm_cli.base.errors import ConfigError
-from rbm_cli.config.excitation import ONLY_FOR
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import Motion, unique_names
 from rbm_cli.config.motions import motion_from_arrays as _from_arrays
-from rbm_cli.config.types import Config
+from rbm_cli.config.types import ONLY_FOR, Config
 
 __all__ = ["Motion", "motion_config", "motion_from_arrays"]
 

@@ -222,3 +222,33 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         sys.exit(1)
     if max_cells is not None or max_shift is not None or "robust" in dom_a.columns:
         click.echo("OK: within the limits")
+
+
+@cli.command("migrate")
+@click.argument("folders", metavar="FOLDER...", nargs=-1, required=True, type=str)
+def migrate_cmd(folders: tuple[str, ...]) -> None:
+    """Bring domains stored by an earlier rbm to this version's config hash.
+
+    Each FOLDER holds a finished domain (meta.json, domain.csv). Its meta.json gets this
+    version's hash and schema once rbm has checked that the domain is the one it makes of
+    the same config (the same settings, no cell that ran out of a budget, the method that
+    ran); its rows and figures are not touched. A folder that does not pass is left as it
+    is, named in one line (re-make it), and the exit status is 2.
+
+    \b
+    Example:
+        rbm migrate results/*/
+        rbm migrate old_results/slender old_results/thick
+    """
+    from rbm_cli.api import migrate
+
+    refused = []
+    for folder in folders:
+        try:
+            click.echo(migrate(folder))
+        except RbmError as exc:
+            refused.append(one_line(exc))
+    if refused:
+        for line in refused[:-1]:
+            click.echo(f"Error: {line}", err=True)
+        raise UserError(refused[-1])

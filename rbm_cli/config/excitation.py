@@ -67,6 +67,7 @@ from rbm_cli.config.types import (
     BASELINES,
     DEFAULT_FREE_TIME,
     EXCITATIONS,
+    ONLY_FOR,
     PULSES,
     RECORD_SCALES,
     RECORD_UNITS,
@@ -145,21 +146,6 @@ INITIAL_MAX = {"rotations": 10.0, "velocities": 1e4}
 PHASE_MAX = 1e3
 #: Range of excitation.angle [deg]: one turn either way.
 ANGLE_RANGE_DEG = (-360.0, 360.0)
-#: Keys that apply to some excitation types only (key -> those types).
-ONLY_FOR = {
-    "duration": tuple(t for t in EXCITATIONS if t != "record"),
-    "file": ("record",),
-    "units": ("record",),
-    "free_time": ("record",),
-    "scale": ("record",),
-    "gamma": ("mavroeidis-papageorgiou",),
-    "nu": ("mavroeidis-papageorgiou",),
-    "vertical": ("record",),
-    "file_y": ("record",),
-    "processing": ("record",),
-    "im_periods": ("record",),
-    "y": tuple(t for t in EXCITATIONS if t not in ("record", "free")),
-}
 #: Periods of the spectral accelerations a record's rows report (excitation.im_periods)
 #: [s], and how many a config may list.
 IM_PERIOD_RANGE_S = (0.01, 20.0)

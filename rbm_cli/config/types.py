@@ -21,6 +21,22 @@ FORMULATIONS = ("relative", "absolute", "geometric")
 #: names: amplitude [g] and frequency [Hz] from the grid, as the half-sine.
 PULSES = ("one-sine", "cycloidal", "ricker", "mavroeidis-papageorgiou")
 EXCITATIONS = ("harmonic", "half-sine", "free", *PULSES, "record")
+#: Keys that apply to some excitation types only (key -> those types); a resolved config
+#: (Config.resolved) leaves out those of other types.
+ONLY_FOR = {
+    "duration": tuple(t for t in EXCITATIONS if t != "record"),
+    "file": ("record",),
+    "units": ("record",),
+    "free_time": ("record",),
+    "scale": ("record",),
+    "gamma": ("mavroeidis-papageorgiou",),
+    "nu": ("mavroeidis-papageorgiou",),
+    "vertical": ("record",),
+    "file_y": ("record",),
+    "processing": ("record",),
+    "im_periods": ("record",),
+    "y": tuple(t for t in EXCITATIONS if t not in ("record", "free")),
+}
 #: Units of a record file's accelerations (excitation.units) and how a record is scaled to
 #: the grid's amplitude (excitation.scale: its PGA [g], or a plain factor).
 RECORD_UNITS = ("g", "m/s2")
@@ -233,13 +249,16 @@ class SecondComponentConfig:
     phase_deg: float = 0.0
 
 
-#: ExcitationConfig fields of type 'record' only, and those never in Config.resolved()
-#: (the absolute path of the file depends on where the checkout lives; the path as
-#: written and the file's digest identify the record).
-_RECORD_FIELDS = ("file", "file_sha256", "units", "free_time", "scale")
-_VERTICAL_FIELDS = ("vertical", "vertical_sha256")
-_FILE_Y_FIELDS = ("file_y", "file_y_sha256")
-_MP_FIELDS = ("gamma", "nu")
+#: A record's files with their digests (left out of a resolved config together).
+_WITH_DIGEST = {
+    "file": ("file", "file_sha256"),
+    "vertical": ("vertical", "vertical_sha256"),
+    "file_y": ("file_y", "file_y_sha256"),
+}
+#: ExcitationConfig fields never in Config.resolved(): the absolute paths of the files
+#: depend on where the checkout lives (the path as written and the file's digest identify
+#: the record), a motion given in memory is named by the grid's records, and ``directed``
+#: is derived from what was written.
 _LOCAL_FIELDS = ("file_path", "vertical_path", "file_y_path", "motion", "directed")
 
 
@@ -348,32 +367,16 @@ class ExcitationConfig:
     y: SecondComponentConfig | None = None
 
     def resolved(self) -> dict:
-        """The settings that define the motion, as plain data: the fields of other
-        excitation types and the absolute paths are left out (so a config that does not
-        use them has the same resolved form, and hash, as before they existed)."""
+        """The settings that define the motion, as plain data: every field, but those of
+        other excitation types (ONLY_FOR, a record's digests with their files) and the
+        local ones (_LOCAL_FIELDS)."""
         out = asdict(self)
         drop = list(_LOCAL_FIELDS)
-        if self.type != "record":
-            drop += _RECORD_FIELDS
-        if self.vertical is None:
-            drop += _VERTICAL_FIELDS
-        if self.file_y is None:
-            drop += _FILE_Y_FIELDS
-        if self.type != "mavroeidis-papageorgiou":
-            drop += _MP_FIELDS
-        if self.processing is None:
-            drop.append("processing")
-        if not self.im_periods:
-            drop.append("im_periods")
-        if self.angle == 0.0:
-            drop.append("angle")
-        if self.y is None:
-            drop.append("y")
+        for key, kinds in ONLY_FOR.items():
+            if self.type not in kinds:
+                drop += _WITH_DIGEST.get(key, (key,))
         for key in drop:
             out.pop(key)
-        for key in ("rotations_across", "velocities_across"):  # none: as before they existed
-            if not out["initial"][key]:
-                del out["initial"][key]
         return out
 
 
@@ -520,25 +523,15 @@ class Config:
     base_dir: str | None = field(default=None, compare=False, repr=False)
 
     def resolved(self) -> dict:
-        """Every resolved setting as plain data (dataclasses.asdict without ``written``,
-        ``base_dir`` and the excitation's fields that do not apply,
-        :meth:`ExcitationConfig.resolved`)."""
+        """Every resolved setting as plain data: dataclasses.asdict without ``written`` and
+        ``base_dir``, the excitation's fields that apply (:meth:`ExcitationConfig.resolved`)
+        and ``dimensions``: 3 where the model moves in three dimensions (:attr:`three_d`),
+        else 2. A config's hash is taken of it (rbm_cli.study.fingerprint)."""
         out = asdict(self)
         out.pop("written", None)
         out.pop("base_dir", None)
         out["excitation"] = self.excitation.resolved()
-        for key in ("capital", "top_mass"):  # a column without them hashes as it always did
-            if out["column"][key] is None:
-                del out["column"][key]
-        if out["interface"]["friction_limit"] is None:  # not checked: hashes as it always did
-            del out["interface"]["friction_limit"]
-        if out["interface"]["damping"] == 0.0:  # an undamped column hashes as it always did
-            del out["interface"]["damping"]
-        for key in ("axes", "records"):  # a plain grid resolves (and hashes) as it always did
-            if not out["grid"][key]:
-                del out["grid"][key]
-        if MODELS[self.model].any_direction and self.three_d:  # planar: as it always did
-            out["dimensions"] = 3
+        out["dimensions"] = 3 if self.three_d else 2
         return out
 
     @property
@@ -581,21 +574,3 @@ class Config:
             if e.type == "record" and written is not None and digest is not None
         )
         return own + tuple(r for r in self.grid.records if r not in own)
-
-
-def hash_form(config: Config) -> dict:
-    """What a config's hash is taken of (rbm_cli.study.sweep.config_hash): its resolved
-    form, without solver.max_wall_time (a guard against a run that would not end, not a
-    setting of the domain; hashes of domains made before it existed stay valid), without
-    solver.stop where it is the default (hashes of domains made before it existed stay
-    valid; `outcome` changes the peaks of a domain, and its hash), and with
-    solver.method auto written as STEP_DEFAULT, the default before auto existed (so stored
-    domains and journals keep their hashes; where auto runs the closed form instead, the two
-    agree on every robust cell: tests/test_closed_form_jit.py, tests/test_regression.py)."""
-    resolved = config.resolved()
-    resolved["solver"].pop("max_wall_time", None)
-    if resolved["solver"].get("stop") == SolverConfig.stop:
-        resolved["solver"].pop("stop")
-    if resolved["solver"]["method"] == "auto":
-        resolved["solver"]["method"] = STEP_DEFAULT
-    return resolved

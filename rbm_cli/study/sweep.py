@@ -16,7 +16,6 @@ order, so the same config gives the same ``domain.csv`` whatever the number of w
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 import os
 import time
@@ -28,7 +27,7 @@ from typing import TYPE_CHECKING
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.grid import MAX_CELLS as GRID_MAX_CELLS
 from rbm_cli.config.points import GridPoint
-from rbm_cli.config.types import MODELS, Config, hash_form
+from rbm_cli.config.types import MODELS, Config
 from rbm_cli.models.methods import compiled_codes
 from rbm_cli.study.cells import (
     Cell,
@@ -44,6 +43,7 @@ from rbm_cli.study.cells import (
     tasks,
 )
 from rbm_cli.study.domain import csv_text, parse_domain
+from rbm_cli.study.fingerprint import config_hash
 from rbm_cli.study.intensities import column_period
 from rbm_cli.study.parallel import run_chunks
 from rbm_cli.study.result import CSV_FIELDS
@@ -92,13 +92,6 @@ class SweepSummary:
     compile_what: str = ""  # what compile_s was spent on ("compiling the integrator", ...)
     already_finished: bool = False  # resume on a folder that holds this config's result
     workers: int | None = None  # the cells ran in this process (0), on N workers, or ? (None)
-
-
-def config_hash(config: Config) -> str:
-    """Fingerprint of everything that changes a domain: the resolved config, as
-    rbm_cli.config.types.hash_form gives it (hashes of stored domains stay valid)."""
-    text = json.dumps(hash_form(config), sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 def _run_cell(config: Config, a: float, f: float | None, runner) -> dict:

@@ -23,9 +23,10 @@ import numpy as np
 from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.motions import named, storable
-from rbm_cli.config.types import Config, hash_form
+from rbm_cli.config.types import Config
 from rbm_cli.study.cells import grid_points, key, max_drums
 from rbm_cli.study.domain import boundary_table, csv_text, domain_frame
+from rbm_cli.study.fingerprint import SCHEMA, hash_form, methods_that_run, same_domain
 from rbm_cli.study.provenance import provenance
 from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
 from rbm_cli.study.store import FINALS, JOURNAL, STATE
@@ -93,8 +94,8 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
             return dict(read.rows), read.solver_method
     else:
         finished = store.finished_hash()
-        if finished not in (None, digest) and _same_settings(folder, config, ensemble):
-            finished = digest  # made before a setting with a default was added to configs
+        if finished not in (None, digest) and _same_domain(folder, config, digest):
+            finished = digest  # stored under an earlier schema of the hash, the same domain
         if finished == digest and resume:
             return None, None
         if finished is not None and finished != digest:
@@ -165,7 +166,7 @@ def _finished_records(folder: Path) -> list | None:
 def as_started(config, points, method: str | None, note) -> tuple:
     """(config, grid points) a resumed sweep runs: with the solver.method its journal was
     started with, where the config now spells the same hash another way (`auto` for
-    `DOP853` or back, rbm_cli.config.types.hash_form). The cells still to do then run by
+    `DOP853` or back, rbm_cli.study.fingerprint.hash_form). The cells still to do then run by
     the method the journal's cells ran by, and the domain is the one a straight run of
     the journal's config gives."""
     if method is None or method == config.solver.method:
@@ -246,29 +247,15 @@ def draw_figure(figure, rows: list[dict], fields: tuple[str, ...], config: Confi
     return figure(domain_frame(rows, fields), config)
 
 
-def _same_settings(folder: Path, config, ensemble: int) -> bool:
-    """Whether meta.json's resolved config equals this config on every key both have
-    (a finished domain made before a config key with a default existed has another hash
-    but the same settings)."""
+def _same_domain(folder: Path, config, digest: str) -> bool:
+    """Whether the finished domain in ``folder`` is the one ``config`` gives under
+    ``digest``, though meta.json holds another hash: stored under an earlier schema of the
+    hash (rbm_cli.study.fingerprint.same_domain)."""
     try:
         meta = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
-        members = meta.get("ensemble", {}).get("members", 1)
-        stored = meta["config"]
-    except (OSError, ValueError, KeyError, AttributeError, TypeError):
+    except (OSError, ValueError):
         return False
-    current = json.loads(json.dumps(config.resolved(), default=str))
-    if not isinstance(stored, dict) or members != ensemble:
-        return False
-    records = current.get("grid", {}).get("records")
-    if records is not None and records != (stored.get("grid") or {}).get("records"):
-        return False  # the records of a suite are compared by content, never left out
-    return _common_equal(stored, current)
-
-
-def _common_equal(a, b) -> bool:
-    if isinstance(a, dict) and isinstance(b, dict):
-        return all(_common_equal(a[k], b[k]) for k in a.keys() & b.keys())
-    return a == b
+    return isinstance(meta, dict) and same_domain(folder, meta, config, digest)
 
 
 def _version(name: str) -> str:
@@ -298,15 +285,6 @@ def _versions() -> dict:
     }
 
 
-def solver_methods(points) -> str:
-    """The method(s) the sweep's cells ran with (solver.method, `auto` resolved at each
-    point of the grid: rbm_cli.models.methods.resolve_method), e.g. 'closed-form' or
-    'closed-form, DOP853' when the points differ."""
-    from rbm_cli.models.methods import resolve_method
-
-    return ", ".join(dict.fromkeys(resolve_method(p.config) for p in points))
-
-
 def sweep_meta(
     config: Config, points: list, digest: str, n_cells: int, n_run: int, counts: dict,
     ensemble: int, folder: Path | None = None,
@@ -323,8 +301,9 @@ def sweep_meta(
         "config": named(config.resolved()),
         "config_written": storable(config.written),  # a motion given as arrays: its identity
         "config_dir": where,
+        "schema": SCHEMA,
         "config_hash": digest,
-        "solver_method": solver_methods(points),
+        "solver_method": methods_that_run(config),
         "versions": _versions(),
         "wall_time_s": None,
         "jobs": None,

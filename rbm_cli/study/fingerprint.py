@@ -14,7 +14,8 @@ form that left out the settings added after the first release where they had the
 defaults (SCHEMA1_LEFT_OUT), solver.stop when it was ``figures``, and wrote ``auto`` as
 DOP853; its step and event budgets were fixed numbers (SCHEMA1_BUDGETS), where ``auto``
 now follows the column and the motion and is never less. A domain stored under it keeps
-its rows: :func:`migrate` rewrites its meta.json with today's hash once it has checked
+its rows (those of the rbm that made them; the regression rule compares them with this
+version's): :func:`migrate` rewrites its meta.json with today's hash once it has checked
 (:func:`schema1_problem`) that
 
 - its meta.json is intact: the stored ``config`` is the config its hash was taken of, and

@@ -37,7 +37,13 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx_gallery.gen_gallery",
     "rbm_reference",
+    "rbm_math",
+    "rbm_docstrings",
 ]
+
+# maths: MathJax from the site's own _static/mathjax/ (docs/_ext/rbm_math.py copies it from
+# the sphinx-mathjax-offline package), not from a CDN: the equations render offline
+mathjax_path = "mathjax/tex-chtml.js"
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
@@ -57,7 +63,8 @@ exclude_patterns = [
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 
-# autodoc + napoleon: the numpydoc-style docstrings of the public API
+# autodoc + napoleon: the numpydoc-style docstrings of the public API, as
+# docs/_ext/rbm_docstrings.py reads them first (fields on one line, |x| as text)
 autodoc_default_options = {"members": True, "member-order": "bysource"}
 autodoc_typehints = "none"
 napoleon_numpy_docstring = True
@@ -75,7 +82,9 @@ sphinx_gallery_conf = {
     "abort_on_example_error": True,
     "matplotlib_animations": False,
     "show_memory": False,
-    "write_computation_times": True,
+    # no page of computation times: sphinx-gallery's loads its table's scripts from CDNs,
+    # and the site loads nothing from a network (each tutorial states its own run time)
+    "write_computation_times": False,
     # two examples at a time (2 cores): the multi-drum tutorial compiles the step
     # integrator on a cold numba cache while the others run
     "parallel": 2,
@@ -90,51 +99,3 @@ html_theme_options = {
     "secondary_sidebar_items": ["page-toc"],
 }
 html_show_sourcelink = False
-
-
-# ---------------------------------------------------------------------------- hooks
-def _split_field_lines(app, what, name, obj, options, lines):
-    """The project's docstrings write a numpydoc field on one line, ``name : type  text``
-    (two spaces before the description); napoleon wants the description on the next line,
-    indented. Split such lines in the Parameters, Returns, Yields and Raises sections."""
-    import re
-
-    sections = {"Parameters", "Returns", "Yields", "Raises", "Other Parameters", "Attributes"}
-    field = re.compile(r"^(?P<head>\S(?:.*?\S)?)\s{2,}(?P<text>\S.*)$")
-    out: list[str] = []
-    in_fields = False
-    for k, line in enumerate(lines):
-        nxt = lines[k + 1] if k + 1 < len(lines) else ""
-        if line.strip() in sections and set(nxt.strip()) == {"-"}:
-            in_fields = True
-            out.append(line)
-            continue
-        if in_fields and line.strip() and not line.startswith(" ") and set(line.strip()) != {"-"}:
-            match = field.match(line)
-            if match and nxt.strip() != "" and set(nxt.strip()) == {"-"}:
-                in_fields = False  # the next section's title
-            elif match:
-                out += [match["head"], "    " + match["text"]]
-                continue
-        if in_fields and line.strip() and not line.startswith(" ") and not field.match(line):
-            # a title of another section ends the fields
-            if set(nxt.strip()) == {"-"}:
-                in_fields = False
-        out.append(line)
-    lines[:] = out
-
-
-#: Links of docs/api.md to the README's former Configuration section, read as the page that
-#: holds it now.
-_MOVED = {"../README.md#configuration": "reference/config.md"}
-
-
-def _moved_links(app, docname, source):
-    if docname == "api":
-        for old, new in _MOVED.items():
-            source[0] = source[0].replace(old, new)
-
-
-def setup(app):
-    app.connect("autodoc-process-docstring", _split_field_lines, priority=400)
-    app.connect("source-read", _moved_links)

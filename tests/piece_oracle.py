@@ -40,13 +40,16 @@ class Pieces:
     def cross(self, i: int, going_up: bool) -> str:
         """Move interface i to its next piece as its argument crosses the current
         piece's upper (going_up) or lower bound. Returns what the crossing is:
-        'uplift' (leaving the elastic branch), 'kink' (another piece of the same
-        side) or 'impact' (a zero crossing after an excursion: the side flips)."""
+        'uplift' (a closed interface leaving the elastic branch), 'kink' (another piece
+        of the same side, or leaving the elastic branch again before the silent zero
+        crossing it awaited: the excursion goes on) or 'impact' (a zero crossing after
+        an excursion: the side flips)."""
         s, k = self.side[i], self.k[i]
         if k == 0 and not self.zero_active(i):
+            reopened = bool(self.awaiting[i])
             self.side[i], self.k[i], self.pending[i] = (1 if going_up else -1), 1, True
             self.awaiting[i] = False
-            return "uplift"
+            return "kink" if reopened else "uplift"
         if going_up == (s > 0):
             self.k[i] = k + 1
             return "kink"

@@ -314,3 +314,18 @@ def test_the_checks_do_not_loop_over_the_samples_in_python(as_list, pair):
 
     small, large = _calls(make(1_000)), _calls(make(100_000))
     assert large <= small + 20, (small, large)
+
+
+def test_a_motion_refuses_the_analytic_second_component_it_would_drop():
+    """A harmonic config's excitation.y is a second component of the harmonic: arrays that
+    replace the harmonic would run without it, silently. Refused in one line that says where
+    a second component of arrays goes."""
+    second = {"amplitude_ratio": 0.5, "phase_deg": 90}
+    cfg = rbm.load_config({"name": "c", "model": "housner-3d", "column": dict(CYLINDER),
+                           "excitation": {"type": "harmonic", "y": second}})  # fmt: skip
+    motion = rbm.motion_from_arrays(T, AX, name="x")
+    for call in (lambda: rbm.run(cfg, 0.3, motion=motion),
+                 lambda: rbm.sweep(cfg, motions=[motion])):  # fmt: skip
+        with pytest.raises(rbm.ConfigError, match=r"excitation\.y .*acceleration_y") as err:
+            call()
+        assert "\n" not in str(err.value)

@@ -79,7 +79,16 @@ def test_rigid_block_fractions_match_the_closed_form(tmp_path):
     below = df["amplitude_g"] < alpha
     assert below.any() and (df.loc[below, "collapse_fraction"] == 0.0).all()
     assert (df["collapse_fraction"] == 1.0).any()
-    np.testing.assert_array_equal(df["robust"], np.isin(expected, [0.0, 1.0]).astype(int))
+    # the solver check: the step kernel at rtol/100, atol/100 (the closed form ran)
+    tight = dataclasses.replace(cfg, solver=dataclasses.replace(
+        cfg.solver, method="DOP853", rtol=1e-12, atol=1e-14))  # fmt: skip
+    same = [simulate(tight, a, f).status == s for a, f, s in
+            zip(df["amplitude_g"], df["frequency_hz"], df["status"], strict=True)]  # fmt: skip
+    robust = np.isin(expected, [0.0, 1.0]) & np.array(same)
+    np.testing.assert_array_equal(df["robust"], robust.astype(int))
+    why = np.where(robust, "none", np.where(np.array(same), "inputs", "solver"))
+    why[~np.isin(expected, [0.0, 1.0]) & ~np.array(same)] = "both"
+    np.testing.assert_array_equal(df["sensitive_to"], why)
     meta = json.loads((ens.folder / "meta.json").read_text())
     assert meta["ensemble"] == {"members": 4, "rule": RULE}
 
@@ -99,7 +108,15 @@ def test_multidrum_ensemble_is_its_members_and_reproducible(tmp_path):
         member_cfg, amp = member_config(cfg, 0.4, m)
         flags.append(simulate(member_cfg, amp, 3.0).status == "collapsed")
     assert row["collapse_fraction"] == pytest.approx(np.mean(flags))
-    assert row["robust"] == int(len(set(flags)) == 1)
+    # the solver check: the step kernel at rtol/100 and atol/100, and the exact integrator
+    checks = [{"method": "DOP853", "rtol": 1e-12, "atol": 1e-14}, {"method": "exact"}]
+    same = [simulate(dataclasses.replace(cfg, solver=dataclasses.replace(cfg.solver, **c)),
+                     0.4, 3.0).status == "collapsed" for c in checks]  # fmt: skip
+    members_agree = len(set(flags)) == 1
+    solver_agrees = all(s == flags[0] for s in same)
+    assert row["robust"] == int(members_agree and solver_agrees)
+    why = ("none", "inputs", "solver", "both")[(not members_agree) + 2 * (not solver_agrees)]
+    assert row["sensitive_to"] == why
 
 
 def test_cli_ensemble_writes_fractions_and_refuses_zero(tmp_path):

@@ -133,19 +133,20 @@ def test_a_compile_in_another_process_is_waited_for_not_repeated(
     assert time.monotonic() - start >= 0.5  # it waited for the lock
     assert warmed == [0]  # once, after the other process had ended
     waiting = "waiting for the fake code to compile in another rbm process (first use only," \
-        " about 7 s)"  # fmt: skip
+        " about 7 s on an idle machine)"  # fmt: skip
     if compiled_there:
         assert notes == [waiting]
         assert what == "waiting for the fake code to compile"
     else:
-        assert notes == [waiting, "compiling the fake code (first use only, about 7 s)"]
+        assert notes == [waiting,
+                         "compiling the fake code (first use only, about 7 s on an idle machine)"]
         assert what == "compiling the fake code"
     assert seconds > 0.0
     # the lock is free again: a compile now starts at once
     fake.needs_compile = lambda: True
     notes.clear()
     assert compile_ahead.compile_once("fake", notes.append)[1] == "compiling the fake code"
-    assert notes == ["compiling the fake code (first use only, about 7 s)"]
+    assert notes == ["compiling the fake code (first use only, about 7 s on an idle machine)"]
 
 
 SMALL_BLOCK = """name: small_block

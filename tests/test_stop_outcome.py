@@ -51,7 +51,8 @@ def _raw(path=CI_BAND) -> dict:
     """The config file as a mapping (for the keys a Config cannot change)."""
     raw = yaml.safe_load(path.read_text())
     raw["interface"]["stiffness"]["normal"] = float(raw["interface"]["stiffness"]["normal"])
-    raw["excitation"]["file"] = [str((path.parent / f).resolve()) for f in raw["excitation"]["file"]]
+    files = raw["excitation"]["file"]
+    raw["excitation"]["file"] = [str((path.parent / f).resolve()) for f in files]
     return raw
 
 
@@ -76,9 +77,9 @@ def test_the_barrier_is_the_least_potential_of_a_joint_at_collapse(xi, ratio):
     raw["collapse"] = {"ratio": ratio}
     model = model_from_config(load_config(raw))
     by_quad = []
-    for law, tu in zip(model.laws, model.column.rotation_capacity):
+    for law, tu in zip(model.laws, model.column.rotation_capacity, strict=True):
         edges = [e for e in law.edges if e < ratio * tu]  # the kinks: quad's breakpoints
-        value, err = quad(lambda x: float(law(x)), 0.0, ratio * tu, points=edges or None,
+        value, err = quad(lambda x, law=law: float(law(x)), 0.0, ratio * tu, points=edges or None,
                           limit=200, epsabs=0.0, epsrel=1e-12)  # fmt: skip
         by_quad.append(value)
     assert survival_barrier(model) == pytest.approx(min(by_quad), rel=1e-9)
@@ -204,7 +205,12 @@ def _check_domain(fresh: dict, stored: dict, at_least: int) -> int:
         found = STOPPED.search(row["message"])
         if found is None:
             for col, value in old.items():  # the stored columns (made before some existed)
-                if col not in ENSEMBLE:
+                if col in ENSEMBLE:
+                    continue
+                if col == "n_uplifts":  # stored when a joint that opened again before it
+                    # closed (e = 1) was a second uplift: now a subset of those is counted
+                    assert int(row[col]) <= int(value), (key, col)
+                else:
                     assert row[col] == value, (key, col)
             continue
         stopped += 1

@@ -29,7 +29,10 @@ from rbm_cli.cli.main import cli
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import G
 from rbm_cli.physics.records import write_csv
+from rbm_cli.report.info import own_point_note
 from rbm_cli.study.store import JOURNAL
+
+from .paths import CONFIGS
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -449,6 +452,16 @@ def test_run_on_a_suite_says_which_record_it_ran(suite, tmp_path):
     assert "this run is the config's own point (excitation.file = rec/r1.csv)" in res.output
     summary = json.loads((tmp_path / "o/suite/run_A0.4/summary.json").read_text())
     assert summary["config"]["excitation"]["file"] == "rec/r1.csv"
+
+
+def test_a_run_on_a_suite_of_pairs_names_the_pair_it_ran():
+    """Defect: on a suite of pairs the note named the first x record and "excitation.file_y
+    = its default", though the run takes the first pair's y record."""
+    cfg = load_config(CONFIGS / "suite_pairs.yaml")
+    note = own_point_note(cfg)
+    assert cfg.excitation.file_y == "records/synthetic/rdk_02.AT2"  # what the run takes
+    assert "excitation.file = records/synthetic/rdk_01.AT2" in note
+    assert "excitation.file_y = records/synthetic/rdk_02.AT2" in note
 
 
 # ------------------------------------------------------------ a backend that cannot run

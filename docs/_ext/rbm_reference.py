@@ -3,8 +3,9 @@
 Two directives:
 
 - ``.. rbm-cli::`` every command of the click group ``rbm_cli.cli.main:main``'s ``cli``
-  with its usage, its help text as ``rbm COMMAND --help`` prints it, and a table of its
-  arguments and options (flags, type, default, help);
+  with its usage, its help text (as ``rbm COMMAND --help`` prints it, once: its options are
+  in the table, not repeated above it) and a table of its arguments and options (the
+  flags; the help, the type and the default);
 - ``.. rbm-config::`` every key of the config: the key paths are read from the loader's key
   tuples (``rbm_cli.config.load.TOP_KEYS`` ...), the defaults from the config dataclasses
   (``rbm_cli.config.types``), the choices and most ranges from the loader's constants; the
@@ -18,6 +19,9 @@ Two directives:
 from __future__ import annotations
 
 import dataclasses
+import inspect
+import re
+import textwrap
 from collections.abc import Iterator
 
 import click
@@ -89,52 +93,122 @@ def _type_text(param: click.Parameter) -> str:
     return {"text": "text", "integer": "integer", "float": "number"}.get(name, name)
 
 
+def _metavar(param: click.Option) -> str:
+    """The word after an option's flag: its metavar, its name for a choice (the choices
+    are listed in the table's meaning), nothing for a flag."""
+    if param.is_flag:
+        return ""
+    if param.metavar:
+        return param.metavar
+    if isinstance(param.type, click.Choice):
+        return param.name.upper()
+    return param.type.get_metavar(param, click.Context(click.Command("x"))) or param.name.upper()
+
+
+def _default_text(param: click.Option) -> str:
+    default = param.default
+    unset = "sentinel" in type(default).__name__.lower()  # click's UNSET: no default
+    if unset or param.is_flag or default is None or callable(default) or default == ():
+        return ""
+    return lit(default if not isinstance(default, tuple | list) else
+               " ".join(str(d) for d in default))  # fmt: skip
+
+
 def _option_row(param: click.Parameter) -> list[str]:
+    """[the flags, the meaning]: its help, then its type and default in a line of their
+    own. The choices of a choice are listed there, not beside the flag (a long
+    ``[a|b|c]`` made the column too wide for the page)."""
     if isinstance(param, click.Argument):
         flags = lit(param.make_metavar(click.Context(click.Command("x"))))
-        meaning = "argument" + (" (required)" if param.required else "")
-        return [flags, esc(_type_text(param)), "\\-", esc(meaning)]
+        meaning = "Argument" + (" (required)." if param.required else ".")
+        return [flags, meaning + "\n\n" + esc(_type_text(param))]
     assert isinstance(param, click.Option)
+    metavar = _metavar(param)
     names = list(param.opts) + list(param.secondary_opts)
-    metavar = ""
-    if not param.is_flag:
-        metavar = " " + (param.metavar or param.type.get_metavar(param, click.Context(
-            click.Command("x"))) or param.name.upper())  # fmt: skip
-    flags = ", ".join(lit(n + metavar) for n in names)
+    flags = ", ".join(lit(n + (" " + metavar if metavar else "")) for n in names)
     if param.nargs and param.nargs > 1:
         flags += f" (takes {param.nargs} values)"
     if param.multiple:
         flags += " (repeatable)"
-    default = param.default
-    unset = "sentinel" in type(default).__name__.lower()  # click's UNSET: no default
-    if unset or param.is_flag or default is None or callable(default) or default == ():
-        default_text = "\\-"
+    kind = _type_text(param)
+    if isinstance(param.type, click.Choice):
+        kind = "one of " + ", ".join(lit(c) for c in param.type.choices)
     else:
-        default_text = lit(default if not isinstance(default, tuple | list) else
-                           " ".join(str(d) for d in default))  # fmt: skip
-    return [flags, esc(_type_text(param)), default_text, esc(param.help or "")]
+        kind = esc(kind)
+    default = _default_text(param)
+    facts = f"*{kind}*" if not isinstance(param.type, click.Choice) else kind
+    if default:
+        facts += f"; default {default}"
+    return [flags, esc(param.help or "") + "\n\n" + facts]
+
+
+def help_rst(text: str) -> list[str]:
+    """A click help text as reStructuredText: its paragraphs as text, each paragraph that
+    click prints as written (one that starts with ``\\b``: examples, lists) as a literal
+    block; what follows a ``\\f`` is not help."""
+    text = inspect.cleandoc(text or "").split("\f")[0]
+    lines: list[str] = []
+    for para in re.split(r"\n\s*\n", text):
+        if not para.strip():
+            continue
+        if para.lstrip().startswith("\b"):
+            body = textwrap.dedent(para.lstrip()[1:].strip("\n"))
+            lines += ["::", ""] + ["   " + line for line in body.splitlines()] + [""]
+        else:
+            lines += [esc(para), ""]
+    return lines
+
+
+def _cell(text: str, first: bool) -> list[str]:
+    """A list-table cell whose text may hold paragraphs (split at blank lines)."""
+    head = "   * - " if first else "     - "
+    paras = text.split("\n\n") if text else ["\\-"]
+    out = [head + paras[0]]
+    for para in paras[1:]:
+        out += ["", "       " + para]
+    return out
+
+
+def option_table(rows: list[list[str]], header: str = "option") -> list[str]:
+    """The two-column table of a command's arguments and options (of the group's
+    commands with ``header="command or option"``)."""
+    lines = [
+        ".. list-table::",
+        "   :header-rows: 1",
+        "   :widths: 32 68",
+        "   :class: rbm-reference rbm-options",
+        "",
+    ]
+    for row in [[header, "meaning"], *rows]:
+        for k, cell in enumerate(row):
+            lines += _cell(cell, k == 0)
+    lines.append("")
+    return lines
 
 
 def cli_rst() -> str:
-    """reStructuredText of every command: usage, help, and a table of its parameters."""
+    """reStructuredText of every command: its usage, its help text once, and a table of its
+    arguments and options (the options' help is in the table, not repeated above it)."""
     group = cli_group()
     lines: list[str] = []
-    top = click.Context(
-        group, info_name="rbm", terminal_width=80, max_content_width=80, **group.context_settings
-    )
+    top = click.Context(group, info_name="rbm", **group.context_settings)
     lines += ["The ``rbm`` command", "-" * 19, "", ".. code-block:: text", ""]
-    lines += ["   " + line for line in group.get_help(top).splitlines()]
-    lines.append("")
+    lines += ["   " + group.get_usage(top), ""]
+    lines += help_rst(group.help)
+    rows = [[lit(f"rbm {name}"), esc(cmd.get_short_help_str(limit=200))]
+            for name, cmd in commands()]  # fmt: skip
+    rows.append([lit("--version"), "Show the version and exit."])
+    rows.append([lit("-h") + ", " + lit("--help"), "Show the help and exit."])
+    lines += option_table(rows, header="command or option")
     for name, cmd in commands():
         ctx = click.Context(cmd, info_name=name, parent=top, **cmd.context_settings)
         title = f"rbm {name}"
         lines += [f".. _cli-{name}:", "", title, "-" * len(title), ""]
-        lines += [esc(cmd.get_short_help_str(limit=200)), "", ".. code-block:: text", ""]
-        lines += ["   " + line for line in cmd.get_help(ctx).splitlines()]
-        lines.append("")
+        lines += [".. code-block:: text", "", "   " + cmd.get_usage(ctx), ""]
+        lines += help_rst(cmd.help)
         rows = [_option_row(p) for p in cmd.params]
-        rows.append([lit("-h") + ", " + lit("--help"), "flag", "\\-", "Show the help and exit."])
-        lines += list_table(["option", "type", "default", "meaning"], rows, [30, 14, 10, 46])
+        rows.append([lit("-h") + ", " + lit("--help"), "Show the help and exit."])
+        lines += option_table(rows)
     return "\n".join(lines) + "\n"
 
 
@@ -146,6 +220,7 @@ def config_keys() -> list[str]:
         FILTER_KEYS,
         INITIAL_KEYS,
         PROCESSING_KEYS,
+        Y_KEYS,
     )
     from rbm_cli.config.grid import EXCITATION_AXES, LINKED, VIRTUAL_PATHS
     from rbm_cli.config.interface import INTERFACE_KEYS, STIFFNESS_KEYS
@@ -169,6 +244,7 @@ def config_keys() -> list[str]:
     sub = {
         "interface.stiffness": STIFFNESS_KEYS,
         "excitation.initial": INITIAL_KEYS,
+        "excitation.y": Y_KEYS,
         "excitation.processing": PROCESSING_KEYS,
         "excitation.processing.filter": FILTER_KEYS,
         "column.capital": CAPITAL_KEYS,
@@ -201,6 +277,7 @@ def _defaults() -> dict[str, str]:
         "interface": t.InterfaceConfig,
         "excitation": t.ExcitationConfig,
         "excitation.initial": t.InitialConfig,
+        "excitation.y": t.SecondComponentConfig,
         "excitation.processing": t.ProcessingConfig,
         "excitation.processing.filter": t.FilterConfig,
         "collapse": t.CollapseConfig,
@@ -231,6 +308,8 @@ def _ranges() -> dict[str, str]:
         MAX_DURATION,
         MAX_IM_PERIODS,
         PHASE_MAX,
+        Y_PHASE_RANGE_DEG,
+        Y_RATIO_MAX,
     )
     from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, MAX_CELLS
     from rbm_cli.config.interface import FRICTION_MAX, NORMAL_RANGE, ROTATIONAL_RANGE
@@ -288,12 +367,23 @@ def _ranges() -> dict[str, str]:
         f", distinct, at most {MAX_IM_PERIODS}",
         "excitation.initial.rotations": f"within +-{fmt(INITIAL_MAX['rotations'])}, one per drum",
         "excitation.initial.velocities": f"within +-{fmt(INITIAL_MAX['velocities'])}, one per drum",
+        "excitation.initial.rotations_across": f"within +-{fmt(INITIAL_MAX['rotations'])}, one"
+        " per drum; ``housner-3d``, ``rbm-3d``",
+        "excitation.initial.velocities_across": f"within +-{fmt(INITIAL_MAX['velocities'])}, one"
+        " per drum; ``housner-3d``, ``rbm-3d``",
+        "excitation.y.amplitude_ratio": f"[0, {fmt(Y_RATIO_MAX)}]",
+        "excitation.y.phase_deg": f"[{fmt(Y_PHASE_RANGE_DEG[0])}, {fmt(Y_PHASE_RANGE_DEG[1])}];"
+        " ``ricker``: a multiple of 180",
         "grid.amplitudes": f"[{fmt(AMPLITUDE_RANGE_G[0])}, {fmt(AMPLITUDE_RANGE_G[1])}]",
         "grid.frequencies": f"[{fmt(FREQUENCY_RANGE_HZ[0])}, {fmt(FREQUENCY_RANGE_HZ[1])}]",
         "grid.<key path>": f"at most {MAX_CELLS:,} cells in all",
         "solver.method": one_of(t.METHODS),
-        "solver.max_steps": f"at most {MAX_BUDGET:,}",
-        "solver.max_events": f"at most {MAX_BUDGET:,}",
+        "solver.max_steps": f"auto ({t.BUDGET_PER_JOINT_SECOND['max_steps']:,} a second of "
+        f"motion and a joint, at least {t.BUDGET_FLOOR['max_steps']:,}), or an integer "
+        f"1,000-{MAX_BUDGET:,}",
+        "solver.max_events": f"auto ({t.BUDGET_PER_JOINT_SECOND['max_events']:,} a second of "
+        f"motion and a joint, at least {t.BUDGET_FLOOR['max_events']:,}), or an integer "
+        f"100-{MAX_BUDGET:,}",
         "solver.time_step": f"[{fmt(TIME_STEP_RANGE[0])}, {fmt(TIME_STEP_RANGE[1])}]",
         "solver.max_wall_time": f"({fmt(WALL_TIME_RANGE[0])}, {fmt(WALL_TIME_RANGE[1])}]",
         "solver.implementation": one_of(t.IMPLEMENTATIONS),
@@ -448,8 +538,57 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "Default 0.",
     ),
     "excitation.initial": ("", "", "Initial state of the drums."),
-    "excitation.initial.rotations": ("rad", "", "Absolute rotation of each drum at t = 0."),
-    "excitation.initial.velocities": ("rad/s", "", "Angular velocity of each drum at t = 0."),
+    "excitation.initial.rotations": (
+        "rad",
+        "",
+        "Absolute rotation of each drum at t = 0, in the motion's vertical plane (the x "
+        "plane of the planar models; ``excitation.angle``'s for the models in three "
+        "dimensions).",
+    ),
+    "excitation.initial.velocities": (
+        "rad/s",
+        "",
+        "Angular velocity of each drum at t = 0, in the motion's vertical plane.",
+    ),
+    "excitation.initial.rotations_across": (
+        "rad",
+        "",
+        "Models in three dimensions: each drum's rotation at t = 0 in the vertical plane "
+        "across the motion's (its direction turned by +90 degrees, a history's "
+        "``theta<i>_across_rad``): with ``rotations`` a rotation vector, rotations d + "
+        "rotations_across d'. ``housner-3d``: the column tilts by the vector's size toward "
+        "its direction. Refused by the planar models and ``bullet``. Default 0.",
+    ),
+    "excitation.initial.velocities_across": (
+        "rad/s",
+        "",
+        "Models in three dimensions: each drum's rate at t = 0 across the motion's plane; "
+        "the rates form a vector as the rotations do (the top moves along velocities d + "
+        "velocities_across d'). ``housner-3d``: its angular velocity is horizontal, no "
+        "spin about the vertical. A tilt in the plane with a rate across it starts a "
+        "wobble. Refused by the planar models and ``bullet``. Default 0.",
+    ),
+    "excitation.y": (
+        "",
+        "a mapping",
+        "``harmonic``, ``half-sine`` and the pulses, models in three dimensions: an "
+        "analytic second horizontal component at 90 degrees counter-clockwise from the "
+        "motion's direction (``excitation.angle`` turns both, as a record pair), the "
+        "same formula times ``amplitude_ratio`` r, its phase led by ``phase_deg`` phi: a "
+        "harmonic's a_y = r A sin(omega t + phase + phi); a sine pulse's the same on the "
+        "pulse (the cycloidal's phase is 90 degrees); ``mavroeidis-papageorgiou``'s the "
+        "pulse with nu + phi and r times its velocity amplitude; ``ricker``'s the wavelet "
+        "times r (phi 0 or 360) or -r (phi 180). r = 1, phi = 90 is a circular motion; the "
+        "grid's amplitude is the first component's. r = 0 is the motion of one component. "
+        "Refused for records (their second component is ``file_y``), free motion and "
+        "the planar models.",
+    ),
+    "excitation.y.amplitude_ratio": (
+        "",
+        "",
+        "Required. r: the second component's multiplier over the first's.",
+    ),
+    "excitation.y.phase_deg": ("deg", "", "phi: the second component's phase lead."),
     "excitation.file": (
         "",
         "a file, a list of files, a folder, a glob, or a list of ``{x: FILE, y: FILE}``",
@@ -591,8 +730,20 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "(0, 1e-3]",
         "Absolute tolerance, relative to theta_u (rates: 10 theta_u).",
     ),
-    "solver.max_steps": ("", "", "Step budget of one run: beyond it the run is ``failed``."),
-    "solver.max_events": ("", "", "Event budget of one run: beyond it the run is ``failed``."),
+    "solver.max_steps": (
+        "",
+        "",
+        "Step budget of one run: beyond it the run is ``failed`` and its message names the "
+        "budget to raise. Default ``auto``: it grows with the motion's duration (its free "
+        "time included) and the column's joints, so a tall column under a long record runs.",
+    ),
+    "solver.max_events": (
+        "",
+        "",
+        "Event budget of one run (uplifts, impacts, kinks): beyond it the run is ``failed`` "
+        "and its message names the budget to raise. Default ``auto``: it grows with the "
+        "motion's duration and the column's joints.",
+    ),
     "solver.time_step": ("s", "", "The contact engine's fixed step (``model: bullet``)."),
     "solver.implementation": (
         "",

@@ -11,8 +11,6 @@ ensemble says which cells are robust and which are chaotic.
 # %%
 # The config, written as YAML
 # ---------------------------
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
@@ -47,28 +45,31 @@ config_file = work / "four_drums.yaml"
 _ = config_file.write_text(config_text)
 
 # %%
-# What the model derives: ``rbm info``
+# What the model derives: ``rbm.info``
 # ------------------------------------
-# Per interface i (1 at the ground): width B_i, drum height h_i, mass m_i and rotary
-# inertia I_Gi, normal force N_i (the weight above), the capacity M_u,i = (B_i / 2) N_i,
-# the zero-moment rotation theta_u,i, the joint's rotational stiffness K_M,i and the
-# normal stiffness k_n,i that gives it, and the rotation where the elastic branch ends.
-# Above the table: the static multiplier (the ground acceleration [g] at which the column
-# starts to rock), the rocking parameter p and the elastic frequencies.
-info = subprocess.run(
-    [sys.executable, "-m", "rbm_cli", "info", str(config_file)],
-    capture_output=True,
-    text=True,
-    check=True,
-)
-print(info.stdout)
+# ``rbm.info`` gives, as data, what ``rbm info four_drums.yaml`` prints. Per interface i (1
+# at the ground): width B_i, drum height h_i, mass m_i and rotary inertia I_Gi, normal
+# force N_i (the weight above), the capacity M_u,i = (B_i / 2) N_i, the zero-moment
+# rotation theta_u,i, the joint's rotational stiffness K_M,i and the normal stiffness
+# k_n,i that gives it, and the rotation where the elastic branch ends. For the column: the
+# static multiplier (the ground acceleration [g] at which it starts to rock), the rocking
+# parameter p and the elastic frequencies.
+cfg = rbm.load_config(config_file)
+figures = rbm.info(cfg)
+print(f"total mass {figures['total_mass_kg']:.0f} kg")
+print(f"static multiplier {figures['static_multiplier_g']:.3f} g")
+print(f"rocking p {figures['rocking_p_rad_s']:.3f} rad/s")
+print("elastic frequencies [Hz]:", ", ".join(f"{f:.1f}" for f in figures["elastic_frequencies_hz"]))
+per_interface = figures["interfaces"].set_index("interface")
+print(per_interface[["width_m", "drum_mass_kg", "normal_force_N", "moment_capacity_Nm",
+                     "rotation_capacity_rad", "stiffness_Nm_per_rad"]]
+      .to_string(float_format=lambda x: f"{x:.4g}"))  # fmt: skip
 
 # %%
 # The domain
 # ----------
 # Twelve cells (4 amplitudes x 3 frequencies). The first run of an elastic column compiles
 # the step integrator once per installation (numba caches it on disk).
-cfg = rbm.load_config(config_file)
 domain = rbm.sweep(cfg, jobs=2)
 columns = ["amplitude_g", "frequency_hz", "status", "collapse_interface", "max_rotation_ratio"]
 print(domain[columns].to_string(index=False))

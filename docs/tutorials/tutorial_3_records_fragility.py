@@ -28,7 +28,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import rbm
-from rbm_cli.api.fragility_curves import run_fragility
 
 # the repository's root: the folder above that holds configs/ (run from the root or docs/)
 ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "configs").is_dir())
@@ -62,11 +61,12 @@ print(f"{len(domain)} runs, {int(domain['collapsed'].sum())} collapses")
 # %%
 # The fragility
 # -------------
-# ``run_fragility`` is what ``rbm fragility DOMAIN.csv`` runs: the per-intensity counts, the
-# fit and its bootstrap band, written beside the domain (``fragility.csv``,
-# ``fragility_curve.csv``, ``fragility.json``, ``fragility.png``, ``ida.png``).
-fr = run_fragility(Path(domain.attrs["folder"]) / "domain.csv", n_resamples=200, seed=1)
-result = fr.result
+# ``rbm.fragility`` fits the lognormal curve by maximum likelihood over the records, with a
+# bootstrap band over them, as ``rbm fragility`` does; it writes nothing.
+# ``rbm fragility <folder>/domain.csv`` fits the same and writes its files beside the
+# domain (``fragility.csv``, ``fragility_curve.csv``, ``fragility.json``, ``fragility.png``,
+# ``ida.png``).
+result = rbm.fragility(domain, n_resamples=200, seed=1)
 print(result.table[["intensity_g", "n_records", "n_collapsed", "fraction"]].to_string(index=False))
 if result.fitted:
     lo, hi = result.median_ci_g
@@ -76,7 +76,7 @@ if result.fitted:
     )
 else:
     print("no fit:", result.note)
-print("files:", ", ".join(p.name for p in fr.paths))
+print("the same, with its files:", f"rbm fragility {Path(domain.attrs['folder']) / 'domain.csv'}")
 
 # %%
 # IDA and the fragility curve, drawn here

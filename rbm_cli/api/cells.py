@@ -17,7 +17,7 @@ from rbm_cli.config.load import shown as shown_value
 from rbm_cli.config.types import Config
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import history_frame, vertical_history
-from rbm_cli.study.result import CSV_FIELDS, RunResult
+from rbm_cli.study.result import CSV_FIELDS, THREE_D_FIELDS, RunResult
 from rbm_cli.study.simulate import simulate
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` never does
@@ -42,14 +42,17 @@ class CellResult(Mapping):
     ('collapsed', 'survived' or 'failed'), ``t_collapse_s`` [s] (nan if none),
     ``collapse_interface`` (int, 1 at the ground; None without a collapse),
     ``max_rotation_ratio`` [-] (the largest rotation over its collapse limit),
-    ``max_top_displacement_m`` [m], ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs``
-    (int), ``message``, then ``friction_demand`` (per interface, max |T/N| [-]),
-    ``wall_time_s`` [s], ``method`` (the method that ran), ``friction_limit`` (model
-    rbm's interface.friction, the coefficient the demand is checked against; None: not
-    checked), ``slip`` ((t [s], interface) where the demand first exceeded it; None:
-    it did not, or no check) and ``energy`` (a recorded run's energy account [J] where its
-    method keeps one: ``initial_J``, ``final_J``, ``ground_work_J``, ``damping_J``,
-    ``impacts_J``, ``residual_J``; else None). Whole numbers are ints, real numbers floats.
+    ``max_top_displacement_m`` [m], for a run in three dimensions (as domain.csv)
+    ``collapse_azimuth_deg`` [deg from x, in (-180, 180]; nan if it did not collapse] and
+    ``wobble_turns`` [-], then ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs`` (int),
+    ``message``, then ``friction_demand`` (per interface, max |T/N| [-]),
+    ``wall_time_s`` [s], ``method`` (the method that ran), ``friction_limit`` (the
+    interface.friction of a model with the RBM's joints, rbm and rbm-3d, the coefficient
+    the demand is checked against; None: not checked), ``slip`` ((t [s], interface) where
+    the demand first exceeded it; None: it did not, or no check) and ``energy`` (a recorded
+    run's energy account [J] where its method keeps one: ``initial_J``, ``final_J``,
+    ``ground_work_J``, ``damping_J``, ``impacts_J``, ``residual_J``; else None). Whole
+    numbers are ints, real numbers floats. The outputs reference defines the counts.
 
     Examples
     --------
@@ -65,7 +68,11 @@ class CellResult(Mapping):
     __slots__ = ("_run", "_values")
 
     def __init__(self, run: RunResult) -> None:
-        values = {k: getattr(run, k) for k in FIELDS}
+        values = {}
+        for k in FIELDS:
+            values[k] = getattr(run, k)
+            if k == "max_top_displacement_m" and run.three_d:  # where domain.csv has them
+                values.update({extra: float(getattr(run, extra)) for extra in THREE_D_FIELDS})
         interface = values["collapse_interface"]
         values["collapse_interface"] = None if interface is None else int(interface)
         for k in ("n_uplifts", "n_impacts", "n_steps", "n_rhs"):

@@ -6,8 +6,10 @@ POLL_STEPS accepted steps instead: an object-mode block (about 1 us) that reads 
 monotonic clock and a flag. Entering Python there also runs any pending signal handler;
 :func:`interruptible` installs, for the length of one kernel call in the main thread, a
 SIGINT handler that only sets that flag (an exception raised inside the object-mode
-block would not cross the compiled frames cleanly), and raises KeyboardInterrupt once the
-kernel has returned. The cost of the poll is discussed in docs/guide/solving.md.
+block would not cross the compiled frames cleanly), and, once the kernel has returned, puts
+back the handler it replaced and calls it: Python's own raises KeyboardInterrupt, and so
+does the ``rbm`` command's (rbm_cli.cli.main), which also ignores the Ctrl-C that follow.
+The cost of the poll is discussed in docs/guide/solving.md.
 """
 
 from __future__ import annotations
@@ -52,29 +54,46 @@ def _flag(signum, frame) -> None:
     _interrupted[0] = True
 
 
+#: The SIGINT handler arm() replaced, put back by disarm().
+_replaced: list = [None]
+
+
+def raises_keyboard_interrupt(handler) -> bool:
+    """Whether a SIGINT handler is one arm() may take over for a kernel call: Python's
+    default, or a handler that says it raises KeyboardInterrupt as that one does (its
+    attribute ``raises_keyboard_interrupt`` is True: the ``rbm`` command's)."""
+    return handler is signal.default_int_handler or (
+        getattr(handler, "raises_keyboard_interrupt", False) is True
+    )
+
+
 def arm() -> bool:
     """Let Ctrl-C stop the kernel call that follows: SIGINT sets the flag that poll
-    reads, until disarm(). Only in the main thread and when SIGINT has Python's default
-    handler (a program that ignores or handles SIGINT itself keeps its handler); True if
-    armed. (The _signal primitives: about 0.5 us for arm and disarm together.)"""
+    reads, until disarm(). Only in the main thread and when SIGINT's handler raises
+    KeyboardInterrupt (raises_keyboard_interrupt: a program that ignores or handles SIGINT
+    otherwise keeps its handler); True if armed. (The _signal primitives: about 0.5 us for
+    arm and disarm together.)"""
     if threading.current_thread() is not threading.main_thread():
         return False
-    if _signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+    handler = _signal.getsignal(signal.SIGINT)
+    if not raises_keyboard_interrupt(handler):
         return False
     _interrupted[0] = False
+    _replaced[0] = handler
     _signal.signal(signal.SIGINT, _flag)
     return True
 
 
 def disarm(armed: bool) -> None:
-    """Restore Python's default SIGINT handler; raise KeyboardInterrupt if Ctrl-C was
-    pressed while armed."""
+    """Put back the SIGINT handler arm() replaced; if Ctrl-C was pressed while armed,
+    call it (it raises KeyboardInterrupt)."""
     if not armed:
         return
-    _signal.signal(signal.SIGINT, signal.default_int_handler)
+    handler, _replaced[0] = _replaced[0], None
+    _signal.signal(signal.SIGINT, handler)
     hit, _interrupted[0] = _interrupted[0], False
     if hit:
-        raise KeyboardInterrupt
+        handler(signal.SIGINT, None)
 
 
 @contextlib.contextmanager
@@ -93,6 +112,7 @@ __all__ = [
     "disarm",
     "poll",
     "interruptible",
+    "raises_keyboard_interrupt",
     "GO_ON",
     "PAST_DEADLINE",
     "INTERRUPTED",

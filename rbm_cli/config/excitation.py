@@ -2,13 +2,21 @@
 
 Keys, by excitation type (a key of another type is refused, naming it):
 
-- every type: ``type``, ``initial: {rotations, velocities}`` [rad, rad/s];
+- every type: ``type``, ``initial: {rotations, velocities}`` [rad, rad/s] (and, for the
+  models in three dimensions, ``rotations_across``, ``velocities_across``: the same across
+  the motion's plane; the loader refuses them for the others);
 - ``harmonic``, ``half-sine``, ``free``: ``duration`` [s]; ``harmonic``: ``phase`` [rad]
   (0 is accepted with any type);
 - pulses, ``one-sine``, ``cycloidal``, ``ricker``, ``mavroeidis-papageorgiou``: as
   ``half-sine``, ``duration`` [s] is the maximum simulated time (default 20 s), the pulse
   then free motion; ``mavroeidis-papageorgiou`` also ``gamma`` (> 1, at most 20 [-]) and
   ``nu`` (in [-2 pi, 2 pi] [rad]), both required;
+- ``harmonic``, ``half-sine`` and the pulses: ``y: {amplitude_ratio, phase_deg}``, an
+  analytic second horizontal component at 90 degrees counter-clockwise from the motion's
+  direction, the same formula scaled by amplitude_ratio (in [0, 10] [-]) and shifted by
+  phase_deg (in [-360, 360] [deg], default 0; a Ricker wavelet has no phase: 0 or
+  +-180, its sign, or +-360) (:func:`second_component`; the loader refuses it for the
+  planar models);
 - ``record``: ``file`` (one PEER NGA ``.AT2`` or CSV file; a relative path is taken from the
   folder of the config file, or from the current directory for a config given as a
   mapping), ``units`` (``g``, default, or ``m/s2``: a CSV's values; an ``.AT2`` is in g),
@@ -67,6 +75,7 @@ from rbm_cli.config.types import (
     G,
     InitialConfig,
     ProcessingConfig,
+    SecondComponentConfig,
 )
 from rbm_cli.config.validate import (
     choice,
@@ -88,6 +97,7 @@ __all__ = [
     "processing_section",
     "record_file",
     "resolve_record_path",
+    "second_component",
     "with_record",
 ]
 
@@ -107,13 +117,21 @@ EXCITATION_KEYS = (
     "im_periods",
     "angle",
     "file_y",
+    "y",
 )
 PROCESSING_KEYS = ("baseline", "filter")
 FILTER_KEYS = ("low_hz", "high_hz", "order")
 #: Largest order of each side of the band-pass [-]: the roll-off is 6 n dB an octave a
 #: side, doubled by the forward and backward pass; strong-motion practice uses 2-8.
 FILTER_ORDER_MAX = 8
-INITIAL_KEYS = ("rotations", "velocities")
+INITIAL_KEYS = ("rotations", "velocities", "rotations_across", "velocities_across")
+#: Keys of excitation.y, the analytic second component.
+Y_KEYS = ("amplitude_ratio", "phase_deg")
+#: Largest excitation.y.amplitude_ratio [-]: a second component stronger than ten times
+#: the first is the first of the motion turned by 90 degrees (excitation.angle).
+Y_RATIO_MAX = 10.0
+#: Range of excitation.y.phase_deg [deg]: one turn either way.
+Y_PHASE_RANGE_DEG = (-360.0, 360.0)
 #: Default ``excitation.duration`` per type [s].
 DEFAULT_DURATION = {"harmonic": 10.0, "half-sine": 20.0, "free": 10.0}
 DEFAULT_DURATION.update({kind: 20.0 for kind in PULSES})  # as the half-sine [assumption]
@@ -140,6 +158,7 @@ ONLY_FOR = {
     "file_y": ("record",),
     "processing": ("record",),
     "im_periods": ("record",),
+    "y": tuple(t for t in EXCITATIONS if t not in ("record", "free")),
 }
 #: Periods of the spectral accelerations a record's rows report (excitation.im_periods)
 #: [s], and how many a config may list.
@@ -328,23 +347,53 @@ def _initial(raw: Any, n: int, kind: str) -> InitialConfig:
     path = "excitation.initial"
     init = mapping(raw, path, INITIAL_KEYS)
     per = f"one value per drum ({n})"
-    values = {
-        key: tuple(
-            in_bounds(x, join(join(path, key), i), unit, (-INITIAL_MAX[key], INITIAL_MAX[key]))
-            for i, x in enumerate(
-                number_list(init[key], join(path, key), unit, length=n, length_text=per)
+    units = {"rotations": "rad", "velocities": "rad/s"}
+    values = {}
+    for key in INITIAL_KEYS:
+        unit, bound = units[key.removesuffix("_across")], INITIAL_MAX[key.removesuffix("_across")]
+        values[key] = (
+            tuple(
+                in_bounds(x, join(join(path, key), i), unit, (-bound, bound))
+                for i, x in enumerate(
+                    number_list(init[key], join(path, key), unit, length=n, length_text=per)
+                )
             )
+            if key in init
+            else ()
         )
-        if key in init
-        else ()
-        for key, unit in (("rotations", "rad"), ("velocities", "rad/s"))
-    }
-    if kind == "free" and not any(values["rotations"]) and not any(values["velocities"]):
+    if kind == "free" and not any(any(v) for v in values.values()):
         raise ConfigError(
             f"{path}: excitation type free needs a non-zero initial rotation or velocity"
             f" ({path}.rotations or .velocities); with none the column stays at rest"
         )
     return InitialConfig(**values)
+
+
+def second_component(raw: Any, kind: str) -> SecondComponentConfig:
+    """The validated ``excitation.y`` of an excitation of type ``kind`` (a harmonic or a
+    pulse): ``amplitude_ratio`` r in [0, Y_RATIO_MAX] (required) and ``phase_deg`` phi in
+    Y_PHASE_RANGE_DEG (default 0); a Ricker wavelet, which has no phase, takes a multiple
+    of 180 degrees only (its sign).
+
+    Raises
+    ------
+    ConfigError  One line naming the key and its range.
+    """
+    path = "excitation.y"
+    y = mapping(raw, path, Y_KEYS, required=("amplitude_ratio",))
+    ratio = number(y["amplitude_ratio"], join(path, "amplitude_ratio"), "", 0.0, Y_RATIO_MAX,
+                   lo_open=False, hint="a larger second component is the first of the motion"
+                   " turned by 90 degrees: excitation.angle")  # fmt: skip
+    phase = number(y.get("phase_deg", 0.0), join(path, "phase_deg"), "deg")
+    phase = in_bounds(
+        phase, join(path, "phase_deg"), "deg", Y_PHASE_RANGE_DEG, "one turn either way"
+    )
+    if kind == "ricker" and phase % 180.0 != 0.0:
+        raise ConfigError(
+            f"{path}.phase_deg: a Ricker wavelet has no phase, so its second component is the"
+            f" same wavelet times r (phase_deg 0 or +-360) or -r (+-180), got {fmt(phase)}"
+        )
+    return SecondComponentConfig(float(ratio), float(phase))
 
 
 def _refuse_foreign_keys(e: dict, kind: str) -> None:
@@ -356,6 +405,11 @@ def _refuse_foreign_keys(e: dict, kind: str) -> None:
                     "excitation.duration does not apply to type record: the run lasts the"
                     " record plus excitation.free_time [s] (default"
                     f" {fmt(DEFAULT_FREE_TIME)} s): delete it"
+                )
+            if key == "y" and kind == "record":
+                raise ConfigError(
+                    "excitation.y is the analytic second component of a harmonic or a pulse;"
+                    " a record's second component is a file: excitation.file_y"
                 )
             raise ConfigError(
                 f"excitation.{key} applies only to type {' or '.join(kinds)}"
@@ -581,5 +635,6 @@ def excitation_section(
         initial=_initial(e.get("initial"), n, kind),
         angle=angle,
         directed="angle" in e,
+        y=second_component(e["y"], kind) if "y" in e else None,
         **fields,
     )

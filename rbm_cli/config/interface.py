@@ -39,11 +39,12 @@ BOTH_FORMS = "{rotational: K_M} [N m/rad] or {normal: k_n} [Pa/m]"
 def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
     """Validate the ``interface`` mapping of a column of n drums for a model."""
     i = mapping(raw, "interface", INTERFACE_KEYS)
-    if "friction" in i and model not in ("bullet", "rbm"):
+    if "friction" in i and not (model == "bullet" or MODELS[model].beam):
+        beams = " and ".join(name for name, entry in MODELS.items() if entry.beam)
         raise ConfigError(
-            f"interface.friction applies only to models bullet (its contacts) and rbm (its"
-            f" friction demand is checked against it); model {model} computes no friction"
-            " demand: delete it"
+            f"interface.friction applies only to models bullet (its contacts) and {beams}"
+            f" (their friction demand is checked against it); model {model} computes no"
+            " friction demand: delete it"
         )
     friction = number(i.get("friction", 1.0), "interface.friction", "", 0.0)
     if friction > FRICTION_MAX:

@@ -379,9 +379,23 @@ def _check_stop(config: Config) -> None:
 def _check_dimensions(config: Config) -> None:
     """A model that moves in three dimensions (Config.three_d) takes a circular column only;
     a planar model takes a motion along its plane only (excitation.angle 0, no
-    excitation.file_y, so no suite of pairs either)."""
+    excitation.file_y, so no suite of pairs either, no excitation.y); only the models in
+    three dimensions (ModelEntry.three_d) take an initial state across the motion's plane."""
     model, excitation = config.model, config.excitation
     section = config.column.section
+    init = excitation.initial
+    if (init.rotations_across or init.velocities_across) and not MODELS[model].three_d:
+        key = "rotations_across" if init.rotations_across else "velocities_across"
+        spatial = ", ".join(name for name, entry in MODELS.items() if entry.three_d)
+        why = (
+            "starts its stack from one rotation and rate in the motion's plane"
+            if MODELS[model].any_direction
+            else "rocks in one plane"
+        )
+        raise ConfigError(
+            f"excitation.initial.{key} is a state across the motion's plane, and model"
+            f" {model} {why}: use a model in three dimensions ({spatial}) or delete it"
+        )
     if config.three_d:
         if section != "circular":
             when = (
@@ -415,6 +429,12 @@ def _check_dimensions(config: Config) -> None:
             f" {{x, y}} in excitation.file), and model {model} rocks in one plane: use a model"
             f" in three dimensions ({three_d}) or delete excitation.file_y (write"
             " excitation.file as files, not pairs)"
+        )
+    if excitation.y is not None:
+        raise ConfigError(
+            "excitation.y is a second horizontal component, and model"
+            f" {model} rocks in one plane: use a model in three dimensions ({three_d}) or"
+            " delete excitation.y"
         )
 
 
@@ -565,6 +585,14 @@ def _drums(value: Any, height: float) -> tuple[float, ...]:
     return heights
 
 
+def _budget(value: Any, path: str, lo: int) -> int | None:
+    """A run's budget: `auto` (None: it scales with the run, SolverConfig.for_run) or an
+    integer in lo..MAX_BUDGET."""
+    if value == "auto":
+        return None
+    return integer(value, path, lo, MAX_BUDGET, " or auto")
+
+
 def _solver(raw: Any) -> SolverConfig:
     s = mapping(raw, "solver", SOLVER_KEYS)
     default = SolverConfig()
@@ -572,12 +600,8 @@ def _solver(raw: Any) -> SolverConfig:
         method=choice(s.get("method", default.method), "solver.method", METHODS),
         rtol=number(s.get("rtol", default.rtol), "solver.rtol", "", 1e-13, 1e-3, lo_open=False),
         atol=number(s.get("atol", default.atol), "solver.atol", "", 0.0, 1e-3),
-        max_steps=integer(
-            s.get("max_steps", default.max_steps), "solver.max_steps", 1000, MAX_BUDGET
-        ),
-        max_events=integer(
-            s.get("max_events", default.max_events), "solver.max_events", 100, MAX_BUDGET
-        ),
+        max_steps=_budget(s.get("max_steps", "auto"), "solver.max_steps", 1000),
+        max_events=_budget(s.get("max_events", "auto"), "solver.max_events", 100),
         time_step=number(
             s.get("time_step", default.time_step),
             "solver.time_step",

@@ -8,7 +8,8 @@ edge of the program; physics code converts with :data:`G`.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+import math
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 #: Acceleration of gravity [m/s^2] (g = 9.81, the value the paper and the reference blocks use).
@@ -175,7 +176,7 @@ class InterfaceConfig:
     friction : float  Coulomb friction coefficient of the joints and the base
         (model bullet's contacts; the RBM and the reference models do not slide) [-]
     friction_limit : float or None  The friction coefficient the RBM's friction demand
-        max |T_i / N_i| is checked against (interface.friction given for model rbm): a run
+        max |T_i / N_i| is checked against (interface.friction given for rbm or rbm-3d): a run
         says where the demand first exceeds it and a domain marks the cells it does
         (``slides``); None: not checked [-]
     damping : float  Ratio zeta of critical damping of the column's first elastic mode,
@@ -196,11 +197,40 @@ class InterfaceConfig:
 class InitialConfig:
     """Initial absolute drum rotations [rad] and rates [rad/s], bottom first.
 
+    rotations, velocities : tuple of float  In the motion's vertical plane (the plane of
+        the planar models; for the models in three dimensions, the vertical plane of
+        excitation.angle)
+    rotations_across, velocities_across : tuple of float  Models in three dimensions
+        only: the same in the vertical plane across it (the motion's direction turned by
+        +90 degrees in plan), as a history's ``rotations_across``
+
     Empty tuples mean zero.
     """
 
     rotations: tuple[float, ...] = ()
     velocities: tuple[float, ...] = ()
+    rotations_across: tuple[float, ...] = ()
+    velocities_across: tuple[float, ...] = ()
+
+    @property
+    def across(self) -> bool:
+        """Whether a rotation or rate across the motion's plane is given (not all 0)."""
+        return any(self.rotations_across) or any(self.velocities_across)
+
+
+@dataclass(frozen=True)
+class SecondComponentConfig:
+    """An analytic second horizontal component (excitation.y) of a harmonic or a pulse,
+    acting at 90 degrees counter-clockwise from the motion's direction: the same formula
+    scaled by amplitude_ratio and shifted in phase by phase_deg (a_y = r A sin(omega t +
+    phase + phi) for a harmonic; rbm_cli.physics.excitation says it for each pulse).
+
+    amplitude_ratio : float  r = the second component's multiplier over the first's [-]
+    phase_deg : float  phi, its phase lead [deg]
+    """
+
+    amplitude_ratio: float
+    phase_deg: float = 0.0
 
 
 #: ExcitationConfig fields of type 'record' only, and those never in Config.resolved()
@@ -283,6 +313,9 @@ class ExcitationConfig:
     directed : bool  excitation.angle was written (0 included): a model that moves in three
         dimensions when its motion is given a direction does so (ModelEntry.any_direction);
         never in :meth:`resolved` (Config.resolved says the dimensions instead)
+    y : SecondComponentConfig or None  A harmonic's or a pulse's analytic second
+        horizontal component, at 90 degrees counter-clockwise from the motion's direction
+        (models in three dimensions only); left out of :meth:`resolved` when None
     processing : ProcessingConfig or None  Record: its baseline correction and band-pass,
         applied to the record (and the vertical record) before scaling; None: the record
         as read (also for a processing that changes nothing, so the config's hash is the
@@ -312,6 +345,7 @@ class ExcitationConfig:
     file_y: str | None = None
     file_y_sha256: str | None = None
     file_y_path: str | None = field(default=None, compare=False)
+    y: SecondComponentConfig | None = None
 
     def resolved(self) -> dict:
         """The settings that define the motion, as plain data: the fields of other
@@ -333,8 +367,13 @@ class ExcitationConfig:
             drop.append("im_periods")
         if self.angle == 0.0:
             drop.append("angle")
+        if self.y is None:
+            drop.append("y")
         for key in drop:
             out.pop(key)
+        for key in ("rotations_across", "velocities_across"):  # none: as before they existed
+            if not out["initial"][key]:
+                del out["initial"][key]
         return out
 
 
@@ -385,6 +424,15 @@ class CollapseConfig:
     ratio: float = 1.0
 
 
+#: A run's budgets when solver.max_steps / max_events are `auto` (SolverConfig.for_run): this
+#: many per second of motion and per joint, and never fewer than the floor (the fixed budgets
+#: of earlier versions). Measured (docs/stability.md): the paper's column in 16 drums under
+#: the 30 s records rdk_01 and rdk_02 and 5 s of free motion, at 0.1 g and rtol 1e-10, takes
+#: 893-935 steps and 461-478 events a second and a joint (0.26 and 0.27 million events).
+BUDGET_PER_JOINT_SECOND = {"max_steps": 20_000, "max_events": 2_000}
+BUDGET_FLOOR = {"max_steps": 2_000_000, "max_events": 200_000}
+
+
 @dataclass(frozen=True)
 class SolverConfig:
     """Integrator settings.
@@ -398,8 +446,10 @@ class SolverConfig:
         closed form: a rigid RBM monolith, housner-linear; rbm_cli.models.rbm.closed_form);
         the tolerances do not apply to exact and closed-form
     rtol, atol : float  Tolerances (atol relative to the rotation scale theta_u)
-    max_steps : int  Step budget of one run; beyond it the run is 'failed'
-    max_events : int  Budget of events (kinks, impacts) of one run
+    max_steps : int or None  Step budget of one run; beyond it the run is 'failed'. None
+        (`auto`, the default): it scales with the run (:meth:`for_run`)
+    max_events : int or None  Budget of events (kinks, impacts) of one run; None (`auto`):
+        it scales with the run
     time_step : float  Fixed time step of the contact engine (model bullet) [s]
     implementation : str  'compiled' (numba) or 'python' (the same source run uncompiled,
         rbm_cli.base.jit.plain: the same bits, 30-100x slower; for debugging)
@@ -413,12 +463,28 @@ class SolverConfig:
     method: str = "auto"
     rtol: float = 1e-10
     atol: float = 1e-12
-    max_steps: int = 2_000_000
-    max_events: int = 200_000
+    max_steps: int | None = None
+    max_events: int | None = None
     time_step: float = 1e-4
     implementation: str = "compiled"
     max_wall_time: float = 3600.0
     stop: str = "figures"
+
+    def for_run(self, duration_s: float, joints: int) -> SolverConfig:
+        """These settings with the budgets of one run: a budget written stays as written;
+        `auto` (None) gives BUDGET_PER_JOINT_SECOND steps or events per second of motion
+        [s] and per joint (a column's joints, 1 for a block), and never fewer than
+        BUDGET_FLOOR: a 16-drum column under a 35 s record gets 11.2 million steps and
+        1.12 million events, a block under 10 s the floors."""
+        if self.max_steps is not None and self.max_events is not None:
+            return self
+        scale = max(float(duration_s), 0.0) * max(int(joints), 1)
+        budgets = {}
+        for key in ("max_steps", "max_events"):
+            written = getattr(self, key)
+            scaled = math.ceil(BUDGET_PER_JOINT_SECOND[key] * scale)
+            budgets[key] = written if written is not None else max(BUDGET_FLOOR[key], scaled)
+        return replace(self, **budgets)
 
 
 @dataclass(frozen=True)
@@ -481,7 +547,8 @@ class Config:
         dimensions (ModelEntry.three_d); for a model that takes any direction
         (ModelEntry.any_direction), when the motion is given a direction
         (``excitation.angle`` written, 0 included, or an axis over it) or a second
-        horizontal component (``excitation.file_y``, or an axis over it: a suite of pairs)."""
+        horizontal component (``excitation.file_y`` or ``excitation.y``, or an axis over
+        either: a suite of pairs)."""
         entry = MODELS[self.model]
         if entry.three_d:
             return True
@@ -493,8 +560,10 @@ class Config:
             e.directed
             or e.angle != 0.0
             or e.file_y is not None
+            or e.y is not None
             or "excitation.angle" in paths
             or "excitation.file_y" in paths
+            or any(p == "excitation.y" or p.startswith("excitation.y.") for p in paths)
         )
 
     def record_files(self) -> tuple[tuple[str, str, str], ...]:

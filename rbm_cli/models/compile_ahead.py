@@ -118,7 +118,7 @@ def compile_once(
     """
     module, name = _module(target), NAMES[target]
     say = notify or (lambda text: None)
-    about = f"(first use only, about {ABOUT_S[target]} s)"
+    about = f"(first use only, about {ABOUT_S[target]} s on an idle machine)"
     start = time.perf_counter()
     needs = module.needs_compile()
     waited = False

@@ -16,6 +16,12 @@ import numpy as np
 
 from rbm_cli.models.history import History
 
+#: A joint's lean is wobbling (Outcome.turns counts its direction's turning) while it is at
+#: least this fraction of the joint's collapse limit [-]: nearer closure the direction of a
+#: small rotation, which turns round at every pass near zero, says nothing of a rolling
+#: column [assumption; the contact engine's reading of its joints uses the same fraction].
+WOBBLE_LEVEL = 0.1
+
 
 class EnergyAccount(NamedTuple):
     """The energy account of a run [J], relative to the ground (Model.energy: kinetic, the
@@ -40,6 +46,15 @@ class EnergyAccount(NamedTuple):
         return {"initial_J": self.initial, "final_J": self.final,
                 "ground_work_J": self.ground_work, "damping_J": self.damping,
                 "impacts_J": self.impacts, "residual_J": self.residual}  # fmt: skip
+
+
+def budget_message(kind: str, budget: int) -> str:
+    """The message of a run that used up its step or event budget (kind: 'step' or
+    'event'): which budget, its size and how to raise it."""
+    return (
+        f"{kind} budget exceeded ({budget:,} {kind}s; raise solver.max_{kind}s, by default"
+        " auto: it scales with the motion's duration and the joints)"
+    )
 
 
 @dataclass
@@ -67,7 +82,8 @@ class Outcome:
     method: str = ""  # the method that ran (solver.method, `auto` resolved), set by the runner
     energy: EnergyAccount | None = None  # a recorded run's energy account, where kept
     #: a model in three dimensions: where its lean pointed at collapse [rad from x], and
-    #: the angle its lean's direction swept while it rolled, in turns [-]
+    #: the angle its lean's direction swept while it leant by WOBBLE_LEVEL of its collapse
+    #: limit or more (a wobble), in turns [-] (the largest over the joints)
     azimuth: float = math.nan
     turns: float = math.nan
     top_plan: np.ndarray | None = None  # a recorded 3D run: the top in plan per sample [m]
@@ -109,11 +125,11 @@ class Outcome:
 
     def out_of_steps(self, solver, t: float) -> Outcome:
         """The run ended 'failed' at t [s]: more steps than solver.max_steps."""
-        return self.stop("failed", f"step budget exceeded ({solver.max_steps} steps)", t)
+        return self.stop("failed", budget_message("step", solver.max_steps), t)
 
     def out_of_events(self, solver, t: float) -> Outcome:
         """The run ended 'failed' at t [s]: more events than solver.max_events."""
-        return self.stop("failed", f"event budget exceeded ({solver.max_events} events)", t)
+        return self.stop("failed", budget_message("event", solver.max_events), t)
 
     def out_of_time(self, solver, t: float) -> Outcome:
         """The run ended 'failed' at t [s]: past its wall-clock budget."""

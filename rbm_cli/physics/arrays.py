@@ -111,7 +111,7 @@ def survival_barrier(model: Model) -> float:
         return math.nan
     limit = model.collapse_ratio * model.column.rotation_capacity
     return float(min(min(law.potential(x), law.potential(-x))
-                     for law, x in zip(model.laws, limit)))  # fmt: skip
+                     for law, x in zip(model.laws, limit, strict=True)))  # fmt: skip
 
 
 @jit

@@ -35,9 +35,11 @@ right-hand side (rbm_cli.models.rbm.step.rk.rhs: a state of 4n values is this mo
 - ``cs`` (9n): per joint, the piece it is on: intercept, weight slope, elastic slope, its
   damping (0 off the elastic branch), pinned (1.0 or 0.0), the pinned direction (x, y),
   then 2n of scratch for the moments (:func:`pack_pieces` fills it);
-- ``es`` (n + 8): -M^-1 r, the motion's direction in plan (cos, sin), then the second
-  horizontal component's straight piece of a record pair (flag, gain, a_{k+1} - a_k, a_k,
-  t_k, t_{k+1} - t_k; flag 0 for one component), then 1.0 if K_g is not zero.
+- ``es`` (n + 10): -M^-1 r, the motion's direction in plan (cos, sin), then the second
+  horizontal component (flag, gain, omega, phase, centre, gamma: a record pair's straight
+  piece, a_{k+1} - a_k, a_k, t_k, t_{k+1} - t_k, or an analytic component's formula; flag
+  0 for one component), then 1.0 if K_g is not zero, then the second component's form
+  (physics.ground: LINE for a record pair's piece, or SINE, RICKER, MP).
 """
 
 from __future__ import annotations
@@ -45,22 +47,26 @@ from __future__ import annotations
 import math
 
 from rbm_cli.base.jit import jit
-from rbm_cli.physics.ground import gravity_factor, ground
+from rbm_cli.physics.ground import LINE, gravity_factor, ground, shape_at
 
-#: Entries of ``es`` after the n loads: the direction, the second component's piece, and
-#: whether gravity's term K_g is there (`geometric`).
-ES_EXTRA = 9
+#: Entries of ``es`` after the n loads: the direction, the second component's piece or
+#: formula, whether gravity's term K_g is there (`geometric`), and the second component's
+#: form.
+ES_EXTRA = 10
 #: Entries per joint of ``cs`` (pieces, pinned direction, scratch).
 CS_PER_JOINT = 9
 
 
 @jit(inline=True)
 def second_component(t, es, n):
-    """a_y(t) [m/s^2] of a pair's second record on its current straight piece (0 without)."""
+    """a_y(t) [m/s^2] of a pair's second component: a record's on its current straight
+    piece, or an analytic one's formula (0 without)."""
     if es[n + 2] == 0.0 or es[n + 3] == 0.0:
         return 0.0
-    v = es[n + 5] + es[n + 4] * ((t - es[n + 6]) / es[n + 7])
-    return v if es[n + 3] == 1.0 else es[n + 3] * v
+    if es[n + 9] == LINE:
+        v = es[n + 5] + es[n + 4] * ((t - es[n + 6]) / es[n + 7])
+        return v if es[n + 3] == 1.0 else es[n + 3] * v
+    return shape_at(t, int(es[n + 9]), es[n + 3], es[n + 4], es[n + 5], es[n + 6], es[n + 7])
 
 
 @jit(inline=True)

@@ -5,7 +5,8 @@
 every model integrates: a harmonic, a half-sine or near-fault pulse (physics/pulses.py),
 or a record read from its file (physics/records.py) or given as arrays
 (rbm_cli.config.motions.Motion), with its vertical record if any, both processed as
-``excitation.processing`` says before they are scaled.
+``excitation.processing`` says before they are scaled; a harmonic or a pulse with its
+analytic second horizontal component (``excitation.y``: :func:`second_component`).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import PULSES, ExcitationConfig, G, ProcessingConfig
-from rbm_cli.physics.ground import mp_knots, ricker_knots
+from rbm_cli.physics.ground import MP, RICKER, SINE, mp_knots, ricker_knots
 from rbm_cli.physics.motion import PULSE_KINDS, SAMPLES_PER_PERIOD, GroundMotion
 from rbm_cli.physics.pulses import (
     mavroeidis_papageorgiou_duration,
@@ -42,6 +43,7 @@ __all__ = [
     "processed_record",
     "pulse_motion",
     "record_motion",
+    "second_component",
 ]
 
 
@@ -155,13 +157,12 @@ def pair_times(excitation: ExcitationConfig) -> str | None:
     when both have the same sample times (run as read), ``union`` when they differ (both
     on the union of their times, each linear between its own samples:
     :func:`common_knots`); None without a second component."""
+    if excitation.motion is not None:  # given as arrays: a pair has one time base
+        return "shared" if excitation.motion.is_pair else None
     if excitation.file_y is None:
         return None
     path = excitation.file_path or excitation.file
-    if excitation.motion is not None:
-        t = np.asarray(excitation.motion.time_s, dtype=float)
-    else:
-        t = load_record(str(path), excitation.units, excitation.file_sha256).t
+    t = load_record(str(path), excitation.units, excitation.file_sha256).t
     path_y = excitation.file_y_path or excitation.file_y
     t_y = load_record(str(path_y), excitation.units, excitation.file_y_sha256).t
     return "shared" if np.array_equal(t, t_y) else "union"
@@ -281,11 +282,50 @@ def make_ground_motion(
     """Ground motion of a run; amplitude in g, frequency in Hz and the angle in degrees at
     this edge only.
 
-    frequency_hz is not used by 'free' and 'record' (None is accepted there)."""
+    frequency_hz is not used by 'free' and 'record' (None is accepted there). With
+    excitation.y the motion has its analytic second component (:func:`second_component`),
+    along (-sin angle, cos angle) as a record pair's y."""
     motion = _motion(excitation, amplitude_g, frequency_hz)
+    y = excitation.y
+    if y is not None and y.amplitude_ratio != 0.0 and motion.amplitude != 0.0:
+        motion = dataclasses.replace(
+            motion, second=second_component(motion, y.amplitude_ratio, y.phase_deg)
+        )
     if excitation.angle == 0.0:
         return motion
     return dataclasses.replace(motion, angle=math.radians(excitation.angle))
+
+
+def second_component(motion: GroundMotion, ratio: float, phase_deg: float) -> GroundMotion:
+    """The analytic second horizontal component (excitation.y) of a harmonic or a pulse:
+    its formula times ratio r [-], its phase led by phi = phase_deg [deg], on the same
+    support (a_y = 0 where a_x is, after the pulse):
+
+    - a sine (harmonic, half-sine, one-sine, cycloidal): a_y = r A sin(omega t + phase +
+      phi), phase the first's (the harmonic's excitation.phase, pi/2 for the cycloidal);
+    - mavroeidis-papageorgiou: the same pulse with nu + phi and the same velocity
+      amplitude times r, so its peak is r A where phi is a multiple of pi;
+    - ricker (no phase): the same wavelet times r, or -r where phi is an odd multiple of
+      180 degrees (the config takes multiples of 180 only).
+    """
+    phi = math.radians(phase_deg)
+    if motion.form == SINE:
+        return dataclasses.replace(motion, amplitude=ratio * motion.amplitude,
+                                   phase=motion.phase + phi)  # fmt: skip
+    if motion.form == RICKER:
+        sign = 1.0 if phase_deg % 360.0 == 0.0 else -1.0
+        return dataclasses.replace(motion, amplitude=ratio * motion.amplitude,
+                                   gain=sign * ratio * motion.shape_gain)  # fmt: skip
+    if motion.form != MP:
+        raise RbmError(f"excitation.y does not apply to a motion of kind {motion.kind}")
+    nu, gain = motion.phase + phi, ratio * motion.shape_gain
+    return dataclasses.replace(
+        motion,
+        amplitude=abs(gain) * mp_peak(motion.gamma, nu),
+        phase=nu,
+        gain=gain,
+        knots=mp_knots(motion.omega / (2.0 * math.pi), motion.gamma, nu),
+    )
 
 
 def _motion(

@@ -100,6 +100,15 @@ def ground(t, gr):
 
 
 @jit(inline=True)
+def shape_at(t, form, amp, om, ph, c, gamma):
+    """a(t) [m/s^2] of a form's formula (SINE, RICKER, MP, or a record's straight piece,
+    LINE), its numbers given one by one (a pair's second component, physics.beam3d)."""
+    if form == SINE:
+        return amp * dsin(om * t + ph)
+    return _ground_other(t, form, amp, om, ph, c, gamma)
+
+
+@jit(inline=True)
 def gravity_factor(t, gr):
     """(g + a_v(t)) / g [-] of the ground tuple gr (1 with no vertical record)."""
     if gr[6] == 0.0:
@@ -346,6 +355,132 @@ def pair_exceedance(t0, ratio, last, knots, ax, ay, av):
             t = ta + s * (tb - ta)
             return t if t < last else -1.0
     return -1.0
+
+
+@jit
+def _turn(c, d):
+    """The angle [rad] whose cosine and sine are c / hypot(c, d) and d / hypot(c, d) (up to
+    a whole turn), by detmath's asin on its well-conditioned half (no atan2: the C
+    library's differs in the last bit from one CPU to another)."""
+    r = math.sqrt(c * c + d * d)
+    if abs(d) <= abs(c):
+        b = dasin(d / r)
+        return b if c > 0.0 else math.pi - b
+    b = _HALF_PI - dasin(c / r)
+    return b if d > 0.0 else -b
+
+
+@jit
+def _sine_pair_exceedance(t0, level, last, gr, gy):
+    """The first time in [t0, last) where |(a_x, a_y)| > level [m/s^2], -1 for none: two
+    sines of one frequency, a_x = g_x sin(psi), a_y = g_y sin(psi + delta), psi = om t +
+    ph_x. In closed form: |a|^2 = (g_x^2 + g_y^2) / 2 - (R / 2) cos(2 psi + beta), with
+    g_x^2 cos 2 psi + g_y^2 cos(2 psi + 2 delta) = R cos(2 psi + beta), so |a| > level
+    where sin(chi) > s, chi = 2 psi + beta - pi / 2, s = (2 level^2 - g_x^2 - g_y^2) / R;
+    the time returned is where |a| = level and rising (t0 itself when already above)."""
+    if t0 >= last:
+        return -1.0
+    om, gx, gyy = gr[2], gr[1], gy[1]
+    d2 = 2.0 * (gy[3] - gr[3])
+    gx2, gy2 = gx * gx, gyy * gyy
+    c = gx2 + gy2 * dsin(d2 + _HALF_PI)
+    d = gy2 * dsin(d2)
+    r = math.sqrt(c * c + d * d)
+    over = 2.0 * level * level - gx2 - gy2
+    if r == 0.0:  # a circle: |a| constant
+        return t0 if over < 0.0 else -1.0
+    s = over / r
+    if s >= 1.0:
+        return -1.0
+    ph = 2.0 * gr[3] + _turn(c, d) - _HALF_PI
+    chi0 = 2.0 * om * t0 + ph
+    if s < -1.0 or dsin(chi0) > s:
+        return t0
+    lo = dasin(s)
+    kk = math.ceil((chi0 - lo) / (2.0 * math.pi))
+    chi = lo + kk * 2.0 * math.pi
+    if chi < chi0:
+        chi += 2.0 * math.pi
+    t = (chi - ph) / (2.0 * om)
+    return t if t < last else -1.0
+
+
+#: Depth of the interval search of a pair of formulas (more halvings than a double has
+#: between two knots but near t = 0; deeper, an interval is taken as a point).
+PAIR_DEPTH = 128
+
+
+@jit
+def _pair_first_above(a, b, l2, gr, gy):
+    """The first time in (a, b] where a_x^2 + a_y^2 > l2, -1 for none, with a_x and a_y
+    each monotone on [a, b] (between knots of both): on an interval, a_x^2 + a_y^2 is at
+    most the larger of a_x^2 at its ends plus the larger of a_y^2 there, so an interval
+    whose bound is at most l2 holds no crossing; the others are halved, the earlier half
+    first, down to the last bit (the earliest float past the crossing)."""
+    los, his = np.empty(PAIR_DEPTH + 1), np.empty(PAIR_DEPTH + 1)
+    los[0], his[0] = a, b
+    top = 1
+    while top > 0:
+        top -= 1
+        lo, hi = los[top], his[top]
+        xl, yl = ground(lo, gr), ground(lo, gy)
+        xh, yh = ground(hi, gr), ground(hi, gy)
+        if max(xl * xl, xh * xh) + max(yl * yl, yh * yh) <= l2:
+            continue
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi or top + 2 > PAIR_DEPTH:
+            if xh * xh + yh * yh > l2:
+                return hi
+            continue
+        los[top], his[top] = mid, hi
+        los[top + 1], his[top + 1] = lo, mid
+        top += 2
+    return -1.0
+
+
+@jit
+def _formula_pair_exceedance(t0, level, last, gr, gy, knots, knots_y):
+    """The first time in [t0, last) where |(a_x, a_y)| > level [m/s^2], -1 for none: two
+    formulas (a Ricker or MP pulse and its second component), each monotone between its
+    knots, searched on the intervals between the knots of both (_pair_first_above); t0
+    itself when already above."""
+    if t0 >= last:
+        return -1.0
+    l2 = level * level
+    x0, y0 = ground(t0, gr), ground(t0, gy)
+    if x0 * x0 + y0 * y0 > l2:
+        return t0
+    i, j = _first_after(knots, t0), _first_after(knots_y, t0)
+    tl = t0
+    while True:
+        tx = knots[i] if i < knots.size else last
+        ty = knots_y[j] if j < knots_y.size else last
+        tr = min(tx, ty, last)
+        if tr > tl:
+            t = _pair_first_above(tl, tr, l2, gr, gy)
+            if t >= 0.0:
+                return t if t < last else -1.0
+        if tr >= last:
+            return -1.0
+        if tx == tr:
+            i += 1
+        if ty == tr:
+            j += 1
+        tl = tr
+
+
+@jit
+def pair_uplift(t0, ratio, last, gr, gy, knots, values, values_y, knots_y, vertical):
+    """The first time t in [t0, last) where a pair's horizontal acceleration's magnitude
+    exceeds ratio (g + a_v(t)) [m/s^2], -1 for none: a pair of records (values_y not
+    empty: :func:`pair_exceedance`), or a formula gr and its second component gy (ground
+    tuples; knots_y gy's knots): two sines in closed form, the other forms by halving
+    intervals between both knots to the last bit."""
+    if values_y.size > 0:
+        return pair_exceedance(t0, ratio, last, knots, values, values_y, vertical)
+    if gr[0] == SINE:
+        return _sine_pair_exceedance(t0, ratio * G, last, gr, gy)
+    return _formula_pair_exceedance(t0, ratio * G, last, gr, gy, knots, knots_y)
 
 
 @jit

@@ -27,7 +27,7 @@ from rbm_cli.physics.ground import (
     as_samples,
     form_function,
     next_uplift,
-    pair_exceedance,
+    pair_uplift,
     sampled_displacement,
     vertical_factor,
 )
@@ -73,6 +73,9 @@ class GroundMotion:
         [m/s^2], acting along (-sin angle, cos angle) (excitation.file_y; models in three
         dimensions only). Sampled at other times than the record, both are on the union
         of their samples' times (each linear between its own samples, as read)
+    second : GroundMotion or None  A harmonic's or a pulse's analytic second horizontal
+        component (excitation.y: the same form and support, its own gain, phase and
+        knots), acting along (-sin angle, cos angle) as values_y does
     """
 
     kind: str
@@ -90,6 +93,13 @@ class GroundMotion:
     vertical: np.ndarray | None = None
     angle: float = 0.0
     values_y: np.ndarray | None = None
+    second: GroundMotion | None = None
+
+    @property
+    def paired(self) -> bool:
+        """Whether the motion has a second horizontal component (a record's, values_y, or
+        a formula's, second)."""
+        return self.values_y is not None or self.second is not None
 
     @property
     def direction(self) -> np.ndarray:
@@ -100,17 +110,66 @@ class GroundMotion:
 
     @cached_property
     def _y_component(self) -> GroundMotion:
-        """The second horizontal component as a motion of its own (its samples on the same
-        knots), whose compiled form a run evaluates."""
+        """The second horizontal component as a motion of its own (a record's samples on the
+        same knots, or the formula's second), whose compiled form a run evaluates."""
+        if self.second is not None:
+            return self.second
         peak = float(np.max(np.abs(self.values_y)))
         return dataclasses.replace(self, amplitude=peak, values=self.values_y, values_y=None)
 
     def accel_y(self, t: np.ndarray) -> np.ndarray | None:
         """A pair's second component a_y(t) [m/s^2] as read (along (-sin angle, cos angle)),
         vectorised as :meth:`accel`; None for a motion of one component."""
-        if self.values_y is None:
+        if not self.paired:
             return None
         return self._y_component.accel(t)
+
+    @property
+    def ground_y(self) -> tuple:
+        """The second component's ground tuple as the compiled functions read it
+        (physics.ground; a record pair's says SAMPLED, its values being values_y; gain 0
+        for a motion of one component)."""
+        if self.second is not None:
+            return self.second._ground
+        if self.values_y is not None:
+            return (SAMPLED, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+        return (SINE, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+
+    @property
+    def knots_y(self) -> np.ndarray:
+        """The knots of a formula's second component (empty for none or a record's)."""
+        return as_samples(None if self.second is None else self.second.knots)
+
+    @cached_property
+    def horizontal_peak(self) -> float:
+        """max over the motion of |(a_x, a_y)| [m/s^2]: the amplitude, or a pair's
+        resultant (a record pair's at its samples; a formula pair's on its pulse, or a
+        period of a harmonic, sampled 256 times a period and at both knots, its best local
+        maxima then refined by Brent's method)."""
+        if self.second is None:
+            return self.amplitude
+        from scipy.optimize import minimize_scalar  # here: no scipy at import
+
+        end = min(self.pulse_end, self.t_end)
+        if self.kind == "harmonic":  # periodic: one period holds its largest value
+            end = min(end, 2.0 * math.pi / self.omega)
+        count = max(8, math.ceil(256 * self.omega * end / (2.0 * math.pi)))
+        extra = [k for k in (self.knots, self.second.knots) if k is not None]
+        ts = np.union1d(np.linspace(0.0, end, count + 1), np.concatenate([[0.0], *extra]))
+        ts = ts[(ts >= 0.0) & (ts <= end)]
+
+        def size(t):
+            ax, ay = self.accel(t), self.second.accel(t)
+            return np.hypot(ax, ay)
+
+        values = size(ts)
+        best = float(np.max(values))
+        inner = np.nonzero((values[1:-1] >= values[:-2]) & (values[1:-1] >= values[2:]))[0] + 1
+        for k in inner[np.argsort(values[inner])[::-1][:4]]:
+            found = minimize_scalar(lambda x: -float(size(x)), bounds=(ts[k - 1], ts[k + 1]),
+                                    method="bounded", options={"xatol": 1e-13 * end})  # fmt: skip
+            best = max(best, -float(found.fun))
+        return best
 
     def accel_plan(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(a_x(t), a_y(t)) [m/s^2] in the ground's axes at times t [s] (vectorised as
@@ -130,7 +189,7 @@ class GroundMotion:
         records); 0 off a forced segment."""
         d = self.direction
         a = self.scalar(forced)
-        if self.values_y is None:
+        if not self.paired:
             return lambda tt: (a(tt) * d[0], a(tt) * d[1])
         b = self._y_component.scalar(forced)
 
@@ -141,14 +200,15 @@ class GroundMotion:
         return pair
 
     def next_pair_exceedance(self, t0: float, ratio: float, t_stop: float) -> float | None:
-        """A pair of records: the first time t in [t0, t_stop) where the horizontal
-        acceleration's magnitude exceeds ratio (g + a_v(t)) [m/s^2] (ratio = tan(alpha) for
-        a block's uplift), or None (physics.ground.pair_exceedance: exact on each sample
-        interval)."""
+        """A pair: the first time t in [t0, t_stop) where the horizontal acceleration's
+        magnitude exceeds ratio (g + a_v(t)) [m/s^2] (ratio = tan(alpha) for a block's
+        uplift), or None (physics.ground.pair_uplift: exact on each sample interval of a
+        record pair; two sines in closed form; other formulas to the last bit)."""
         knots, values, vertical = self._samples
         last = min(self.pulse_end, self.t_end, t_stop)
-        t = pair_exceedance(float(t0), float(ratio), float(last), knots, values,
-                            as_samples(self.values_y), vertical)  # fmt: skip
+        t = pair_uplift(float(t0), float(ratio), float(last), self._ground, self.ground_y,
+                        knots, values, as_samples(self.values_y), self.knots_y,
+                        vertical)  # fmt: skip
         return None if t < 0.0 else t
 
     @property
@@ -205,8 +265,12 @@ class GroundMotion:
 
     def until(self, t_stop: float) -> GroundMotion:
         """The motion simulated up to t_stop [s] only (its pulse cut there)."""
+        second = None if self.second is None else self.second.until(t_stop)
         return dataclasses.replace(
-            self, pulse_end=min(self.pulse_end, t_stop), t_end=min(self.t_end, t_stop)
+            self,
+            pulse_end=min(self.pulse_end, t_stop),
+            t_end=min(self.t_end, t_stop),
+            second=second,
         )
 
     def scalar(self, forced: bool = True):
@@ -291,12 +355,12 @@ class GroundMotion:
         (physics.ground.next_uplift: exact for the sine, exact on the monotone pieces of
         the other forms; with a vertical record the level is level (g + a_v(t)) / g). The
         time returned is where |a_g| = level and rising (t0 itself when already above)."""
-        if self.amplitude <= level and self.vertical is None:
-            return None
+        if self.amplitude <= level and self.vertical is None and self.second is None:
+            return None  # (a record pair's amplitude is its resultant's peak)
         last = min(self.pulse_end, self.t_end)
         if t0 >= last:
             return None
-        if self.values_y is not None:  # a pair: the magnitude of the two components
+        if self.paired:  # a pair: the magnitude of the two components
             return self.next_pair_exceedance(t0, level / G, last)
         t = next_uplift(float(t0), float(level), float(self.amplitude), self._ground,
                         *self._samples, float(last))  # fmt: skip
@@ -330,7 +394,7 @@ class GroundMotion:
     def uplift_direction(self, t: float) -> np.ndarray:
         """The unit vector in plan a block at rest lifts toward at time t: away from the
         horizontal acceleration (a pair's resultant, or a_g along ``direction``)."""
-        if self.values_y is None:
+        if not self.paired:
             return self.uplift_side(t) * self.direction
         ax, ay = self.horizontal(True)(t)
         size = math.hypot(ax, ay)

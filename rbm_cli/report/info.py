@@ -237,8 +237,8 @@ def _value_at(config: Config, path: str) -> str:
     """The value a run of the config takes for a grid axis's key path, as written."""
     if path in VIRTUAL_PATHS:
         return "as written"
-    if path in ("excitation.file", "excitation.vertical"):  # a suite's first record
-        return str(getattr(config.excitation, path.split(".")[1]))
+    if path in ("excitation.file", "excitation.file_y", "excitation.vertical"):
+        return str(getattr(config.excitation, path.split(".")[1]))  # a suite's first record
     node = config.written or {}
     for key in path.split("."):
         node = node.get(key) if isinstance(node, dict) else None

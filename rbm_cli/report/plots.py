@@ -45,6 +45,19 @@ def top_relative_displacement(history: History) -> np.ndarray:
     return u[:, -1] - u[:, 0]
 
 
+def _plot_top_in_plan(ax, history: History, colour: str, what: str) -> None:
+    """A model in three dimensions: the top's displacement in plan (History.top_plan),
+    its resultant (gid 'top') and both components (gids 'top-x', 'top-y')."""
+    t = np.asarray(history.t, dtype=float)
+    xy = np.asarray(history.top_plan, dtype=float)
+    ax.plot(t, np.hypot(xy[:, 0], xy[:, 1]), color=colour, linewidth=1.2,
+            label=f"{what}: resultant", gid="top")  # fmt: skip
+    ax.plot(t, xy[:, 0], color=colour, linewidth=0.7, linestyle="--", alpha=0.8,
+            label=f"{what}: x", gid="top-x")  # fmt: skip
+    ax.plot(t, xy[:, 1], color=colour, linewidth=0.7, linestyle=":", alpha=0.8,
+            label=f"{what}: y", gid="top-y")  # fmt: skip
+
+
 #: The ground's displacement is said to drift (and plot_history draws the column relative
 #: to it by default) when its range over the run is more than this many times the range of
 #: the top's displacement relative to the base: drawn together on one scale, the column's
@@ -77,7 +90,8 @@ def plot_history(
     relative : bool or None  True: the top drawn relative to the ground (the base at 0),
         and the ground's displacement on a second axis on the right, with its own scale;
         False: both absolute, on one scale; None (default): relative when the ground
-        drifts (:func:`ground_drifts`), else absolute
+        drifts (:func:`ground_drifts`), else absolute. A model in three dimensions (the
+        history has ``top_plan``) is drawn relative: its top moves in plan
 
     Notes
     -----
@@ -85,17 +99,23 @@ def plot_history(
     displacement of the top node. Harmonic runs use the steady ground motion
     u_g = -a_g / omega^2; pulses and records the ground's displacement integrated from
     rest (a record's after its processing, excitation.processing) (see
-    :class:`rbm_cli.models.history.History`).
+    :class:`rbm_cli.models.history.History`). A model in three dimensions draws its top's
+    displacement in plan from where it stood (``top_plan``): the resultant and its x and y
+    components, the ground's (the motion's own, the first record's for a pair) on the right.
     """
     ax = _new_axes(ax)
     t = np.asarray(history.t, dtype=float)
     ug = np.asarray(history.ground_displacement, dtype=float)
-    if relative is None:
-        relative = ground_drifts(history)
+    plan = history.top_plan is not None
+    if relative is None or plan:
+        relative = plan or ground_drifts(history)
     if relative:
         ax.axhline(0.0, color="0.4", linewidth=1.0, label="base (ground)")
-        ax.plot(t, top_relative_displacement(history), color="tab:blue", linewidth=1.2,
-                label="top, relative to the ground")  # fmt: skip
+        if plan:
+            _plot_top_in_plan(ax, history, "tab:blue", "top in plan")
+        else:
+            ax.plot(t, top_relative_displacement(history), color="tab:blue", linewidth=1.2,
+                    label="top, relative to the ground")  # fmt: skip
         right = ax.twinx()
         right.plot(t, ug, color="0.55", linewidth=0.9, linestyle="--", gid="ground",
                    label="ground (right axis)")  # fmt: skip
@@ -103,9 +123,8 @@ def plot_history(
         # the ground's line in the left axis's legend
         ax.plot([], [], color="0.55", linewidth=0.9, linestyle="--", label="ground (right axis)")
         ax.set_ylabel("top - ground [m]")
-        ax.set_title(
-            f"Top relative to the ground; the ground, which moves {np.ptp(ug):.3g} m, on the right"
-        )
+        what = "Top in plan (resultant, x, y)" if plan else "Top relative to the ground"
+        ax.set_title(f"{what}; the ground, which moves {np.ptp(ug):.3g} m, on the right")
     else:
         ax.plot(t, ug, color="0.4", linewidth=1.0, label="base (ground)")
         ax.plot(t, ug + top_relative_displacement(history), color="tab:blue", linewidth=1.2,
@@ -120,7 +139,9 @@ def plot_history(
 
 
 def plot_top_relative(history: History, ax=None, t_collapse: float | None = None):
-    """Top displacement relative to the base, u_{n+1} - u_1, against time.
+    """Top displacement relative to the base, u_{n+1} - u_1, against time; for a model in
+    three dimensions the top's displacement in plan from where it stood: its resultant
+    (gid 'top') and its x and y components (gids 'top-x', 'top-y').
 
     Parameters
     ----------
@@ -130,13 +151,16 @@ def plot_top_relative(history: History, ax=None, t_collapse: float | None = None
     """
     ax = _new_axes(ax)
     t = np.asarray(history.t, dtype=float)
-    ax.plot(
-        t,
-        top_relative_displacement(history),
-        color="tab:orange",
-        linewidth=1.2,
-        label="top relative to base",
-    )
+    if history.top_plan is not None:
+        _plot_top_in_plan(ax, history, "tab:orange", "top in plan")
+    else:
+        ax.plot(
+            t,
+            top_relative_displacement(history),
+            color="tab:orange",
+            linewidth=1.2,
+            label="top relative to base",
+        )
     ax.axhline(0.0, color="0.6", linewidth=0.6)
     _mark_collapse(ax, t_collapse)
     ax.set_xlabel("time [s]")
@@ -311,7 +335,12 @@ def plot_joint_rotations(
 
     Returns
     -------
-    matplotlib Axes; line k (gid 'joint-<k+1>') is joint k+1's rotation / theta_u,k+1 [-]
+    matplotlib Axes; line k (gid 'joint-<k+1>') is joint k+1's rotation / theta_u,k+1 [-].
+    A model in three dimensions (the history has ``rotations_across``): line k is the
+    resultant of the rotations seen in the motion's plane and across it (the magnitude of
+    the joint's rotation vector, which collapse reads), and the joint that comes nearest
+    its limit has its two components drawn too (gids 'joint-<k+1>-along' and
+    'joint-<k+1>-across')
     """
     ax = _new_axes(ax)
     theta = np.atleast_2d(np.asarray(history.rotations, dtype=float))
@@ -319,23 +348,38 @@ def plot_joint_rotations(
     if limits.shape != (theta.shape[1],):
         n = theta.shape[1]
         raise ValueError(f"rotation_capacity has {limits.size} entries, the history {n} drums")
-    if formulation == "absolute":
-        angle, symbol = theta, r"\theta_i"
-    else:
-        angle, symbol = np.diff(theta, axis=1, prepend=0.0), r"\varphi_i"
+
+    def joint_angles(rotations):
+        if formulation == "absolute":
+            return rotations
+        return np.diff(rotations, axis=1, prepend=0.0)
+
+    symbol = r"\theta_i" if formulation == "absolute" else r"\varphi_i"
+    along = joint_angles(theta) / limits
+    across = None
+    if history.rotations_across is not None:
+        seen = np.atleast_2d(np.asarray(history.rotations_across, dtype=float))
+        across = joint_angles(seen) / limits
     from matplotlib import colormaps
 
     colours = colormaps["viridis"](np.linspace(0.0, 0.85, theta.shape[1]))
     t = np.asarray(history.t, dtype=float)
+    ratio = along if across is None else np.hypot(along, across)
     for i in range(theta.shape[1]):
         ax.plot(
             t,
-            angle[:, i] / limits[i],
+            ratio[:, i],
             color=colours[i],
             linewidth=1.0,
-            label=f"joint {i + 1}",
+            label=f"joint {i + 1}" + ("" if across is None else ": resultant"),
             gid=f"joint-{i + 1}",
         )
+    if across is not None and ratio.size:  # the components of the joint nearest its limit
+        k = int(np.argmax(np.max(ratio, axis=0)))
+        for part, style, where in ((along, "--", "along"), (across, ":", "across")):
+            seen_in = "in the motion's plane" if where == "along" else "across it"
+            ax.plot(t, part[:, k], color=colours[k], linewidth=0.7, linestyle=style,
+                    label=f"joint {k + 1}: {seen_in}", gid=f"joint-{k + 1}-{where}")  # fmt: skip
     for sign in (1.0, -1.0):
         ax.axhline(
             sign * collapse_ratio,

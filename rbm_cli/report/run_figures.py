@@ -87,11 +87,11 @@ def plot_ground(history: History, ax, vertical=None, t_collapse: float | None = 
     t = np.asarray(history.t, dtype=float)
     ag = np.asarray(history.ground_acceleration, dtype=float) / G
     pair = history.ground_acceleration_y is not None
-    label = "$a_x$ (horizontal, x record)" if pair else "$a_g$ (horizontal)"
+    label = "$a_x$ (horizontal, x)" if pair else "$a_g$ (horizontal)"
     ax.plot(t, ag, color="0.35", linewidth=0.8, label=label, gid="a_g")
     if pair:
         ay = np.asarray(history.ground_acceleration_y, dtype=float) / G
-        ax.plot(t, ay, color="tab:purple", linewidth=0.8, label="$a_y$ (horizontal, y record)",
+        ax.plot(t, ay, color="tab:purple", linewidth=0.8, label="$a_y$ (horizontal, y)",
                 gid="a_y")  # fmt: skip
     if vertical is not None:
         av = np.asarray(vertical, dtype=float) / G

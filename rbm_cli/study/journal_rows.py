@@ -11,6 +11,7 @@ import math
 
 from rbm_cli.study.domain import row_key
 from rbm_cli.study.result import STATUSES
+from rbm_cli.study.robustness import SENSITIVE_TO
 
 COUNT_FIELDS = ("n_uplifts", "n_impacts", "n_steps", "n_rhs")
 
@@ -75,6 +76,11 @@ def validate_row(
             return f"robust must be 0 or 1, got {robust!r}"
         if robust == 1 and cf not in (0.0, 1.0):
             return f"robust 1 but collapse_fraction {cf!r}: they disagree"
+        why = row.get("sensitive_to")
+        if why not in SENSITIVE_TO:
+            return f"sensitive_to must be one of {', '.join(SENSITIVE_TO)}, got {why!r}"
+        if (robust == 1) != (why == "none"):
+            return f"robust {robust} but sensitive_to {why!r}: they disagree"
     return ""
 
 

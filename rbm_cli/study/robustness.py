@@ -19,9 +19,28 @@ or all survive, none fails):
   or 10 rtol if rtol/10 is below the solver's range), so more than one tolerance
   must agree.
 
-Otherwise the cell is **sensitive**: reported, not scored, by the regression
-(tests/test_regression.py, `rbm compare`) and by `rbm bench --quick`. The rule
-is deterministic: the same config gives the same ensemble, byte for byte.
+and the same cell passes the **solver check**: re-run unperturbed with
+another way of computing it (:func:`solver_checks`), each run gives the member
+0's outcome (and none fails):
+
+- the same method at tolerances 100 times tighter (rtol/100 and atol/100; 100 rtol
+  where rtol/100 is below the solver's range), for every model with tolerances;
+- and, for the Rigid Beam Model, the other exact method where one applies: the exact
+  integrator (``solver.method: exact``) beside the step kernel on an elastic column;
+  the step kernel (at rtol/100) where the rigid block's closed form or the exact
+  integrator ran;
+- the contact engine (model ``bullet``, no tolerance) at half its time step;
+- ``housner-linear`` is its closed form only (no tolerance, no other method): its
+  check is empty.
+
+One or two extra runs a cell, against the MEMBERS - 1 of the ensemble.
+
+Otherwise the cell is **sensitive**, and ``sensitive_to`` says why: ``inputs`` (the
+members disagree, or one failed), ``solver`` (the solver check disagrees, or a check
+run failed) or ``both``; ``none`` for a robust cell. Sensitive cells are reported,
+not scored, by the regression (tests/test_regression.py, `rbm compare`) and by `rbm
+bench --quick`. The rule is deterministic: the same config gives the same ensemble,
+byte for byte.
 """
 
 from __future__ import annotations
@@ -30,7 +49,9 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from rbm_cli.config.types import Config
+from rbm_cli.config.load import TIME_STEP_RANGE
+from rbm_cli.config.types import Config, SolverConfig
+from rbm_cli.models.methods import METHODS, resolve
 
 #: Ensemble size the rule needs for a cell to be called robust.
 MEMBERS = 16
@@ -38,12 +59,19 @@ MEMBERS = 16
 SMALLEST, LARGEST = 1e-12, 1e-6
 #: The solver's tightest rtol (config validation range).
 MIN_RTOL = 1e-13
+#: The solver check divides the tolerances by this.
+TIGHTER = 100.0
 #: What meta.json records of the rule.
 RULE = (
     f"robust: all {MEMBERS} or more ensemble members agree and none fails; member j >= 1 "
     f"shifts phase and scales amplitude by eps_j log-spaced {SMALLEST:g}..{LARGEST:g} "
-    "(all four sign pairs); odd members at rtol, even members at rtol/10"
+    "(all four sign pairs); odd members at rtol, even members at rtol/10; and the solver "
+    f"check agrees: the cell at rtol/{TIGHTER:g} and atol/{TIGHTER:g}, and with the "
+    "other exact method where one applies (rbm: exact beside the step kernel, the step "
+    "kernel beside the closed form or exact; bullet: half the time step)"
 )
+#: The values of domain.csv's ``sensitive_to``: why a cell is not robust.
+SENSITIVE_TO = ("none", "inputs", "solver", "both")
 
 
 @dataclass(frozen=True)
@@ -82,12 +110,68 @@ def member_config(config: Config, a: float, member: Member) -> tuple[Config, flo
     return cfg, a * (1.0 + member.amplitude_relative)
 
 
-def summarise(flags: list[int], n_failed: int) -> tuple[float, int]:
-    """(collapse_fraction, robust) of a cell from its members' collapsed flags
-    (members that did not fail) and the count of members that failed."""
+def tighter(solver: SolverConfig) -> SolverConfig:
+    """The solver check's tolerances: rtol/TIGHTER and atol/TIGHTER (TIGHTER rtol where
+    rtol/TIGHTER is below the solver's range: the two must agree either way)."""
+    rtol = solver.rtol / TIGHTER
+    rtol = rtol if rtol >= MIN_RTOL else solver.rtol * TIGHTER
+    return dataclasses.replace(solver, rtol=rtol, atol=solver.atol / TIGHTER)
+
+
+def solver_checks(config: Config) -> tuple[SolverConfig, ...]:
+    """The solvers of a cell's solver check (see the module): each re-runs the
+    unperturbed cell, and each must give its outcome."""
+    solver = config.solver
+    method = resolve(config).name
+    if config.model == "housner-linear":
+        return ()
+    if config.model == "bullet":
+        step = max(solver.time_step / 2.0, TIME_STEP_RANGE[0])
+        return (dataclasses.replace(solver, time_step=step),)
+    if config.model != "rbm":
+        return (tighter(dataclasses.replace(solver, method=method)),)
+    if method in ("closed-form", "exact"):
+        return (tighter(dataclasses.replace(solver, method="DOP853")),)
+    pair = "DOP853" if method == "exact-first" else method
+    checks = (tighter(dataclasses.replace(solver, method=pair)),)
+    if METHODS["exact"].why_not(config, None) is None:
+        checks += (dataclasses.replace(solver, method="exact"),)
+    return checks
+
+
+def check_config(config: Config, solver: SolverConfig) -> Config:
+    """The config of a solver check's run (:func:`solver_checks`)."""
+    return dataclasses.replace(config, solver=solver)
+
+
+def summarise(
+    outcomes: list[int | None], checks: list[int | None] = ()
+) -> tuple[float, int, str]:
+    """(collapse_fraction, robust, sensitive_to) of a cell from its members' outcomes
+    (member 0 first) and its solver check's: 1 collapsed, 0 survived, None failed.
+
+    The members agree when none failed and all collapsed or all survived; the solver
+    check agrees when each of its runs has member 0's outcome (a run that failed where
+    member 0 did not, or the other way round, disagrees)."""
+    flags = [o for o in outcomes if o is not None]
     fraction = sum(flags) / len(flags) if flags else math.nan
-    robust = int(n_failed == 0 and bool(flags) and fraction in (0.0, 1.0))
-    return fraction, robust
+    inputs = not (len(flags) == len(outcomes) and bool(flags) and fraction in (0.0, 1.0))
+    reference = outcomes[0] if outcomes else None
+    solver = any(c != reference for c in checks)
+    why = SENSITIVE_TO[int(inputs) + 2 * int(solver)]
+    return fraction, int(not (inputs or solver)), why
 
 
-__all__ = ["MEMBERS", "RULE", "Member", "member_config", "members", "summarise", "tight_rtol"]
+__all__ = [
+    "MEMBERS",
+    "RULE",
+    "SENSITIVE_TO",
+    "Member",
+    "check_config",
+    "member_config",
+    "members",
+    "solver_checks",
+    "summarise",
+    "tight_rtol",
+    "tighter",
+]

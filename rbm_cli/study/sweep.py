@@ -47,7 +47,13 @@ from rbm_cli.study.domain import csv_text, parse_domain
 from rbm_cli.study.intensities import column_period
 from rbm_cli.study.parallel import run_chunks
 from rbm_cli.study.result import CSV_FIELDS
-from rbm_cli.study.robustness import member_config, members, summarise
+from rbm_cli.study.robustness import (
+    check_config,
+    member_config,
+    members,
+    solver_checks,
+    summarise,
+)
 from rbm_cli.study.store import JOURNAL, SweepStore
 from rbm_cli.study.sweep_folder import (
     as_started,
@@ -69,7 +75,7 @@ MAX_CELLS = 100_000
 MAX_RUNS = GRID_MAX_CELLS
 BACKENDS = ("loky", "threading", "sequential", "dask")
 #: Columns an ensemble sweep adds to domain.csv (rbm_cli.study.robustness).
-ENSEMBLE_FIELDS = ("collapse_fraction", "robust")
+ENSEMBLE_FIELDS = ("collapse_fraction", "robust", "sensitive_to")
 
 
 @dataclass(frozen=True)
@@ -110,15 +116,22 @@ def _run_cell(config: Config, a: float, f: float | None, runner) -> dict:
         }
 
 
+def _outcomes(rows: list[dict]) -> list[int | None]:
+    """Each run's outcome for the robustness rule: collapsed (1 or 0), None if it failed."""
+    return [None if r["status"] == "failed" else r["collapsed"] for r in rows]
+
+
 def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict]:
     """Run cells of one point's config in this process; a cell that raises is 'failed'.
 
     Cells are (amplitude_g, frequency_hz, point values) (rbm_cli.study.cells); each row
     gets its point's values and its column's scales. With ensemble K > 1 each cell is
-    run K times (rbm_cli.study.robustness.members) and its row is member 0's, plus
+    run K times (rbm_cli.study.robustness.members) and once or twice more by the solver
+    check (rbm_cli.study.robustness.solver_checks); its row is member 0's, plus
     collapse_fraction (the fraction of the members that did not fail which collapsed;
-    NaN if all failed) and robust (1 when all members agree and none failed: the
-    robustness rule)."""
+    NaN if all failed), robust (1 when all members agree, none failed and the solver
+    check agrees: the robustness rule) and sensitive_to (why not: inputs, solver, both;
+    none when robust)."""
     from rbm_cli.models.registry import make_runner
     from rbm_cli.physics.similarity import rocking_scales
 
@@ -127,14 +140,15 @@ def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict
     period = column_period(config) if has_records(config) else None
     rows = []
     others = members(ensemble)[1:]
+    checks = [check_config(config, s) for s in solver_checks(config)] if ensemble > 1 else []
     for cell in cells:
         a, f, _ = cell
         row = add_point(_run_cell(config, a, f, runner), config, cell, scales, period)
         if ensemble > 1:
             runs = [row] + [_run_cell(*member_config(config, a, m), f, runner) for m in others]
-            flags = [r["collapsed"] for r in runs if r["status"] != "failed"]
-            fraction, robust = summarise(flags, len(runs) - len(flags))
-            row["collapse_fraction"], row["robust"] = fraction, robust
+            checked = [_run_cell(c, a, f, runner) for c in checks]
+            summary = summarise(_outcomes(runs), _outcomes(checked))
+            row["collapse_fraction"], row["robust"], row["sensitive_to"] = summary
         rows.append(row)
     return rows
 

@@ -202,6 +202,7 @@ def run_closed_form(
     (t, [theta], [rate]) every output_dt [s] when record.
     """
     seg_t, seg_fc, seg_v = seg if seg is not None else block_segments(motion, not block.rbm)
+    solver = solver.for_run(motion.t_end, 1)
     mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit)
     samples = sample_buffer(motion.t_end, output_dt, record, 1)
     run = run_block if solver.implementation == "compiled" else plain(run_block)

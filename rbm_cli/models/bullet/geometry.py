@@ -72,8 +72,10 @@ def drum_solids(column: ColumnConfig, sides: int = CIRCLE_SIDES) -> tuple[DrumSo
     with j_y = d w^3 / 12 (rectangle) or pi w^4 / 64 (circle), and alike for
     I_xx (j_x = w d^3 / 12); I_zz = rho int j_z dz with j_z = w d (w^2 + d^2) / 12
     (or pi w^4 / 32).
-    The collision shape of a circular drum is a regular polygonal frustum whose
-    apothem is the true radius; its mass and inertia are the circle's.
+    The hull (``vertices``) of a circular drum is a regular polygonal frustum whose
+    apothem is the true radius; its mass and inertia are the circle's. A run collides
+    circular drums as the engine's cylinders (rbm_cli.models.bullet.scene.cylinder_shape),
+    not as this hull.
     """
     z0 = np.concatenate([[0.0], np.cumsum(column.drum_heights)])
     return tuple(_drum(column, z0, i, h, sides) for i, h in enumerate(column.drum_heights))

@@ -130,7 +130,8 @@ def _free_rocking(config, tilt_fraction, crossings, settings, tail=0.0):
     settings = settings or settings_from_config(config)
     alpha = stack_slenderness(solids)
     client = PhysicsClient.for_process()
-    bodies = build_scene(client, solids, settings, tilt_fraction * alpha[0], 0.0)
+    circular = config.column.section == "circular"  # the engine's cylinders, as a run's
+    bodies = build_scene(client, solids, settings, tilt_fraction * alpha[0], 0.0, circular)
     tilt, rate = _rock(client.module, client.id, bodies, settings.time_step, crossings, tail)
     return tilt, rate, settings.time_step
 

@@ -22,11 +22,16 @@ angular damping (PyBullet's defaults are not 0), collision margin 0, split
 impulse on, erp 0.2.
 
 In three dimensions (Config.three_d: the motion given a direction, ``excitation.angle``,
-or a second horizontal component, ``excitation.file_y``; circular drums), the drums are
+or a second horizontal component, ``excitation.file_y`` or ``excitation.y``; circular
+drums), the drums are
 the engine's cylinders (:func:`rbm_cli.models.bullet.scene.cylinder_shape`) and nothing
 holds them in a plane: they rock, roll on their rims, slide and twist as the contacts
 let them, the gravity vector (-a_x(t), -a_y(t), -(g + a_v(t))); the joints are read by
-:mod:`rbm_cli.models.bullet.space` (the same rules in any direction).
+:mod:`rbm_cli.models.bullet.space` (the same rules in any direction). An azimuth is taken
+modulo a whole turn (rbm_cli.models.plan.wrapped): 360 degrees is 0 to the bit. Circular
+drums are the engine's cylinders in the plane too, held in it: along x the run in the
+plane is then the run free in three dimensions (to 1e-10 of the peak: a pair whose second
+record is zeros, or an angle of 0, gives the run of the motion in the plane).
 
 Collapse: the run stops when, at a joint (or the base), the centre of mass of
 the drums above it passes over the pivot edge of the contact, i.e. when the
@@ -74,6 +79,7 @@ from rbm_cli.models.bullet.watch import (
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.history import History
 from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.plan import wrapped
 from rbm_cli.physics.excitation import GroundMotion
 
 __all__ = [
@@ -127,6 +133,8 @@ def ground_friction_demand(motion: GroundMotion) -> float:
     resultant). With a vertical record both are linear between the same knots (a pair's
     resultant convex), so the ratio is at most its value at an end of each interval and
     its maximum is at a knot."""
+    if motion.second is not None:  # an analytic second component (no vertical record)
+        return motion.horizontal_peak / G
     horizontal = None
     if motion.values_y is not None:  # a pair: the resultant, convex on each interval
         horizontal = np.hypot(motion.values, motion.values_y)
@@ -235,6 +243,8 @@ def bullet_run(
     n = len(solids)
     settings = settings or settings_from_config(config)
     tilt, rate = _initial(config)
+    if motion.angle != 0.0:  # a whole turn is none
+        motion = dataclasses.replace(motion, angle=wrapped(motion.angle))
     t_lift = motion.lift_off  # a vertical record dropping faster than gravity
     if t_lift is not None:
         motion = motion.until(t_lift)
@@ -256,7 +266,9 @@ def bullet_run(
     if client is None:
         client = PhysicsClient.for_process()
     space = config.three_d
-    bodies = build_scene(client, solids, settings, tilt, rate, cylinders=space)
+    # circular drums as the engine's cylinders, in three dimensions and held in the plane
+    cylinders = space or config.column.section == "circular"
+    bodies = build_scene(client, solids, settings, tilt, rate, cylinders=cylinders)
     samples, watch = _drive(
         client,
         bodies,

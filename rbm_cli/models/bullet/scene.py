@@ -35,7 +35,8 @@ def build_scene(
     tilt [rad], rate [rad/s]: the whole stack turned rigidly about the bottom
     corner of the base on the side of the tilt (positive: towards +x).
     cylinders: circular drums collided as the engine's cylinders (:func:`cylinder_shape`)
-    rather than as polygonal prisms (the run in three dimensions).
+    rather than as polygonal prisms (a run's circular drums, in three dimensions or held
+    in the plane).
     """
     p, cid = client.module, client.id
     _reset_world(p, cid, settings)

@@ -26,7 +26,7 @@ from rbm_cli.models.bullet.space import (
     joint_state_3d,
     normals,
 )
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome
 from rbm_cli.physics.excitation import GroundMotion
 
 #: Interval of the collapse, sliding and contact checks [s].
@@ -38,8 +38,9 @@ FRICTION_DT = 1e-2
 #: A joint is open when its relative rotation exceeds this fraction of alpha_i.
 OPEN_FRACTION = 1e-3
 #: In three dimensions a joint's lean turning is swept (a wobble) only while it is open by
-#: more than this fraction of alpha_i at two checks running.
-NEAR_FRACTION = 0.1
+#: more than this fraction of alpha_i at two checks running (the wobble's level of every
+#: model in three dimensions, models.outcome.WOBBLE_LEVEL).
+NEAR_FRACTION = WOBBLE_LEVEL
 #: In three dimensions a joint lands (an impact) when its lean crosses the line across
 #: the direction it leant to at the peak of its excursion, nearer closure than this
 #: fraction of that peak (or when it closes).

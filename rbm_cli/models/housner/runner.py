@@ -42,7 +42,7 @@ from rbm_cli.models.housner.steps import (
     peak_in_step,
 )
 from rbm_cli.models.methods import step_method
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import Outcome, budget_message
 from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.block import (
     BlockGeometry,
@@ -141,7 +141,7 @@ def _step_to_event(blk: HousnerBlock, run: HousnerRun, eqs: HousnerSide, integ, 
             return _fail(run.finish(), f"integrator: {msg} at t={run.t:.6g} s")
         out.n_steps += 1
         if out.n_steps > solver.max_steps:
-            return _fail(run.finish(), f"step budget exceeded ({solver.max_steps} steps)")
+            return _fail(run.finish(), budget_message("step", solver.max_steps))
         step = _cut_at_event(eqs, integ, run.y)
         t_pk, dense = peak_in_step(run, eqs.s, integ, step)
         if t_pk is not None and stop_ok:
@@ -169,7 +169,7 @@ def _on_event(blk: HousnerBlock, run: HousnerRun, kind: str) -> Outcome | None:
     out.n_impacts += 1
     run.note((t, "impact"))
     if out.n_uplifts + out.n_impacts > blk.solver.max_events:
-        return _fail(run.finish(), f"event budget exceeded ({blk.solver.max_events} events)")
+        return _fail(run.finish(), budget_message("event", blk.solver.max_events))
     run.y = np.array([0.0, blk.e_rest * run.y[1]])
     run.side = -run.side
     if abs(run.y[1]) < blk.rest_rate:
@@ -199,7 +199,7 @@ def _segment(
                 return None
             run.y = np.zeros(2)
             if out.n_uplifts + out.n_impacts > solver.max_events:
-                return _fail(run.finish(), f"event budget exceeded ({solver.max_events} events)")
+                return _fail(run.finish(), budget_message("event", solver.max_events))
         eqs = HousnerSide(blk, run.side, forced, out)
         y = run.y
         stop_ok = can_stop and housner_energy(y[0], y[1], blk.alpha, blk.p) < blk.barrier * (
@@ -273,6 +273,7 @@ def housner_run(
     e_rest = resolve(restitution, lambda: block_restitution(geometry))
     if not 0.0 < e_rest <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
+    solver = solver.for_run(motion.t_end, 1)
     blk, run = _start(
         geometry, motion, e_rest, collapse_ratio, solver, record, output_dt, initial, events
     )

@@ -12,15 +12,22 @@ RK23) step by step like `housner`, the events located on each step's dense outpu
   distance out. A lean that passes farther from the vertical rolls round it (Srinivasan
   and Ruina 2008). In a plane this is Housner's impact (theta' <- e theta');
 - **collapse** at a tilt of collapse.ratio alpha (Outcome.azimuth: where it leaned);
-  Outcome.turns is the angle the lean's direction swept while the column rolled (away
-  from the vertical, where the contact is not pinned), in turns;
+  Outcome.turns is the angle the lean's direction swept while the tilt was WOBBLE_LEVEL
+  alpha or more at both ends of a step (a wobble), in turns;
 - **rest** after an impact below REST_RATE p alpha.
 
 max_rotation_ratio is the peak tilt over alpha in any direction (Brent on the dense output
 where the tilt turns); max_top the top centre's largest distance in plan from where it
-stood (rolling moves the base), at step ends and peaks. A run stops early only at rest
-after the motion (a wobbling column's later peaks can exceed its earlier ones). A history's
-rotation is the tilt in the motion's vertical plane: Housner's theta in a planar motion.
+stood (rolling moves the base), at step ends and peaks.
+
+The motion is run in its own frame (rbm_cli.models.plan): along x, a pair's second
+component along y, and what is reported in plan (the top's path, the collapse azimuth) is
+turned back to the ground's axes; a motion of one component stays in its vertical plane to
+the bit. A run stops early at rest after the motion and, a sweep's run, where `housner`
+stops: at a peak of free motion after a pulse or a record, its energy below the collapse
+barrier, while it lies in that plane (one that left it may wobble, its later peaks higher:
+it runs to rest or to the end). A history's rotation is the tilt in the motion's vertical
+plane: Housner's theta in a planar motion.
 """
 
 from __future__ import annotations
@@ -32,18 +39,20 @@ import numpy as np
 from scipy.integrate import DOP853, RK23, RK45
 from scipy.optimize import brentq
 
-from rbm_cli.base.events import EVENT_EPS, first_crossing
+from rbm_cli.base.events import EVENT_EPS, STOP_MARGIN, first_crossing
 from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.config.types import G, SolverConfig
 from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.housner.state import BlockRun
 from rbm_cli.models.methods import step_method
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome, budget_message
+from rbm_cli.models.plan import from_ground, to_ground, wrapped
 from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.cylinder import (
     STATE_SIZE,
     CylinderGeometry,
+    cylinder_energy,
     cylinder_geometry,
     lean_direction,
     lean_rates,
@@ -71,7 +80,8 @@ class _Run3d(BlockRun):
     start_top: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(2))
     azimuth: float = math.nan
     phase: int = 0  # LEAVING, FREE or APPROACH (near the vertical)
-    swept: float = 0.0  # the angle the lean's direction swept while it rolled [rad]
+    swept: float = 0.0  # the angle the lean's direction swept while it wobbled [rad]
+    angle: float = 0.0  # the motion's azimuth [rad]: its frame turned to the ground's axes
 
 
 def _ground(motion: GroundMotion, forced: bool):
@@ -98,6 +108,7 @@ def cylinder_run(
     early_stop: bool = True,
     events: list | None = None,
     state: np.ndarray | None = None,
+    across: tuple[float, float] = (0.0, 0.0),
 ) -> Outcome:
     """One run of the rigid cylinder in three dimensions (the module's rules).
 
@@ -111,11 +122,18 @@ def cylinder_run(
         [rad/s] and h alpha [m]), step and event budgets
     record : bool  Keep samples every output_dt [s] (the module's history angle)
     initial : (float, float)  Initial tilt [rad] and its rate [rad/s] in the motion's plane
-    early_stop : bool  Stop at rest after the motion
+    across : (float, float)  The same across it (the motion's direction d turned by +90
+        degrees in plan, d'): the column starts tilted by |(theta, theta')| toward theta d
+        + theta' d' (theta the first of ``initial``, theta' the first of ``across``), its
+        angular velocity horizontal, rate (e_z x d) + rate' (e_z x d') (the top moving
+        along rate d + rate' d'), no spin about the vertical
+    early_stop : bool  Stop at rest after the motion, and at a peak of free motion in the
+        motion's plane below the collapse barrier (the module's notes)
     events : list or None  If a list, (t [s], kind) is appended for every 'uplift',
         'impact', 'rest' and 'collapse'
     state : (7,) array or None  A whole initial state in place of ``initial``: the lean q,
-        the angular velocity w [rad/s] and the centre in plan [m] (a wobble, say)
+        the angular velocity w [rad/s] and the centre in plan [m], in the ground's axes (a
+        wobble, say)
 
     Returns
     -------
@@ -124,8 +142,12 @@ def cylinder_run(
     """
     if not 0.0 < restitution <= 1.0:
         raise ValueError("restitution must be in (0, 1]")
+    solver = solver.for_run(motion.t_end, 1)
     alpha, p = geo.slenderness, geo.block.frequency_parameter
     limit = collapse_ratio * alpha
+    angle = wrapped(motion.angle)  # the motion's frame (rbm_cli.models.plan)
+    if motion.angle != 0.0:
+        motion = dataclasses.replace(motion, angle=0.0)
     d = motion.direction
     run = _Run3d(
         alpha=alpha,
@@ -139,8 +161,13 @@ def cylinder_run(
     run.c = side * d
     run.y[0:2] = math.sin(abs(theta0)) * run.c
     run.y[2:4] = rate0 * np.array([-d[1], d[0]])  # about the horizontal normal to d
+    if across[0] != 0.0 or across[1] != 0.0:
+        run.y, run.c = _initial_state(d, theta0, rate0, float(across[0]), float(across[1]))
+    run.angle = angle
     if state is not None:
         run.y = np.array(state, dtype=float)
+        for part in (0, 2, 5):  # the lean, w's horizontal part, the centre: the motion's frame
+            run.y[part : part + 2] = from_ground(run.y[None, part : part + 2], angle)[0]
         run.c = lean_direction(run.y[0:2], run.c)
     run.at_rest = not np.any(run.y[0:5])
     run.start_top = top_in_plan(geo, run.y)
@@ -153,9 +180,13 @@ def cylinder_run(
         return _finish(run, "collapsed", "initial rotation beyond the collapse limit")
     scale = np.array([alpha, alpha, p * alpha, p * alpha, p * alpha])
     atol = solver.atol * np.concatenate([scale, [geo.centre_height * alpha] * 2])
+    at_barrier = np.zeros(STATE_SIZE)
+    at_barrier[0] = math.sin(min(limit, alpha))
     consts = dict(
         geo=geo, e=restitution, s_limit=math.sin(limit), eps=EVENT_EPS * math.sin(alpha),
         rest_rate=REST_RATE * p * alpha, level=uplift_level(geo), atol=atol,
+        barrier=cylinder_energy(geo, at_barrier, np.array([1.0, 0.0])),
+        wobble=math.sin(WOBBLE_LEVEL * alpha),
     )  # fmt: skip
     for seg_start, seg_end in motion.segments():
         if run.t >= seg_end:
@@ -168,9 +199,28 @@ def cylinder_run(
     return _finish(run)
 
 
+def _initial_state(d: np.ndarray, theta: float, rate: float, theta_across: float,
+                   rate_across: float) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The state (7,) and the contact direction of a column tilted by theta along d and
+    theta_across across it (d' = d turned by +90 degrees), turning at rate and rate_across
+    (cylinder_run's ``across``): the lean q = sin|v| v / |v|, v = theta d + theta_across d',
+    the angular velocity rate (e_z x d) + rate_across (e_z x d'); the contact toward v, or
+    toward where the top moves when upright."""
+    across = np.array([-d[1], d[0]])
+    v = theta * d + theta_across * across
+    size = math.hypot(v[0], v[1])
+    moving = rate * d + rate_across * across
+    speed = math.hypot(moving[0], moving[1])
+    c = v / size if size > 0.0 else (moving / speed if speed > 0.0 else d)
+    y = np.zeros(STATE_SIZE)
+    y[0:2] = math.sin(size) * c
+    y[2:4] = rate * np.array([-d[1], d[0]]) + rate_across * np.array([-across[1], across[0]])
+    return y, c
+
+
 def _finish(run: _Run3d, status: str = "survived", message: str = "") -> Outcome:
     out = run.finish(status, message)
-    out.azimuth, out.turns = run.azimuth, run.swept / (2.0 * math.pi)
+    out.azimuth, out.turns = run.azimuth + run.angle, run.swept / (2.0 * math.pi)
     if run.rec.samples is not None:  # the top in plan at each sample; at rest where it was
         place, top_plan = run.start_top, np.zeros((len(out.samples), 2))
         across = np.zeros((len(out.samples), 1))
@@ -178,8 +228,14 @@ def _finish(run: _Run3d, status: str = "survived", message: str = "") -> Outcome
             place = run.plan.get(i, place)
             top_plan[i] = place
             across[i, 0] = run.across.get(i, 0.0)
-        out.top_plan, out.across = top_plan, across
+        out.top_plan, out.across = to_ground(top_plan, run.angle), across
     return out
+
+
+def _in_plane(y: np.ndarray) -> bool:
+    """Whether a state lies in the vertical plane of x to the bit (the lean, the rates and
+    the centre: nothing across it)."""
+    return y[1] == 0.0 and y[2] == 0.0 and y[4] == 0.0 and y[6] == 0.0
 
 
 #: The phases of a rocking column near the vertical (rolling_rates' pinned contact):
@@ -206,8 +262,12 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
             run.c = motion.uplift_direction(run.t)
             run.y, run.phase = np.zeros(STATE_SIZE), LEAVING
             if out.n_uplifts + out.n_impacts > solver.max_events:
-                return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+                return _fail(run, budget_message("event", solver.max_events))
         c0, pinned = run.c.copy(), run.phase != FREE
+        # a peak of free motion may end the run (as `housner`'s): in the plane, below the
+        # collapse barrier (its energy is constant up to the next impact)
+        energy = cylinder_energy(geo, run.y, c0, pinned) if can_stop else math.inf
+        stop_ok = _in_plane(run.y) and energy < k["barrier"] * (1.0 - STOP_MARGIN)
 
         def rhs(t, y, c0=c0, pinned=pinned):
             out.n_rhs += 1
@@ -216,7 +276,7 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
         stepper = _METHODS[step_method(solver)]
         integ = stepper(rhs, run.t, run.y, seg_end, rtol=solver.rtol, atol=k["atol"])
         integ.knots = motion.knots if motion.clipped else None
-        kind = _steps(run, integ, k, solver, d)
+        kind = _steps(run, integ, k, solver, d, stop_ok)
         if isinstance(kind, Outcome):
             return kind
         if kind == "left":
@@ -230,12 +290,13 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
     return None
 
 
-def _steps(run, integ, k, solver, d):
+def _steps(run, integ, k, solver, d, stop_ok=False):
     """Step until the phase's event, the state on it: 'left' (leaving: the lean is
     LEAVE_FACTOR pinned leans out), 'near' (free: the lean is within the pinned lean),
     'impact' (leaving or approaching: the lean crosses the line across its pinned
     direction; approaching: or turns away from the vertical), None at the segment's end,
-    or the Outcome when the run ends (a collapse, a budget)."""
+    or the Outcome when the run ends (a collapse, a budget, or with stop_ok a peak of the
+    tilt: every figure final)."""
     out, upright, s_limit, eps = run.out, k["geo"].upright, k["s_limit"], k["eps"]
     phase, c0 = run.phase, run.c
     while integ.status == "running":
@@ -245,7 +306,7 @@ def _steps(run, integ, k, solver, d):
             return _fail(run, f"integrator: {msg} at t={run.t:.6g} s")
         out.n_steps += 1
         if out.n_steps > solver.max_steps:
-            return _fail(run, f"step budget exceeded ({solver.max_steps} steps)")
+            return _fail(run, budget_message("step", solver.max_steps))
         dense = integ.dense_output()
 
         def rows(ts, dense=dense):
@@ -270,11 +331,17 @@ def _steps(run, integ, k, solver, d):
         hit = first_crossing(rows, t_old, integ.t, xtol=1e-15)
         t_new = integ.t if hit is None else hit[0]
         y_end = dense(t_new)  # the dense output at the step's (cut) end, evaluated once
-        _peaks(run, dense, t_old, t_new, y_end, k["geo"])
+        t_pk = _peaks(run, dense, t_old, t_new, y_end, k["geo"])
+        if stop_ok and t_pk is not None:
+            if run.rec.samples is not None:
+                _emit(run, dense, t_pk, d, k["geo"])
+            run.t = t_pk
+            return _finish(run, message="free motion below the collapse barrier: stopped early")
         if run.rec.samples is not None:
             _emit(run, dense, t_new, d, k["geo"])
         y_new = y_end if hit is not None else integ.y.copy()
-        if phase == FREE:  # near the vertical the contact is pinned: no rolling there
+        wobble = k["wobble"]  # a wobble: the lean WOBBLE_LEVEL alpha or more at both ends
+        if math.hypot(run.y[0], run.y[1]) >= wobble and math.hypot(y_new[0], y_new[1]) >= wobble:
             run.swept += _turned(run.y, y_new)
         run.t, run.y = t_new, y_new
         if hit is None:
@@ -307,7 +374,7 @@ def _impact(run, k, solver) -> Outcome | None:
     out.n_impacts += 1
     run.note((run.t, "impact"))
     if out.n_uplifts + out.n_impacts > solver.max_events:
-        return _fail(run, f"event budget exceeded ({solver.max_events} events)")
+        return _fail(run, budget_message("event", solver.max_events))
     y = run.y.copy()
     y[0:2] = 0.0
     y[2:4] *= k["e"]
@@ -323,10 +390,11 @@ def _impact(run, k, solver) -> Outcome | None:
     return None
 
 
-def _peaks(run, dense, t_old, t_new, y_end, geo) -> None:
+def _peaks(run, dense, t_old, t_new, y_end, geo) -> float | None:
     """The peak tilt and the top's farthest place on [t_old, t_new]: at the end (y_end, the
     dense output there), and where the tilt's rate turns from rising to falling (Brent on
-    the dense output)."""
+    the dense output). Returns the time of a peak of the tilt in the step (the tilt rising
+    at its start and not at its end, as `housner` finds it), or None."""
 
     def lean_rate(yy):
         dq = lean_rates(yy)
@@ -339,7 +407,10 @@ def _peaks(run, dense, t_old, t_new, y_end, geo) -> None:
     consider(y_end)
     r0, r1 = lean_rate(dense(t_old)), lean_rate(y_end)
     if r0 > 0.0 and r1 < 0.0:
-        consider(dense(brentq(lambda t: lean_rate(dense(t)), t_old, t_new, xtol=1e-15)))
+        t_pk = brentq(lambda t: lean_rate(dense(t)), t_old, t_new, xtol=1e-15)
+        consider(dense(t_pk))
+        return t_pk
+    return t_new if r0 > 0.0 and r1 == 0.0 else None
 
 
 def _emit(run, dense, t_stop, d, geo) -> None:
@@ -349,7 +420,7 @@ def _emit(run, dense, t_stop, d, geo) -> None:
         th, rate = tilt_in_plane(y, d)
         run.rec.emit(np.array([t]), th, rate)
         at = len(run.out.samples) - 1
-        run.plan[at] = top_in_plan(geo, y)
+        run.plan[at] = top_in_plan(geo, y)  # in the motion's frame, turned by _finish
         run.across[at] = tilt_in_plane(y, np.array([-d[1], d[0]]))[0]
 
 
@@ -366,6 +437,11 @@ class Housner3dRunner(BlockRunner):
     def __init__(self, config) -> None:
         super().__init__(config)
         self.cylinder = cylinder_geometry(config.column)
+        init = config.excitation.initial
+        self.across = (
+            float(init.rotations_across[0]) if init.rotations_across else 0.0,
+            float(init.velocities_across[0]) if init.velocities_across else 0.0,
+        )
         methods.resolve(config)  # an explicit method that does not apply: refused
 
     def _integrate(self, motion: GroundMotion, solver: SolverConfig, **options) -> Outcome:
@@ -378,6 +454,7 @@ class Housner3dRunner(BlockRunner):
             collapse_ratio=self.config.collapse.ratio,
             solver=solver,
             initial=self.initial,
+            across=self.across,
             **options,
         )
         out.method = solver.method

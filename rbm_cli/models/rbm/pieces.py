@@ -10,7 +10,9 @@ f = a_k + b_k x on [x_k, x_{k+1}), the edges x_1 < x_2 < ... padded with inf
 argument) and its index k_i; ``pending[i]`` marks an excursion beyond the elastic branch
 (piece 0 is then bounded by 0: the next zero crossing is an impact), ``awaiting[i]`` an
 interface back on piece 0 whose zero crossing is silent (counted, not stopped at:
-Model.silent_impacts). The arrays are changed in place.
+Model.silent_impacts). An uplift is a closed interface opening; one that leaves its elastic
+branch again before its zero crossing goes on with its excursion (no uplift), whether that
+crossing would be silent or not. The arrays are changed in place.
 
 tests/piece_oracle.py writes the same bookkeeping from the laws' objects, as a check.
 """
@@ -93,15 +95,18 @@ def cross(i, going_up, side, k, pending, awaiting, rigid, silent):
 
     Returns
     -------
-    int  UPLIFT, KINK or IMPACT.
+    int  UPLIFT (a closed interface opens), KINK or IMPACT. An interface awaiting a silent
+        zero crossing that leaves its elastic branch again has not closed: its excursion
+        goes on (a KINK), as with pending when e < 1.
     """
     s, ki = side[i], k[i]
     if ki == 0 and not zero_active(i, pending, rigid):
+        reopened = awaiting[i]
         side[i] = 1 if going_up else -1
         k[i] = 1
         pending[i] = True
         awaiting[i] = False
-        return UPLIFT
+        return KINK if reopened else UPLIFT
     if going_up == (s > 0):
         k[i] = ki + 1
         return KINK

@@ -20,6 +20,8 @@ from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
+from rbm_cli.models.outcome import WOBBLE_LEVEL
+from rbm_cli.models.rbm.pieces import below_barrier, law_potential
 from rbm_cli.models.rbm.step.rk import (
     NS_MAX,
     STEP_TAKEN,
@@ -32,6 +34,7 @@ from rbm_cli.models.rbm.step.rk import (
     initial_step,
     rhs,
 )
+from rbm_cli.models.rbm.step.stepper import GL_NODES, GL_WEIGHTS
 from rbm_cli.models.status import (
     COLLAPSED,
     FAILED_EVENTS,
@@ -39,17 +42,22 @@ from rbm_cli.models.status import (
     FAILED_STEP,
     FAILED_STEPS,
     GOING,
+    STOP_NEVER,
+    STOPPED_EARLY,
     SURVIVED,
     guard_code,
 )
 from rbm_cli.physics.arrays import ColumnArrays
 from rbm_cli.physics.beam3d import CS_PER_JOINT, ES_EXTRA, horizontal, pack_pieces
 from rbm_cli.physics.ground import (
+    LINE,
     gravity_factor,
     ground_at,
     next_uplift,
-    pair_exceedance,
+    pair_uplift,
     record_piece,
+    rest_demand,
+    vertical_factor,
 )
 
 #: A closed rigid joint's direction is pinned within UPRIGHT_LEAN theta_u of closure ...
@@ -373,6 +381,93 @@ def _pieces(t, knots, values, values_y, vertical, gain, seg_end, es):
 
 
 @jit
+def energy3d(y, n, col):
+    """Energy [J] of a state y (4n,) (physics.beam3d): the kinetic energy of both
+    directions, gravity's for `geometric` and the laws' potential of |phi_i|
+    (pieces.law_potential), as the planar Model.energy in each direction."""
+    e = 0.0
+    for i in range(n):
+        for j in range(n):
+            e += 0.5 * col.mass[i, j] * (y[2 * n + i] * y[2 * n + j] + y[3 * n + i] * y[3 * n + j])
+            e -= 0.5 * col.gravity[i, j] * (y[i] * y[j] + y[n + i] * y[n + j])
+    for i in range(n):
+        px, py, _, _ = _phi(i, y, n, col.argmap)
+        e += law_potential(i, math.sqrt(px * px + py * py), col.edges, col.nedges,
+                           col.intercepts, col.slopes)  # fmt: skip
+    return e
+
+
+@jit
+def account_step3d(mc, t_old, t_new, h, y_old, F, yq, n, col, k, es, gr, ledger):
+    """Add one step's work of the ground and the energy its damping took to ledger[2] and
+    ledger[3] [J] (as the planar stepper.account_step): over [t_old, t_new] on the step's
+    dense output, the power -(a_x r . theta_x' + a_y r . theta_y') (r the ground load) and
+    sum_i c_i |phi_i'|^2 (the joints on their elastic piece) by Gauss-Legendre."""
+    dt = t_new - t_old
+    for q in range(GL_NODES.size):
+        tq = t_old + GL_NODES[q] * dt
+        dense_eval(mc, tq, t_old, h, y_old, F, yq)
+        ax, ay = horizontal(tq, es, n, gr)
+        p_in = 0.0
+        for j in range(n):
+            p_in -= col.ground_load[j] * (ax * yq[2 * n + j] + ay * yq[3 * n + j])
+        p_d = 0.0
+        for i in range(n):
+            if col.damp[i] != 0.0 and k[i] == 0:
+                _, _, vx, vy = _phi(i, yq, n, col.argmap)
+                p_d += col.damp[i] * (vx * vx + vy * vy)
+        ledger[2] += GL_WEIGHTS[q] * dt * p_in
+        ledger[3] += GL_WEIGHTS[q] * dt * p_d
+
+
+@jit
+def pair_rest_demand(t0, t1, gr, gy, knots, values, values_y, knots_y, vertical):
+    """The friction demand max |a_h| / (g + a_v) [-] of a column at rest under a pair over
+    [t0, t1] [s], a_h = (a_x, a_y). A pair of records: both components and a_v are straight
+    between samples, where |a_h| / (g + a_v) has no interior maximum (its sublevel sets
+    are convex), so the ends and the samples between them hold it. A formula and its
+    second component (gy): the largest ratio that physics.ground.pair_uplift finds
+    exceeded on [t0, t1), by halving to the last bit (closed-form exceedance times)."""
+    if gr[1] == 0.0 or t1 < t0:
+        return 0.0
+    if values_y.size == 0:
+        lo, hi = 0.0, 1.0
+        while pair_uplift(t0, hi, t1, gr, gy, knots, values, values_y, knots_y, vertical) >= 0.0:
+            lo, hi = hi, 2.0 * hi
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if mid <= lo or mid >= hi:
+                break
+            if pair_uplift(t0, mid, t1, gr, gy, knots, values, values_y, knots_y,
+                           vertical) >= 0.0:  # fmt: skip
+                lo = mid
+            else:
+                hi = mid
+        return lo
+    best = 0.0
+    for j in range(knots.size + 2):
+        tt = t0 if j == 0 else (t1 if j == 1 else knots[j - 2])
+        if tt < t0 or tt > t1:
+            continue
+        ax = ground_at(tt, gr, knots, values)
+        ay = ground_at(tt, gr, knots, values_y)
+        d = math.sqrt(ax * ax + ay * ay) / (G * vertical_factor(tt, knots, vertical))
+        if d > best:
+            best = d
+    return best
+
+
+@jit
+def in_plane(y, n):
+    """Whether the state y (4n,) lies in the motion's vertical plane to the bit: nothing
+    across it (theta_y and its rate all zero)."""
+    for j in range(n):
+        if y[n + j] != 0.0 or y[3 * n + j] != 0.0:
+            return False
+    return True
+
+
+@jit
 def run3d(col, motion, solver, task, pair):
     """Run one motion of one column in two directions.
 
@@ -381,19 +476,24 @@ def run3d(col, motion, solver, task, pair):
     col : ColumnArrays  The column (physics.arrays), as the planar kernel reads it
     motion : Excitation  The motion along its direction (step.inputs)
     solver : SolverSettings  atol of 4n entries
-    task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 3n), friction_limit); y0
-        is the state, changed in place: the state where the run ended
-    pair : tuple  (d0, d1, values_y: the second record's samples, or empty)
+    task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 3n), friction_limit,
+        early stop (models.status.stop_level)); y0 is the state, changed in place: the
+        state where the run ended
+    pair : tuple  (d0, d1, values_y: a second record's samples, or empty; gy: the second
+        component's ground tuple, physics.ground, gain 0 for none; knots_y: its knots)
 
     Returns
     -------
     tuple  (code, t_end, t_collapse, collapsed joint (from 0; -1), max_ratio (n), max_top,
         friction (n), slip (2), n_uplifts, n_impacts, n_steps, n_rhs, n_events, n_samples,
-        azimuth [rad], swept (n) [rad])
+        azimuth [rad], swept (n) [rad], ledger (5)). ledger: the energy account of a
+        recorded run without a vertical record [J] (zeros otherwise), as the planar
+        kernel's: the energy at the start and at the end (energy3d), the ground's work,
+        the energy the joints' damping and the impacts took.
     """
     col = ColumnArrays(*col)
-    y0, record, output_dt, samples, mu = task
-    d0, d1, values_y = pair
+    y0, record, output_dt, samples, mu, stop = task
+    d0, d1, values_y, gy, knots_y = pair
     mc, rtol, atol = solver[0], solver[1], solver[2]
     max_steps, max_events, deadline = solver[3], solver[4], solver[5]
     form, gain, center, gamma = motion[6], motion[7], motion[8], motion[9]
@@ -401,7 +501,11 @@ def run3d(col, motion, solver, task, pair):
     bounds, forced, pulse_end, t_end = motion[14], motion[15], motion[4], motion[5]
     gr_full = (form, gain, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
     gr_free = (form, 0.0, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
-    pair_on = values_y.size > 0
+    pair_on = values_y.size > 0 or gy[1] != 0.0
+    formula_y = values_y.size == 0 and gy[1] != 0.0  # an analytic second component
+    pulse = motion[16]
+    account = record and vertical.size == 0  # the energy account (see Returns)
+    ledger = np.zeros(5)
     n = col.tu.size
     m4 = 4 * n
     nrow_max = 5 * n
@@ -417,6 +521,7 @@ def run3d(col, motion, solver, task, pair):
     es[:n] = col.es
     es[n], es[n + 1] = d0, d1
     es[n + 8] = 1.0 if np.any(col.mg != 0.0) else 0.0
+    es[n + 9] = LINE if values_y.size > 0 else gy[0]
 
     k = np.zeros(n, dtype=np.int64)
     pending = np.zeros(n, dtype=np.bool_)
@@ -482,8 +587,11 @@ def run3d(col, motion, solver, task, pair):
             azimuth = math.atan2(vy_, vx_)
             max_ratio[i] = max(v, col.c_ratio)
             return (COLLAPSED, 0.0, 0.0, i, max_ratio, max_top, friction, slip, n_upl,
-                    n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                    n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip
     max_top = _magnitude(top_row, y, n)[0]
+    if account:
+        ledger[0] = energy3d(y, n, col)
+        ledger[1] = ledger[0]
 
     for seg in range(bounds.size - 1):
         seg_end = bounds[seg + 1]
@@ -492,6 +600,12 @@ def run3d(col, motion, solver, task, pair):
         free_seg = not forced[seg]
         gr = gr_free if free_seg else gr_full
         seg_gain = gr[1]
+        if formula_y:  # its formula in es, 0 on a free segment
+            es[n + 2], es[n + 3], es[n + 4] = 1.0, 0.0 if free_seg else gy[1], gy[2]
+            es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
+        # solver.stop: a monolith past a peak of free motion after a pulse or a record, below
+        # its collapse barrier, in the motion's plane (there the planar model's stop)
+        can_stop = stop != STOP_NEVER and free_seg and pulse and n == 1
         h_carry = -1.0
         while t < seg_end:
             if at_rest:
@@ -500,14 +614,33 @@ def run3d(col, motion, solver, task, pair):
                         n_out, next_out = _emit(mc, t_end, t, 0.0, y, F, yq, samples, n_out,
                                                 next_out, output_dt, n, d0, d1, col)  # fmt: skip
                     return (AT_REST, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
+                            ledger)  # fmt: skip
                 last = min(pulse_end, t_end)
                 if pair_on:
-                    t_up = pair_exceedance(t, col.uplift_level / G, min(last, seg_end), knots,
-                                           values, values_y, vertical)  # fmt: skip
+                    t_up = pair_uplift(t, col.uplift_level / G, min(last, seg_end), gr_full, gy,
+                                       knots, values, values_y, knots_y, vertical)  # fmt: skip
                 else:
                     t_up = next_uplift(t, col.uplift_level, motion[1], gr_full, knots, values,
                                        vertical, last)  # fmt: skip
+                # the friction demand at rest (as the planar kernel), and where it first
+                # exceeds the limit
+                t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
+                if pair_on:
+                    d_rest = pair_rest_demand(t, t_rest, gr_full, gy, knots, values, values_y,
+                                              knots_y, vertical)  # fmt: skip
+                else:
+                    d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
+                if d_rest > friction[0]:
+                    friction[0] = d_rest
+                if slip[1] == 0.0 and d_rest > mu:
+                    if pair_on:
+                        slip[0] = pair_uplift(t, mu, t_rest, gr_full, gy, knots, values,
+                                              values_y, knots_y, vertical)  # fmt: skip
+                    else:
+                        slip[0] = next_uplift(t, mu * G, motion[1], gr_full, knots, values,
+                                              vertical, t_rest)  # fmt: skip
+                    slip[1] = 1.0
                 if t_up < 0.0 or t_up >= seg_end:
                     if record:
                         n_out, next_out = _emit(mc, seg_end, t, 0.0, y, F, yq, samples, n_out,
@@ -520,7 +653,7 @@ def run3d(col, motion, solver, task, pair):
                 t = t_up
                 y[:] = 0.0
                 a_d = ground_at(t, gr_full, knots, values)
-                a_y = ground_at(t, gr_full, knots, values_y) if pair_on else 0.0
+                a_y = ground_at(t, gy, knots, values_y) if pair_on else 0.0
                 ax, ay = a_d * d0 - a_y * d1, a_d * d1 + a_y * d0
                 size = math.sqrt(ax * ax + ay * ay)
                 c[0, 0], c[0, 1] = -ax / size, -ay / size
@@ -560,17 +693,18 @@ def run3d(col, motion, solver, task, pair):
                 if taken != STEP_TAKEN:
                     code = FAILED_STEP if taken == STEP_TOO_SMALL else FAILED_NONFINITE
                     return (code, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl,
-                            n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                            n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip
                 n_steps += 1
                 if n_steps > max_steps:
                     return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
+                            ledger)  # fmt: skip
                 if n_steps % POLL_STEPS == 0:
                     code = guard_code(deadline)
                     if code != GOING:
                         return (code, t, t_col, c_if, max_ratio, max_top, friction,
                                 slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth,
-                                swept)  # fmt: skip
+                                swept, ledger)  # fmt: skip
                 if t_new - seg_end >= 0:
                     running = False
                 t_old = t
@@ -605,11 +739,17 @@ def run3d(col, motion, solver, task, pair):
                 if record:
                     n_out, next_out = _emit(mc, t_new, t_old, h, y, F, yq, samples, n_out,
                                             next_out, output_dt, n, d0, d1, col)  # fmt: skip
+                if account:  # the step's dense output is ready (recorded runs always are)
+                    account_step3d(mc, t_old, t_new, h, y, F, yq, n, col, k, es, gr, ledger)
+                    ledger[1] = energy3d(y_new, n, col)
                 # peaks: at the end, and where a magnitude's rate turns inside the step
+                turned = False  # the first joint's ratio passed a peak in this step
                 for i in range(n + 1):
                     row = col.families[n + i] if i < n else top_row
                     v1, r1 = _magnitude(row, y_new, n)
                     _, r0 = _magnitude(row, y, n)
+                    if i == 0:
+                        turned = r0 > 0.0 >= r1
                     if r0 > 0.0 and r1 < 0.0:
                         if not dense_ready:
                             n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs,
@@ -620,14 +760,20 @@ def run3d(col, motion, solver, task, pair):
                         max_ratio[i] = max(max_ratio[i], v1)
                     else:
                         max_top = max(max_top, v1)
-                # the angle each open joint's direction turned
+                # the angle each joint's lean turned, where it leans by WOBBLE_LEVEL of its
+                # collapse limit or more at both ends of the step (a wobble)
                 for i in range(n):
-                    if k[i] > 0 or (col.rigid[i] and phase[i] == FREE):
-                        ax_, ay_, _, _ = _phi(i, y, n, col.argmap)
-                        bx_, by_, _, _ = _phi(i, y_new, n, col.argmap)
+                    row = col.families[n + i]
+                    ax_, ay_, bx_, by_ = 0.0, 0.0, 0.0, 0.0
+                    for j in range(n):
+                        ax_ += row[j] * y[j]
+                        ay_ += row[j] * y[n + j]
+                        bx_ += row[j] * y_new[j]
+                        by_ += row[j] * y_new[n + j]
+                    if (ax_ * ax_ + ay_ * ay_ >= WOBBLE_LEVEL * WOBBLE_LEVEL
+                            and bx_ * bx_ + by_ * by_ >= WOBBLE_LEVEL * WOBBLE_LEVEL):  # fmt: skip
                         cr, dt_ = ax_ * by_ - ay_ * bx_, ax_ * bx_ + ay_ * by_
-                        if cr != 0.0 or dt_ != 0.0:
-                            swept[i] += abs(math.atan2(cr, dt_))
+                        swept[i] += abs(math.atan2(cr, dt_))
                 # silent closures (e = 1, elastic joints): counted at the step's end
                 if col.e_rest == 1.0:
                     for i in range(n):
@@ -640,6 +786,15 @@ def run3d(col, motion, solver, task, pair):
                 y[:] = y_new
                 if event:
                     break
+                # free motion past a peak below the collapse barrier, in the plane: every
+                # figure final (the planar kernel's stop, its energy of the state in the plane)
+                if (can_stop and turned and in_plane(y, n)
+                        and below_barrier(y[:n], y[2 * n : 3 * n], col.mass, col.argmap,
+                                          col.gravity, col.edges, col.nedges, col.intercepts,
+                                          col.slopes, col.barrier)):  # fmt: skip
+                    return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction, slip,
+                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
+                            ledger)  # fmt: skip
                 f[:] = K[ns]
                 d_old, d_new = d_new, d_old
                 r_old, r_new = r_new, r_old
@@ -652,7 +807,8 @@ def run3d(col, motion, solver, task, pair):
             n_ev += 1
             if n_ev > max_events:
                 return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
+                        ledger)  # fmt: skip
             kind, i = kinds[hit], joints[hit]
             px, py, vx, vy = _phi(i, y, n, col.argmap)
             r = math.sqrt(px * px + py * py)
@@ -664,14 +820,16 @@ def run3d(col, motion, solver, task, pair):
                 azimuth = math.atan2(vy_, vx_)
                 max_ratio[i] = max(max_ratio[i], col.c_ratio)
                 return (COLLAPSED, t, t, i, max_ratio, max_top, friction, slip, n_upl, n_imp,
-                        n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+                        n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip
             if kind == UP or kind == DOWN:
                 q = k[i] if kind == UP else k[i] - 1
                 e = _edge(i, q, gravity_factor(t, gr), col.edges, col.nedges, col.edge_w)
                 if r > 0.0:
                     _move(i, y, n, col.arg_inv, px * (e / r - 1.0), py * (e / r - 1.0))
                 if kind == UP:
-                    if k[i] == 0 and not col.rigid[i] and not pending[i]:
+                    # an uplift: a closed joint opens; one back on its elastic branch that
+                    # opens again before it closed goes on with its excursion
+                    if k[i] == 0 and not col.rigid[i] and not pending[i] and phase[i] != APPROACH:
                         n_upl += 1
                     if not col.rigid[i]:
                         pending[i] = True
@@ -719,5 +877,10 @@ def run3d(col, motion, solver, task, pair):
                         phase[i] = LEAVING
                         if speed > 0.0:
                             c[i, 0], c[i, 1] = vx / speed, vy / speed
+            if account:
+                after = energy3d(y, n, col)
+                if kind == ACROSS or kind == TURNED:
+                    ledger[4] += ledger[1] - after
+                ledger[1] = after
     return (SURVIVED, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl, n_imp,
-            n_steps, n_rhs, n_ev, n_out, azimuth, swept)  # fmt: skip
+            n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip

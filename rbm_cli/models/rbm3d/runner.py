@@ -25,15 +25,32 @@ RK45, RK23) in a compiled run of its own (kernel.py; its source uncompiled with
 - **rest** (a rigid monolith) after an impact below REST_RATE p theta_u, and an uplift
   away from the ground's acceleration when it exceeds the uplift level.
 
+An **uplift** is a closed joint opening (leaving its elastic branch; a rigid monolith
+lifting from rest); a joint back on its elastic branch that opens again before it closed
+goes on with its excursion, as in the plane (rbm_cli.models.rbm.pieces.cross).
+
+The motion is run in its own frame (rbm_cli.models.plan): along x, a pair's second
+component along y; what is reported in plan (the top's path, the collapse azimuth) is
+turned back to the ground's axes. A motion of one component then stays in its vertical
+plane to the bit, and a sweep's run (solver.stop) of a monolith stops where the planar
+kernel's does: at a peak of free motion after a pulse or a record, below the collapse
+barrier, while the state lies in that plane (a state that left it may wobble, its later
+peaks higher: it runs to rest or to the end).
+
 Peaks (max_ratio per joint, the top's displacement in plan) are taken at step ends and
 where their rates turn inside a step (Brent on the dense output); the friction demand
-|T_i| / N_i at step ends. Outcome.turns: the largest angle a joint's direction swept while
-it was open (a wobble), in turns. A history's rotations are seen in the motion's vertical
-plane (theta_x cos angle + theta_y sin angle); the top's path in plan is kept beside them.
+|T_i| / N_i at step ends in motion and, at rest, exactly over the rest (a pair: its
+resultant), as the planar kernel's. Outcome.turns: the largest angle the direction of a
+joint's lean (its collapse quantity in plan) swept while that lean was WOBBLE_LEVEL of its
+collapse limit or more at both ends of a step (a wobble), in turns. A recorded run keeps
+the energy account of the planar kernel (Outcome.energy, without a vertical record). A
+history's rotations are seen in the motion's vertical plane (its frame's x); the top's
+path in plan is kept beside them.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
@@ -43,11 +60,19 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import SolverConfig
-from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.outcome import EnergyAccount, Outcome
+from rbm_cli.models.plan import from_ground, to_ground, wrapped
 from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.models.rbm.step.inputs import excitation, prepare_kernel, solver_settings
 from rbm_cli.models.rbm3d.kernel import AT_REST, run3d
-from rbm_cli.models.status import COLLAPSED, FAILED_NONFINITE, FAILED_STEP, end_by_budget
+from rbm_cli.models.status import (
+    COLLAPSED,
+    FAILED_NONFINITE,
+    FAILED_STEP,
+    STOPPED_EARLY,
+    end_by_budget,
+    stop_level,
+)
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.ground import as_samples
 
@@ -66,6 +91,7 @@ def integrate3d(
     prepared=None,
     state: np.ndarray | None = None,
     end: list | None = None,
+    across: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Outcome:
     """One run of a column's RBM in two directions (the module's rules).
 
@@ -75,60 +101,82 @@ def integrate3d(
     motion : GroundMotion  The ground motion, in any direction, one or two components
     theta0, rate0 : (n,)  Initial drum rotations [rad] and rates [rad/s] in the motion's
         vertical plane
+    across : ((n,), (n,)) or None  Those in the vertical plane across it (the motion's
+        direction turned by +90 degrees in plan); None: 0
     solver : SolverConfig  Runge-Kutta pair, rtol, atol (scaled by theta_u and 10 theta_u
         per second, as the planar step kernel), budgets, implementation
     record, output_dt : as the planar integrators
-    early_stop : bool  Unused: a run stops early only at rest after the motion (a rigid
-        monolith), since a wobbling column's later peaks can exceed its earlier ones
+    early_stop : bool  A sweep's run: a monolith may stop at a peak of free motion in the
+        motion's plane below its collapse barrier (solver.stop; the module's notes); a
+        run also stops at rest after the motion (a rigid monolith)
     friction_limit : float  Outcome.slip where |T_i| / N_i first exceeds it (inf: none)
     prepared : PreparedModel, optional  prepare_kernel(model), made once by a caller
-    state : (4n,) array, optional  A whole initial state (theta_x, theta_y, their rates) in
-        place of theta0, rate0
-    end : list, optional  If a list, the state where the run ended is appended to it
+    state : (4n,) array, optional  A whole initial state (theta_x, theta_y, their rates, in
+        the ground's axes) in place of theta0, rate0
+    end : list, optional  If a list, the state where the run ended is appended to it (in
+        the ground's axes)
     """
-    del early_stop
     prepared = prepare_kernel(model) if prepared is None else prepared
     n = model.n
-    d = motion.direction
+    angle = wrapped(motion.angle)  # the motion's frame (rbm_cli.models.plan)
+    own = motion if motion.angle == 0.0 else dataclasses.replace(motion, angle=0.0)
     if state is None:
         theta0, rate0 = np.asarray(theta0, float), np.asarray(rate0, float)
-        y0 = np.concatenate([theta0 * d[0], theta0 * d[1], rate0 * d[0], rate0 * d[1]])
+        y0 = np.concatenate([theta0, np.zeros(n), rate0, np.zeros(n)])
+        if across is not None:  # across the motion's plane: along y in the motion's frame
+            tc, rc = np.asarray(across[0], float), np.asarray(across[1], float)
+            y0 = np.concatenate([theta0, tc, rate0, rc])
     else:
         y0 = np.array(state, dtype=float)
+        for part in (0, 2 * n):
+            pairs = from_ground(np.stack([y0[part : part + n], y0[part + n : part + 2 * n]], 1),
+                                angle)  # fmt: skip
+            y0[part : part + n], y0[part + n : part + 2 * n] = pairs[:, 0], pairs[:, 1]
     scale = np.concatenate([prepared.atol_scale[:n], prepared.atol_scale[:n],
                             prepared.atol_scale[n:], prepared.atol_scale[n:]])  # fmt: skip
+    solver = solver.for_run(motion.t_end, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     rows = int(math.floor(motion.t_end / output_dt + 1e-9)) + 2 if record else 0
     samples = np.zeros((rows, 3 + 3 * n))
-    task = (y0, bool(record), float(output_dt), samples, float(friction_limit))
-    pair = (float(d[0]), float(d[1]), as_samples(motion.values_y))
+    task = (y0, bool(record), float(output_dt), samples, float(friction_limit),
+            stop_level(early_stop, solver))  # fmt: skip
+    pair = (1.0, 0.0, as_samples(own.values_y), own.ground_y, own.knots_y)
     armed = arm()
     try:
         kernel = run3d if solver.implementation == "compiled" else plain(run3d)
-        res = kernel(prepared.packed, excitation(motion), solver_settings(solver, scale, deadline),
+        res = kernel(prepared.packed, excitation(own), solver_settings(solver, scale, deadline),
                      task, pair)  # fmt: skip
     finally:
         disarm(armed)
     (code, t_end, t_col, c_if, max_ratio, max_top, friction, slip, n_upl, n_imp, n_steps,
-     n_rhs, n_ev, n_out, azimuth, swept) = res  # fmt: skip
+     n_rhs, n_ev, n_out, azimuth, swept, ledger) = res  # fmt: skip
     if end is not None:
-        end.append(task[0])
+        y_end = task[0].copy()
+        for part in (0, 2 * n):
+            pairs = to_ground(np.stack([y_end[part : part + n], y_end[part + n : part + 2 * n]],
+                                       1), angle)  # fmt: skip
+            y_end[part : part + n], y_end[part + n : part + 2 * n] = pairs[:, 0], pairs[:, 1]
+        end.append(y_end)
     out = Outcome(
         t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=friction,
         n_uplifts=int(n_upl), n_impacts=int(n_imp), n_steps=int(n_steps), n_rhs=int(n_rhs),
         n_events=int(n_ev), slip=(float(slip[0]), int(slip[1])) if slip[1] > 0 else None,
-        azimuth=float(azimuth), turns=float(swept.max()) / (2.0 * math.pi),
+        azimuth=float(azimuth) + angle, turns=float(swept.max()) / (2.0 * math.pi),
     )  # fmt: skip
     if record:
         rows = samples[:n_out]
         out.samples = [(float(r[0]), r[1 : 1 + n].copy(), r[1 + n : 1 + 2 * n].copy())
                        for r in rows]  # fmt: skip
-        out.top_plan = rows[:, 1 + 2 * n : 3 + 2 * n].copy()
+        out.top_plan = to_ground(rows[:, 1 + 2 * n : 3 + 2 * n].copy(), angle)
         out.across = rows[:, 3 + 2 * n :].copy()
+        if motion.vertical is None:
+            out.energy = EnergyAccount(*(float(v) for v in ledger))
     if code == COLLAPSED:
         out.collapse(float(t_col), int(c_if) + 1)
     elif code == AT_REST:
         out.message = "at rest in free motion: stopped"
+    elif code == STOPPED_EARLY:
+        out.stopped_early()
     elif code == FAILED_STEP:
         out.stop("failed", "integrator: Required step size is less than spacing between "
                  "numbers.", t_end)  # fmt: skip
@@ -163,12 +211,18 @@ class Rbm3dRunner(RbmRunner):
     the Rigid Beam Model, in two horizontal directions."""
 
     def integrator_of(self, method):
-        """The integrator of every method that runs `rbm-3d` (a step pair): this module's."""
+        """The integrator of every method that runs `rbm-3d` (a step pair): this module's,
+        from the config's initial state in the motion's plane and across it."""
         prepared = prepare_kernel(self.model)
+        init, n = self.config.excitation.initial, self.model.n
+        across = None
+        if init.rotations_across or init.velocities_across:
+            across = tuple(np.asarray(v, float) if v else np.zeros(n)
+                           for v in (init.rotations_across, init.velocities_across))  # fmt: skip
 
         def run(model, motion, theta0, rate0, solver, **options):
             return integrate3d(model, motion, theta0, rate0, solver, prepared=prepared,
-                               **options)  # fmt: skip
+                               across=across, **options)  # fmt: skip
 
         return run
 

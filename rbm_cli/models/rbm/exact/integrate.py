@@ -112,6 +112,7 @@ def integrate_exact(
     if prepared is None:
         prepared = prepare_exact(model)
     n = model.n
+    solver = solver.for_run(motion.t_end, n)
     mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit, until_open)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)

@@ -95,6 +95,7 @@ def integrate(
     if prepared is None:
         prepared = prepare_kernel(model)
     n = model.n
+    solver = solver.for_run(motion.t_end, n)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)

@@ -233,8 +233,8 @@ def migrate_cmd(folders: tuple[str, ...]) -> None:
     version's hash and schema once rbm has checked that the domain was made by the config
     this version reads from it (the same settings, no cell that ran out of a budget, the
     method this version runs); its rows and figures, those of the rbm that made them, are
-    not touched (rbm compare judges them against this version's). A folder that does not pass is left as it
-    is, named in one line (re-make it), and the exit status is 2.
+    not touched (rbm compare judges them against this version's). A folder that does not
+    pass is left as it is, named in one line (re-make it), and the exit status is 2.
 
     \b
     Example:

@@ -88,17 +88,13 @@ def _cylinder(model: str, drums: int, restitution: float, **interface) -> dict:
     }
 
 
+#: The 4 m x 1 m rigid monolith of the block grids.
+BLOCK_COLUMN = {"height": 4.0, "base_width": 1.0, "section": "rectangular", "depth": 1.0,
+                "density": 2700, "drums": 1}  # fmt: skip
 BULLET = {
     "name": "bullet_block",
     "model": "bullet",
-    "column": {
-        "height": 4.0,
-        "base_width": 1.0,
-        "section": "rectangular",
-        "depth": 1.0,
-        "density": 2700,
-        "drums": 1,
-    },  # fmt: skip
+    "column": dict(BLOCK_COLUMN),
     "excitation": {"type": "harmonic", "duration": 3.0},
     "collapse": {"ratio": 1.0},
 }
@@ -107,14 +103,7 @@ RBM_3D = _cylinder("rbm-3d", 4, 1.0, stiffness={"normal": 1e9})
 RICKER = {
     "name": "ricker_block",
     "model": "rbm",
-    "column": {
-        "height": 4.0,
-        "base_width": 1.0,
-        "section": "rectangular",
-        "depth": 1.0,
-        "density": 2700,
-        "drums": 1,
-    },  # fmt: skip
+    "column": dict(BLOCK_COLUMN),
     "interface": {"stiffness": "rigid", "restitution": "housner"},
     "excitation": {"type": "ricker", "duration": 10.0},
     "collapse": {"ratio": 1.0},

@@ -20,7 +20,7 @@ docstring with its units and an example (``help(rbm.run)``).
   :func:`fragility` the lognormal fragility of a suite's domain with its bootstrap band,
   as ``rbm fragility`` fits it (no files)
 - :func:`migrate` brings a domain stored by an earlier rbm to this version's config hash,
-  once it has checked that the domain is the one this version makes
+  once it has checked that the domain was made by the config this version reads from it
 - :func:`plot_domain`, :func:`plot_history` draw on a matplotlib axes and return it
 - :class:`Config`, :class:`ConfigError`, :class:`RbmError`, :class:`SweepInterrupted`,
   ``__version__``

@@ -20,6 +20,7 @@ from scipy.optimize import brentq
 from rbm_cli.config.types import ColumnConfig, SolverConfig
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.housner.runner import housner_run
+from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.block import block_geometry
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.restitution import block_restitution
@@ -362,7 +363,7 @@ def test_uplift_levels_differ():
 def test_rest_after_impacts(model):
     """Free rocking with e < 1: the k-th post-impact rate is e^k v0 (energy is
     conserved between impacts); the block rests at the first k with
-    e^k v0 < 1e-3 p alpha (the RBM integrator's rest rule)."""
+    e^k v0 < REST_RATE p alpha (the RBM integrator's rest rule)."""
     e, th0 = 0.7, 0.5 * ALPHA
     geo = block_geometry(rectangle(ALPHA, half_diagonal=3 * G / (4 * P * P)))
     alpha = ALPHA if model == "linear" else geo.slenderness
@@ -370,8 +371,8 @@ def test_rest_after_impacts(model):
         v0 = P * math.sqrt(2 * alpha * th0 - th0 * th0)
     else:
         v0 = P * math.sqrt(2 * (math.cos(alpha - th0) - math.cos(alpha)))
-    k = math.ceil(math.log(1e-3 * P * alpha / v0) / math.log(e))
-    assert e**k * v0 < 1e-3 * P * alpha <= e ** (k - 1) * v0
+    k = math.ceil(math.log(REST_RATE * P * alpha / v0) / math.log(e))
+    assert e**k * v0 < REST_RATE * P * alpha <= e ** (k - 1) * v0
     events = []
     out = run_model(model, free(50.0), restitution=e, initial=(th0, 0.0), events=events)
     assert out.n_impacts == k and events[-1][1] == "rest"

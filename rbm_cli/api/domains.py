@@ -279,9 +279,11 @@ def migrate(folder: str | os.PathLike) -> str:
     """Bring a domain stored by an earlier rbm (its meta.json under an earlier schema of the
     config hash) to this version's hash, so that this version resumes, compares and keeps
     it as its own; its rows (amplitudes [g], frequencies [Hz], ...) and figures are not
-    touched. It checks first that the domain
-    is the one this version makes of its config (the same settings, no cell that ran out of
-    a budget, the method that ran: docs/guide/reproducibility.md) and refuses otherwise.
+    touched. It checks first that the domain was made by the config this version reads
+    from it (the same settings, no cell that ran out of a budget, the method this version
+    runs: docs/reproducibility.md) and refuses otherwise. Its rows stay those of the rbm
+    that made them (meta.json's provenance); the regression rule (``rbm compare``) is
+    what compares them with this version's.
 
     Returns a one-line note; RbmError (one line) when it cannot (re-make the domain).
 

@@ -230,10 +230,11 @@ def migrate_cmd(folders: tuple[str, ...]) -> None:
     """Bring domains stored by an earlier rbm to this version's config hash.
 
     Each FOLDER holds a finished domain (meta.json, domain.csv). Its meta.json gets this
-    version's hash and schema once rbm has checked that the domain is the one it makes of
-    the same config (the same settings, no cell that ran out of a budget, the method that
-    ran); its rows and figures are not touched. A folder that does not pass is left as it
-    is, named in one line (re-make it), and the exit status is 2.
+    version's hash and schema once rbm has checked that the domain was made by the config
+    this version reads from it (the same settings, no cell that ran out of a budget, the
+    method this version runs); its rows and figures, those of the rbm that made them, are
+    not touched (rbm compare judges them against this version's). A folder that does not
+    pass is left as it is, named in one line (re-make it), and the exit status is 2.
 
     \b
     Example:

@@ -17,15 +17,20 @@ from typing import NamedTuple
 import numpy as np
 
 from rbm_cli.base.detmath import matmul, matvec
+from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
 from rbm_cli.physics.equations import Model, event_families
 from rbm_cli.physics.law import law_arrays
 
 #: A rigid block whose post-impact rate is below REST_RATE * p * theta_u is
 #: put to rest [assumption]: its next excursion would stay below
-#: (REST_RATE^2 / 2) theta_u = 5e-7 theta_u. This ends Zeno impact sequences
-#: (e < 1) and micro-chatter (e = 1, demand just above uplift) in finite work.
-REST_RATE = 1e-3
+#: (REST_RATE^2 / 2) theta_u = 100 EVENT_EPS theta_u, a hundred times the offset of the
+#: event surfaces (the smallest rotation the event location tells from zero), 1e-10
+#: theta_u. This ends Zeno impact sequences (e < 1) and micro-chatter (e = 1, demand
+#: just above uplift) in finite work, once the hops are about to sink below what the
+#: integrators resolve. (At 1e-3, 5e-7 theta_u, a block under a record was put to rest
+#: that the ground would have rocked on: docs/stability.md, "Numerical constants".)
+REST_RATE = math.sqrt(200.0 * EVENT_EPS)
 
 
 class ColumnArrays(NamedTuple):

@@ -24,17 +24,20 @@ elastic branch (Model.joint_damping). On the elastic branch f = K_M |phi| and th
 -K_M phi: the column is linear and the two directions do not meet at all.
 
 Near a closed joint of a rigid law (f jumps at 0: a rigid monolith) the direction of phi is
-round-off; there the law reads the component x = phi . c of phi along a pinned direction c
-(the side the joint rocks onto), as a base flat to that side, and m = -f(x) c
-(rbm_cli.models.rbm3d says when).
+not defined at phi = 0 and turns without bound as phi passes closure ever nearer; within a
+pinned distance of closure the law reads the component x = phi . c of phi along a pinned
+direction c (the side the joint rocks onto), as a base flat to that side, and m = -f(x) c
+(rbm_cli.models.rbm3d says when: that distance is the integrator's absolute tolerance of
+the rotation, solver.atol theta_u).
 
 The equations are compiled (numba) as the planar kernel's are, into the same slots of its
 right-hand side (rbm_cli.models.rbm.step.rk.rhs: a state of 4n values is this model's):
 
 - ``As`` (n, 3n): [M^-1 D^T | M^-1 K_g | the argument map];
 - ``cs`` (9n): per joint, the piece it is on: intercept, weight slope, elastic slope, its
-  damping (0 off the elastic branch), pinned (1.0 or 0.0), the pinned direction (x, y),
-  then 2n of scratch for the moments (:func:`pack_pieces` fills it);
+  damping (0 off the elastic branch), pinned (0.0, 1.0, or 2.0: at phi = 0 alone), the
+  pinned direction (x, y), then 2n of scratch for the moments (:func:`pack_pieces` fills
+  it);
 - ``es`` (n + 10): -M^-1 r, the motion's direction in plan (cos, sin), then the second
   horizontal component (flag, gain, omega, phase, centre, gamma: a record pair's straight
   piece, a_{k+1} - a_k, a_k, t_k, t_{k+1} - t_k, or an analytic component's formula; flag
@@ -94,12 +97,13 @@ def beam_rates(t, y, n, As, cs, es, gr, out):
             vy += a * y[3 * n + j]
         a0 = gam * cs[i]
         slope = gam * cs[n + i] + cs[2 * n + i]
-        if cs[4 * n + i] != 0.0:  # pinned: the law of the component along c
+        r = math.sqrt(px * px + py * py)
+        pin = cs[4 * n + i]
+        if pin == 1.0 or (pin == 2.0 and r == 0.0):  # pinned: the law along c
             cx, cy = cs[5 * n + i], cs[6 * n + i]
             along = a0 + slope * (px * cx + py * cy)
             mx, my = -along * cx, -along * cy
         else:
-            r = math.sqrt(px * px + py * py)
             k = (a0 / r if r > 0.0 else 0.0) + slope
             mx, my = -k * px, -k * py
         damp = cs[3 * n + i]
@@ -124,9 +128,10 @@ def beam_rates(t, y, n, As, cs, es, gr, out):
 
 @jit
 def pack_pieces(k, pinned, c, intercepts, weight, elastic, damp, rigid, cs):
-    """cs's pieces (beam_rates) of joints on pieces k (n,) of their laws, pinned (n,) bool
-    along c (n, 2): each piece's intercept and slopes, the damping of an elastic joint on
-    its elastic branch."""
+    """cs's pieces (beam_rates) of joints on pieces k (n,) of their laws, pinned (n,) along
+    c (n, 2 or more: the direction in its first two columns; 0 free, 1 pinned, 2 pinned
+    where phi = 0 exactly, its own direction elsewhere): each piece's intercept and slopes,
+    the damping of an elastic joint on its elastic branch."""
     n = k.size
     for i in range(n):
         q = k[i]
@@ -134,6 +139,6 @@ def pack_pieces(k, pinned, c, intercepts, weight, elastic, damp, rigid, cs):
         cs[n + i] = weight[i, q]
         cs[2 * n + i] = elastic[i, q]
         cs[3 * n + i] = damp[i] if (q == 0 and not rigid[i]) else 0.0
-        cs[4 * n + i] = 1.0 if pinned[i] else 0.0
+        cs[4 * n + i] = float(pinned[i])
         cs[5 * n + i] = c[i, 0]
         cs[6 * n + i] = c[i, 1]

@@ -30,14 +30,15 @@ this is Housner's equation of the block whose corner is the rim's point in that 
 theta'' = -p^2 [sin(alpha - theta) + (a / g) cos(alpha - theta)], p^2 = m g |r| / I_O,
 I_O = I_t + m |r|^2 (the rotary inertia about the tangent to the rim at P).
 
-Near the vertical the direction of q is round-off (a lean of 1e-27 after an uplift at 37
-degrees pointed 8 degrees off the motion's plane), and a lean that passes the vertical at
-a distance delta turns the contact point round the rim at a rate |q'| / delta (Srinivasan
-and Ruina 2008): as delta goes to 0, without bound. Within UPRIGHT_LEAN sin(alpha) of the
-vertical the column's contact direction is therefore *pinned* to a given c0 (the side it
-lifts to or rocks onto, or the direction it leaned as it came within that distance): a
-base flat to that lean strikes or leaves the ground as a whole (rbm_cli.models.housner3d
-says when).
+At q = 0 the contact direction is not defined by q, and a lean that passes the vertical
+at a distance delta turns the contact point round the rim at a rate |q'| / delta
+(Srinivasan and Ruina 2008): as delta goes to 0, without bound. Within a *pinned lean* of
+the vertical the column's contact direction is therefore held at a given c0 (the side it
+lifts to or rocks onto, or the direction it leaned as it came within that lean): the base
+strikes or leaves the ground as a whole there. That lean is a numerical one, not a
+flatness of the stone: rbm_cli.models.housner3d ties it to the integrator's absolute
+tolerance of the lean (solver.atol alpha; housner3d.runner.pinned_lean), so that the
+answer is the rigid cylinder's, converged as the tolerances shrink.
 
 References
 ----------
@@ -60,11 +61,6 @@ from rbm_cli.physics.block import BlockGeometry, block_geometry
 
 #: Number of state components: q (2), w (3), the centre in plan (2).
 STATE_SIZE = 7
-#: Within UPRIGHT_LEAN sin(alpha) of the vertical the column's contact direction is pinned
-#: [-]: a lean of 2.6e-7 rad for alpha 0.27 rad, a rise of the rim of 0.26 um over a 1 m
-#: base, far below any flatness of a stone base, far above the round-off of a motion turned
-#: out of the x axis.
-UPRIGHT_LEAN = 1e-6
 
 
 @dataclass(frozen=True)
@@ -93,12 +89,6 @@ class CylinderGeometry:
     def slenderness(self) -> float:
         """alpha = atan(R / h) [rad]."""
         return self.block.slenderness
-
-    @property
-    def upright(self) -> float:
-        """The lean |q| within which the contact direction is pinned: UPRIGHT_LEAN sin(alpha)
-        [-]."""
-        return UPRIGHT_LEAN * math.sin(self.block.slenderness)
 
 
 def cylinder_geometry(column: ColumnConfig) -> CylinderGeometry:
@@ -178,8 +168,8 @@ def rolling_rates(
     y : (7,) State (q [-], w [rad/s], centre in plan [m])
     c0 : (2,) The contact direction where q = 0, and wherever pinned
     ge : (3,) g_e = (-a_x, -a_y, -(g + a_v)) [m/s^2]
-    pinned : bool  The contact direction is c0 (a column within UPRIGHT_LEAN sin(alpha)
-        of the vertical), not q's own
+    pinned : bool  The contact direction is c0 (a column within the pinned lean of the
+        vertical, module docstring), not q's own
     """
     qx, qy = float(y[0]), float(y[1])
     w0, w1, w2 = float(y[2]), float(y[3]), float(y[4])
@@ -275,7 +265,6 @@ def uplift_level(geo: CylinderGeometry) -> float:
 
 __all__ = [
     "STATE_SIZE",
-    "UPRIGHT_LEAN",
     "CylinderGeometry",
     "axis",
     "cylinder_energy",

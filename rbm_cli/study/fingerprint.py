@@ -14,7 +14,8 @@ form that left out the settings added after the first release where they had the
 defaults (SCHEMA1_LEFT_OUT), solver.stop when it was ``figures``, and wrote ``auto`` as
 DOP853; its step and event budgets were fixed numbers (SCHEMA1_BUDGETS), where ``auto``
 now follows the column and the motion and is never less. A domain stored under it keeps
-its rows: :func:`migrate` rewrites its meta.json with today's hash once it has checked
+its rows (those of the rbm that made them; the regression rule compares them with this
+version's): :func:`migrate` rewrites its meta.json with today's hash once it has checked
 (:func:`schema1_problem`) that
 
 - its meta.json is intact: the stored ``config`` is the config its hash was taken of, and
@@ -88,12 +89,13 @@ def _digest(form: dict) -> str:
     return hashlib.sha256(json.dumps(form, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
-def methods_that_run(config: Config) -> str:
+def methods_that_run(config: Config, points: list | None = None) -> str:
     """The method(s) the cells of a config run with: solver.method with ``auto`` resolved at
     each point of the grid (rbm_cli.models.methods.resolve_method), e.g. 'closed-form' or
     'closed-form, DOP853' when the points differ; the method as written where it does not
     apply (the sweep refuses it, in one line). The points take the config's solver, unless
-    an axis of the grid is over one of its keys."""
+    an axis of the grid is over one of its keys. ``points``: the config's grid points
+    where the caller has them (rbm_cli.study.cells.grid_points), else expanded here."""
     own = not any(path.startswith("solver.") for path in config.grid.axis_paths)
     try:
         return ", ".join(
@@ -101,27 +103,28 @@ def methods_that_run(config: Config) -> str:
                 resolve_method(
                     dataclasses.replace(p.config, solver=config.solver) if own else p.config
                 )  # fmt: skip
-                for p in grid_points(config)
+                for p in (grid_points(config) if points is None else points)
             )
         )
     except (RbmError, ConfigError):
         return config.solver.method
 
 
-def hash_form(config: Config) -> dict:
+def hash_form(config: Config, points: list | None = None) -> dict:
     """What a config's hash is taken of: its resolved form with the methods that run
-    (:func:`methods_that_run`), without NOT_SETTINGS, and the SCHEMA."""
+    (:func:`methods_that_run`; ``points`` its grid points, if the caller has them), without
+    NOT_SETTINGS, and the SCHEMA."""
     form = config.resolved()
     for section, key in NOT_SETTINGS:
         form[section].pop(key, None)
-    form["solver"]["method"] = methods_that_run(config)
+    form["solver"]["method"] = methods_that_run(config, points)
     form["schema"] = SCHEMA
     return form
 
 
-def config_hash(config: Config) -> str:
+def config_hash(config: Config, points: list | None = None) -> str:
     """Fingerprint of everything that changes a domain (:func:`hash_form`), 16 hex digits."""
-    return _digest(hash_form(config))
+    return _digest(hash_form(config, points))
 
 
 def schema1_hash(stored: dict) -> str:

@@ -391,7 +391,7 @@ def run_sweep(
     points = _check_points(grid_points(config))
     cells = grid_cells(config, points)
     folder = Path(output) / config.name
-    digest = config_hash(config) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
+    digest = config_hash(config, points) + (f"-ensemble{ensemble}" if ensemble > 1 else "")
     fields = sweep_fields(config, ensemble)
     resume_command = resume_command or f"rbm sweep CONFIG.yaml -o {output} --resume"
     note = notify or (lambda text: None)

@@ -303,7 +303,7 @@ def sweep_meta(
         "config_dir": where,
         "schema": SCHEMA,
         "config_hash": digest,
-        "solver_method": methods_that_run(config),
+        "solver_method": methods_that_run(config, points),
         "versions": _versions(),
         "wall_time_s": None,
         "jobs": None,

@@ -3,14 +3,16 @@ under a ground motion in any horizontal direction, integrated by scipy's DOP853 
 RK23) step by step like `housner`, the events located on each step's dense output:
 
 - **uplift** when |a_g| exceeds (g + a_v) tan(alpha), onto the rim's point away from a_g;
-- **impact** where the lean crosses the vertical. Within UPRIGHT_LEAN sin(alpha) of it
-  the contact is pinned: a lean that comes that near is followed, its contact held where
-  it leaned as it came in, until it crosses the line across that direction (theta = 0
-  exactly in a plane) or turns away. The horizontal angular velocity then becomes e times
-  itself, the spin about the axis is kept, the lean is set upright, and the column rocks
-  on toward where its axis moves, pinned until its lean is LEAVE_FACTOR times that
-  distance out. A lean that passes farther from the vertical rolls round it (Srinivasan
-  and Ruina 2008). In a plane this is Housner's impact (theta' <- e theta');
+- **impact** where the lean crosses the vertical. Within the pinned lean of it
+  (pinned_lean: 1000 solver.atol alpha, solver.atol alpha from an uplift from rest up to
+  the next impact) the contact is pinned: a lean that comes that near is followed, its
+  contact held where it leaned as it came in, until it crosses the line across that
+  direction (theta = 0 exactly in a plane) or turns away. The horizontal angular velocity
+  then becomes e times itself, the spin about the axis is kept, the lean is set upright,
+  and the column rocks on toward where its axis moves, pinned until its lean is
+  LEAVE_FACTOR times that distance out. A lean that passes farther from the vertical rolls
+  round it (Srinivasan and Ruina 2008). In a plane this is Housner's impact
+  (theta' <- e theta');
 - **collapse** at a tilt of collapse.ratio alpha (Outcome.azimuth: where it leaned);
   Outcome.turns is the angle the lean's direction swept while the tilt was WOBBLE_LEVEL
   alpha or more at both ends of a step (a wobble), in turns;
@@ -47,7 +49,7 @@ from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.housner.state import BlockRun
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome, budget_message
-from rbm_cli.models.plan import from_ground, to_ground, wrapped
+from rbm_cli.models.plan import as_line, from_ground, to_ground, turned_start, wrapped
 from rbm_cli.physics.arrays import REST_RATE
 from rbm_cli.physics.cylinder import (
     STATE_SIZE,
@@ -80,6 +82,7 @@ class _Run3d(BlockRun):
     start_top: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(2))
     azimuth: float = math.nan
     phase: int = 0  # LEAVING, FREE or APPROACH (near the vertical)
+    rising: bool = False  # from an uplift from rest up to the next impact (pinned_lean)
     swept: float = 0.0  # the angle the lean's direction swept while it wobbled [rad]
     angle: float = 0.0  # the motion's azimuth [rad]: its frame turned to the ground's axes
 
@@ -145,6 +148,11 @@ def cylinder_run(
     solver = solver.for_run(motion.t_end, 1)
     alpha, p = geo.slenderness, geo.block.frequency_parameter
     limit = collapse_ratio * alpha
+    motion, beta = as_line(motion)  # a pair in phase: one component turned by beta
+    if beta != 0.0:  # the start, given in the first component's plane, in the line's
+        (initial, across) = zip(turned_start(float(initial[0]), float(across[0]), beta),
+                                turned_start(float(initial[1]), float(across[1]), beta),
+                                strict=True)  # fmt: skip
     angle = wrapped(motion.angle)  # the motion's frame (rbm_cli.models.plan)
     if motion.angle != 0.0:
         motion = dataclasses.replace(motion, angle=0.0)
@@ -172,7 +180,7 @@ def cylinder_run(
     run.at_rest = not np.any(run.y[0:5])
     run.start_top = top_in_plan(geo, run.y)
     lean = math.hypot(run.y[0], run.y[1])
-    run.phase = LEAVING if lean <= LEAVE_FACTOR * geo.upright else FREE
+    run.phase = LEAVING if lean <= LEAVE_FACTOR * alpha * PIN_FACTOR * solver.atol else FREE
     run.peak = tilt(run.y[0:2])
     if run.peak >= limit:
         run.out.t_collapse, run.out.collapse_interface = 0.0, 1
@@ -186,7 +194,9 @@ def cylinder_run(
         geo=geo, e=restitution, s_limit=math.sin(limit), eps=EVENT_EPS * math.sin(alpha),
         rest_rate=REST_RATE * p * alpha, level=uplift_level(geo), atol=atol,
         barrier=cylinder_energy(geo, at_barrier, np.array([1.0, 0.0])),
-        wobble=math.sin(WOBBLE_LEVEL * alpha),
+        wobble=math.sin(WOBBLE_LEVEL * alpha), alpha=alpha, pin=PIN_FACTOR * solver.atol,
+        rise=solver.atol,
+        pin_rate=PIN_ROUNDOFF * EPS * p,
     )  # fmt: skip
     for seg_start, seg_end in motion.segments():
         if run.t >= seg_end:
@@ -244,6 +254,40 @@ def _in_plane(y: np.ndarray) -> bool:
 #: within the pinned lean (pinned to where it leaned as it came in), up to the impact.
 LEAVING, FREE, APPROACH = 0, 1, 2
 LEAVE_FACTOR = 2.0
+#: Spacing of doubles at 1 [-].
+EPS = float(np.finfo(float).eps)
+#: The pinned lean is never below PIN_ROUNDOFF eps p t alpha at time t [-] (pinned_lean).
+PIN_ROUNDOFF = 100.0
+#: The pinned lean is PIN_FACTOR atol alpha [-] (pinned_lean).
+PIN_FACTOR = 1000.0
+
+
+def pinned_lean(ts, k, rising: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """The pinned lean |q| at times ts [s] and its rate [1/s]: alpha times the larger of
+
+    - PIN_FACTOR solver.atol: the integrator's absolute tolerance of the lean is atol
+      alpha, so a lean that passes the vertical that near cannot be told from one through
+      it, and its direction is not what the steps control; the events that pin and free
+      the contact are located on the dense output, whose error is of that order: a
+      thousand times it (at atol alone a record's 90 impacts along x moved the peak 1e-8
+      from Housner's block, at 1000 atol 7e-12). 100 times smaller tolerances take it 100
+      times nearer (a cell that turns on it is not robust to the solver);
+    - PIN_ROUNDOFF eps p t: a lean that passes the vertical at a distance delta turns the
+      contact round the rim at |q'| / delta (of the order of p alpha / delta), which steps
+      of delta / |q'| resolve; at time t those must stay well above the spacing of
+      doubles, eps t (at 1e-13 alpha and 21 s a run of this module's tests failed there).
+
+    rising: from an uplift from rest up to the next impact, with solver.atol in place of
+    PIN_FACTOR solver.atol: held to its uplift's direction while it leans slowly off the
+    vertical as the motion turns, the column's peak moves by about the square root of that
+    lean (a cylinder under an elliptic motion: 0.5820 alpha at 1e-9 alpha, 0.5793 at 1e-12
+    and at 1e-14).
+    """
+    ts = np.asarray(ts, dtype=float)
+    base = k["rise"] if rising else k["pin"]
+    floor = k["pin_rate"] * ts
+    pin = k["alpha"] * np.maximum(base, floor)
+    return pin, np.where(floor > base, k["alpha"] * k["pin_rate"], 0.0)
 
 
 def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | None:
@@ -260,7 +304,7 @@ def _segment(run, motion, seg_end, forced, can_stop, solver, k) -> Outcome | Non
             if kind == "segment":
                 return None
             run.c = motion.uplift_direction(run.t)
-            run.y, run.phase = np.zeros(STATE_SIZE), LEAVING
+            run.y, run.phase, run.rising = np.zeros(STATE_SIZE), LEAVING, True
             if out.n_uplifts + out.n_impacts > solver.max_events:
                 return _fail(run, budget_message("event", solver.max_events))
         c0, pinned = run.c.copy(), run.phase != FREE
@@ -297,8 +341,8 @@ def _steps(run, integ, k, solver, d, stop_ok=False):
     direction; approaching: or turns away from the vertical), None at the segment's end,
     or the Outcome when the run ends (a collapse, a budget, or with stop_ok a peak of the
     tilt: every figure final)."""
-    out, upright, s_limit, eps = run.out, k["geo"].upright, k["s_limit"], k["eps"]
-    phase, c0 = run.phase, run.c
+    out, s_limit, eps = run.out, k["s_limit"], k["eps"]
+    phase, c0, rising = run.phase, run.c, run.rising
     while integ.status == "running":
         t_old = run.t
         msg = integ.step()
@@ -315,13 +359,17 @@ def _steps(run, integ, k, solver, d, stop_ok=False):
             lean = np.hypot(q[0], q[1])
             d_lean = (q[0] * dq[0] + q[1] * dq[1]) / np.where(lean > 0.0, lean, 1.0)
             collapse, d_collapse = s_limit - lean, -d_lean
-            if phase == FREE:
-                return np.array([lean - upright, collapse]), np.array([d_lean, d_collapse])
+            pin, d_pin = pinned_lean(ts, k, rising)
+            if phase == FREE:  # within the pinned lean: its square, smooth through the
+                # vertical, so that a dip of a lean passing within it is seen
+                near, d_near = lean * lean - pin * pin, 2.0 * (q[0] * dq[0] + q[1] * dq[1]
+                                                              - pin * d_pin)  # fmt: skip
+                return np.array([near, collapse]), np.array([d_near, d_collapse])
             # leaving or approaching: the lean back across the line across c0 (an impact)
             across = q[0] * c0[0] + q[1] * c0[1] + eps
             d_across = dq[0] * c0[0] + dq[1] * c0[1]
             if phase == LEAVING:  # or out to LEAVE_FACTOR pinned leans (free from there)
-                dist, rate = LEAVE_FACTOR * upright - lean, -d_lean
+                dist, rate = LEAVE_FACTOR * pin - lean, LEAVE_FACTOR * d_pin - d_lean
                 return (np.array([dist, collapse, across]),
                         np.array([rate, d_collapse, d_across]))  # fmt: skip
             turned = -d_lean  # > 0 while it comes nearer
@@ -380,7 +428,7 @@ def _impact(run, k, solver) -> Outcome | None:
     y[2:4] *= k["e"]
     moving = np.array([y[3], -y[2]])  # n' = w x e_z in plan
     speed = math.hypot(moving[0], moving[1])
-    run.phase = LEAVING
+    run.phase, run.rising = LEAVING, False
     if speed < k["rest_rate"]:
         y[2:5] = 0.0
         run.y, run.at_rest = y, True

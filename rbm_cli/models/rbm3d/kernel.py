@@ -68,9 +68,9 @@ from rbm_cli.physics.ground import (
     vertical_factor,
 )
 
-#: A closed rigid joint's direction is pinned within UPRIGHT_LEAN theta_u of closure ...
-UPRIGHT_LEAN = 1e-6
-#: ... and after an uplift or an impact, until LEAVE_FACTOR times that distance.
+#: A rigid joint's direction is pinned within a distance of closure (c[i, 2], solver.atol
+#: theta_u: the runner's notes) and after an uplift or an impact, until LEAVE_FACTOR times
+#: that distance.
 LEAVE_FACTOR = 2.0
 #: A joint's phase: free (its own direction), leaving or approaching closure (pinned).
 FREE, LEAVING, APPROACH = 0, 1, 2
@@ -121,7 +121,8 @@ def _edge(i, q, gam, edges, nedges, edge_w):
 
 @jit(inline=True)
 def distance(kind, i, y, n, col, k, c, gam):
-    """A watched event's distance [-] and its rate [-/s] at state y."""
+    """A watched event's distance [-] and its rate [-/s] at state y (c: each joint's pinned
+    direction and pinned distance, run3d's notes)."""
     if kind == COLLAPSE:
         m, dm = _magnitude(col.families[n + i], y, n)
         return col.c_ratio + EVENT_EPS - m, -dm
@@ -135,9 +136,9 @@ def distance(kind, i, y, n, col, k, c, gam):
     if kind == DOWN:
         e = _edge(i, k[i] - 1, gam, col.edges, col.nedges, col.edge_w)
         return (r - e) / tu + EVENT_EPS, dr / tu
-    pin = UPRIGHT_LEAN * tu
-    if kind == NEAR:
-        return (r - pin) / tu, dr / tu
+    pin = c[i, 2]
+    if kind == NEAR:  # the square, smooth through closure: a dip within pin is seen
+        return (r * r - pin * pin) / (tu * tu), 2.0 * (px * vx + py * vy) / (tu * tu)
     if kind == LEFT:
         return (LEAVE_FACTOR * pin - r) / tu, -dr / tu
     if kind == ACROSS:
@@ -478,9 +479,10 @@ def run3d(col, motion, solver, task, pair):
     motion : Excitation  The motion along its direction (step.inputs)
     solver : SolverSettings  atol of 4n entries
     task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 3n), friction_limit,
-        early stop (models.status.stop_level), held: the held friction demand,
-        pieces.held_array); y0 and held are changed in place: the state where the run
-        ended, the samples of the demand held
+        early stop (models.status.stop_level), pin: a rigid joint's pinned distance of
+        closure over its theta_u [-], held: the held friction demand, pieces.held_array);
+        y0 and held are changed in place: the state where the run ended, the samples of
+        the demand held
     pair : tuple  (d0, d1, values_y: a second record's samples, or empty; gy: the second
         component's ground tuple, physics.ground, gain 0 for none; knots_y: its knots)
 
@@ -494,7 +496,7 @@ def run3d(col, motion, solver, task, pair):
         the energy the joints' damping and the impacts took.
     """
     col = ColumnArrays(*col)
-    y0, record, output_dt, samples, mu, stop, held = task
+    y0, record, output_dt, samples, mu, stop, pin, held = task
     d0, d1, values_y, gy, knots_y = pair
     mc, rtol, atol = solver[0], solver[1], solver[2]
     max_steps, max_events, deadline = solver[3], solver[4], solver[5]
@@ -528,9 +530,11 @@ def run3d(col, motion, solver, task, pair):
     k = np.zeros(n, dtype=np.int64)
     pending = np.zeros(n, dtype=np.bool_)
     phase = np.zeros(n, dtype=np.int64)
-    c = np.zeros((n, 2))
+    # leaving closure from phi = 0 exactly (an uplift from rest): pinned at phi = 0 alone
+    rising = np.zeros(n, dtype=np.bool_)
+    c = np.zeros((n, 3))  # per joint: the pinned direction (x, y), the pinned distance [rad]
     for i in range(n):
-        c[i, 0], c[i, 1] = d0, d1
+        c[i, 0], c[i, 1], c[i, 2] = d0, d1, pin * col.tu[i]
     kinds, joints = np.zeros(nrow_max, dtype=np.int64), np.zeros(nrow_max, dtype=np.int64)
     d_old, r_old = np.empty(nrow_max), np.empty(nrow_max)
     d_new, r_new = np.empty(nrow_max), np.empty(nrow_max)
@@ -573,7 +577,7 @@ def run3d(col, motion, solver, task, pair):
                 at_rest = False
         px, py, vx, vy = _phi(0, y, n, col.argmap)
         r = math.sqrt(px * px + py * py)
-        if not at_rest and r <= LEAVE_FACTOR * UPRIGHT_LEAN * col.tu[0]:
+        if not at_rest and r <= LEAVE_FACTOR * c[0, 2]:
             if r > 0.0:
                 c[0, 0], c[0, 1] = px / r, py / r
             else:
@@ -666,15 +670,16 @@ def run3d(col, motion, solver, task, pair):
                 ax, ay = a_d * d0 - a_y * d1, a_d * d1 + a_y * d0
                 size = math.sqrt(ax * ax + ay * ay)
                 c[0, 0], c[0, 1] = -ax / size, -ay / size
-                phase[0] = LEAVING
+                phase[0], rising[0] = LEAVING, True
                 at_rest = False
                 n_upl += 1
                 h_carry = -1.0
 
             # a new stepper from (t, y), its pieces packed
-            pinned = np.zeros(n, dtype=np.bool_)
+            pinned = np.zeros(n, dtype=np.int64)  # beam3d.pack_pieces
             for i in range(n):
-                pinned[i] = phase[i] != FREE and col.rigid[i]
+                if phase[i] != FREE and col.rigid[i]:
+                    pinned[i] = 2 if rising[i] else 1
             pack_pieces(k, pinned, c, col.intercepts, weight, elastic, col.damp, col.rigid, cs)
             m = watch(n, k, phase, pending, col, kinds, joints)
             t_bound = seg_end
@@ -872,8 +877,9 @@ def run3d(col, motion, solver, task, pair):
                 phase[i] = APPROACH
                 c[i, 0], c[i, 1] = px / r, py / r
             elif kind == LEFT:
-                phase[i] = FREE
+                phase[i], rising[i] = FREE, False
             else:  # ACROSS or TURNED: the joint closes
+                rising[i] = False
                 cx, cy = c[i, 0], c[i, 1]
                 if col.rigid[i]:
                     _move(i, y, n, col.arg_inv, -px, -py)

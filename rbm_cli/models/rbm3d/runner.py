@@ -10,10 +10,19 @@ RK45, RK23) in a compiled run of its own (kernel.py; its source uncompiled with
   branch after an excursion has its direction c pinned there (phi_i / |phi_i|); the
   impact is where phi_i crosses the line across c (phi_i . c = 0: phi_i = 0 in a plane).
   For a rigid law (no elastic branch: a rigid monolith) the joint is pinned within
-  UPRIGHT_LEAN theta_u of closure, where its direction is round-off (as `housner-3d`
-  pins its contact), and closes there (crossing the line, or turning away); after the
-  impact it rocks on toward where it moves, pinned until |phi| is LEAVE_FACTOR times that
-  distance. A joint that passes farther from closure rolls round it (a wobble).
+  solver.atol theta_u of closure (the integrator's absolute tolerance of the rotation:
+  a joint that passes closure that near cannot be told from one through it, and its
+  direction there is not what the steps control; as `housner-3d` pins its contact), and
+  closes there (crossing the line, or turning away); after the impact it rocks on toward
+  where it moves, pinned until |phi| is LEAVE_FACTOR times that distance (its phi is
+  round-off there). A monolith lifting from rest (phi = 0 exactly, growing from it) is
+  pinned at phi = 0 alone, and follows its own direction from there: pinned while it
+  leans slowly off the vertical, as the motion turns, its peak moved by about the square
+  root of that distance (1e-3 at atol 1e-12 just above the uplift level). A joint that
+  passes farther from closure rolls round it (a wobble), and a passage within that
+  distance is found wherever it falls in a step (the square of |phi| is watched, smooth
+  through closure). 100 times smaller tolerances take that distance 100 times nearer
+  closure, so the robustness rule's solver check sees a cell that turns on it.
   The rule: an impulsive moment along c acts at the joint, so that the component of its
   relative rate along c becomes e times itself (momentum-consistent, as in the plane:
   Model.impact_rates; `absolute` scales that rate alone) and the rolling component across
@@ -61,7 +70,7 @@ from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import SolverConfig
 from rbm_cli.models.outcome import EnergyAccount, Outcome
-from rbm_cli.models.plan import from_ground, to_ground, wrapped
+from rbm_cli.models.plan import as_line, from_ground, to_ground, turned_start, wrapped
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.models.rbm.step.inputs import excitation, prepare_kernel, solver_settings
@@ -122,14 +131,18 @@ def integrate3d(
     """
     prepared = prepare_kernel(model) if prepared is None else prepared
     n = model.n
+    motion, beta = as_line(motion)  # a pair in phase: one component turned by beta
     angle = wrapped(motion.angle)  # the motion's frame (rbm_cli.models.plan)
     own = motion if motion.angle == 0.0 else dataclasses.replace(motion, angle=0.0)
     if state is None:
         theta0, rate0 = np.asarray(theta0, float), np.asarray(rate0, float)
-        y0 = np.concatenate([theta0, np.zeros(n), rate0, np.zeros(n)])
+        tc, rc = np.zeros(n), np.zeros(n)
         if across is not None:  # across the motion's plane: along y in the motion's frame
             tc, rc = np.asarray(across[0], float), np.asarray(across[1], float)
-            y0 = np.concatenate([theta0, tc, rate0, rc])
+        # given in the first component's plane; in the line's (as_line)
+        theta0, tc = turned_start(theta0, tc, beta)
+        rate0, rc = turned_start(rate0, rc, beta)
+        y0 = np.concatenate([theta0, tc, rate0, rc])
     else:
         y0 = np.array(state, dtype=float)
         for part in (0, 2 * n):
@@ -144,7 +157,7 @@ def integrate3d(
     samples = np.zeros((rows, 3 + 3 * n))
     held = held_array(n, float(friction_duration), float(friction_limit))
     task = (y0, bool(record), float(output_dt), samples, float(friction_limit),
-            stop_level(early_stop, solver), held)  # fmt: skip
+            stop_level(early_stop, solver), float(solver.atol), held)  # fmt: skip
     pair = (1.0, 0.0, as_samples(own.values_y), own.ground_y, own.knots_y)
     armed = arm()
     try:

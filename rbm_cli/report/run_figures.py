@@ -16,6 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from rbm_cli.models.history import History
+from rbm_cli.study.schema import C
 
 #: Number of deformed shapes drawn in shapes.png.
 N_SHAPES = 6
@@ -55,8 +56,8 @@ def run_title(summary: dict) -> str | None:
         if kind == "free":
             return f"{name}: free motion"
         if kind == "record":
-            return record_title(name, summary["record"], float(inputs["amplitude_g"]))
-        amplitude, frequency = float(inputs["amplitude_g"]), float(inputs["frequency_hz"])
+            return record_title(name, summary[C.record], float(inputs[C.amplitude_g]))
+        amplitude, frequency = float(inputs[C.amplitude_g]), float(inputs[C.frequency_hz])
         cell = f"A = {amplitude:.4g} g, f = {frequency:.4g} Hz"
     except (KeyError, TypeError, ValueError, AttributeError):
         return None

@@ -1,7 +1,7 @@
 """Safe-unsafe domains as tables: rows, CSV text, boundary, comparison.
 
-A domain is a pandas DataFrame with the columns of domain.csv
-(:data:`rbm_cli.study.result.CSV_FIELDS`), one row per (amplitude, frequency) cell, or
+A domain is a pandas DataFrame with the columns of domain.csv (their schema:
+rbm_cli.study.schema), one row per (amplitude, frequency) cell, or
 the list of its rows (dicts) a sweep makes. pandas is imported where a DataFrame is built
 or read, not with this module: a sweep writes domain.csv and boundary.csv from its rows
 (:func:`csv_text`, :func:`boundary_table`) without it.

@@ -14,6 +14,7 @@ from __future__ import annotations
 import importlib.util
 import io
 import json
+import re
 import sys
 import tokenize
 from pathlib import Path
@@ -198,7 +199,12 @@ def test_column_names_are_typed_only_in_the_schema_and_the_registry():
         if rel in NOT_COLUMNS | {"rbm_cli/study/schema.py", "rbm_cli/study/intensities.py"}:
             continue
         for tok in tokenize.generate_tokens(io.StringIO(path.read_text()).readline):
-            if tok.type == tokenize.STRING and tok.string[1:-1] in names \
-                    and tok.string[0] == tok.string[-1] == '"':  # fmt: skip
+            if tok.type != tokenize.STRING:
+                continue
+            if tok.string[1:-1] in names and tok.string[0] == tok.string[-1] == '"':
                 found.append(f"{rel}:{tok.start[0]}: {tok.string}")
+            elif tok.string.startswith(("f", "rf", "fr")):  # a name inside an f-string
+                for name in re.findall(r"\[['\"](\w+)['\"]\]", tok.string):
+                    if name in names:
+                        found.append(f"{rel}:{tok.start[0]}: {name} in an f-string")
     assert not found, "\n".join(found)

@@ -68,10 +68,10 @@ def record_title(name: str, record: dict, amplitude: float) -> str:
     """Title of a record run: the config's name, the record's, its scaled PGA [g] (and the
     scale factor with ``scale: factor``), the vertical record's name and scaled peak."""
     if record.get("record_y"):
-        title = (f"{name}: records {record['record']} (x) and {record['record_y']} (y) scaled"
-                 f" to PGA {float(record['pga_g']):.4g} g (the larger)")  # fmt: skip
+        title = (f"{name}: records {record[C.record]} (x) and {record['record_y']} (y) scaled"
+                 f" to PGA {float(record[C.pga_g]):.4g} g (the larger)")  # fmt: skip
     else:
-        title = f"{name}: record {record['record']} scaled to PGA {float(record['pga_g']):.4g} g"
+        title = f"{name}: record {record[C.record]} scaled to PGA {float(record[C.pga_g]):.4g} g"
     if record.get("scale") == "factor":
         title += f" (factor {amplitude:.4g})"
     if record.get("vertical"):

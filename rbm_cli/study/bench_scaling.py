@@ -78,8 +78,8 @@ def _series(series: str, xs, make, log) -> list[dict]:
                              "elastic_hz": _elastic_hz(cfg), **_time(cfg, cell)})  # fmt: skip
                 unit = "pieces" if method == "exact" else "steps"
                 log(f"scaling: {series} {x:g}, {label}, {cell_name} cell: "
-                    f"{rows[-1]['time_per_run_s'] * 1e3:.1f} ms/run, {rows[-1]['n_steps']} "
-                    f"{unit}, {rows[-1]['status']}")  # fmt: skip
+                    f"{rows[-1]['time_per_run_s'] * 1e3:.1f} ms/run, {rows[-1][C.n_steps]} "
+                    f"{unit}, {rows[-1][C.status]}")  # fmt: skip
     return rows
 
 

@@ -163,7 +163,7 @@ def _ensemble_trials(rows: pd.DataFrame, df: pd.DataFrame, outcome: str, n_membe
     if bad.any():
         i = int(np.argmax(bad))
         raise RbmError(f"fragility: row {i + 1}: collapse_fraction must be in [0, 1], "
-                       f"got {df['collapse_fraction'].iat[i]!r}")  # fmt: skip
+                       f"got {df[C.collapse_fraction].iat[i]!r}")  # fmt: skip
     failed = np.isnan(fraction) | rows["failed"].to_numpy(dtype=bool)
     if outcome == "majority":
         trials, hits = np.ones(len(df)), (fraction >= 0.5).astype(float)

@@ -34,10 +34,10 @@ from rbm_cli.physics.closed_forms import (  # noqa: E402
     linear_rocking_parameters,
 )
 from rbm_cli.physics.column import build_column  # noqa: E402
-from rbm_cli.physics.similarity import SCALE_FIELDS  # noqa: E402
 from rbm_cli.report.domain_figure import domain_figure  # noqa: E402
 from rbm_cli.report.domain_view import axis_groups, domain_view  # noqa: E402
 from rbm_cli.study.domain import domain_config, read_domain  # noqa: E402
+from rbm_cli.study.schema import SCALE_COLUMNS as SCALE_FIELDS  # noqa: E402
 
 from .paths import RESULTS  # noqa: E402
 

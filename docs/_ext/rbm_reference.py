@@ -1,18 +1,21 @@
 """The site's reference pages, generated from the code at build time so they cannot drift.
 
-Two directives:
+Three directives:
 
 - ``.. rbm-cli::`` every command of the click group ``rbm_cli.cli.main:main``'s ``cli``
   with its usage, its help text (as ``rbm COMMAND --help`` prints it, once: its options are
   in the table, not repeated above it) and a table of its arguments and options (the
   flags; the help, the type and the default);
+- ``.. rbm-domain-columns::`` the columns of domain.csv, in order, read from its schema
+  (``rbm_cli.study.schema.columns``) and the registry of intensity measures;
 - ``.. rbm-config::`` every key of the config: the key paths are read from the loader's key
   tuples (``rbm_cli.config.load.TOP_KEYS`` ...), the defaults from the config dataclasses
   (``rbm_cli.config.types``), the choices and most ranges from the loader's constants; the
   unit and the meaning of each key are written here, in :data:`KEY_DOCS`. A key the loader
   accepts and this table lacks (or the reverse) stops the build.
 
-:func:`cli_rst` and :func:`config_rst` return the reStructuredText the directives parse;
+:func:`cli_rst`, :func:`config_rst` and :func:`domain_columns_rst` return the
+reStructuredText the directives parse;
 ``tests/test_docs_reference.py`` checks that every option and every key appears in it.
 """
 
@@ -804,6 +807,35 @@ def config_rst() -> str:
     return "\n".join(lines) + "\n"
 
 
+# ---------------------------------------------------------------- domain.csv's columns
+def domain_columns_rst() -> str:
+    """reStructuredText of domain.csv's columns, in the order the writer writes them: a
+    table read from the schema (rbm_cli.study.schema.columns()), the intensity measures'
+    rows from their registry (rbm_cli.study.intensities.MEASURES, with how each scales with
+    the record's factor)."""
+    from rbm_cli.study.intensities import MEASURES
+    from rbm_cli.study.schema import columns
+
+    words = {"float": "number", "int": "whole number", "0/1": "0 or 1", "str": "text"}
+    rows = [[lit("<path>"), "text or number", "", esc(
+        "one column per grid axis over a config key, named by its path (column.size,"
+        " excitation.file, ...; none for an amplitude x frequency grid)"), ""]]  # fmt: skip
+    for column in columns():
+        what = esc(column.quantity)
+        measure = {m.column: m for m in MEASURES}.get(column.name)
+        if measure is not None:
+            if measure.period == "im_periods":
+                what += esc(" (sa_0p5s_g: 0.5 s)")
+            what += esc(f"; scales with the record's factor c: {measure.scaling}")
+        rows.append([lit(column.name), words[column.dtype], esc(column.unit), what,
+                     esc(column.filled or "every domain")])  # fmt: skip
+    return "\n".join(
+        list_table(
+            ["column", "type", "unit", "what it holds", "written for"], rows, [22, 10, 7, 40, 21]
+        )  # fmt: skip
+    )
+
+
 # --------------------------------------------------------------------- the directives
 def setup(app):  # pragma: no cover - exercised by the docs build
     from docutils import nodes
@@ -830,11 +862,16 @@ def setup(app):  # pragma: no cover - exercised by the docs build
     class ConfigDirective(_Generated):
         make = staticmethod(config_rst)
 
+    class DomainColumnsDirective(_Generated):
+        make = staticmethod(domain_columns_rst)
+
     app.add_directive("rbm-cli", CliDirective)
     app.add_directive("rbm-config", ConfigDirective)
+    app.add_directive("rbm-domain-columns", DomainColumnsDirective)
     return {"parallel_read_safe": True, "version": "1"}
 
 
-if __name__ == "__main__":  # python docs/_ext/rbm_reference.py: print both
+if __name__ == "__main__":  # python docs/_ext/rbm_reference.py: print them
     print(cli_rst())
     print(config_rst())
+    print(domain_columns_rst())

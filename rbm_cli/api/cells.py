@@ -18,6 +18,7 @@ from rbm_cli.config.types import Config
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import history_frame, vertical_history
 from rbm_cli.study.result import CSV_FIELDS, THREE_D_FIELDS, RunResult
+from rbm_cli.study.schema import C
 from rbm_cli.study.simulate import simulate
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built: `rbm sweep` never does
@@ -74,16 +75,16 @@ class CellResult(Mapping):
         values = {}
         for k in FIELDS:
             values[k] = getattr(run, k)
-            if k == "max_top_displacement_m" and run.three_d:  # where domain.csv has them
+            if k == C.max_top_displacement_m and run.three_d:  # where domain.csv has them
                 values.update({extra: float(getattr(run, extra)) for extra in THREE_D_FIELDS})
-        interface = values["collapse_interface"]
-        values["collapse_interface"] = None if interface is None else int(interface)
-        for k in ("n_uplifts", "n_impacts", "n_steps", "n_rhs"):
+        interface = values[C.collapse_interface]
+        values[C.collapse_interface] = None if interface is None else int(interface)
+        for k in (C.n_uplifts, C.n_impacts, C.n_steps, C.n_rhs):
             values[k] = int(values[k])
-        for k in ("amplitude_g", "t_collapse_s", "max_rotation_ratio", "max_top_displacement_m",
+        for k in (C.amplitude_g, C.t_collapse_s, C.max_rotation_ratio, C.max_top_displacement_m,
                   "wall_time_s"):  # fmt: skip
             values[k] = float(values[k])
-        values["friction_demand"] = tuple(float(v) for v in values["friction_demand"])
+        values[C.friction_demand] = tuple(float(v) for v in values[C.friction_demand])
         values["friction_demand_peak"] = tuple(float(v) for v in values["friction_demand_peak"])
         object.__setattr__(self, "_run", run)
         object.__setattr__(self, "_values", values)
@@ -118,8 +119,8 @@ class CellResult(Mapping):
 
 #: CellResult's keys, in order: domain.csv's columns of a run (the collapsed flag is
 #: status == 'collapsed'), then figures a domain does not keep.
-FIELDS = tuple(k for k in CSV_FIELDS if k not in ("collapsed", "friction_demand")) + (
-    "friction_demand",
+FIELDS = tuple(k for k in CSV_FIELDS if k not in (C.collapsed, C.friction_demand)) + (
+    C.friction_demand,
     "friction_demand_peak",
     "wall_time_s",
     "method",

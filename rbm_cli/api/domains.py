@@ -18,6 +18,7 @@ from rbm_cli.study.domain import compare as compare_domains
 from rbm_cli.study.domain import read_domain as _read_domain
 from rbm_cli.study.fingerprint import migrate as _migrate
 from rbm_cli.study.result import STATUSES
+from rbm_cli.study.schema import C
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -30,11 +31,17 @@ __all__ = [
     "compare_domains",
     "domain_config",
     "draw_domain",
+    "has_robustness",
     "migrate",
     "plot_domain",
     "read_domain",
     "save_figure",
 ]
+
+
+def has_robustness(df) -> bool:
+    """Whether a domain table holds an ensemble's robustness (its ``robust`` column)."""
+    return C.robust in df.columns
 
 
 def save_figure(fig, path: str | os.PathLike) -> Path:
@@ -189,10 +196,10 @@ def compare(a: pd.DataFrame | str | os.PathLike, b: pd.DataFrame | str | os.Path
     """
     frames = [_domain_frame(x, which) for x, which in ((a, "a"), (b, "b"))]
     for k, df in enumerate(frames):
-        if "collapsed" not in df.columns:
-            frames[k] = df.assign(collapsed=(df["status"] == "collapsed").astype(int))
+        if C.collapsed not in df.columns:
+            frames[k] = df.assign(collapsed=(df[C.status] == "collapsed").astype(int))
     cmp = compare_domains(*frames)
-    rule = check_regression(*frames) if "robust" in frames[0].columns else None
+    rule = check_regression(*frames) if C.robust in frames[0].columns else None
     return DomainComparison(n_common=cmp.n_common, n_differ=cmp.n_differ, fraction=cmp.fraction,
                             only_a=cmp.only_a, only_b=cmp.only_b, max_shift_g=cmp.max_shift_g,
                             shifts=cmp.shifts, regression=rule)  # fmt: skip
@@ -221,7 +228,7 @@ def _domain_frame(value: Any, which: str) -> pd.DataFrame:
         )
     if value.empty:
         raise RbmError(f"{where} has no rows")
-    for col, unit, positive in (("amplitude_g", "g", False), ("frequency_hz", "Hz", True)):
+    for col, unit, positive in ((C.amplitude_g, "g", False), (C.frequency_hz, "Hz", True)):
         x = pd.to_numeric(value[col], errors="coerce").to_numpy(float)
         with np.errstate(invalid="ignore"):
             bad = ~np.isfinite(x) | ((x <= 0.0) if positive else (x < 0.0))
@@ -233,7 +240,7 @@ def _domain_frame(value: Any, which: str) -> pd.DataFrame:
                 f"{where}: row {i}: {col} must be a finite number {'> 0' if positive else '>= 0'}"
                 f" [{unit}], got {value[col].iloc[i]!r}"
             )
-    bad = ~value["status"].isin(STATUSES).to_numpy()
+    bad = ~value[C.status].isin(STATUSES).to_numpy()
     if bad.any():
         i = int(np.argmax(bad))
         raise RbmError(

@@ -18,41 +18,56 @@ __all__ = [
     "check_intensity",
     "check_members",
     "fragility",
+    "intensity_help",
     "intensity_names",
     "run_fragility",  # noqa: F822 (read on first use)
 ]
 
-#: A record's measures that are not intensities: its column's elastic period and its
-#: significant duration (neither grows with the record's scale).
-NOT_INTENSITIES = ("t1_s", "d5_95_s")
-
 
 def intensity_names() -> tuple[str, ...]:
     """The columns a fragility may be fitted on: the amplitude's
-    (rbm_cli.study.outcomes.INTENSITY_COLUMNS, the first present by default), then a
-    record's measures that grow with its scale (rbm_cli.study.intensities), the spectral
-    accelerations at ``excitation.im_periods`` written ``sa_<T>s_g``."""
-    from rbm_cli.study.intensities import BASE_FIELDS, ROCKING_FIELDS
-    from rbm_cli.study.outcomes import INTENSITY_COLUMNS
+    (rbm_cli.study.schema.DEFAULT_INTENSITIES, the first present by default), then a
+    record's measures that grow with its scale (the registry of
+    rbm_cli.study.intensities, in its order; a measure per period as its pattern,
+    ``sa_<T>s_g``)."""
+    from rbm_cli.study.intensities import fragility_measures
+    from rbm_cli.study.schema import DEFAULT_INTENSITIES
 
-    measures = tuple(f for f in BASE_FIELDS + ROCKING_FIELDS if f not in NOT_INTENSITIES)
-    return INTENSITY_COLUMNS + measures + ("sa_<T>s_g",)
+    return DEFAULT_INTENSITIES + tuple(m.column for m in fragility_measures())
+
+
+def intensity_help() -> str:
+    """The help of ``rbm fragility --intensity``: the measures it takes (the registry's,
+    read when the help is shown) and its default."""
+    from rbm_cli.study.schema import DEFAULT_INTENSITIES
+
+    measures = intensity_names()[len(DEFAULT_INTENSITIES) :]
+    defaults = DEFAULT_INTENSITIES
+    return (
+        f"The intensity measure to fit on, a column of the domain: a record's"
+        f" {', '.join(measures[:-1])} or {measures[-1]}  [default: the amplitude,"
+        f" {', '.join(defaults[:-1])} or {defaults[-1]}, the first present]"
+    )
 
 
 def check_intensity(name, where: str = "intensity") -> str | None:
     """``name`` (None: the default), checked to be an intensity measure's column
-    (:func:`intensity_names`): a count, a time or another result is not one.
+    (:func:`intensity_names`; ``sa_0p5s_g`` for the pattern ``sa_<T>s_g``): a count, a
+    time or another result is not one.
 
     Raises
     ------
     RbmError  One line naming ``where`` and the measures there are
     """
     from rbm_cli.base.errors import RbmError
-    from rbm_cli.study.intensities import sa_field
+    from rbm_cli.study.intensities import measure_of
+    from rbm_cli.study.schema import DEFAULT_INTENSITIES
 
     if name is None:
         return None
-    ok = isinstance(name, str) and (name in intensity_names() or _is_sa(name, sa_field))
+    ok = isinstance(name, str) and (
+        name in DEFAULT_INTENSITIES or _grows_with_scale(measure_of(name))
+    )
     if not ok:
         shown = repr(name) if isinstance(name, str) else type(name).__name__
         raise RbmError(
@@ -62,16 +77,11 @@ def check_intensity(name, where: str = "intensity") -> str | None:
     return name
 
 
-def _is_sa(name: str, sa_field) -> bool:
-    """Whether ``name`` is the column of a spectral acceleration, ``sa_<T>s_g`` with T > 0
-    [s] written as sa_field writes it."""
-    if not (name.startswith("sa_") and name.endswith("s_g")):
-        return False
-    try:
-        period = float(name[3:-3].replace("p", "."))
-    except ValueError:
-        return False
-    return period > 0.0 and sa_field(period) == name
+def _grows_with_scale(measure) -> bool:
+    """Whether a registry entry (None: not a measure's column) is a fragility's intensity."""
+    from rbm_cli.study.intensities import fragility_measures
+
+    return measure is not None and measure in fragility_measures()
 
 
 def check_members(n_members) -> int | None:

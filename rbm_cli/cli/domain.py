@@ -179,7 +179,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         rbm compare results/spanos_koh_slender/domain.csv out/spanos_koh_slender/domain.csv \\
             --max-cells 0.01 --max-shift 0.05
     """
-    from rbm_cli.api.domains import compare_domains, read_domain
+    from rbm_cli.api.domains import compare_domains, has_robustness, read_domain
 
     for name, value in (("--max-cells", max_cells), ("--max-shift", max_shift)):
         if value is not None and not value >= 0:
@@ -206,7 +206,8 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
     click.echo(f"largest boundary shift: {cmp.max_shift_g:.4g} g")
     _print_shifts(cmp.shifts)
     failed = []
-    if "robust" in dom_a.columns:
+    robust = has_robustness(dom_a)
+    if robust:
         from rbm_cli.api.domains import check_regression
 
         rule = check_regression(dom_a, dom_b)
@@ -220,7 +221,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
     if failed:
         click.echo("FAIL: " + "; ".join(failed), err=True)
         sys.exit(1)
-    if max_cells is not None or max_shift is not None or "robust" in dom_a.columns:
+    if max_cells is not None or max_shift is not None or robust:
         click.echo("OK: within the limits")
 
 

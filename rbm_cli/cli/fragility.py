@@ -19,6 +19,21 @@ MAX_RESAMPLES_SHOWN = "100,000"
 PROGRESS_AFTER_S = 2.0
 
 
+class MeasureOption(click.Option):
+    """--intensity, whose help lists the measures of the registry of intensity measures
+    (rbm_cli.api.fragility_curves.intensity_help), read when the help is shown."""
+
+    @property
+    def help(self) -> str:
+        from rbm_cli.api.fragility_curves import intensity_help
+
+        return intensity_help()
+
+    @help.setter
+    def help(self, value) -> None:  # click sets it from the decorator: none given
+        pass
+
+
 @cli.command()
 @click.argument("domain", metavar="DOMAIN.csv", type=str)
 @click.option("-o", "--output", default=None, metavar="DIR", callback=check_output,
@@ -29,11 +44,7 @@ PROGRESS_AFTER_S = 2.0
 @click.option("--seed", type=click.IntRange(min=0, max=2**64 - 1), default=0, show_default=True,
               help="Seed of the bootstrap (0 to 2^64 - 1).")  # fmt: skip
 @click.option("--intensity", "--intensity-column", "intensity_column", default=None,
-              metavar="NAME",
-              help="The intensity measure to fit on, a column of the domain: a record's "
-              "pga_g, pgv_m_s, pgd_m, arias_m_s, cav_m_s, sa_t1_g, sa_<T>s_g, "
-              "pga_over_g_tan_alpha or pgv_p_over_g_tan_alpha  [default: the amplitude, "
-              "intensity_g, amplitude_g or intensity, the first present]")  # fmt: skip
+              metavar="NAME", cls=MeasureOption)  # fmt: skip
 @click.option("--ensemble-outcome", type=click.Choice(["members", "majority", "member0"]),
               default="members", show_default=True,
               help="An ensemble domain's trials: every member of each cell (all the runs "

@@ -75,7 +75,8 @@ def sweep(
 ) -> None:
     """Run the config's amplitude x frequency grid and write the safe-unsafe domain.
 
-    Writes OUTPUT/<name>/domain.csv (one row per cell, the columns of CSV_FIELDS),
+    Writes OUTPUT/<name>/domain.csv (one row per cell, its columns listed in the
+    docs' Output files page),
     boundary.csv (lowest unsafe amplitude per frequency), meta.json (resolved
     config, versions, wall time, workers) and domain.png, all published in one
     step at the end. One sweep at a time writes a folder (a second one is

@@ -27,9 +27,11 @@ steps. The recurrence here is exact for the signal the column integrates; the te
 it against closed forms and against eqsig on a uniform record.
 
 Scaling: a record scaled by a factor c has PGA, PGV, PGD, CAV and Sa times |c|, Arias
-times c^2 and the same D5-95. :func:`record_measures` computes them once per record
-(:class:`RecordMeasures`, the record as read) and :meth:`RecordMeasures.scaled` gives a
-cell's, so a sweep over N amplitudes integrates each record once.
+times c^2 and the same D5-95. Each measure here is a function of the record as read;
+:func:`record_measures` gathers them (:class:`RecordMeasures`). Which measures a domain
+holds, and how each scales with a cell's factor, is the registry of
+rbm_cli.study.intensities (``MEASURES``), so a sweep over N amplitudes integrates each
+record once.
 
 References
 ----------
@@ -44,7 +46,7 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -73,20 +75,6 @@ class RecordMeasures:
     cav: float
     d5_95: float
     sa: dict
-
-    def scaled(self, factor: float) -> RecordMeasures:
-        """The measures of the record times ``factor`` (module docstring: linear in |c|,
-        Arias in c^2, D5-95 unchanged)."""
-        c = abs(float(factor))
-        return replace(
-            self,
-            pga=c * self.pga,
-            pgv=c * self.pgv,
-            pgd=c * self.pgd,
-            arias=c * c * self.arias,
-            cav=c * self.cav,
-            sa={period: c * value for period, value in self.sa.items()},
-        )
 
 
 def _checked(t, a) -> tuple[np.ndarray, np.ndarray]:
@@ -145,6 +133,26 @@ def peak_displacement(t, a) -> float:
             inner = u0[ok] + v0[ok] * x + a0[ok] * x * x / 2.0 + s[ok] * x**3 / 6.0
             peak = max(peak, float(np.max(np.abs(inner))))
     return peak
+
+
+def peak_acceleration(t, a) -> float:
+    """PGA [m/s^2]: max |a| (a record linear between samples peaks at one)."""
+    t, a = _checked(t, a)
+    return float(np.max(np.abs(a)))
+
+
+def arias_intensity(t, a) -> float:
+    """Arias intensity I_A = pi / (2 g) int a^2 dt [m/s], exact for a linear between
+    samples."""
+    t, a = _checked(t, a)
+    return math.pi / (2.0 * G) * float(husid(t, a)[-1])
+
+
+def cumulative_absolute_velocity(t, a) -> float:
+    """CAV = int |a| dt [m/s], exact for a linear between samples (its zero crossing inside
+    a step counted)."""
+    t, a = _checked(t, a)
+    return _abs_integral(t, a)
 
 
 def _abs_integral(t, a) -> float:
@@ -275,11 +283,11 @@ def record_measures(t, a, periods=(), damping: float = DAMPING) -> RecordMeasure
     docstring); ``periods`` [s] of the spectral accelerations."""
     t, a = _checked(t, a)
     return RecordMeasures(
-        pga=float(np.max(np.abs(a))),
+        pga=peak_acceleration(t, a),
         pgv=peak_velocity(t, a),
         pgd=peak_displacement(t, a),
-        arias=math.pi / (2.0 * G) * float(husid(t, a)[-1]),
-        cav=_abs_integral(t, a),
+        arias=arias_intensity(t, a),
+        cav=cumulative_absolute_velocity(t, a),
         d5_95=significant_duration(t, a),
         sa={float(p): spectral_acceleration(t, a, float(p), damping) for p in periods},
     )
@@ -302,8 +310,11 @@ __all__ = [
     "DAMPING",
     "PERIOD_RANGE_S",
     "RecordMeasures",
+    "arias_intensity",
+    "cumulative_absolute_velocity",
     "first_elastic_period",
     "husid",
+    "peak_acceleration",
     "peak_displacement",
     "peak_velocity",
     "record_measures",

@@ -32,9 +32,6 @@ from dataclasses import dataclass
 
 from rbm_cli.config.types import MODELS, Config, InterfaceConfig, StiffnessConfig
 
-#: The columns a domain gets from :func:`cell_scales` (domain.csv).
-SCALE_FIELDS = ("alpha_rad", "p_rad_s", "static_multiplier", "a_over_g_alpha", "omega_over_p")
-
 
 @dataclass(frozen=True)
 class RockingScales:
@@ -80,16 +77,4 @@ def rocking_scales(config: Config) -> RockingScales:
     return RockingScales(block.slenderness, block.frequency_parameter, static)
 
 
-def scale_fields(scales: RockingScales, amplitude_g: float, frequency_hz: float | None) -> dict:
-    """The :data:`SCALE_FIELDS` of one cell, as domain.csv holds them."""
-    a_ratio, w_ratio = scales.dimensionless(amplitude_g, frequency_hz)
-    return {
-        "alpha_rad": scales.alpha,
-        "p_rad_s": scales.p,
-        "static_multiplier": scales.static_multiplier,
-        "a_over_g_alpha": a_ratio,
-        "omega_over_p": w_ratio,
-    }
-
-
-__all__ = ["SCALE_FIELDS", "RockingScales", "rocking_scales", "scale_fields"]
+__all__ = ["RockingScales", "rocking_scales"]

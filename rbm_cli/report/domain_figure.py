@@ -22,6 +22,7 @@ from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, upli
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.report.plot_polar import ANGLE_AXIS, draw_polar, has_angle_axis
 from rbm_cli.study.domain import axis_columns
+from rbm_cli.study.schema import C
 
 __all__ = ["POLAR_SIZE", "column_note", "domain_figure", "draw_domain_on", "uplift_level"]
 
@@ -122,7 +123,7 @@ def _config_options(config: Config | None) -> dict:
     return {
         "column": build_column(config.column, config.interface),
         "excitation_type": config.excitation.type,
-        "static_multiplier": level,
+        C.static_multiplier: level,
         "static_label": label,
     }
 
@@ -263,8 +264,8 @@ def domain_figure(
     kind = f" ({config.excitation.type})" if config is not None else ""
     title = (f"{name}: " if name else "") + f"safe-unsafe domain{kind}" + (
         ", dimensionless" if dimensionless else "")  # fmt: skip
-    freqs = df["frequency_hz"].dropna().unique()
-    if view.line != "frequency_hz" and len(freqs) == 1:
+    freqs = df[C.frequency_hz].dropna().unique()
+    if view.line != C.frequency_hz and len(freqs) == 1:
         title += f", at {freqs[0]:g} Hz"
     if config is not None:
         title += "\n" + column_note(config)
@@ -273,7 +274,7 @@ def domain_figure(
     else:
         drawn.set_title(title)
     fig.tight_layout()
-    if isinstance(drawn, list) and "collapse_fraction" in df.columns:
+    if isinstance(drawn, list) and C.collapse_fraction in df.columns:
         _colorbar_below(fig, drawn)
     return fig
 

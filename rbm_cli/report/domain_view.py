@@ -45,9 +45,11 @@ import pandas as pd
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.grid import RECORD_PATHS
 from rbm_cli.config.types import Config
-from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
+from rbm_cli.physics.similarity import rocking_scales
 from rbm_cli.study.cells import grid_points
 from rbm_cli.study.domain import axis_columns, cell_key, keys_of
+from rbm_cli.study.schema import SCALE_COLUMNS, C, scale_values
+from rbm_cli.study.schema import label as column_label
 
 #: Layouts a caller asks for: 'auto' (the rule of the module docstring), 'panels' or
 #: 'overlay' (a view's own layout is one of these two or 'single').
@@ -62,7 +64,9 @@ UNITS = {
     "excitation.duration": "s", "excitation.phase": "rad",
 }  # fmt: skip
 #: Axis labels of the dimensionless plane.
-DIMENSIONLESS_LABELS = (r"$\omega / p$ [-]", r"$A / (g \tan\alpha)$ [-]")
+DIMENSIONLESS_LABELS = (column_label(C.omega_over_p), column_label(C.a_over_g_alpha))
+#: The physical axes' labels (rbm_cli.study.schema).
+FREQUENCY_LABEL, AMPLITUDE_LABEL = column_label(C.frequency_hz), column_label(C.amplitude_g)
 #: What the records of a record axis are called in a panel's title.
 RECORD_WORDS = {"excitation.file": "record", "excitation.file_y": "y record",
                 "excitation.vertical": "vertical record"}  # fmt: skip
@@ -115,12 +119,12 @@ class DomainView:
     def plane(self, rows: pd.DataFrame) -> pd.DataFrame:
         """``rows`` in the plane's coordinates, as the domain plot reads them: x in
         frequency_hz, y in amplitude_g (the axis and scale columns dropped)."""
-        out = rows.drop(columns=[*axis_columns(rows.columns), "frequency_hz", "amplitude_g"])
+        out = rows.drop(columns=[*axis_columns(rows.columns), C.frequency_hz, C.amplitude_g])
         x = rows[self.x]
         if self.categories is not None:  # a value no category holds (another domain's): nan
             x = x.map(lambda v: self.category_of.get(str(v), math.nan))
-        out.insert(0, "frequency_hz", pd.to_numeric(x).to_numpy(float))
-        out.insert(0, "amplitude_g", rows[self.y].to_numpy(float))
+        out.insert(0, C.frequency_hz, pd.to_numeric(x).to_numpy(float))
+        out.insert(0, C.amplitude_g, rows[self.y].to_numpy(float))
         return out
 
 
@@ -160,8 +164,8 @@ def axis_names(df: pd.DataFrame) -> dict[str, dict[str, str]]:
     for path in RECORD_PATHS:
         if path in df.columns:
             named = None
-            if path == "excitation.file" and "record" in df.columns:
-                named = dict(zip(df[path].astype(str), df["record"].astype(str), strict=True))
+            if path == "excitation.file" and C.record in df.columns:
+                named = dict(zip(df[path].astype(str), df[C.record].astype(str), strict=True))
             out[path] = record_names(df[path], named)
     return out
 
@@ -218,33 +222,33 @@ def point_configs(df: pd.DataFrame, config: Config | None) -> dict:
 
 
 def with_scales(df: pd.DataFrame, config: Config | None, where: str = "the domain") -> pd.DataFrame:
-    """The domain with its scale columns (SCALE_FIELDS: alpha_rad, p_rad_s,
+    """The domain with its scale columns (SCALE_COLUMNS: alpha_rad, p_rad_s,
     static_multiplier, a_over_g_alpha, omega_over_p): as written, or computed from the
     config of each cell's point for a domain written before them. RbmError (one line) when
     they are missing and there is no config, or when the domain has no frequency."""
-    if df["frequency_hz"].isna().all():
+    if df[C.frequency_hz].isna().all():
         raise RbmError(
             f"dimensionless axes need the excitation's frequency (omega / p): {where} has none"
             " (an excitation without one, such as a record)"
         )
-    if all(c in df.columns for c in SCALE_FIELDS):
+    if all(c in df.columns for c in SCALE_COLUMNS):
         return df
     if config is None:
         raise RbmError(
-            f"dimensionless axes need the column's scales: {where} has no {SCALE_FIELDS[0]}"
+            f"dimensionless axes need the column's scales: {where} has no {SCALE_COLUMNS[0]}"
             " ... omega_over_p columns (written before them) and no config to compute them"
             " from (give its config: --config)"
         )
     configs = point_configs(df, config)
     scales = {k: rocking_scales(c) for k, c in configs.items()}
     keys = [k[2:] for k in keys_of(df)]
-    amps, freqs = df["amplitude_g"].to_numpy(float), df["frequency_hz"].to_numpy(float)
-    rows = [scale_fields(scales[k], a, f) for k, a, f in zip(keys, amps, freqs, strict=True)]
-    return df.assign(**pd.DataFrame(rows, index=df.index)[list(SCALE_FIELDS)])
+    amps, freqs = df[C.amplitude_g].to_numpy(float), df[C.frequency_hz].to_numpy(float)
+    rows = [scale_values(scales[k], a, f) for k, a, f in zip(keys, amps, freqs, strict=True)]
+    return df.assign(**pd.DataFrame(rows, index=df.index)[list(SCALE_COLUMNS)])
 
 
 def _frequencies(df: pd.DataFrame) -> int:
-    return int(df["frequency_hz"].dropna().nunique())
+    return int(df[C.frequency_hz].dropna().nunique())
 
 
 def _split(df, groups, layout, where) -> tuple[str, list]:
@@ -257,14 +261,14 @@ def _split(df, groups, layout, where) -> tuple[str, list]:
         )
     n_freq = _frequencies(df)
     if n_freq > 1 or not groups:
-        return "frequency_hz", groups
+        return C.frequency_hz, groups
     if layout in ("panels", "overlay") and len(groups) == 1:
         if n_freq == 0:
             raise RbmError(
                 f"{layout}: {where} has no frequency and one axis ({', '.join(groups[0])}),"
                 " drawn against amplitude in a single plane: leave out the layout"
             )
-        return "frequency_hz", groups
+        return C.frequency_hz, groups
     return groups[-1][0], groups[:-1]
 
 
@@ -288,17 +292,17 @@ def _coordinates(df, line, dimensionless, config, group=(), names=None) -> dict:
     """x, y, axis labels, log x and categories of the view (``group``: the linked paths of
     the line's axis; ``names``: the records' names of the record axes)."""
     if dimensionless:
-        return dict(x="omega_over_p", y="a_over_g_alpha", labels=DIMENSIONLESS_LABELS,
+        return dict(x=C.omega_over_p, y=C.a_over_g_alpha, labels=DIMENSIONLESS_LABELS,
                     log_x=False, categories=None)  # fmt: skip
-    if line == "frequency_hz":
-        return dict(x=line, y="amplitude_g", labels=("frequency [Hz]", "amplitude [g]"),
+    if line == C.frequency_hz:
+        return dict(x=line, y=C.amplitude_g, labels=(FREQUENCY_LABEL, AMPLITUDE_LABEL),
                     log_x=False, categories=None)  # fmt: skip
     names = names or {}
     if line in names:  # a suite: its records by name, one category each
         words = "record pair (x record)" if "excitation.file_y" in group else RECORD_WORDS[line]
         keys = list(names[line])
         categories = tuple(names[line][k] for k in keys)
-        return dict(x=line, y="amplitude_g", labels=(words, "amplitude [g]"), log_x=False,
+        return dict(x=line, y=C.amplitude_g, labels=(words, AMPLITUDE_LABEL), log_x=False,
                     categories=categories, category_of={k: i for i, k in enumerate(keys)},
                     category_word="record")  # fmt: skip
     unit = UNITS.get(line)
@@ -306,11 +310,11 @@ def _coordinates(df, line, dimensionless, config, group=(), names=None) -> dict:
     numeric = pd.to_numeric(df[line], errors="coerce")
     if numeric.notna().all():
         log = _log_axis(numeric, line, config)
-        return dict(x=line, y="amplitude_g", labels=(label, "amplitude [g]"), log_x=log,
+        return dict(x=line, y=C.amplitude_g, labels=(label, AMPLITUDE_LABEL), log_x=log,
                     categories=None)  # fmt: skip
     categories = tuple(dict.fromkeys(value_text(v) for v in df[line]))
     category_of = {str(v): categories.index(value_text(v)) for v in df[line]}
-    return dict(x=line, y="amplitude_g", labels=(label, "amplitude [g]"), log_x=False,
+    return dict(x=line, y=C.amplitude_g, labels=(label, AMPLITUDE_LABEL), log_x=False,
                 categories=categories, category_of=category_of)  # fmt: skip
 
 

@@ -21,6 +21,8 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.report.fragility_store import FragilityFolder
 from rbm_cli.study.fragility import METHOD, MIN_BAND_RECORDS, FragilityResult
 from rbm_cli.study.outcomes import intensity_column as find_intensity_column
+from rbm_cli.study.schema import C
+from rbm_cli.study.schema import label as column_label
 
 #: Float format of the CSV files (12 significant digits, as domain.csv).
 FLOAT_FORMAT = "%.12g"
@@ -326,22 +328,22 @@ def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):
     from matplotlib.lines import Line2D
 
     column = find_intensity_column(df, intensity_column)
-    needed = ["record", column or "intensity_g", "max_rotation_ratio", "collapsed"]
+    needed = [C.record, column or "intensity_g", C.max_rotation_ratio, C.collapsed]
     missing = [c for c in needed if c not in df.columns]
     if missing:
         raise RbmError(f"IDA plot: missing column {missing[0]!r}")
-    rows = df if "status" not in df.columns else df[df["status"].astype(str) != "failed"]
+    rows = df if C.status not in df.columns else df[df[C.status].astype(str) != "failed"]
     ax = ax if ax is not None else _new_axes()
-    ratios = rows["max_rotation_ratio"].to_numpy(float)
+    ratios = rows[C.max_rotation_ratio].to_numpy(float)
     finite = ratios[np.isfinite(ratios)]
     right = 1.5 * max(1.0, float(finite.max()) if finite.size else 1.0)
     handles, above_any, collapse_any = [], False, False
-    groups = sorted(rows.groupby(rows["record"].astype(str)), key=lambda g: g[0])
+    groups = sorted(rows.groupby(rows[C.record].astype(str)), key=lambda g: g[0])
     for k, (name, group) in enumerate(groups):
         group = group.sort_values(column)
         x = group[column].to_numpy(float)
-        y = group["max_rotation_ratio"].to_numpy(float)
-        hit = group["collapsed"].to_numpy(float) == 1.0
+        y = group[C.max_rotation_ratio].to_numpy(float)
+        hit = group[C.collapsed].to_numpy(float) == 1.0
         response, intensity, first = ida_curve(x, y, hit, right)
         style = ida_style(k)
         (line,) = ax.plot(response, intensity, lw=1.0, alpha=0.85, label=name, **style)
@@ -368,7 +370,7 @@ def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):
         keys.append(Line2D([], [], color="0.3", marker="o", mfc="none", ls="none",
                            label="survived above its first collapse"))  # fmt: skip
     ax.set_ylabel("intensity: peak ground acceleration [g]")
-    ax.set_xlabel("peak rotation ratio (collapse quantity / limit) [-]")
+    ax.set_xlabel(column_label(C.max_rotation_ratio))
     ax.set_xlim(0.0, right)
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)

@@ -39,6 +39,7 @@ from rbm_cli.study.outcomes import (
     prepare_outcomes,
     read_suite_domain_hashed,
 )
+from rbm_cli.study.schema import C
 
 #: Bootstrap resamples of the records by default.
 DEFAULT_RESAMPLES = 500
@@ -199,7 +200,7 @@ def intensity_label(column: str, meta: dict | None = None) -> str:
     with its unit (rbm_cli.study.intensities), or the column's name."""
     written = (meta or {}).get("config_written")
     excitation = written.get("excitation") if isinstance(written, dict) else None
-    if column in ("amplitude_g", "intensity_g"):
+    if column in (C.amplitude_g, "intensity_g"):
         if isinstance(excitation, dict) and excitation.get("scale") == "factor":
             return "intensity: scale factor of the records [-]"
         return "intensity: peak ground acceleration [g]"

@@ -48,6 +48,7 @@ from rbm_cli.report.plot_domain import (
     plot_levels,
 )
 from rbm_cli.study.domain import boundary
+from rbm_cli.study.schema import C
 
 #: Marker size [points] of the cells on a log x axis (marker_size assumes a linear one).
 LOG_MARKER = 3.0
@@ -92,7 +93,7 @@ def _single_config(point: Point) -> Config | None:
 def _dimensionless_levels(view: DomainView, rows: pd.DataFrame, configs: list):
     """(x, level) of each distinct point of ``rows`` in dimensionless axes, and whether the
     closed forms apply to every row."""
-    level = rows["static_multiplier"].to_numpy(float) / np.tan(rows["alpha_rad"].to_numpy(float))
+    level = rows[C.static_multiplier].to_numpy(float) / np.tan(rows[C.alpha_rad].to_numpy(float))
     x = rows[view.x].to_numpy(float)
     pairs = np.unique(np.column_stack([x, level]), axis=0)
     distinct = {id(c): c for c in configs}.values()  # one config per point, not per row
@@ -106,7 +107,7 @@ def _axis_levels(view: DomainView, point: Point):
     point is a rigid monolith under a half-sine)."""
     plane = view.plane(point.rows)
     rows = []
-    for x, cfg, f in zip(plane["frequency_hz"], row_configs(point), point.rows["frequency_hz"],
+    for x, cfg, f in zip(plane[C.frequency_hz], row_configs(point), point.rows[C.frequency_hz],
                          strict=True):  # fmt: skip
         if cfg is not None:  # a record has no frequency (None or NaN)
             rows.append((float(x), cfg, np.nan if f is None else float(f)))
@@ -155,7 +156,7 @@ def draw_levels(ax, view: DomainView, point: Point, x_range) -> float | None:
         if apply:
             draw_dimensionless_curves(ax, x_range)
         return float(np.max(y))
-    if view.line == "frequency_hz":
+    if view.line == C.frequency_hz:
         cfg = _single_config(point)
         if cfg is None:
             return None
@@ -187,7 +188,7 @@ def draw_dimensionless_curves(ax, x_range) -> None:
 
 
 def _x_range(plane: pd.DataFrame) -> tuple[float, float]:
-    x = plane["frequency_hz"].to_numpy(float)
+    x = plane[C.frequency_hz].to_numpy(float)
     x = x[np.isfinite(x)]
     return (float(x.min()), float(x.max())) if x.size else (0.0, 1.0)
 
@@ -260,9 +261,9 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
     of its own colour labelled by the point, the levels, and the closed forms that apply
     (module docstring)."""
     rows = pd.concat([p.rows for p in view.points])
-    plane = view.plane(rows).drop(columns=["collapse_fraction"], errors="ignore")
+    plane = view.plane(rows).drop(columns=[C.collapse_fraction], errors="ignore")
     # cells of several points at one place are drawn once per status (faint marks add up)
-    cells = plane.drop_duplicates(["frequency_hz", "amplitude_g", "status"])
+    cells = plane.drop_duplicates([C.frequency_hz, C.amplitude_g, C.status])
     draw_cells(ax, cells, size=LOG_MARKER if view.log_x else None)
     for artist in (*ax.lines, *ax.collections):
         artist.set_alpha(FAINT)
@@ -271,7 +272,7 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
     joined = view.categories is None  # over categories, marks alone: no line between them
     for k, (point, colour) in enumerate(zip(view.points, colours, strict=True)):
         bnd = boundary(view.plane(point.rows))
-        f = bnd["frequency_hz"].to_numpy(float)
+        f = bnd[C.frequency_hz].to_numpy(float)
         style = ("-", "--", "-.")[k // 10 % 3] if not numeric else "-"
         ax.plot(f, bnd["lowest_unsafe_g"].to_numpy(float),
                 color=colour, linewidth=1.5, marker="o", markersize=3.5, label=point.label,
@@ -317,7 +318,7 @@ def _overlay_levels(ax, view: DomainView, point: Point, k: int, colour):
         return (pairs[:, 0], pairs[:, 1]), apply
     style = dict(color=colour, linestyle=":", linewidth=1.3, gid=f"linear-{k}")
     style["label"] = "exact linear threshold of each point (dotted)" if k == 0 else "_"
-    if view.line != "frequency_hz":
+    if view.line != C.frequency_hz:
         static, curves = _axis_levels(view, point)
         if curves is not None:
             ax.plot(curves[0], curves[2], **style)
@@ -351,7 +352,7 @@ def label_static_levels(ax, view: DomainView, levels: list) -> None:
     multiplier <level> g' (the engine's uplift level for bullet). Physical axes with
     frequency on x only (a level is one value per point there); an overlay in
     dimensionless axes or over another x keeps its labels."""
-    if view.dimensionless or view.line != "frequency_hz":
+    if view.dimensionless or view.line != C.frequency_hz:
         return
     lines = {line.get_gid(): line for line in ax.lines}
     for k, (point, (_, ys)) in enumerate(zip(view.points, levels, strict=True)):
@@ -388,7 +389,7 @@ def draw_panels(fig, view: DomainView, spec=None, compare=(), labels=None, color
         axes.append(ax)
     axes[0].set_ylim(0.0, top)
     _panel_legend(axes[min(ncols, n) - 1], axes, proxies)
-    if colorbar and any("collapse_fraction" in p.rows.columns for p in view.points):
+    if colorbar and any(C.collapse_fraction in p.rows.columns for p in view.points):
         fraction_colorbar(fig, axes)
     return axes
 

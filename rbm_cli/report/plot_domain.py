@@ -25,6 +25,8 @@ import pandas as pd
 from rbm_cli.physics.closed_forms import halfsine_threshold_curves
 from rbm_cli.physics.column import Column
 from rbm_cli.study.domain import MAJORITY, boundary
+from rbm_cli.study.schema import C
+from rbm_cli.study.schema import label as column_label
 
 __all__ = [
     "BAR_LABEL",
@@ -50,7 +52,7 @@ COMPARE_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:bro
 #: without its light yellow end, so every mark stays visible on white.
 FRACTION_CMAP = ("plasma", 0.0, 0.82)
 #: Legend and colour-bar wording of ensemble domains.
-FRACTION_LABEL = "fraction of ensemble members that collapsed [-]"
+FRACTION_LABEL = column_label(C.collapse_fraction)
 #: Legend title of ensemble domains: what marker and colour say.
 FRACTION_TITLE = "marker: member 0's outcome\ncolour: fraction collapsed"
 #: Label of the boundary line of a domain.
@@ -70,7 +72,7 @@ BAR_STYLE = dict(linestyle="none", marker="_", markeredgewidth=2.0)
 BAR_MEMBER0_STYLE = dict(linestyle="none", marker="_", markeredgewidth=1.4, color="0.55")
 BAR_WIDTH = 3.0
 #: The column of domain.csv marking cells whose friction demand exceeds interface.friction.
-SLIDES = "slides"
+SLIDES = C.slides
 #: Legend labels of the marks over the cells (mark_cells).
 UPPER_JOINT_LABEL = "collapsed at an upper joint (in a triangle; a cross alone: at the base)"
 SLIDES_LABEL = "slides: max |T/N| > interface.friction"
@@ -107,13 +109,13 @@ def marker_size(ax, df: pd.DataFrame) -> float:
     width_in, height_in = ax.figure.get_size_inches()
     points = []
     for column, extent in (
-        ("frequency_hz", bbox.width * width_in),
-        ("amplitude_g", bbox.height * height_in),
+        (C.frequency_hz, bbox.width * width_in),
+        (C.amplitude_g, bbox.height * height_in),
     ):
         values = np.unique(df[column].to_numpy(float))
         values = values[np.isfinite(values)]
         if values.size > 1:
-            span = 1.1 * (values[-1] - values[0]) if column == "frequency_hz" else 1.06 * values[-1]
+            span = 1.1 * (values[-1] - values[0]) if column == C.frequency_hz else 1.06 * values[-1]
             step = float(np.min(np.diff(values)))
             points.append(72.0 * extent * step / span)
     if not points:
@@ -123,7 +125,7 @@ def marker_size(ax, df: pd.DataFrame) -> float:
 
 def _masks(df: pd.DataFrame):
     """Boolean masks of the safe, unsafe and failed cells."""
-    status = df["status"].astype(str)
+    status = df[C.status].astype(str)
     unsafe = (status == "collapsed").to_numpy()
     failed = (status == "failed").to_numpy()
     return ~unsafe & ~failed, unsafe, failed
@@ -132,8 +134,8 @@ def _masks(df: pd.DataFrame):
 def _plot_cells(ax, df: pd.DataFrame, size: float | None = None) -> None:
     """Safe cells as open circles, unsafe as crosses, failed as grey squares, above the
     lines; ``size`` [points] defaults to :func:`marker_size`."""
-    f = df["frequency_hz"].to_numpy(float)
-    a = df["amplitude_g"].to_numpy(float)
+    f = df[C.frequency_hz].to_numpy(float)
+    a = df[C.amplitude_g].to_numpy(float)
     safe, unsafe, failed = _masks(df)
     size = marker_size(ax, df) if size is None else size
     style = dict(linestyle="none", markersize=size, zorder=CELL_Z)
@@ -156,9 +158,9 @@ def _plot_fraction_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None)
     from matplotlib.lines import Line2D
 
     cmap, norm = _fraction_cmap(), Normalize(0.0, 1.0)
-    f = df["frequency_hz"].to_numpy(float)
-    a = df["amplitude_g"].to_numpy(float)
-    frac = df["collapse_fraction"].to_numpy(float)
+    f = df[C.frequency_hz].to_numpy(float)
+    a = df[C.amplitude_g].to_numpy(float)
+    frac = df[C.collapse_fraction].to_numpy(float)
     safe, unsafe, failed = _masks(df)
     colours = cmap(norm(np.nan_to_num(frac, nan=0.0)))
     size = marker_size(ax, df) if size is None else size
@@ -197,7 +199,7 @@ def fraction_colorbar(fig, axes, cax=None, pad: float = 0.16) -> None:
 
 def is_ensemble(df: pd.DataFrame) -> bool:
     """A domain of an ensemble sweep: its boundary is the majority's."""
-    return "collapse_fraction" in df.columns
+    return C.collapse_fraction in df.columns
 
 
 def _listed(label: str, y: np.ndarray) -> str:
@@ -213,7 +215,7 @@ def _plot_boundary(ax, df: pd.DataFrame, colour, label: str, gid: str, member0=N
     ``member0``: the label of member 0's boundary of an ensemble, drawn dotted (grey bars)
     beside the majority's where the two differ, and not at all where they never do."""
     bnd = boundary(df)
-    f = bnd["frequency_hz"].to_numpy(float)
+    f = bnd[C.frequency_hz].to_numpy(float)
     y = bnd["lowest_unsafe_g"].to_numpy(float)
     style = dict(color=colour, linewidth=1.4) if bars is None else dict(
         color=colour, markersize=bars, **BAR_STYLE)  # fmt: skip
@@ -301,12 +303,12 @@ def finish_axes(
     domains: list,
     static_multiplier: float | None,
     proxies: list,
-    labels: tuple[str, str] = ("frequency [Hz]", "amplitude [g]"),
+    labels: tuple[str, str] = (column_label(C.frequency_hz), column_label(C.amplitude_g)),
     legend: bool = True,
 ) -> None:
     """Amplitude range (from 0 to just above the largest amplitude or level), the axis
     ``labels`` (x, y), grid and (if ``legend``) the legend beside the axes."""
-    amplitudes = np.concatenate([d["amplitude_g"].to_numpy(float) for d in domains])
+    amplitudes = np.concatenate([d[C.amplitude_g].to_numpy(float) for d in domains])
     top = max([float(np.nanmax(amplitudes))] if len(amplitudes) else [1.0])
     if static_multiplier is not None:
         top = max(top, float(static_multiplier))
@@ -352,7 +354,7 @@ def plot_levels(ax, domains, column, excitation_type, static_multiplier, static_
             gid="static",
         )
 
-    frequencies = np.concatenate([d["frequency_hz"].to_numpy(float) for d in domains])
+    frequencies = np.concatenate([d[C.frequency_hz].to_numpy(float) for d in domains])
     if (
         column is not None
         and column.n == 1
@@ -370,7 +372,7 @@ def draw_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None) -> list:
     amplitude_g (y), with the marks of :func:`mark_cells`; returns the ensemble's legend
     proxies ([] for a plain domain)."""
     size = marker_size(ax, df) if size is None else size
-    if "collapse_fraction" in df.columns:
+    if C.collapse_fraction in df.columns:
         proxies = _plot_fraction_cells(ax, df, colorbar, size)
     else:
         _plot_cells(ax, df, size)
@@ -391,12 +393,12 @@ def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
     legend entry says both), and
     the cells whose friction demand exceeds interface.friction (slides = 1: an open
     diamond around the cell; gid 'slides')."""
-    f = df["frequency_hz"].to_numpy(float)
-    a = df["amplitude_g"].to_numpy(float)
+    f = df[C.frequency_hz].to_numpy(float)
+    a = df[C.amplitude_g].to_numpy(float)
     _, unsafe, _ = _masks(df)
     style = dict(linestyle="none", markerfacecolor="none", zorder=CELL_Z + 1)
-    if "collapse_interface" in df.columns and unsafe.any():
-        where = pd.to_numeric(df["collapse_interface"], errors="coerce").to_numpy(float)
+    if C.collapse_interface in df.columns and unsafe.any():
+        where = pd.to_numeric(df[C.collapse_interface], errors="coerce").to_numpy(float)
         upper = unsafe & (where > 1)
         if upper.any():  # (a cross alone is the collapse's own entry: not listed twice)
             ax.plot(f[upper], a[upper], marker="^", color="tab:red", markersize=1.5 * size,
@@ -406,7 +408,7 @@ def mark_cells(ax, df: pd.DataFrame, size: float) -> None:
         if slides.any():
             ax.plot(f[slides], a[slides], marker="D", color="tab:orange",
                     markersize=1.5 * size, markeredgewidth=1.1, label=SLIDES_LABEL,
-                    gid="slides", **style)  # fmt: skip
+                    gid=C.slides, **style)  # fmt: skip
 
 
 def draw_domain(

@@ -42,6 +42,7 @@ from rbm_cli.report.plot_axes import STATIC, point_colours, uplift_level
 from rbm_cli.study.boundary_lines import MAJORITY, line_ident, line_order, majority_status
 from rbm_cli.study.domain import axis_columns, boundary
 from rbm_cli.study.outcomes import ANGLE_AXIS
+from rbm_cli.study.schema import C
 
 __all__ = [
     "ANGLE_AXIS",
@@ -85,7 +86,7 @@ def has_angle_axis(df: pd.DataFrame) -> bool:
 def curve_columns(df: pd.DataFrame) -> list[str]:
     """The columns whose values make one curve: the axes other than the angle, then
     frequency_hz."""
-    return [c for c in axis_columns(df.columns) if c != ANGLE_AXIS] + ["frequency_hz"]
+    return [c for c in axis_columns(df.columns) if c != ANGLE_AXIS] + [C.frequency_hz]
 
 
 def _angles(df: pd.DataFrame, where: str) -> np.ndarray:
@@ -106,9 +107,9 @@ def _angles(df: pd.DataFrame, where: str) -> np.ndarray:
 def _outcomes(df: pd.DataFrame) -> pd.Series:
     """Each cell's outcome as the boundary counts it: the status, or for an ensemble the
     majority's ('failed' where every member failed)."""
-    if "collapse_fraction" in df.columns:
-        return df["collapse_fraction"].map(majority_status)
-    return df["status"].astype(str)
+    if C.collapse_fraction in df.columns:
+        return df[C.collapse_fraction].map(majority_status)
+    return df[C.status].astype(str)
 
 
 def polar_boundary(df: pd.DataFrame, where: str = "the domain") -> pd.DataFrame:
@@ -135,7 +136,7 @@ def polar_boundary(df: pd.DataFrame, where: str = "the domain") -> pd.DataFrame:
     if not has_angle_axis(df):
         raise RbmError(f"{where} has no {ANGLE_AXIS} column: it has no polar picture")
     df = df.assign(**{ANGLE_AXIS: _angles(df, where)})
-    by = [*axis_columns(df.columns), "frequency_hz"]
+    by = [*axis_columns(df.columns), C.frequency_hz]
     bnd = boundary(df)
     failed = df.loc[(_outcomes(df) == "failed").to_numpy(), by]
     counts: dict = {}
@@ -160,7 +161,7 @@ def curve_label(columns: list[str], values) -> str:
     record)."""
     parts = []
     for column, value in zip(columns, values, strict=True):
-        if column == "frequency_hz":
+        if column == C.frequency_hz:
             if value is not None and not pd.isna(value):
                 parts.append(f"{float(value):g} Hz")
         else:
@@ -285,8 +286,8 @@ def static_level(df: pd.DataFrame, config: Config | None) -> tuple[float, str] |
     """(level [g], name) at which the column starts to rock: the domain's static_multiplier
     column where it holds one value, else the config's (rbm_cli.report.plot_axes.uplift_level);
     None where the domain's values differ (an axis over the column) or neither is known."""
-    if "static_multiplier" in df.columns:
-        values = pd.to_numeric(df["static_multiplier"], errors="coerce").to_numpy(float)
+    if C.static_multiplier in df.columns:
+        values = pd.to_numeric(df[C.static_multiplier], errors="coerce").to_numpy(float)
         values = values[np.isfinite(values)]
         if values.size and np.ptp(values) <= 1e-9 * abs(values[0]):
             return float(values[0]), "static multiplier"
@@ -304,7 +305,7 @@ def draw_polar(ax, df: pd.DataFrame, config: Config | None = None, where: str = 
     from matplotlib.ticker import FuncFormatter
 
     radii = polar_boundary(df, where)
-    amplitudes = df["amplitude_g"].to_numpy(float)
+    amplitudes = df[C.amplitude_g].to_numpy(float)
     top = float(np.nanmax(amplitudes)) if np.isfinite(amplitudes).any() else 1.0
     top = top if top > 0.0 else 1.0
     ring = OPEN_RING * top
@@ -354,10 +355,10 @@ def draw_polar(ax, df: pd.DataFrame, config: Config | None = None, where: str = 
         _sector(ax, start, end)
     ax.set_rlabel_position(start + 0.5 * (end - start) if not closed else 67.5)
     ax.grid(True, alpha=0.35)
-    what = " and ".join(c.replace("_hz", "") for c in curve if c != "frequency_hz" or
-                        radii["frequency_hz"].notna().any())  # fmt: skip
+    what = " and ".join(c.replace("_hz", "") for c in curve if c != C.frequency_hz or
+                        radii[C.frequency_hz].notna().any())  # fmt: skip
     title = f"one curve per {what}" if what else ""
-    if "collapse_fraction" in df.columns:
+    if C.collapse_fraction in df.columns:
         title += f"\noutcome: the majority's (collapse fraction >= {MAJORITY:g})"
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.12, 1.0), borderaxespad=0.0,
               fontsize="small", title=title.strip() or None, title_fontsize="small")  # fmt: skip

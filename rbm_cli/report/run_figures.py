@@ -16,6 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from rbm_cli.models.history import History
+from rbm_cli.study.schema import C
 
 #: Number of deformed shapes drawn in shapes.png.
 N_SHAPES = 6
@@ -55,8 +56,8 @@ def run_title(summary: dict) -> str | None:
         if kind == "free":
             return f"{name}: free motion"
         if kind == "record":
-            return record_title(name, summary["record"], float(inputs["amplitude_g"]))
-        amplitude, frequency = float(inputs["amplitude_g"]), float(inputs["frequency_hz"])
+            return record_title(name, summary[C.record], float(inputs[C.amplitude_g]))
+        amplitude, frequency = float(inputs[C.amplitude_g]), float(inputs[C.frequency_hz])
         cell = f"A = {amplitude:.4g} g, f = {frequency:.4g} Hz"
     except (KeyError, TypeError, ValueError, AttributeError):
         return None
@@ -67,10 +68,10 @@ def record_title(name: str, record: dict, amplitude: float) -> str:
     """Title of a record run: the config's name, the record's, its scaled PGA [g] (and the
     scale factor with ``scale: factor``), the vertical record's name and scaled peak."""
     if record.get("record_y"):
-        title = (f"{name}: records {record['record']} (x) and {record['record_y']} (y) scaled"
-                 f" to PGA {float(record['pga_g']):.4g} g (the larger)")  # fmt: skip
+        title = (f"{name}: records {record[C.record]} (x) and {record['record_y']} (y) scaled"
+                 f" to PGA {float(record[C.pga_g]):.4g} g (the larger)")  # fmt: skip
     else:
-        title = f"{name}: record {record['record']} scaled to PGA {float(record['pga_g']):.4g} g"
+        title = f"{name}: record {record[C.record]} scaled to PGA {float(record[C.pga_g]):.4g} g"
     if record.get("scale") == "factor":
         title += f" (factor {amplitude:.4g})"
     if record.get("vertical"):

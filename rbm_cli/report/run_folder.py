@@ -38,6 +38,7 @@ from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figure
     shape_instants,
 )
 from rbm_cli.study.result import RunResult
+from rbm_cli.study.schema import C
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -147,12 +148,12 @@ def record_of_run(config, amplitude_g: float) -> dict | None:
     if excitation.type != "record":
         return None
     motion = make_ground_motion(excitation, amplitude_g)
-    info = {"record": motion.name, "pga_g": float(np.max(np.abs(motion.values))) / G,
+    info = {C.record: motion.name, C.pga_g: float(np.max(np.abs(motion.values))) / G,
             "scale": excitation.scale, "vertical": None, "vertical_peak_g": None}  # fmt: skip
     if motion.values_y is not None:  # a pair: its PGA is the larger component's
         info["record_y"] = Path(str(excitation.file_y)).stem
         info["pair_times"] = pair_times(excitation)
-        info["pga_g"] = max(info["pga_g"], float(np.max(np.abs(motion.values_y))) / G)
+        info[C.pga_g] = max(info[C.pga_g], float(np.max(np.abs(motion.values_y))) / G)
     if motion.vertical is not None:
         info["vertical"] = Path(str(excitation.vertical)).stem
         info["vertical_peak_g"] = float(np.max(np.abs(motion.vertical))) / G
@@ -193,13 +194,13 @@ def run_summary(
     summary = dict(result.summary())
     summary["inputs"] = {
         "config_file": os.fspath(config_path) if config_path is not None else None,
-        "amplitude_g": amplitude_g,
-        "frequency_hz": frequency_hz,
+        C.amplitude_g: amplitude_g,
+        C.frequency_hz: frequency_hz,
         "output_dt_s": output_dt,
     }
     record = record_of_run(config, amplitude_g)
     if record is not None:
-        summary["record"] = record
+        summary[C.record] = record
     summary["config"] = json_ready(config.resolved())
     summary["config_written"] = json_ready(config.written)
     summary["rbm_version"] = __version__

@@ -59,6 +59,7 @@ from rbm_cli.models.methods import resolve_method
 from rbm_cli.study.bench_runs import run_cells
 from rbm_cli.study.bench_scoring import agreement, cell_keys, errors
 from rbm_cli.study.robustness import MEMBERS, member_config, members
+from rbm_cli.study.schema import C
 
 ROOT = Path(__file__).resolve().parents[2]  # the repository (rbm_cli/study/bench.py)
 
@@ -150,10 +151,10 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
     if problem.reference == "closed-form":
         ref, _ = run_cells("closed-form", cfg, cells, jobs)
         other, _ = run_cells("closed-form", cfg, nudged, jobs)
-        same = ref["collapsed"].to_numpy() == other["collapsed"].to_numpy()
+        same = ref[C.collapsed].to_numpy() == other[C.collapsed].to_numpy()
         robust = robust_flags("closed-form", cfg, cells, ref, jobs)
         peak_ok = _close(
-            other["max_rotation_ratio"].to_numpy(), ref["max_rotation_ratio"].to_numpy()
+            other[C.max_rotation_ratio].to_numpy(), ref[C.max_rotation_ratio].to_numpy()
         )
     else:
         runs = [run_cells("rbm", _with_solver(cfg, "compiled", "DOP853", r), cells, jobs)[0]
@@ -161,21 +162,21 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
         ref = runs[-1].copy()
         same = np.ones(len(ref), dtype=bool)
         for run in runs[:-1]:
-            same &= run["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
+            same &= run[C.collapsed].to_numpy() == ref[C.collapsed].to_numpy()
         tight = _with_solver(cfg, "compiled", "DOP853", REFERENCE_RTOLS[-1])
         other, _ = run_cells("rbm", tight, nudged, jobs)
-        same &= other["collapsed"].to_numpy() == ref["collapsed"].to_numpy()
+        same &= other[C.collapsed].to_numpy() == ref[C.collapsed].to_numpy()
         robust = robust_flags("rbm", tight, cells, ref, jobs)
-        p12 = ref["max_rotation_ratio"].to_numpy()
-        peak_ok = _close(runs[-2]["max_rotation_ratio"].to_numpy(), p12)
-        peak_ok &= _close(other["max_rotation_ratio"].to_numpy(), p12)
+        p12 = ref[C.max_rotation_ratio].to_numpy()
+        peak_ok = _close(runs[-2][C.max_rotation_ratio].to_numpy(), p12)
+        peak_ok &= _close(other[C.max_rotation_ratio].to_numpy(), p12)
         # and the same sequence of discrete events: a chaotic run can keep an early
         # peak in all three runs while the trajectories have parted (a later, larger
         # peak then appears at another tolerance)
-        for col in ("n_uplifts", "n_impacts"):
+        for col in (C.n_uplifts, C.n_impacts):
             for run in (runs[-2], other):
                 peak_ok &= run[col].to_numpy() == ref[col].to_numpy()
-    ref["robust"] = robust.astype(int)
+    ref[C.robust] = robust.astype(int)
     ref["converged"] = (robust & same).astype(int)
     ref["peak_converged"] = (robust & same & peak_ok).astype(int)
     return ref[_REF_COLUMNS]
@@ -184,18 +185,18 @@ def make_reference(problem: Problem, cfg: Config, jobs: int) -> pd.DataFrame:
 def robust_flags(kind: str, cfg: Config, cells, ref: pd.DataFrame, jobs: int) -> np.ndarray:
     """The robustness rule (rbm_cli.study.robustness) on a reference: True where all
     MEMBERS members (ref is member 0) collapse or all survive and none fails."""
-    flags = ref["collapsed"].to_numpy()
-    robust = (ref["status"] != "failed").to_numpy().copy()
+    flags = ref[C.collapsed].to_numpy()
+    robust = (ref[C.status] != "failed").to_numpy().copy()
     for member in members(MEMBERS)[1:]:
         member_cfg, _ = member_config(cfg, 1.0, member)
         moved = [(a * (1.0 + member.amplitude_relative), f) for a, f in cells]
         run, _ = run_cells(kind, member_cfg, moved, jobs)
-        robust &= (run["status"] != "failed").to_numpy() & (run["collapsed"].to_numpy() == flags)
+        robust &= (run[C.status] != "failed").to_numpy() & (run[C.collapsed].to_numpy() == flags)
     return robust
 
 
-_REF_COLUMNS = ["amplitude_g", "frequency_hz", "status", "collapsed", "t_collapse_s",
-                "max_rotation_ratio", "robust", "converged", "peak_converged"]  # fmt: skip
+_REF_COLUMNS = [C.amplitude_g, C.frequency_hz, C.status, C.collapsed, C.t_collapse_s,
+                C.max_rotation_ratio, C.robust, "converged", "peak_converged"]  # fmt: skip
 
 
 # ---------------------------------------------------------------- the benchmark
@@ -315,7 +316,7 @@ def _method_rows(
     """One table row per method of `results` (from :func:`_run_methods`): times and errors."""
     default = _default_method(problem_config(prob, stride=40))
     # paired times: each method's run times summed over the sample's cells
-    on_sample = set(cell_keys(pd.DataFrame(sample, columns=["amplitude_g", "frequency_hz"])))
+    on_sample = set(cell_keys(pd.DataFrame(sample, columns=[C.amplitude_g, C.frequency_hz])))
     paired = [
         float(d.loc[cell_keys(d).isin(on_sample), "wall_time_s"].sum()) for _, d, _, _ in results
     ]
@@ -341,7 +342,7 @@ def _method_rows(
             "domain_estimated": int(sampled),
             "jobs": jobs,
             "speedup_vs_baseline": base_sum / own if own > 0 else math.nan,
-            "steps_median": float(df["n_steps"].median()) if "n_steps" in df else math.nan,
+            "steps_median": float(df[C.n_steps].median()) if C.n_steps in df else math.nan,
         }
         row.update(errors(df, ref))
         row.update(agreement(df, results[k_default][1], ref))

@@ -16,13 +16,14 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.config.types import Config
+from rbm_cli.study.schema import C
 
 
 def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: float) -> dict:
     """One cell's outcome, as every runner of the benchmark reports it."""
-    return {"amplitude_g": a, "frequency_hz": f, "status": status,
-            "collapsed": int(status == "collapsed"), "t_collapse_s": t_collapse,
-            "max_rotation_ratio": peak, "wall_time_s": wall}  # fmt: skip
+    return {C.amplitude_g: a, C.frequency_hz: f, C.status: status,
+            C.collapsed: int(status == "collapsed"), C.t_collapse_s: t_collapse,
+            C.max_rotation_ratio: peak, "wall_time_s": wall}  # fmt: skip
 
 
 def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:

@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.config.load import parse_config
+from rbm_cli.study.schema import C
 
 #: The paper's tapered column (5 m, 0.96 -> 0.66 m), one cell that stays elastic
 #: for all drum counts (0.05 g, 2 Hz; at 0.15 g joints of 32-50 thin drums chatter), 10 s.
@@ -62,8 +63,8 @@ def _time(cfg, cell=CELL, repeats: int = 3) -> dict:
         for _ in range(repeats):
             res = simulate(cfg, *cell, runner=runner)
             walls.append(res.wall_time_s)
-    return {"time_per_run_s": float(np.median(walls)), "n_steps": res.n_steps,
-            "n_rhs": res.n_rhs, "status": res.status, "peak": res.max_rotation_ratio}  # fmt: skip
+    return {"time_per_run_s": float(np.median(walls)), C.n_steps: res.n_steps,
+            C.n_rhs: res.n_rhs, C.status: res.status, "peak": res.max_rotation_ratio}  # fmt: skip
 
 
 def _series(series: str, xs, make, log) -> list[dict]:
@@ -77,8 +78,8 @@ def _series(series: str, xs, make, log) -> list[dict]:
                              "elastic_hz": _elastic_hz(cfg), **_time(cfg, cell)})  # fmt: skip
                 unit = "pieces" if method == "exact" else "steps"
                 log(f"scaling: {series} {x:g}, {label}, {cell_name} cell: "
-                    f"{rows[-1]['time_per_run_s'] * 1e3:.1f} ms/run, {rows[-1]['n_steps']} "
-                    f"{unit}, {rows[-1]['status']}")  # fmt: skip
+                    f"{rows[-1]['time_per_run_s'] * 1e3:.1f} ms/run, {rows[-1][C.n_steps]} "
+                    f"{unit}, {rows[-1][C.status]}")  # fmt: skip
     return rows
 
 

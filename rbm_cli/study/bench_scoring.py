@@ -15,35 +15,36 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.study.domain import compare
+from rbm_cli.study.schema import C
 
 
 def cell_keys(df: pd.DataFrame) -> pd.Series:
-    return df["amplitude_g"].round(9).astype(str) + "|" + df["frequency_hz"].round(9).astype(str)
+    return df[C.amplitude_g].round(9).astype(str) + "|" + df[C.frequency_hz].round(9).astype(str)
 
 
 def errors(run: pd.DataFrame, ref: pd.DataFrame) -> dict:
     """Errors of a run's rows against the reference rows of the same cells."""
     m = run.assign(key=cell_keys(run)).merge(ref.assign(key=cell_keys(ref)), on="key",
                                         suffixes=("", "_ref"))  # fmt: skip
-    n_failed = int((m["status"] == "failed").sum())
-    conv = m[(m["converged"] == 1) & (m["status"] != "failed")]
-    differ = int((conv["collapsed"] != conv["collapsed_ref"]).sum())
-    both_surv = m[(m["peak_converged"] == 1) & (m["collapsed"] == 0) & (m["collapsed_ref"] == 0)]
+    n_failed = int((m[C.status] == "failed").sum())
+    conv = m[(m["converged"] == 1) & (m[C.status] != "failed")]
+    differ = int((conv[C.collapsed] != conv["collapsed_ref"]).sum())
+    both_surv = m[(m["peak_converged"] == 1) & (m[C.collapsed] == 0) & (m["collapsed_ref"] == 0)]
     both_surv = both_surv[both_surv["max_rotation_ratio_ref"] > 0]
-    peak = (both_surv["max_rotation_ratio"] - both_surv["max_rotation_ratio_ref"]).abs()
+    peak = (both_surv[C.max_rotation_ratio] - both_surv["max_rotation_ratio_ref"]).abs()
     peak = (peak / both_surv["max_rotation_ratio_ref"]).to_numpy()
-    both_col = conv[(conv["collapsed"] == 1) & (conv["collapsed_ref"] == 1)]
-    tcol = ((both_col["t_collapse_s"] - both_col["t_collapse_s_ref"]).abs()
+    both_col = conv[(conv[C.collapsed] == 1) & (conv["collapsed_ref"] == 1)]
+    tcol = ((both_col[C.t_collapse_s] - both_col["t_collapse_s_ref"]).abs()
             / both_col["t_collapse_s_ref"]).to_numpy()  # fmt: skip
     shift = math.nan
-    if len(conv) and conv["frequency_hz"].nunique() > 0:
-        a = conv[["amplitude_g", "frequency_hz", "collapsed"]].assign(
-            status=np.where(conv["collapsed"] == 1, "collapsed", "survived")
+    if len(conv) and conv[C.frequency_hz].nunique() > 0:
+        a = conv[[C.amplitude_g, C.frequency_hz, C.collapsed]].assign(
+            status=np.where(conv[C.collapsed] == 1, "collapsed", "survived")
         )
-        b = conv[["amplitude_g", "frequency_hz", "collapsed_ref"]].rename(
+        b = conv[[C.amplitude_g, C.frequency_hz, "collapsed_ref"]].rename(
             columns={"collapsed_ref": "collapsed"}
         )
-        b = b.assign(status=np.where(b["collapsed"] == 1, "collapsed", "survived"))
+        b = b.assign(status=np.where(b[C.collapsed] == 1, "collapsed", "survived"))
         shift = compare(a, b).max_shift_g
     return {
         "n_cells": len(m),
@@ -74,11 +75,11 @@ def agreement(run: pd.DataFrame, other: pd.DataFrame, ref: pd.DataFrame) -> dict
     own, theirs = float(m["wall_time_s"].sum()), float(m["wall_time_s_other"].sum())
     flags = ref.assign(key=cell_keys(ref))[["key", "converged", "peak_converged"]]
     m = m.merge(flags, on="key")
-    ok = (m["status"] != "failed") & (m["status_other"] != "failed") & (m["converged"] == 1)
+    ok = (m[C.status] != "failed") & (m["status_other"] != "failed") & (m["converged"] == 1)
     differ = int((m.loc[ok, "collapsed"] != m.loc[ok, "collapsed_other"]).sum())
-    surv = m[ok & (m["peak_converged"] == 1) & (m["collapsed"] == 0) & (m["collapsed_other"] == 0)]
+    surv = m[ok & (m["peak_converged"] == 1) & (m[C.collapsed] == 0) & (m["collapsed_other"] == 0)]
     surv = surv[surv["max_rotation_ratio_other"] > 0]
-    rel = ((surv["max_rotation_ratio"] - surv["max_rotation_ratio_other"]).abs()
+    rel = ((surv[C.max_rotation_ratio] - surv["max_rotation_ratio_other"]).abs()
            / surv["max_rotation_ratio_other"]).to_numpy()  # fmt: skip
     return {
         "differ_vs_default": differ,

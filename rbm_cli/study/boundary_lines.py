@@ -26,6 +26,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rbm_cli.study.schema import C
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -50,7 +52,7 @@ def line_row(by: list[str], values) -> dict:
     def freq(v) -> float:
         return math.nan if v is None else float(v)
 
-    return {c: (freq(v) if c == "frequency_hz" else v) for c, v in zip(by, values, strict=False)}
+    return {c: (freq(v) if c == C.frequency_hz else v) for c, v in zip(by, values, strict=False)}
 
 
 def is_empty(value) -> bool:
@@ -115,15 +117,15 @@ def boundary_table(rows: list[dict], columns) -> tuple[tuple[str, ...], list[dic
     ensemble, member0_lowest_unsafe_g, member0_highest_safe_g) and its rows (:func:`boundary`
     says what they hold), in plain Python: a sweep writes boundary.csv from its rows
     without pandas."""
-    by = (*axis_columns(columns), "frequency_hz")
-    ensemble = "collapse_fraction" in columns
+    by = (*axis_columns(columns), C.frequency_hz)
+    ensemble = C.collapse_fraction in columns
     lines: dict[tuple, tuple[tuple, list]] = {}
     for row in rows:
         values = tuple(row.get(c) for c in by)
-        status = row.get("status")
-        outcome = majority_status(row.get("collapse_fraction")) if ensemble else status
+        status = row.get(C.status)
+        outcome = majority_status(row.get(C.collapse_fraction)) if ensemble else status
         cells = lines.setdefault(line_ident(values), (values, []))[1]
-        cells.append((outcome, status, row.get("amplitude_g")))
+        cells.append((outcome, status, row.get(C.amplitude_g)))
     out = []
     for ident in sorted(lines, key=line_order(list(lines))):
         values, cells = lines[ident]

@@ -18,11 +18,11 @@ import numpy as np
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import Motion
 from rbm_cli.config.points import GridPoint, expand
-from rbm_cli.config.types import MODELS, Config
-from rbm_cli.physics.similarity import SCALE_FIELDS, rocking_scales, scale_fields
+from rbm_cli.config.types import Config
+from rbm_cli.physics.similarity import rocking_scales
 from rbm_cli.study.domain import cell_key, row_key
-from rbm_cli.study.intensities import column_period, measure_fields, measure_values
-from rbm_cli.study.result import SLIDES_FIELD, THREE_D_FIELDS
+from rbm_cli.study.intensities import column_period, measure_values
+from rbm_cli.study.schema import C, domain_columns, scale_values
 
 Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
 
@@ -71,21 +71,15 @@ def record_name(config: Config) -> str:
     return motion.name if motion is not None else Path(str(config.excitation.file)).stem
 
 
-def domain_fields(config: Config, fields: tuple[str, ...]) -> tuple[str, ...]:
-    """domain.csv's columns: the axis paths, ``record`` (the record's name, for record
-    excitations), the result's ``fields`` (with ``slides`` after friction_demand when
-    model rbm's demand is checked against interface.friction; the collapse azimuth and the
-    wobbling turns after max_top_displacement_m for a model in three dimensions), the
-    scales, the record's intensity measures (record excitations only)."""
-    record = ("record",) if has_records(config) else ()
-    fields = tuple(fields)
-    if MODELS[config.model].beam and config.interface.friction_limit is not None:
-        at = fields.index("friction_demand") + 1 if "friction_demand" in fields else len(fields)
-        fields = fields[:at] + (SLIDES_FIELD,) + fields[at:]
-    if config.three_d:
-        at = fields.index("max_top_displacement_m") + 1
-        fields = fields[:at] + THREE_D_FIELDS + fields[at:]
-    return config.grid.axis_paths + record + fields + SCALE_FIELDS + measure_fields(config)
+def domain_fields(config: Config, fields: tuple[str, ...] | None = None) -> tuple[str, ...]:
+    """domain.csv's columns without an ensemble's (rbm_cli.study.schema.domain_columns):
+    the axis paths, ``record`` (the record's name, for record excitations), the result's
+    columns (of those every domain has, ``fields`` only when given; ``slides`` after
+    friction_demand when model rbm's demand is checked against interface.friction; the
+    collapse azimuth and the wobbling turns after max_top_displacement_m for a model in
+    three dimensions), the scales, the record's intensity measures (record excitations
+    only)."""
+    return domain_columns(config, 1, fields)
 
 
 def tasks(
@@ -120,9 +114,9 @@ def add_point(row: dict, config: Config, cell: Cell, scales=None, period=_FROM_C
     a, f, values = cell
     row.update({p: str(v) if isinstance(v, Motion) else v for p, v in values})
     if has_records(config):
-        row["record"] = record_name(config)
+        row[C.record] = record_name(config)
     scales = scales or rocking_scales(config)
-    row.update(scale_fields(scales, a, f))
+    row.update(scale_values(scales, a, f))
     if has_records(config):
         t1 = column_period(config) if period is _FROM_CONFIG else period
         row.update(measure_values(config, a, scales, t1))

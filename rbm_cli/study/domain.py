@@ -1,7 +1,7 @@
 """Safe-unsafe domains as tables: rows, CSV text, boundary, comparison.
 
-A domain is a pandas DataFrame with the columns of domain.csv
-(:data:`rbm_cli.study.result.CSV_FIELDS`), one row per (amplitude, frequency) cell, or
+A domain is a pandas DataFrame with the columns of domain.csv (their schema:
+rbm_cli.study.schema), one row per (amplitude, frequency) cell, or
 the list of its rows (dicts) a sweep makes. pandas is imported where a DataFrame is built
 or read, not with this module: a sweep writes domain.csv and boundary.csv from its rows
 (:func:`csv_text`, :func:`boundary_table`) without it.
@@ -29,12 +29,13 @@ from rbm_cli.study.boundary_lines import boundary as boundary
 from rbm_cli.study.boundary_lines import boundary_table as boundary_table
 from rbm_cli.study.boundary_lines import line_ident, line_order, line_row
 from rbm_cli.study.result import CSV_FIELDS, STATUSES
+from rbm_cli.study.schema import C, columns
 
 if TYPE_CHECKING:
     import pandas as pd
 
 #: Columns a domain CSV must have for plotting and comparing.
-REQUIRED = ("amplitude_g", "frequency_hz", "status")
+REQUIRED = (C.amplitude_g, C.frequency_hz, C.status)
 
 
 def format_value(value) -> str:
@@ -85,13 +86,13 @@ def cell_key(amplitude_g: float, frequency_hz: float | None, *values) -> tuple[s
 
 def row_key(row, paths: tuple[str, ...] = ()) -> tuple[str, ...]:
     """The cell identity of a domain or journal row whose point is in the columns ``paths``."""
-    return cell_key(row.get("amplitude_g"), row.get("frequency_hz"), *(row.get(p) for p in paths))
+    return cell_key(row.get(C.amplitude_g), row.get(C.frequency_hz), *(row.get(p) for p in paths))
 
 
 def keys_of(df: pd.DataFrame) -> list[tuple[str, ...]]:
     """The cell identity of every row of a domain table (its axis columns included)."""
     paths = axis_columns(df.columns)
-    cols = [df["amplitude_g"], df["frequency_hz"], *(df[p] for p in paths)]
+    cols = [df[C.amplitude_g], df[C.frequency_hz], *(df[p] for p in paths)]
     return [cell_key(*vals) for vals in zip(*cols, strict=True)]
 
 
@@ -126,22 +127,27 @@ def parse_domain(source, path: str | Path) -> pd.DataFrame:
     if df.empty:
         raise RbmError(f"{path} has no rows")
     _check_cells(df, path)
-    if "collapsed" not in df.columns:
-        df["collapsed"] = (df["status"] == "collapsed").astype(int)
+    if C.collapsed not in df.columns:
+        df[C.collapsed] = (df[C.status] == "collapsed").astype(int)
     _set_types(df)
     return df
 
 
-#: domain.csv's columns of whole numbers (a failed run, or a run without collapse for
-#: collapse_interface, leaves them empty) and of real numbers, by name.
-INTEGER_COLUMNS = ("collapsed", "collapse_interface", "n_uplifts", "n_impacts", "n_steps",
-                   "n_rhs", "robust", "slides")  # fmt: skip
-FLOAT_COLUMNS = ("t_collapse_s", "max_rotation_ratio", "max_top_displacement_m",
-                 "friction_demand", "collapse_azimuth_deg", "wobble_turns",
-                 "collapse_fraction", "alpha_rad", "p_rad_s", "static_multiplier",
-                 "a_over_g_alpha", "omega_over_p", "pga_g", "pgv_m_s", "pgd_m", "arias_m_s",
-                 "cav_m_s", "d5_95_s", "t1_s", "sa_t1_g", "pga_over_g_tan_alpha",
-                 "pgv_p_over_g_tan_alpha")  # fmt: skip
+def integer_columns() -> tuple[str, ...]:
+    """domain.csv's columns of whole numbers (a failed run, or a run without collapse for
+    collapse_interface, leaves them empty), by the schema's dtypes."""
+    return tuple(c.name for c in columns() if c.dtype in ("int", "0/1"))
+
+
+def float_columns() -> tuple[str, ...]:
+    """domain.csv's columns of real numbers, by the schema's dtypes (amplitude and
+    frequency are checked and converted by _check_cells; a measure per period, written
+    sa_<T>s_g, is left as read)."""
+    return tuple(
+        c.name
+        for c in columns()
+        if c.dtype == "float" and c.name not in REQUIRED and c.name.isidentifier()
+    )
 
 
 def _set_types(df: pd.DataFrame) -> None:
@@ -152,14 +158,14 @@ def _set_types(df: pd.DataFrame) -> None:
     that does not hold such numbers is left as read."""
     import pandas as pd
 
-    for col in INTEGER_COLUMNS:
+    for col in integer_columns():
         if col in df.columns and pd.api.types.is_numeric_dtype(df[col]):
             values = df[col]
             whole = values.dropna()
             if len(whole) and not (whole == whole.round()).all():
                 continue
             df[col] = values.astype("Int64" if values.isna().any() else "int64")
-    for col in FLOAT_COLUMNS:
+    for col in float_columns():
         if col in df.columns and pd.api.types.is_numeric_dtype(df[col]):
             df[col] = df[col].astype("float64")
 
@@ -174,7 +180,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
     def got(value) -> str:
         return "an empty field" if pd.isna(value) else repr(str(value))
 
-    for col, unit, positive in (("amplitude_g", "g", False), ("frequency_hz", "Hz", True)):
+    for col, unit, positive in ((C.amplitude_g, "g", False), (C.frequency_hz, "Hz", True)):
         raw = df[col]
         x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
         with np.errstate(invalid="ignore"):
@@ -189,16 +195,16 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
                 f" got {got(raw.iloc[i])}"
             )
         df[col] = x
-    bad = ~df["status"].isin(STATUSES).to_numpy()
+    bad = ~df[C.status].isin(STATUSES).to_numpy()
     if bad.any():
         i = int(np.argmax(bad))
         raise RbmError(
             f"{path}: line {i + 2}: status must be one of {', '.join(STATUSES)},"
             f" got {got(df['status'].iloc[i])}"
         )
-    if "collapsed" in df.columns:
+    if C.collapsed in df.columns:
         _check_collapsed(df, path, got)
-    if "collapse_fraction" in df.columns:
+    if C.collapse_fraction in df.columns:
         _check_fraction(df, path, got)
     seen: dict[tuple[str, ...], int] = {}
     paths = axis_columns(df.columns)
@@ -217,7 +223,7 @@ def _check_fraction(df: pd.DataFrame, path: Path, got) -> None:
     of an ensemble is drawn from it. Converts it to float in place."""
     import pandas as pd
 
-    raw = df["collapse_fraction"]
+    raw = df[C.collapse_fraction]
     x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
     with np.errstate(invalid="ignore"):
         bad = (np.isnan(x) & raw.notna().to_numpy()) | np.isinf(x) | (x < 0.0) | (x > 1.0)
@@ -227,7 +233,7 @@ def _check_fraction(df: pd.DataFrame, path: Path, got) -> None:
             f"{path}: line {i + 2}: collapse_fraction must be a number in [0, 1] or empty"
             f" (every member failed), got {got(raw.iloc[i])}"
         )
-    df["collapse_fraction"] = x
+    df[C.collapse_fraction] = x
 
 
 def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
@@ -236,28 +242,28 @@ def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
     they disagree would make the two disagree quietly. Converts it to int."""
     import pandas as pd
 
-    raw = df["collapsed"]
+    raw = df[C.collapsed]
     x = pd.to_numeric(raw, errors="coerce").to_numpy(float)
     bad = ~np.isin(x, (0.0, 1.0))
     if bad.any():
         i = int(np.argmax(bad))
         raise RbmError(f"{path}: line {i + 2}: collapsed must be 0 or 1, got {got(raw.iloc[i])}")
     flags = x.astype(int)
-    disagree = flags != (df["status"] == "collapsed").to_numpy(int)
+    disagree = flags != (df[C.status] == "collapsed").to_numpy(int)
     if disagree.any():
         i = int(np.argmax(disagree))
         raise RbmError(
             f"{path}: line {i + 2}: status {df['status'].iloc[i]!r} but collapsed {flags[i]}:"
             " the two columns disagree (collapsed is 1 exactly when status is collapsed)"
         )
-    df["collapsed"] = flags
+    df[C.collapsed] = flags
 
 
 def _groups(df: pd.DataFrame):
     """(group columns, groupby) of a domain's boundary lines: one per point of its axes
     and frequency (NaN frequency kept: a record's), in the order the rows first hold them
     (:func:`line_order` orders them: an axis may mix strings and numbers)."""
-    by = [*axis_columns(df.columns), "frequency_hz"]
+    by = [*axis_columns(df.columns), C.frequency_hz]
     return by, df.groupby(by if len(by) > 1 else by[0], sort=False, dropna=False)
 
 
@@ -290,8 +296,8 @@ def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
     out = {}
     for values, grp in groups:
         values = values if isinstance(values, tuple) else (values,)
-        amps = np.sort(grp["amplitude_g"].to_numpy(float))
-        unsafe = grp.loc[grp["status"] == "collapsed", "amplitude_g"]
+        amps = np.sort(grp[C.amplitude_g].to_numpy(float))
+        unsafe = grp.loc[grp[C.status] == "collapsed", C.amplitude_g]
         if len(unsafe):
             edge = float(unsafe.min())
         else:
@@ -313,7 +319,7 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
     import pandas as pd
 
     def flags(df):
-        return dict(zip(keys_of(df), df["collapsed"].astype(int), strict=True))
+        return dict(zip(keys_of(df), df[C.collapsed].astype(int), strict=True))
 
     ka, kb = flags(a), flags(b)
     common = ka.keys() & kb.keys()

@@ -46,6 +46,7 @@ from rbm_cli.config.types import MODELS, ONLY_FOR, STEP_DEFAULT, Config
 from rbm_cli.models.methods import resolve_method
 from rbm_cli.study.cells import grid_points
 from rbm_cli.study.domain import domain_config
+from rbm_cli.study.schema import C
 from rbm_cli.study.store import JOURNAL
 
 #: The form of the config hash (written as meta.json's ``schema``).
@@ -188,8 +189,8 @@ def _budget_rows(domain_csv: Path) -> int:
         return sum(
             1
             for row in csv.DictReader(handle)
-            if row.get("status") == "failed"
-            and any(word in (row.get("message") or "") for word in _BUDGET_WORDS)
+            if row.get(C.status) == "failed"
+            and any(word in (row.get(C.message) or "") for word in _BUDGET_WORDS)
         )
 
 

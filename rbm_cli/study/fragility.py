@@ -67,6 +67,7 @@ from rbm_cli.study.outcomes import (
     prepare_outcomes,
     worst_angle,
 )
+from rbm_cli.study.schema import C
 
 METHOD = (
     "lognormal fragility, maximum likelihood on per-record outcomes "
@@ -145,8 +146,8 @@ def _record_matrices(rows: pd.DataFrame, levels: np.ndarray):
     """Per record and level: trials and collapses of the non-failed rows (0/1 each, or an
     ensemble cell's member counts)."""
     ok = rows[~rows["failed"]]
-    records = np.unique(rows["record"].to_numpy())
-    r_index = pd.Index(records).get_indexer(ok["record"])
+    records = np.unique(rows[C.record].to_numpy())
+    r_index = pd.Index(records).get_indexer(ok[C.record])
     l_index = np.searchsorted(levels, ok["x"].to_numpy())
     runs = np.zeros((records.size, levels.size))
     hits = np.zeros((records.size, levels.size))
@@ -253,7 +254,7 @@ def fragility(
     grid = (
         np.linspace(0.0, 1.1 * levels.max(), 201) if grid_g is None else np.asarray(grid_g, float)
     )
-    n_records = int(rows["record"].nunique())
+    n_records = int(rows[C.record].nunique())
     fit, note, n_resamples = _fit_table(rows, levels, n_records, n_resamples,
                                         intensity_unit(column))  # fmt: skip
     band = _bootstrap_band(rows, levels, fit, n_resamples, seed, grid, [lo_pct, hi_pct], progress)

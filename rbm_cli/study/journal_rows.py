@@ -12,8 +12,9 @@ import math
 from rbm_cli.study.domain import row_key
 from rbm_cli.study.result import STATUSES
 from rbm_cli.study.robustness import SENSITIVE_TO
+from rbm_cli.study.schema import C
 
-COUNT_FIELDS = ("n_uplifts", "n_impacts", "n_steps", "n_rhs")
+COUNT_FIELDS = (C.n_uplifts, C.n_impacts, C.n_steps, C.n_rhs)
 
 
 def _is_number(x) -> bool:
@@ -45,7 +46,7 @@ def validate_row(
         return "not a JSON object"
     if "config_hash" in row and row["config_hash"] != digest:
         return f"made by another config (hash {str(row['config_hash'])[:24]!r})"
-    a, f = row.get("amplitude_g"), row.get("frequency_hz")
+    a, f = row.get(C.amplitude_g), row.get(C.frequency_hz)
     if not (_is_number(a) and math.isfinite(a) and a >= 0):
         return f"amplitude_g must be a finite number >= 0, got {a!r}"
     if not (f is None or (_is_number(f) and math.isfinite(f) and f > 0)):
@@ -53,30 +54,30 @@ def validate_row(
     if row_key(row, paths) not in grid:
         point = "".join(f", {p} {row.get(p)!r}" for p in paths)
         return f"the cell ({a} g, {f} Hz{point}) is not in the config's grid"
-    status = row.get("status")
+    status = row.get(C.status)
     if status not in STATUSES:
         return f"status must be one of {', '.join(STATUSES)}, got {str(status)[:40]!r}"
-    collapsed = row.get("collapsed")
+    collapsed = row.get(C.collapsed)
     if collapsed not in (0, 1) or isinstance(collapsed, bool):
         return f"collapsed must be 0 or 1, got {collapsed!r}"
     if collapsed != (status == "collapsed"):
         return f"status {status!r} but collapsed {collapsed}: they disagree"
-    if not isinstance(row.get("message"), str):
+    if not isinstance(row.get(C.message), str):
         return "message must be a string"
     failed = status == "failed"
     problem = _check_numbers(row, failed, status == "collapsed", n_interfaces)
     if problem:
         return problem
     if ensemble > 1:
-        cf = row.get("collapse_fraction")
+        cf = row.get(C.collapse_fraction)
         if not (_is_number(cf) and (math.isnan(cf) or 0.0 <= cf <= 1.0)):
             return f"collapse_fraction must be in [0, 1] or NaN, got {cf!r}"
-        robust = row.get("robust")
+        robust = row.get(C.robust)
         if robust not in (0, 1) or isinstance(robust, bool):
             return f"robust must be 0 or 1, got {robust!r}"
         if robust == 1 and cf not in (0.0, 1.0):
             return f"robust 1 but collapse_fraction {cf!r}: they disagree"
-        why = row.get("sensitive_to")
+        why = row.get(C.sensitive_to)
         if why not in SENSITIVE_TO:
             return f"sensitive_to must be one of {', '.join(SENSITIVE_TO)}, got {why!r}"
         if (robust == 1) != (why == "none"):
@@ -91,13 +92,13 @@ def _check_numbers(row: dict, failed: bool, collapsed: bool, n_interfaces: int) 
             continue
         if not (isinstance(v, int) and not isinstance(v, bool) and v >= 0):
             return f"{key} must be an integer >= 0, got {v!r}"
-    for key in ("max_rotation_ratio", "max_top_displacement_m"):
+    for key in (C.max_rotation_ratio, C.max_top_displacement_m):
         v = row.get(key)
         if failed and (v is None or _nan_or_none(v)):
             continue
         if not (_is_number(v) and math.isfinite(v) and v >= 0):
             return f"{key} must be a finite number >= 0, got {v!r}"
-    t, where = row.get("t_collapse_s"), row.get("collapse_interface")
+    t, where = row.get(C.t_collapse_s), row.get(C.collapse_interface)
     if collapsed:
         if not (_is_number(t) and math.isfinite(t) and t >= 0):
             return f"t_collapse_s of a collapsed cell must be a finite time >= 0, got {t!r}"

@@ -42,22 +42,28 @@ import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.study.domain import check_collapsed
+from rbm_cli.study.schema import DEFAULT_INTENSITIES, C
+from rbm_cli.study.schema import unit as schema_unit
 
 #: Intensity columns looked for, in order, when none is named.
-INTENSITY_COLUMNS = ("intensity_g", "amplitude_g", "intensity")
+INTENSITY_COLUMNS = DEFAULT_INTENSITIES
 
 #: Statuses a row may have; ``failed`` rows are left out of the fit and counted.
 STATUSES = ("collapsed", "survived", "failed")
 #: How the runs of an ensemble domain's cells count (module docstring); the first is the
 #: default.
 ENSEMBLE_OUTCOMES = ("members", "majority", "member0")
-#: Unit of an intensity column, by the end of its name (the longest that matches).
+#: Unit of an intensity column the schema lacks (a table of an older rbm's or a user's), by
+#: the end of its name (the first that matches).
 UNITS = (("_m_s", "m/s"), ("_g", "g"), ("_m", "m"), ("_s", "s"), ("intensity", "g"))
 
 
 def intensity_unit(column: str) -> str:
-    """The unit of an intensity column by its name (``pgv_m_s``: m/s, ``amplitude_g``: g,
-    ``pga_over_g_tan_alpha``: -)."""
+    """The unit of an intensity column: the schema's (rbm_cli.study.schema: ``pgv_m_s``:
+    m/s, ``amplitude_g``: g, ``pga_over_g_tan_alpha``: -), else by the end of its name."""
+    known = schema_unit(column)
+    if known:
+        return known
     for end, unit in UNITS:
         if column.endswith(end):
             return unit
@@ -66,7 +72,7 @@ def intensity_unit(column: str) -> str:
 
 def is_ensemble(df: pd.DataFrame) -> bool:
     """Whether a domain is an ensemble's (it has a collapse_fraction column)."""
-    return "collapse_fraction" in df.columns
+    return C.collapse_fraction in df.columns
 
 
 def intensity_column(df: pd.DataFrame, name: str | None = None) -> str | None:
@@ -101,7 +107,7 @@ def prepare_outcomes(
     if not isinstance(df, pd.DataFrame):
         raise RbmError("fragility: the input must be a table (pandas DataFrame)")
     column = intensity_column(df, name)
-    needed = ["record", column or "intensity_g", "collapsed"]
+    needed = [C.record, column or "intensity_g", C.collapsed]
     missing = [c for c in needed if c not in df.columns]
     if missing:
         raise RbmError(
@@ -110,11 +116,11 @@ def prepare_outcomes(
         )
     if df.empty:
         raise RbmError("fragility: the table has no rows")
-    rows = pd.DataFrame({"record": df["record"].astype(str).to_numpy()})
+    rows = pd.DataFrame({C.record: df[C.record].astype(str).to_numpy()})
     x = pd.to_numeric(df[column], errors="coerce").to_numpy(dtype=float)
-    status = df["status"].astype(str).to_numpy() if "status" in df.columns else None
+    status = df[C.status].astype(str).to_numpy() if C.status in df.columns else None
     failed = status == "failed" if status is not None else np.zeros(len(df), bool)
-    collapsed = pd.to_numeric(df["collapsed"], errors="coerce").to_numpy(dtype=float)
+    collapsed = pd.to_numeric(df[C.collapsed], errors="coerce").to_numpy(dtype=float)
     for i in range(len(df)):
         where = f"fragility: row {i + 1} (record {rows['record'].iat[i]!r})"
         if not (np.isfinite(x[i]) and x[i] > 0.0):
@@ -130,12 +136,12 @@ def prepare_outcomes(
             raise RbmError(f"{where}: collapsed must be 0 or 1, got {df['collapsed'].iat[i]!r}")
         if status is not None and (status[i] == "collapsed") != (collapsed[i] == 1.0):
             raise RbmError(f"{where}: status {status[i]!r} but collapsed = {int(collapsed[i])}")
-    rows["x"], rows["collapsed"], rows["failed"] = x, collapsed, failed
+    rows["x"], rows[C.collapsed], rows["failed"] = x, collapsed, failed
     rows["trials"], rows["hits"] = np.where(failed, 0.0, 1.0), np.where(failed, 0.0, collapsed)
     if is_ensemble(df) and ensemble_outcome != "member0":
         _ensemble_trials(rows, df, ensemble_outcome, n_members)
         failed = rows["failed"].to_numpy()
-    dup = rows.duplicated(["record", "x"])
+    dup = rows.duplicated([C.record, "x"])
     if dup.any():
         i = int(np.argmax(dup.to_numpy()))
         raise RbmError(
@@ -152,12 +158,12 @@ def _ensemble_trials(rows: pd.DataFrame, df: pd.DataFrame, outcome: str, n_membe
     """The trials and hits of an ensemble domain's rows, in place (module docstring): a
     failed row (its status) stays failed, and a cell whose members all failed (no
     fraction) is one too."""
-    fraction = pd.to_numeric(df["collapse_fraction"], errors="coerce").to_numpy(dtype=float)
+    fraction = pd.to_numeric(df[C.collapse_fraction], errors="coerce").to_numpy(dtype=float)
     bad = ~np.isnan(fraction) & ((fraction < 0.0) | (fraction > 1.0))
     if bad.any():
         i = int(np.argmax(bad))
         raise RbmError(f"fragility: row {i + 1}: collapse_fraction must be in [0, 1], "
-                       f"got {df['collapse_fraction'].iat[i]!r}")  # fmt: skip
+                       f"got {df[C.collapse_fraction].iat[i]!r}")  # fmt: skip
     failed = np.isnan(fraction) | rows["failed"].to_numpy(dtype=bool)
     if outcome == "majority":
         trials, hits = np.ones(len(df)), (fraction >= 0.5).astype(float)
@@ -166,7 +172,7 @@ def _ensemble_trials(rows: pd.DataFrame, df: pd.DataFrame, outcome: str, n_membe
             n_members = 1  # the same fit: every cell has the same weight (module docstring)
         trials, hits = np.full(len(df), float(n_members)), fraction * n_members
     rows["failed"] = failed
-    rows["collapsed"] = np.where(failed, 0.0, (fraction >= 0.5).astype(float))
+    rows[C.collapsed] = np.where(failed, 0.0, (fraction >= 0.5).astype(float))
     rows["trials"] = np.where(failed, 0.0, trials)
     rows["hits"] = np.where(failed, 0.0, hits)
 
@@ -208,21 +214,21 @@ def worst_angle(df: pd.DataFrame) -> pd.DataFrame:
     collapse before a failed run before a survival; then the larger collapse_fraction,
     then the larger max_rotation_ratio), in the order of their first rows; the table as
     it is otherwise."""
-    if not {ANGLE_AXIS, "amplitude_g", "record", "collapsed"} <= set(df.columns):
+    if not {ANGLE_AXIS, C.amplitude_g, C.record, C.collapsed} <= set(df.columns):
         return df  # (a table without them is refused, in one line, by prepare_outcomes)
     df = df.reset_index(drop=True)
-    status = df["status"].astype(str) if "status" in df.columns else None
-    collapsed = pd.to_numeric(df["collapsed"], errors="coerce").fillna(0.0)
+    status = df[C.status].astype(str) if C.status in df.columns else None
+    collapsed = pd.to_numeric(df[C.collapsed], errors="coerce").fillna(0.0)
     rank = 2.0 * collapsed + (status == "failed").astype(float) if status is not None else collapsed
     keys = pd.DataFrame({"_rank": rank.to_numpy()}, index=df.index)
-    for column in ("collapse_fraction", "max_rotation_ratio"):
+    for column in (C.collapse_fraction, C.max_rotation_ratio):
         if column in df.columns:
             keys[column] = pd.to_numeric(df[column], errors="coerce").fillna(-np.inf)
     order = keys.sort_values(list(keys.columns), ascending=False, kind="stable").index
-    worst = df.loc[order].drop_duplicates(["record", "amplitude_g"], keep="first")
-    cells = list(zip(df["record"], df["amplitude_g"], strict=True))
+    worst = df.loc[order].drop_duplicates([C.record, C.amplitude_g], keep="first")
+    cells = list(zip(df[C.record], df[C.amplitude_g], strict=True))
     position = {cell: i for i, cell in enumerate(dict.fromkeys(cells))}  # first rows' order
-    at = [position[cell] for cell in zip(worst["record"], worst["amplitude_g"], strict=True)]
+    at = [position[cell] for cell in zip(worst[C.record], worst[C.amplitude_g], strict=True)]
     return worst.iloc[np.argsort(at, kind="stable")].reset_index(drop=True)
 
 
@@ -265,18 +271,18 @@ def read_suite_domain_hashed(path: str | Path) -> tuple[pd.DataFrame, str]:
     try:
         data = path.read_bytes()
         df = pd.read_csv(
-            io.BytesIO(data), dtype={"record": str}, keep_default_na=False, na_values=[""]
+            io.BytesIO(data), dtype={C.record: str}, keep_default_na=False, na_values=[""]
         )
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         reason = " ".join(str(exc).split())
         raise RbmError(f"cannot read {path} as a domain CSV: {reason}") from None
     except OSError as exc:
         raise RbmError(f"cannot read {path}: {exc.strerror or exc}") from None
-    if "status" not in df.columns or not isinstance(df.index, pd.RangeIndex):
+    if C.status not in df.columns or not isinstance(df.index, pd.RangeIndex):
         raise RbmError(f"{path} is not a domain CSV (no status column, or ragged rows)")
     if df.empty:
         raise RbmError(f"{path} has no rows")
-    empty = df["record"].isna().to_numpy() if "record" in df.columns else np.ones(len(df), bool)
+    empty = df[C.record].isna().to_numpy() if C.record in df.columns else np.ones(len(df), bool)
     if empty.all():
         raise RbmError(
             f"{path} is the domain of an amplitude x frequency sweep, not of a record suite "
@@ -285,6 +291,6 @@ def read_suite_domain_hashed(path: str | Path) -> tuple[pd.DataFrame, str]:
         )
     if empty.any():
         raise RbmError(f"{path}: line {int(np.argmax(empty)) + 2}: the record field is empty")
-    if "collapsed" in df.columns:
+    if C.collapsed in df.columns:
         check_collapsed(df, path)
     return worst_angle(df), hashlib.sha256(data).hexdigest()

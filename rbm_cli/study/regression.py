@@ -22,6 +22,7 @@ import pandas as pd
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.study.domain import keys_of
+from rbm_cli.study.schema import C
 
 #: The bound on the re-made count of sensitive cells: the stored count plus
 #: max(SLACK_CELLS, SLACK_FRACTION x the stored count). Measured: re-drawing
@@ -83,13 +84,13 @@ def _flags(df: pd.DataFrame, column: str) -> dict:
 
 def check(stored: pd.DataFrame, fresh: pd.DataFrame) -> RegressionCheck:
     """Apply the regression rule; `stored` must carry the `robust` column."""
-    if "robust" not in stored.columns:
+    if C.robust not in stored.columns:
         raise RbmError(
             "the stored domain records no robustness (no 'robust' column): "
             "make it with rbm sweep --ensemble 16"
         )
-    robust = _flags(stored, "robust")
-    old, new = _flags(stored, "collapsed"), _flags(fresh, "collapsed")
+    robust = _flags(stored, C.robust)
+    old, new = _flags(stored, C.collapsed), _flags(fresh, C.collapsed)
     common = old.keys() & new.keys()
     robust_differ = sorted(
         (float(k[0]), float(k[1] or "nan"), *k[2:])
@@ -99,8 +100,8 @@ def check(stored: pd.DataFrame, fresh: pd.DataFrame) -> RegressionCheck:
     sensitive_differ = sum(1 for k in common if int(robust[k]) != 1 and old[k] != new[k])
     n_sensitive = sum(1 for v in robust.values() if int(v) != 1)
     fresh_sensitive = None
-    if "robust" in fresh.columns:
-        fresh_sensitive = int((fresh["robust"].astype(int) != 1).sum())
+    if C.robust in fresh.columns:
+        fresh_sensitive = int((fresh[C.robust].astype(int) != 1).sum())
     return RegressionCheck(
         n_cells=len(old),
         n_robust=len(old) - n_sensitive,

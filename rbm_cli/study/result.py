@@ -9,33 +9,19 @@ import numpy as np
 
 from rbm_cli.config.types import MODELS
 from rbm_cli.models.history import History
+from rbm_cli.study.schema import COMMON_RESULT_COLUMNS, C
 
 STATUSES = ("collapsed", "survived", "failed")
 
-#: Columns of domain.csv, in order.
-CSV_FIELDS = (
-    "amplitude_g",
-    "frequency_hz",
-    "status",
-    "collapsed",
-    "t_collapse_s",
-    "collapse_interface",
-    "max_rotation_ratio",
-    "max_top_displacement_m",
-    "n_uplifts",
-    "n_impacts",
-    "n_steps",
-    "n_rhs",
-    "friction_demand",
-    "message",
-)
+#: The result's columns every domain.csv has, in order (rbm_cli.study.schema).
+CSV_FIELDS = COMMON_RESULT_COLUMNS
 #: The column a domain of model rbm with interface.friction given adds after
 #: friction_demand: 1 where the demand exceeds the coefficient, else 0.
-SLIDES_FIELD = "slides"
+SLIDES_FIELD = C.slides
 #: The columns a domain of a model in three dimensions adds after max_top_displacement_m:
 #: the azimuth its lean pointed to at collapse [deg from x, in (-180, 180]; empty if it
 #: survived], and the angle its lean's direction swept while it rolled [turns].
-THREE_D_FIELDS = ("collapse_azimuth_deg", "wobble_turns")
+THREE_D_FIELDS = (C.collapse_azimuth_deg, C.wobble_turns)
 
 
 @dataclass(frozen=True)
@@ -140,8 +126,8 @@ class RunResult:
         """The domain.csv fields, in CSV_FIELDS order (collapsed as 0/1), and ``slides``
         when the demand was checked against a friction coefficient."""
         out = {k: getattr(self, k) for k in CSV_FIELDS}
-        out["collapsed"] = int(self.collapsed)
-        out["friction_demand"] = self.domain_friction_demand
+        out[C.collapsed] = int(self.collapsed)
+        out[C.friction_demand] = self.domain_friction_demand
         if self.friction_limit is not None:
             out[SLIDES_FIELD] = self.slides
         if self.three_d:
@@ -153,7 +139,7 @@ class RunResult:
         RBM's joints also the duration it is held for and its instantaneous peak), the first
         exceedance of the friction coefficient (when checked) and wall time (JSON-ready)."""
         out = self.row()
-        out["friction_demand"] = [v if np.isfinite(v) else None for v in self.friction_demand]
+        out[C.friction_demand] = [v if np.isfinite(v) else None for v in self.friction_demand]
         out["max_friction_demand"] = self.max_friction_demand
         if self.friction_duration_s is not None:
             out["friction_duration_s"] = self.friction_duration_s

@@ -33,7 +33,6 @@ from rbm_cli.study.cells import (
     Cell,
     add_point,
     count_cells,
-    domain_fields,
     grid_cells,
     grid_points,
     has_records,
@@ -46,7 +45,6 @@ from rbm_cli.study.domain import csv_text, parse_domain
 from rbm_cli.study.fingerprint import config_hash
 from rbm_cli.study.intensities import column_period
 from rbm_cli.study.parallel import run_chunks
-from rbm_cli.study.result import CSV_FIELDS
 from rbm_cli.study.robustness import (
     check_config,
     member_config,
@@ -54,6 +52,7 @@ from rbm_cli.study.robustness import (
     solver_checks,
     summarise,
 )
+from rbm_cli.study.schema import ENSEMBLE_COLUMNS, C, domain_columns
 from rbm_cli.study.store import JOURNAL, SweepStore
 from rbm_cli.study.sweep_folder import (
     as_started,
@@ -75,7 +74,7 @@ MAX_CELLS = 100_000
 MAX_RUNS = GRID_MAX_CELLS
 BACKENDS = ("loky", "threading", "sequential", "dask")
 #: Columns an ensemble sweep adds to domain.csv (rbm_cli.study.robustness).
-ENSEMBLE_FIELDS = ("collapse_fraction", "robust", "sensitive_to")
+ENSEMBLE_FIELDS = ENSEMBLE_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -101,17 +100,17 @@ def _run_cell(config: Config, a: float, f: float | None, runner) -> dict:
         return simulate(config, a, f, runner=runner).row()
     except Exception as exc:  # a sweep goes on past one bad cell
         return {
-            "amplitude_g": a,
-            "frequency_hz": f,
-            "status": "failed",
-            "collapsed": 0,
-            "message": f"{type(exc).__name__}: {' '.join(str(exc).split())}",
+            C.amplitude_g: a,
+            C.frequency_hz: f,
+            C.status: "failed",
+            C.collapsed: 0,
+            C.message: f"{type(exc).__name__}: {' '.join(str(exc).split())}",
         }
 
 
 def _outcomes(rows: list[dict]) -> list[int | None]:
     """Each run's outcome for the robustness rule: collapsed (1 or 0), None if it failed."""
-    return [None if r["status"] == "failed" else r["collapsed"] for r in rows]
+    return [None if r[C.status] == "failed" else r[C.collapsed] for r in rows]
 
 
 def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict]:
@@ -141,7 +140,7 @@ def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict
             runs = [row] + [_run_cell(*member_config(config, a, m), f, runner) for m in others]
             checked = [_run_cell(c, a, f, runner) for c in checks]
             summary = summarise(_outcomes(runs), _outcomes(checked))
-            row["collapse_fraction"], row["robust"], row["sensitive_to"] = summary
+            row.update(zip(ENSEMBLE_FIELDS, summary, strict=True))
         rows.append(row)
     return rows
 
@@ -221,7 +220,7 @@ class SweepRows:
 
 def sweep_fields(config: Config, ensemble: int = 1) -> tuple[str, ...]:
     """domain.csv's columns for a sweep of ``config`` with ``ensemble`` runs per cell."""
-    return domain_fields(config, CSV_FIELDS) + (ENSEMBLE_FIELDS if ensemble > 1 else ())
+    return domain_columns(config, ensemble)
 
 
 def sweep_rows(

@@ -29,6 +29,7 @@ from rbm_cli.study.domain import boundary_table, csv_text, domain_frame
 from rbm_cli.study.fingerprint import SCHEMA, hash_form, methods_that_run, same_domain
 from rbm_cli.study.provenance import provenance
 from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
+from rbm_cli.study.schema import C
 from rbm_cli.study.store import FINALS, JOURNAL, STATE
 
 
@@ -232,7 +233,7 @@ def publish_result(store, figure, config, rows, fields, meta, resume_command) ->
 def status_counts(rows: list[dict]) -> dict[str, int]:
     """meta.json's status_counts: cells per status, the most frequent first (ties in the
     order of their first row), as pandas' value_counts gives them."""
-    counts = Counter(row["status"] for row in rows if row.get("status") is not None)
+    counts = Counter(row[C.status] for row in rows if row.get(C.status) is not None)
     return dict(sorted(counts.items(), key=lambda item: -item[1]))
 
 

@@ -295,3 +295,42 @@ def test_docs_holds_the_site_and_no_script():
     the tutorials and the API example are run by the build and the tests)."""
     assert sorted(p.name for p in (ROOT / "docs").glob("*.py")) == ["conf.py"]
     assert (TOOLS / "make_validation.py").is_file()
+
+
+def unexplained_lazy_imports(path: Path) -> list[int]:
+    """Lines of the imports inside functions of a file that no `# lazy:` comment explains
+    (on the import's line or the line above it, or above the first of a run of imports)."""
+    lines = path.read_text().splitlines()
+    found = []
+    for node in ast.walk(ast.parse("\n".join(lines))):
+        if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            continue
+        for inner in ast.walk(node):
+            if not isinstance(inner, ast.Import | ast.ImportFrom):
+                continue
+            k = inner.lineno - 1
+            while k > 0 and lines[k - 1].lstrip().startswith(("from ", "import ")):
+                k -= 1  # the first of a run of imports
+            if not any("# lazy:" in lines[j] for j in (inner.lineno - 1, k - 1) if j >= 0):
+                found.append(inner.lineno)
+    return sorted(set(found))
+
+
+def test_every_import_inside_a_function_says_why():
+    """Imports sit at the top of a module; one inside a function is there for start-up time
+    and says why in a `# lazy:` comment (docs/architecture.md, Start-up)."""
+    found = [
+        f"{path.relative_to(PACKAGE.parent)}:{line}"
+        for path in sorted(PACKAGE.rglob("*.py"))
+        for line in unexplained_lazy_imports(path)
+    ]
+    assert not found, "imports inside functions with no '# lazy:' reason:\n" + "\n".join(found)
+
+
+def test_the_check_sees_an_unexplained_lazy_import(tmp_path):
+    """The checker itself finds an import inside a function with no reason, and takes one
+    with its reason above it (on its own or at the head of a run of imports)."""
+    path = tmp_path / "x.py"
+    path.write_text("def f():\n    import json\n\n\ndef g():\n    # lazy: heavy\n"
+                    "    import pandas\n    import scipy\n")  # fmt: skip
+    assert unexplained_lazy_imports(path) == [2]

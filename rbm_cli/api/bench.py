@@ -20,6 +20,7 @@ __all__ = [
 
 def run_scaling(**options):
     """The scaling study (rbm_cli.study.bench_scaling.run_scaling: output, log)."""
+    # lazy: loads pandas and joblib only where needed (docs/architecture.md, Start-up)
     from rbm_cli.study.bench_scaling import run_scaling as scaling
 
     return scaling(**options)

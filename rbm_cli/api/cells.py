@@ -13,10 +13,20 @@ from typing import TYPE_CHECKING, Any
 from rbm_cli.api.configs import as_config, check_cell, check_flag, check_output_dt
 from rbm_cli.api.motions import Motion, motion_config
 from rbm_cli.base.errors import ConfigError, RbmError
+from rbm_cli.base.files import check_writable_dir
 from rbm_cli.config.load import shown as shown_value
 from rbm_cli.config.types import Config
+from rbm_cli.models.compile_ahead import compile_once
+from rbm_cli.models.methods import compiled_codes
+from rbm_cli.physics.column import build_column
 from rbm_cli.report.plots import plot_history as _plot_history
-from rbm_cli.report.run_folder import history_frame, vertical_history
+from rbm_cli.report.run_folder import (
+    history_frame,
+    run_folder_name,
+    run_summary,
+    vertical_history,
+    write_run,
+)
 from rbm_cli.study.result import CSV_FIELDS, THREE_D_FIELDS, RunResult
 from rbm_cli.study.schema import C
 from rbm_cli.study.simulate import simulate
@@ -293,9 +303,6 @@ def compile_ahead(config: Config, notify: Callable[[str], None]) -> None:
     (rbm_cli.models.compile_ahead.compile_once), and ``notify`` is told what it waits
     for. Nothing to do for a run in Python (``solver.implementation: python``) or a model
     without compiled code."""
-    from rbm_cli.models.compile_ahead import compile_once
-    from rbm_cli.models.methods import compiled_codes
-
     for code in compiled_codes(config):
         compile_once(code, notify=notify)
 
@@ -308,9 +315,6 @@ def check_run_output(config: Config, output: str | os.PathLike):
     ------
     RbmError  An unwritable folder or a bad column (one line)
     """
-    from rbm_cli.base.files import check_writable_dir
-    from rbm_cli.physics.column import build_column
-
     check_writable_dir(Path(output) / config.name)
     return build_column(config.column, config.interface)
 
@@ -323,12 +327,6 @@ def write_run_folder(config: Config, column, result: RunResult | CellResult,
     shapes.png, summary.json: rbm_cli.report.run_folder.write_run); returns the folder.
     figure_process: the rbm_cli.report.figure_process.FigureProcess that draws the
     figures, or None to draw them here."""
-    from rbm_cli.report.run_folder import (
-        run_folder_name,
-        run_summary,
-        write_run,
-    )
-
     if isinstance(result, CellResult):
         result = result.run_result
     summary = run_summary(result, config, config_path=config_path, amplitude_g=amplitude_g,

@@ -77,6 +77,7 @@ def info(
     >>> rbm.info([cfg, rbm.with_value(cfg, "column.height", 4.0)])["height_m"].tolist()
     [2.0, 4.0]
     """  # noqa: E501
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     if isinstance(config, list | tuple):

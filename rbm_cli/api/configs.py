@@ -9,6 +9,8 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.load import check_cell as check_amplitude_frequency
 from rbm_cli.config.load import finite_number, parse_config, shown
@@ -89,8 +91,6 @@ def check_config(config: Any, where: str) -> Config:
 def check_flag(value: Any, name: str) -> bool:
     """``value``, checked to be True or False (a numpy boolean too): a string such as "no"
     or a number is not taken for one (RbmError naming ``name``)."""
-    import numpy as np
-
     if not isinstance(value, bool | np.bool_):
         raise RbmError(f"{name} must be True or False, got {shown(value)}")
     return bool(value)

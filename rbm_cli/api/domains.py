@@ -9,8 +9,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from rbm_cli.api.configs import as_config
 from rbm_cli.api.motions import motion_config
+from rbm_cli.base import files
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config
 from rbm_cli.study.domain import REQUIRED, axis_columns, domain_config
@@ -47,14 +50,13 @@ def has_robustness(df) -> bool:
 def save_figure(fig, path: str | os.PathLike) -> Path:
     """Save a matplotlib figure to ``path`` in one step (rbm_cli.base.files.save_figure_atomic:
     its type from the suffix, 150 dpi); returns the path."""
-    from rbm_cli.base import files
-
     return files.save_figure_atomic(fig, path)
 
 
 def check_regression(a: pd.DataFrame, b: pd.DataFrame):
     """The regression rule of domain B against the reference A (rbm_cli.study.regression.check:
     robust cells must not differ; B an ensemble within its bound of sensitive cells)."""
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
     from rbm_cli.study.regression import check
 
     return check(a, b)
@@ -63,6 +65,7 @@ def check_regression(a: pd.DataFrame, b: pd.DataFrame):
 def draw_domain(df: pd.DataFrame, config: Config | None, **options):
     """domain.png's figure of a domain (rbm_cli.report.domain_figure.domain_figure: compare,
     labels, dimensionless, layout, compare_configs, where); matplotlib imported here."""
+    # lazy: loads pandas and matplotlib only where needed (docs/architecture.md, Start-up)
     from rbm_cli.report.domain_figure import domain_figure
 
     return domain_figure(df, config, **options)
@@ -115,7 +118,8 @@ def plot_domain(
     >>> import rbm
     >>> ax = rbm.plot_domain(rbm.read_domain("out/block/domain.csv"))  # doctest: +SKIP
     """
-    from rbm_cli.report.domain_figure import draw_domain_on  # matplotlib, pandas: when drawn
+    # lazy: loads pandas and matplotlib only where needed (docs/architecture.md, Start-up)
+    from rbm_cli.report.domain_figure import draw_domain_on
 
     cfg = None if config is None else as_config(config)
     motions = getattr(df, "attrs", {}).get("motions")
@@ -209,7 +213,7 @@ def _domain_frame(value: Any, which: str) -> pd.DataFrame:
     """A domain for :func:`compare`: read from a path, or a DataFrame checked to hold a
     domain's cells (amplitude_g >= 0 [g], frequency_hz > 0 [Hz] or empty on every row,
     status one of STATUSES); an RbmError naming the argument and the row otherwise."""
-    import numpy as np
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     if isinstance(value, str | os.PathLike):

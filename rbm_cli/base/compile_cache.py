@@ -192,6 +192,7 @@ def key_numba_cache() -> bool:
     cache internals are not the ones this reads (nothing is changed then).
     """
     try:
+        # lazy: numba.core loads only where needed (docs/architecture.md, Start-up)
         from numba.core import caching
 
         classes = _impl_class(caching)._locator_classes

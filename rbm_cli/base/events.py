@@ -97,7 +97,8 @@ def first_crossing(dist, t0, t1, intervals=CHECK_INTERVALS, xtol=1e-14):
         if dip is not None and row_value(a + dip[0], dip[1]) < 0.0:
             cands.append((a + dip[0], dip[1]))
         if cands:
-            from scipy.optimize import brentq  # here: no scipy at import (a shorter start-up)
+            # lazy: scipy.optimize loads only where needed (docs/architecture.md, Start-up)
+            from scipy.optimize import brentq
 
             roots = [(brentq(row_value, a, hi, args=(r,), xtol=xtol), r) for hi, r in cands]
             return min(roots)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import fcntl
 import os
 import signal
 import threading
@@ -88,8 +89,6 @@ class FolderLock:
 
     def _lock_once(self) -> int | None:
         """The locked file's descriptor; None if the file was replaced meanwhile."""
-        import fcntl
-
         try:
             fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as exc:

@@ -50,6 +50,7 @@ def jit(function: Callable | None = None, *, inline: bool = False):
     def decorate(f: Callable) -> Callable:
         if not ENABLED:
             return f
+        # lazy: numba loads only where needed (docs/architecture.md, Start-up)
         from numba import njit
 
         return njit(cache=True, inline="always" if inline else "never")(f)

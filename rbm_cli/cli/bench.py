@@ -50,9 +50,11 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references, 
         rbm bench --pair --reuse-references --problem multidrum
         rbm bench -o bench --scaling
     """
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.bench import (
         check_targets,
         run_bench,
+        run_scaling,
         save_figure,
         scaling_figure,
         work_precision_figure,
@@ -68,8 +70,6 @@ def bench(quick, output, jobs, problems, references, scaling, reuse_references, 
                           pair=pair, log=log)  # fmt: skip
         save_figure(work_precision_figure(table), Path(output) / "bench.png")
         if scaling:
-            from rbm_cli.api.bench import run_scaling
-
             scaling_table = run_scaling(output=output, log=log)
             save_figure(scaling_figure(scaling_table), Path(output) / "scaling.png")
     except RbmError as exc:

@@ -9,6 +9,8 @@ options) end in one line ``Error: ...`` on stderr and exit status 2.
 
 from __future__ import annotations
 
+import gc
+
 import click
 
 from rbm_cli.api import __version__
@@ -63,8 +65,6 @@ LATE_GC = ("sweep", "run")
 def work_starts() -> None:
     """The command's imports and set-up are done: what they made is frozen out of the
     garbage collector (it lives to the end) and the collector is turned back on. Idempotent."""
-    import gc
-
     if not gc.isenabled():
         gc.freeze()
         gc.enable()
@@ -72,6 +72,7 @@ def work_starts() -> None:
 
 def load(config_path: str):
     """Load a config, turning every library error into a one-line CLI error."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.configs import load_config
 
     try:
@@ -87,8 +88,7 @@ def first_use(cfg) -> None:
     with the compiled code, as every later run does; a compile another rbm process runs is
     waited for, not repeated. Nothing to do for a run in Python
     (``solver.implementation: python``) or a model without compiled code."""
-    import gc
-
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.cells import compile_ahead
 
     collecting = gc.isenabled()

@@ -80,8 +80,10 @@ def plot_domain_cmd(
         rbm plot-domain out/size_effect/domain.csv --dimensionless --overlay
         rbm plot-domain out/polar/domain.csv -o polar.png
     """
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.backend_bases import FigureCanvasBase
 
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.domains import draw_domain, read_domain, save_figure
 
     if png is not None and not png.strip():
@@ -121,6 +123,7 @@ def _config_for(domain_csv: str, config_path: str | None):
     """The config of a domain: given, or the one stored in meta.json beside it (as the
     user wrote it); None when neither is there (the plot then lacks the curves that
     need the column)."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.domains import domain_config
 
     if config_path:
@@ -134,6 +137,7 @@ def _config_for(domain_csv: str, config_path: str | None):
 def _print_shifts(shifts) -> None:
     """The boundary shifts, one line per frequency (and point of any axes over config
     keys, whose columns come first)."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.domains import axis_columns
 
     axes = axis_columns(shifts.columns)
@@ -179,6 +183,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
         rbm compare results/spanos_koh_slender/domain.csv out/spanos_koh_slender/domain.csv \\
             --max-cells 0.01 --max-shift 0.05
     """
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.domains import compare_domains, has_robustness, read_domain
 
     for name, value in (("--max-cells", max_cells), ("--max-shift", max_shift)):
@@ -208,6 +213,7 @@ def compare(a_csv: str, b_csv: str, max_cells: float | None, max_shift: float | 
     failed = []
     robust = has_robustness(dom_a)
     if robust:
+        # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
         from rbm_cli.api.domains import check_regression
 
         rule = check_regression(dom_a, dom_b)
@@ -242,6 +248,7 @@ def migrate_cmd(folders: tuple[str, ...]) -> None:
         rbm migrate results/*/
         rbm migrate old_results/slender old_results/thick
     """
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api import migrate
 
     refused = []

@@ -70,6 +70,7 @@ def _unraisable(info) -> None:
     if not _stopped[0]:
         sys.__unraisablehook__(info)
     elif isinstance(info.exc_value, KeyboardInterrupt) and not _ending[0]:
+        # lazy: after the Ctrl-C handler is in place (module docstring)
         import threading
 
         try:
@@ -91,6 +92,7 @@ def _forget_caught_keyboard_interrupts() -> None:
 
 def commands():
     """The `rbm` click group with every command registered (imports the command modules)."""
+    # lazy: after the Ctrl-C handler is in place (module docstring)
     from rbm_cli.cli import bench, domain, fragility, run, sweep  # noqa: F401  (register them)
     from rbm_cli.cli.common import cli as group
 
@@ -128,6 +130,7 @@ def main(argv: list[str] | None = None) -> None:
 
 def _run(group, argv: list[str] | None):
     """The command's exit status; click's errors said as click says them."""
+    # lazy: after the Ctrl-C handler is in place (module docstring)
     import click
 
     try:

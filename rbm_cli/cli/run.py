@@ -28,6 +28,7 @@ def _check_excitation(cfg, amplitude: float | None, frequency: float | None):
     """Validate --amplitude [g] and --frequency [Hz] for the config's excitation type (the
     grid's ranges: rbm_cli.api.configs.check_options). Returns (amplitude [g], frequency
     [Hz] or None for a record)."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.configs import check_options
 
     try:
@@ -153,6 +154,7 @@ def run(
     _check_output_dt(cfg, output_dt)
     _say_which_point(cfg)
 
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.sweeps import RUN_IMPORTS, FigureProcess
 
     # before numba and matplotlib are imported: the child imports the figures' while this
@@ -168,6 +170,7 @@ def run(
 
 def _check_output_dt(cfg, output_dt: float | None) -> None:
     """--dt checked as the library checks output_dt (rbm_cli.api.configs.check_output_dt)."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.configs import check_output_dt
 
     try:
@@ -179,6 +182,7 @@ def _check_output_dt(cfg, output_dt: float | None) -> None:
 def _say_which_point(cfg) -> None:
     """A note when the config's grid has axes over config keys (a suite of records, a
     column.height axis...): one run is the config's own point, named here."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.column_info import own_point_note
 
     note = own_point_note(cfg)
@@ -189,6 +193,7 @@ def _say_which_point(cfg) -> None:
 def _run(cfg, config, amplitude_g, frequency_hz, output_dt, output, painter):
     """The body of `rbm run` once its inputs are checked: (RunResult, run folder). painter:
     the FigureProcess that draws history.png and shapes.png, or None to draw them here."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.cells import check_run_output, write_run_folder
     from rbm_cli.api.cells import run as run_cell
 
@@ -227,6 +232,7 @@ def info(config: str, as_json: bool) -> None:
         rbm info configs/harmonic_multidrum.yaml
         rbm info configs/spanos_koh_thick.yaml --json
     """
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.column_info import describe, format_info, info_json
 
     cfg = load(config)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import shlex
 
 import click
 
@@ -17,6 +18,7 @@ from rbm_cli.cli.common import (
     output_option,
     work_starts,
 )
+from rbm_cli.cli.progress import Progress, duration
 
 
 @cli.command()
@@ -97,6 +99,7 @@ def sweep(
     cfg = load(config)
     if scheduler and backend != "dask":
         raise UserError("--scheduler needs --backend dask")
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.sweeps import FigureProcess
 
     # before numba and matplotlib are imported: the child imports the figure's while
@@ -110,8 +113,8 @@ def _sweep(cfg, config, output, jobs, backend, scheduler, resume, force, ensembl
            painter) -> None:  # fmt: skip
     """The body of `rbm sweep` once the config is loaded (painter: the FigureProcess that
     draws domain.png, or None to draw it in this process)."""
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.sweeps import SweepInterrupted, run_sweep
-    from rbm_cli.cli.progress import Progress
 
     reporter = None if quiet else Progress(cfg.name)
 
@@ -162,8 +165,6 @@ def _where(summary, jobs: int) -> str:
 
 def _print_sweep_summary(summary, jobs: int) -> None:
     """What a finished `rbm sweep` says on stdout (failed cells: a warning on stderr)."""
-    from rbm_cli.cli.progress import duration
-
     if summary.already_finished:
         click.echo(
             f"{summary.folder} is already finished ({summary.n_cells} cells: domain.csv,"
@@ -188,8 +189,6 @@ def _print_sweep_summary(summary, jobs: int) -> None:
 
 def _resume_command(config, output, jobs, backend, scheduler, ensemble, force) -> str:
     """The exact command that resumes this sweep (quoted for a POSIX shell)."""
-    import shlex
-
     words = ["rbm", "sweep", config, "-o", output]
     if jobs != 2:
         words += ["--jobs", str(jobs)]

@@ -21,6 +21,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.excitation import excitation_section
 from rbm_cli.config.grid import (
@@ -181,8 +183,6 @@ def check_cell(
 
 def finite_number(value: Any) -> bool:
     """A finite real number: int, float or a numpy number (a 0-d array's), not a boolean."""
-    import numpy as np
-
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value.item()
     if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
@@ -193,8 +193,6 @@ def finite_number(value: Any) -> bool:
 def shown(value: Any) -> str:
     """A value as a message shows it: numbers as written (a numpy number as its number),
     anything else by its repr, cut to 60 characters."""
-    import numpy as np
-
     if isinstance(value, np.generic | np.ndarray) and np.ndim(value) == 0:
         value = value.item()
     if is_number(value):

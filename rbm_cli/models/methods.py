@@ -38,6 +38,7 @@ import numpy as np
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import CLOSED_FORM_KINDS, STEP_DEFAULT, Config, SolverConfig
 from rbm_cli.models.outcome import Outcome
+from rbm_cli.models.rbm.exact.motion import exact_why_not
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
 
@@ -108,8 +109,6 @@ def _closed_form_why_not(config: Config, model: Model | None) -> str | None:
 
 
 def _exact_why_not(config: Config, model: Model | None, method: str = "exact") -> str | None:
-    from rbm_cli.models.rbm.exact.motion import exact_why_not
-
     excitation = config.excitation
     return exact_why_not(
         config.interface.formulation,

@@ -93,7 +93,8 @@ def _halfsine_psi(ratio: float) -> float:
     hi = 0.5 * math.pi
     if f(hi) <= 0.0:  # k so small that sin(pi/2 - k) rounds the sign away
         return hi
-    from scipy.optimize import brentq  # here: no scipy at import (a shorter start-up)
+    # lazy: scipy.optimize loads only where needed (docs/architecture.md, Start-up)
+    from scipy.optimize import brentq
 
     return brentq(f, 0.0, hi, xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
 

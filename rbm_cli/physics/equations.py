@@ -153,6 +153,7 @@ class Model:
         if self.rigid:
             return []
         slopes = np.array([law.slopes[0] for law in self.laws])
+        # lazy: scipy.linalg loads only where needed (docs/architecture.md, Start-up)
         from scipy.linalg import eig  # here: no scipy at import (a shorter start-up)
 
         w2 = np.real(eig(self.stiffness(slopes), self.mass, right=False))

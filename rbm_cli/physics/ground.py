@@ -532,6 +532,7 @@ def ricker_knots(omega: float, center: float) -> np.ndarray:
 def _mp_extrema(gamma: float, nu: float) -> tuple[float, ...]:
     """Extrema of the MP shape (pulses.mp_shape) over s in [-gamma/2, gamma/2] [cycles]:
     sign changes of its slope on 400 points a cycle, each refined by Brent's method."""
+    # lazy: scipy.optimize loads only where needed (docs/architecture.md, Start-up)
     from scipy.optimize import minimize_scalar  # here: no scipy at import (a shorter start-up)
 
     half = gamma / 2.0

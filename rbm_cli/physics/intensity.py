@@ -297,6 +297,7 @@ def first_elastic_period(mass: np.ndarray, stiffness: np.ndarray) -> float | Non
     """The longest period 2 pi / sqrt(lam) [s] of the undamped system M x'' + K x = 0
     (lam the smallest eigenvalue of the pencil (K, M)); None when it is not positive
     (a mechanism or an unstable system: no elastic period)."""
+    # lazy: scipy.linalg loads only where needed (docs/architecture.md, Start-up)
     from scipy.linalg import eigh
 
     lam = eigh(np.asarray(stiffness, float), np.asarray(mass, float), eigvals_only=True)

@@ -148,6 +148,7 @@ class GroundMotion:
         maxima then refined by Brent's method)."""
         if self.second is None:
             return self.amplitude
+        # lazy: scipy.optimize loads only where needed (docs/architecture.md, Start-up)
         from scipy.optimize import minimize_scalar  # here: no scipy at import
 
         end = min(self.pulse_end, self.t_end)

@@ -253,6 +253,7 @@ def _mp_peak(gamma: float, nu: float) -> float:
     values = np.abs(mp_shape(s, gamma, nu))
     k = int(np.argmax(values))
     lo, hi = s[max(k - 1, 0)], s[min(k + 1, s.size - 1)]
+    # lazy: scipy.optimize loads only where needed (docs/architecture.md, Start-up)
     from scipy.optimize import minimize_scalar  # here: no scipy at import (a shorter start-up)
 
     best = minimize_scalar(

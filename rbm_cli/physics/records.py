@@ -218,6 +218,7 @@ def band_pass_sections(low_hz: float, high_hz: float, order: int, fs: float) -> 
               \\frac{1}{1 + (\\tan(\\pi f / f_s) / \\tan(\\pi f_h / f_s))^{2n}}
 
     (the analogue Butterworth's 1 / (1 + (f / f_c)^(2n)) a side, for f well below f_s)."""
+    # lazy: scipy.signal loads only where needed (docs/architecture.md, Start-up)
     from scipy.signal import butter
 
     high = butter(order, low_hz, btype="highpass", fs=fs, output="sos")
@@ -237,6 +238,7 @@ def band_pass(t: np.ndarray, a: np.ndarray, low_hz: float, high_hz: float, order
     RbmError  Uneven time steps (a band-pass needs one step), 0 < low_hz < high_hz <
         the Nyquist frequency not met, or too few samples for the filter's padding.
     """
+    # lazy: scipy.signal loads only where needed (docs/architecture.md, Start-up)
     from scipy.signal import sosfiltfilt
 
     where = f"record {name!r}"

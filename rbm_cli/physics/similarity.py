@@ -31,6 +31,10 @@ import math
 from dataclasses import dataclass
 
 from rbm_cli.config.types import MODELS, Config, InterfaceConfig, StiffnessConfig
+from rbm_cli.physics.block import block_geometry
+from rbm_cli.physics.closed_forms import linear_rocking_parameters
+from rbm_cli.physics.column import build_column
+from rbm_cli.physics.equations import build_model
 
 
 @dataclass(frozen=True)
@@ -53,24 +57,17 @@ class RockingScales:
 
 def rocking_scales(config: Config) -> RockingScales:
     """The scales of a config's column (module docstring); the model decides which."""
-    from rbm_cli.physics.closed_forms import linear_rocking_parameters
-    from rbm_cli.physics.column import build_column
-
     rigid = InterfaceConfig(stiffness=StiffnessConfig("rigid", ()))
     column = build_column(config.column, rigid)
     glued = dataclasses.replace(config.column, drum_heights=(config.column.height,))
     if MODELS[config.model].beam and config.column.capital is not None:
         # shaft and capital glued into one rigid stack: its base's theta_u and its p
-        from rbm_cli.physics.equations import build_model
-
         p = build_model(build_column(glued, rigid)).rocking_p
         tan_alpha = float(column.rotation_capacity[0])
         return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)
     if MODELS[config.model].beam:
         tan_alpha, p = linear_rocking_parameters(build_column(glued, rigid))
         return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)
-    from rbm_cli.physics.block import block_geometry
-
     block = block_geometry(glued)
     tan_alpha = math.tan(block.slenderness)
     static = tan_alpha if config.column.n_drums == 1 else min(tan_alpha, column.static_multiplier)

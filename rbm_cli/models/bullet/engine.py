@@ -83,6 +83,7 @@ class PhysicsClient:
 
 def _quiet_import():
     def load():
+        # lazy: pybullet loads only where needed (docs/architecture.md, Start-up)
         import pybullet
 
         return pybullet

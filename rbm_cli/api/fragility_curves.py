@@ -5,8 +5,14 @@ fit is imported when one is made, not with the package: ``run_fragility`` and
 
 from __future__ import annotations
 
+import numbers
 import os
+from pathlib import Path
 from typing import TYPE_CHECKING
+
+from rbm_cli.base.errors import RbmError
+from rbm_cli.study.intensities import fragility_measures, measure_of
+from rbm_cli.study.schema import DEFAULT_INTENSITIES
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -30,17 +36,12 @@ def intensity_names() -> tuple[str, ...]:
     record's measures that grow with its scale (the registry of
     rbm_cli.study.intensities, in its order; a measure per period as its pattern,
     ``sa_<T>s_g``)."""
-    from rbm_cli.study.intensities import fragility_measures
-    from rbm_cli.study.schema import DEFAULT_INTENSITIES
-
     return DEFAULT_INTENSITIES + tuple(m.column for m in fragility_measures())
 
 
 def intensity_help() -> str:
     """The help of ``rbm fragility --intensity``: the measures it takes (the registry's,
     read when the help is shown) and its default."""
-    from rbm_cli.study.schema import DEFAULT_INTENSITIES
-
     measures = intensity_names()[len(DEFAULT_INTENSITIES) :]
     defaults = DEFAULT_INTENSITIES
     return (
@@ -59,10 +60,6 @@ def check_intensity(name, where: str = "intensity") -> str | None:
     ------
     RbmError  One line naming ``where`` and the measures there are
     """
-    from rbm_cli.base.errors import RbmError
-    from rbm_cli.study.intensities import measure_of
-    from rbm_cli.study.schema import DEFAULT_INTENSITIES
-
     if name is None:
         return None
     ok = isinstance(name, str) and (
@@ -79,8 +76,6 @@ def check_intensity(name, where: str = "intensity") -> str | None:
 
 def _grows_with_scale(measure) -> bool:
     """Whether a registry entry (None: not a measure's column) is a fragility's intensity."""
-    from rbm_cli.study.intensities import fragility_measures
-
     return measure is not None and measure in fragility_measures()
 
 
@@ -91,10 +86,6 @@ def check_members(n_members) -> int | None:
     ------
     RbmError  One line naming it
     """
-    import numbers
-
-    from rbm_cli.base.errors import RbmError
-
     if n_members is None:
         return None
     if isinstance(n_members, bool) or not isinstance(n_members, numbers.Integral) \
@@ -108,10 +99,12 @@ def check_members(n_members) -> int | None:
 
 def __getattr__(name: str):
     if name == "run_fragility":
+        # lazy: loads matplotlib and pandas only where needed (docs/architecture.md, Start-up)
         from rbm_cli.report.fragility_run import run_fragility
 
         return run_fragility
     if name == "MAX_RESAMPLES":
+        # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
         from rbm_cli.study.fragility import MAX_RESAMPLES
 
         return MAX_RESAMPLES
@@ -179,12 +172,19 @@ def fragility(
     >>> round(res.fit.median_g, 2), list(res.curve.columns)  # capacities' geometric mean: 0.47
     (0.48, ['intensity_g', 'probability', 'lower', 'upper'])
     """  # noqa: E501
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
-    from rbm_cli.base.errors import RbmError
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
     from rbm_cli.report.fragility_run import n_members as members_of
+
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
     from rbm_cli.study.fragility import check_options
+
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
     from rbm_cli.study.fragility import fragility as fit
+
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
     from rbm_cli.study.outcomes import prepare_outcomes, read_suite_domain
 
     check_options(n_resamples, seed, ci_percentiles)
@@ -199,8 +199,6 @@ def fragility(
         path = domain
         domain = read_suite_domain(path)
         if n_members is None:
-            from pathlib import Path
-
             n_members = members_of(Path(path), domain)
     elif isinstance(domain, pd.DataFrame):
         domain = domain.copy()

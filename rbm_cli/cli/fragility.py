@@ -25,6 +25,7 @@ class MeasureOption(click.Option):
 
     @property
     def help(self) -> str:
+        # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
         from rbm_cli.api.fragility_curves import intensity_help
 
         return intensity_help()
@@ -84,6 +85,7 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         rbm fragility results/suite_multidrum/domain.csv \
             --compare results/suite_monolithic/domain.csv -o docs/figures/suite
     """
+    # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
     from rbm_cli.api.fragility_curves import MAX_RESAMPLES, check_intensity, run_fragility
 
     try:

@@ -20,6 +20,7 @@ def _series_label(impl: str, method: str) -> str:
 
 def _log_ticks(ax) -> None:
     """Labelled decades only, at most ~6 per axis (minor labels overlap into a smear)."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.ticker import LogLocator, NullFormatter
 
     for axis in (ax.xaxis, ax.yaxis):
@@ -88,6 +89,7 @@ def work_precision_figure(table: pd.DataFrame):
         decades). Zeros (no error, no differing cell) have no place on a log axis:
         they are left out, and a note in the panel counts them. One legend below.
     """
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     probs = list(dict.fromkeys(table["problem"]))
@@ -142,7 +144,10 @@ def scaling_figure(table: pd.DataFrame):
         dashed the rocking one) and a bar chart of the speed-up of 2 workers over 1
         (2 dashed).
     """
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     import matplotlib.ticker
+
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(16, 3.8))

@@ -100,6 +100,7 @@ def _polar_axes(ax, df: pd.DataFrame, config: Config | None, compare, where: str
             " domains in panels (--panels)"
         )
     if ax is None:
+        # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
         from matplotlib.figure import Figure
 
         ax = Figure(figsize=POLAR_SIZE).add_subplot(projection="polar")
@@ -189,6 +190,7 @@ def draw_domain_on(
     view = domain_view(df, config, dimensionless, layout, where)
     others = _compared(view, compare, labels, compare_configs, where)
     if ax is None:
+        # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
         from matplotlib.figure import Figure
 
         ax = Figure(figsize=figure_size(view)).add_subplot()
@@ -252,6 +254,8 @@ def domain_figure(
         return _plain_figure(df, config, compare, labels)
     if _polar(df, dimensionless, layout):
         return _polar_figure(df, config, compare, labels, where)
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     view = domain_view(df, config, dimensionless, layout, where)
@@ -314,6 +318,8 @@ def _polar_figure(df, config, compare, labels, where) -> Figure:
 
 def _plain_figure(df, config, compare, labels) -> Figure:
     """A domain over amplitude and frequency only, in physical axes (as it always was)."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(9.5, 5))

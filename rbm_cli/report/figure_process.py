@@ -87,6 +87,7 @@ def _read(fd: int):
 def domain_figure(df, config):
     """rbm_cli.report.domain_figure.domain_figure(df, config), imported when a figure is
     drawn (matplotlib and pandas with it): the function the child draws with."""
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
     from rbm_cli.report.domain_figure import domain_figure as draw
 
     return draw(df, config)
@@ -96,6 +97,7 @@ def _draw(kind, table, config, path, kwargs) -> None:
     """domain.png of a DataFrame (``kind`` 'frame') or of (rows, fields) (``kind`` 'rows',
     the sweep's), saved to ``path``: what the sweep's child (or this process) runs."""
     if kind == "rows":
+        # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
         from rbm_cli.study.domain import domain_frame
 
         table = domain_frame(*table)
@@ -127,6 +129,7 @@ def _die_with_parent(parent: int) -> None:
     if not sys.platform.startswith("linux"):
         return
     with contextlib.suppress(Exception):
+        # lazy: Linux only (docs/architecture.md, Start-up)
         import ctypes
 
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # 1: PR_SET_PDEATHSIG

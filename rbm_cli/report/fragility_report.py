@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -113,6 +114,7 @@ def write_fragility(result: FragilityResult, folder: str | os.PathLike) -> list[
 
 
 def _new_axes():
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     return Figure(figsize=(7, 5)).subplots()
@@ -189,8 +191,6 @@ NOTE_WIDTH = 120
 def _note(ax, text: str, gid: str, color: str = "black") -> None:
     """A note under the axes (off the points and the legend), below the last one, wrapped
     at NOTE_WIDTH characters."""
-    import textwrap
-
     lines = sum(t.get_text().count("\n") + 1 for t in ax.texts if t.get_gid() in NOTE_GIDS)
     ax.text(0.0, -0.14 - 0.04 * lines, textwrap.fill(text, NOTE_WIDTH), transform=ax.transAxes,
             fontsize=7, va="top", color=color, gid=gid)  # fmt: skip
@@ -290,6 +290,7 @@ def ida_curve(x: np.ndarray, y: np.ndarray, collapsed: np.ndarray, right: float)
 
 def ida_style(k: int) -> dict:
     """Colour and line style of the k-th record (by name) in ida.png."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib import colormaps
 
     colours = colormaps[IDA_COLOURS].colors
@@ -325,6 +326,7 @@ def plot_ida(df: pd.DataFrame, ax=None, *, intensity_column: str | None = None):
         beside the axes, names every record (colour k mod 20, line style k // 20:
         :func:`ida_style`), in columns of :data:`IDA_LEGEND_ROWS`.
     """
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.lines import Line2D
 
     column = find_intensity_column(df, intensity_column)

@@ -248,6 +248,7 @@ def fragility_figure(
 ):
     """A new figure (no pyplot) with :func:`plot_fragility` of ``result`` and, labelled by
     name, of each (name, result) of ``others`` (no counts then: they would overlap)."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     ax = Figure(figsize=(7, 5)).subplots()
@@ -264,6 +265,7 @@ def fragility_figure(
 
 def ida_figure(df: pd.DataFrame, column: str, label: str, title: str = ""):
     """A new figure (no pyplot) with :func:`plot_ida` of the domain's rows."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     ax = Figure(figsize=(7, 5)).subplots()

@@ -59,6 +59,7 @@ def describe(config: Config) -> dict:
         )
     engine = {}
     if config.model == "bullet":  # the engine's true solids move at their own level
+        # lazy: loads pybullet only where needed (docs/architecture.md, Start-up)
         from rbm_cli.models.bullet.run import engine_uplift_g
 
         engine = {"engine_uplift_g": engine_uplift_g(config), "friction": config.interface.friction}

@@ -70,6 +70,7 @@ def uplift_level(config: Config) -> tuple[float, str]:
     """(level [g], label) at which the config's column starts to rock: the RBM's static
     multiplier, or for `bullet` the engine's own level from its true solids."""
     if config.model == "bullet":
+        # lazy: loads pybullet only where needed (docs/architecture.md, Start-up)
         from rbm_cli.models.bullet.run import engine_uplift_g
 
         return engine_uplift_g(config), "engine uplift level"
@@ -205,6 +206,7 @@ def _finish_x(ax, view: DomainView) -> float:
     beyond MAX_CATEGORY_TICKS, and half a category of margin at either end. Returns the
     height the upright names take beyond one line of text [points] (0 otherwise)."""
     if view.log_x:
+        # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
         from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
         ax.set_xscale("log")
@@ -212,6 +214,7 @@ def _finish_x(ax, view: DomainView) -> float:
         ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.xaxis.set_minor_formatter(NullFormatter())
     if view.categories is not None:
+        # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
         from matplotlib.font_manager import FontProperties
 
         n = len(view.categories)
@@ -249,6 +252,7 @@ def draw_plane(ax, view: DomainView, point: Point, compare=(), labels=None, colo
 def point_colours(n: int, numeric: bool) -> list:
     """Colours of n overlaid points: ordered (viridis without its light end) for the
     values of one numeric axis, else distinct."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib import colormaps
 
     if numeric:
@@ -298,6 +302,7 @@ def draw_overlay(ax, view: DomainView, numeric: bool = True) -> None:
     _finish_x(ax, view)
     handles = None
     if ensemble:  # the points' lines are the majority's: the legend says so first
+        # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
         from matplotlib.lines import Line2D
 
         handles, _ = ax.get_legend_handles_labels()

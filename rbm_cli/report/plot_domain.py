@@ -87,13 +87,17 @@ CURVE_POINTS = 300
 def _new_axes(ax):
     if ax is not None:
         return ax
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     return Figure(figsize=(7, 5)).subplots()
 
 
 def _fraction_cmap():
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib import colormaps
+
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.colors import ListedColormap
 
     name, lo, hi = FRACTION_CMAP
@@ -154,7 +158,10 @@ def _plot_fraction_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None)
     ``colorbar`` is False: panels share one, :func:`fraction_colorbar`).
 
     Returns dark legend proxies of the markers (the points' colours vary)."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.colors import Normalize
+
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.lines import Line2D
 
     cmap, norm = _fraction_cmap(), Normalize(0.0, 1.0)
@@ -186,7 +193,10 @@ def _plot_fraction_cells(ax, df: pd.DataFrame, colorbar: bool = True, size=None)
 def fraction_colorbar(fig, axes, cax=None, pad: float = 0.16) -> None:
     """The colour bar of the collapse fraction, below ``axes`` (one or a list; the legend
     sits beside them; ``pad``: the gap, in the axes' height), or in ``cax``."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.cm import ScalarMappable
+
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.colors import Normalize
 
     mappable = ScalarMappable(norm=Normalize(0.0, 1.0), cmap=_fraction_cmap())

@@ -300,8 +300,13 @@ def draw_polar(ax, df: pd.DataFrame, config: Config | None = None, where: str = 
     """Draw the polar picture of a domain over ``excitation.angle`` on a polar axes
     (module docstring); ``config``: the config it was swept with, for the level at which
     the column starts to rock (a dashed circle). Returns the axes."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.lines import Line2D
+
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.patches import Patch
+
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.ticker import FuncFormatter
 
     radii = polar_boundary(df, where)

@@ -22,6 +22,7 @@ SHAPE_MAX_ANGLE = 0.35
 def _new_axes(ax):
     if ax is not None:
         return ax
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     return Figure().subplots()
@@ -227,6 +228,7 @@ def _shape_label(t: float, t_collapse: float | None, slip: float) -> str:
 def _draw_instant(ax, outlines, x0: float, z0: float, pitch: float, height: float, label):
     """One instant of plot_shapes: its drums, the ground with a tick at the rest position,
     and the label under it."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.patches import Polygon
 
     colors = ("#c9b79c", "#b39d7d")
@@ -360,6 +362,7 @@ def plot_joint_rotations(
     if history.rotations_across is not None:
         seen = np.atleast_2d(np.asarray(history.rotations_across, dtype=float))
         across = joint_angles(seen) / limits
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib import colormaps
 
     colours = colormaps["viridis"](np.linspace(0.0, 0.85, theta.shape[1]))

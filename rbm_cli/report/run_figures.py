@@ -15,7 +15,20 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from rbm_cli.base.errors import RbmError
+from rbm_cli.config.load import parse_config
+from rbm_cli.config.types import G
 from rbm_cli.models.history import History
+from rbm_cli.physics.column import build_column
+from rbm_cli.report.plots import (
+    exaggeration_factor,
+    ground_drifts,
+    infer_elevations,
+    plot_history,
+    plot_joint_rotations,
+    plot_shapes,
+    plot_top_relative,
+)
 from rbm_cli.study.schema import C
 
 #: Number of deformed shapes drawn in shapes.png.
@@ -83,8 +96,6 @@ def record_title(name: str, record: dict, amplitude: float) -> str:
 def plot_ground(history: History, ax, vertical=None, t_collapse: float | None = None):
     """The ground's acceleration against time [g]: a_g (gid 'a_g') and, with a vertical
     record, the upward a_v (gid 'a_v', ``vertical`` [m/s^2] at the history's times)."""
-    from rbm_cli.config.types import G
-
     t = np.asarray(history.t, dtype=float)
     ag = np.asarray(history.ground_acceleration, dtype=float) / G
     pair = history.ground_acceleration_y is not None
@@ -112,10 +123,6 @@ def plot_ground(history: History, ax, vertical=None, t_collapse: float | None = 
 
 def run_column(summary: dict):
     """(Column, formulation, collapse ratio) of the config a summary.json holds, or None."""
-    from rbm_cli.base.errors import RbmError
-    from rbm_cli.config.load import parse_config
-    from rbm_cli.physics.column import build_column
-
     try:
         # the column alone: the excitation's files (and a grid over them) are the run's
         # business, and may be relative to a folder the summary does not name
@@ -143,14 +150,8 @@ def history_figure(
     than one drum each joint's rotation over its limit (``joints`` = (Column, formulation,
     collapse ratio), see :func:`rbm_cli.report.plots.plot_joint_rotations`); for a model in
     three dimensions the top's path in plan below them (:func:`plot_top_plan`)."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
-
-    from rbm_cli.report.plots import (
-        ground_drifts,
-        plot_history,
-        plot_joint_rotations,
-        plot_top_relative,
-    )
 
     multi = joints is not None and joints[0].n > 1
     ground = bool(ground or vertical is not None)
@@ -216,9 +217,8 @@ def shapes_figure(
     """shapes.png's figure: the deformed column at chosen instants; for a model in three
     dimensions in two elevations, the motion's vertical plane above and the plane across
     it below (the same instants and exaggeration)."""
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
-
-    from rbm_cli.report.plots import exaggeration_factor, infer_elevations, plot_shapes
 
     instants = shape_instants(history.t)
     z = np.asarray(infer_elevations(history) if elevations is None else elevations, float)

@@ -28,7 +28,11 @@ from rbm_cli.base.files import (
     write_chunks_atomic,
     write_json_atomic,
 )
+from rbm_cli.base.jit import plain
+from rbm_cli.config.types import G
 from rbm_cli.models.history import History
+from rbm_cli.physics.excitation import make_ground_motion, pair_times
+from rbm_cli.physics.ground import as_samples, vertical_factor
 from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figures, here before)
     N_SHAPES,
     RUN_PNGS,
@@ -106,6 +110,7 @@ def history_columns(history: History, vertical=None) -> dict[str, np.ndarray]:
 def history_frame(history: History, vertical=None) -> pd.DataFrame:
     """history.csv as a table (the columns of :func:`history_columns`; pandas is imported
     here, not with the module)."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     return pd.DataFrame(history_columns(history, vertical))
@@ -141,9 +146,6 @@ def record_of_run(config, amplitude_g: float) -> dict | None:
     were put on one time base: ``shared`` (the same sample times) or ``union`` (the union
     of both records' times, each linear between its own samples)), and the vertical
     record's name and scaled peak [g] (None without one); None for another excitation."""
-    from rbm_cli.config.types import G
-    from rbm_cli.physics.excitation import make_ground_motion, pair_times
-
     excitation = config.excitation
     if excitation.type != "record":
         return None
@@ -165,11 +167,6 @@ def vertical_history(config, amplitude_g: float, t) -> np.ndarray | None:
     (excitation.vertical, scaled as the run scales it), at the times ``t`` [s]: as the
     run's ground motion gives it (rbm_cli.physics.motion.GroundMotion, 0 outside the
     record); None without a vertical record."""
-    from rbm_cli.base.jit import plain
-    from rbm_cli.config.types import G
-    from rbm_cli.physics.excitation import make_ground_motion
-    from rbm_cli.physics.ground import as_samples, vertical_factor
-
     excitation = config.excitation
     if excitation.type != "record" or excitation.vertical is None:
         return None

@@ -53,9 +53,11 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.base.files import write_text_atomic
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import STEP_DEFAULT, Config, GridConfig, SolverConfig
 from rbm_cli.models.methods import resolve_method
+from rbm_cli.models.rbm.step import warm_up
 from rbm_cli.study.bench_runs import run_cells
 from rbm_cli.study.bench_scoring import agreement, cell_keys, errors
 from rbm_cli.study.robustness import MEMBERS, member_config, members
@@ -225,9 +227,6 @@ def run_bench(
 
     The figure (bench.png) is drawn by the caller from the returned table
     (:func:`rbm_cli.report.bench_figures.work_precision_figure`)."""
-    from rbm_cli.base.files import write_text_atomic
-    from rbm_cli.models.rbm.step import warm_up
-
     ref_dir = Path(reference_dir) if reference_dir else REFERENCE_DIR
     out_dir = Path(output)
     try:
@@ -262,8 +261,6 @@ def _reference(
     log,
 ) -> pd.DataFrame:
     """The stored reference of a problem (quick, or full with reuse), or a new one, stored."""
-    from rbm_cli.base.files import write_text_atomic
-
     ref_path = ref_dir / f"{prob.name}_reference.csv"
     if quick or (reuse_references and ref_path.is_file()):
         if not ref_path.is_file():

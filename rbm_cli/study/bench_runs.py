@@ -16,7 +16,16 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.config.types import Config
+from rbm_cli.models.block.closed_form import linear_run, warm_up
+from rbm_cli.models.compile_ahead import compile_once
+from rbm_cli.models.methods import compiled_codes
+from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.physics.closed_forms import linear_rocking_parameters
+from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.study.bench_baseline import baseline_run
 from rbm_cli.study.schema import C
+from rbm_cli.study.simulate import simulate
 
 
 def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: float) -> dict:
@@ -27,11 +36,6 @@ def _row(a: float, f: float, status: str, t_collapse: float, peak: float, wall: 
 
 
 def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
-    from rbm_cli.models.compile_ahead import compile_once
-    from rbm_cli.models.methods import compiled_codes
-    from rbm_cli.models.registry import make_runner
-    from rbm_cli.study.simulate import simulate
-
     for code in compiled_codes(cfg):  # load the compiled code in this worker before timing
         compile_once(code)
     runner = make_runner(cfg)
@@ -44,10 +48,6 @@ def _run_rbm_chunk(cfg: Config, cells) -> list[dict]:
 
 
 def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dict]:
-    from rbm_cli.physics.assembly import model_from_config
-    from rbm_cli.physics.excitation import make_ground_motion
-    from rbm_cli.study.bench_baseline import baseline_run
-
     model = model_from_config(cfg)
     rows = []
     for a, f in cells:
@@ -60,11 +60,6 @@ def _run_baseline_chunk(cfg: Config, cells, budget_s: float = 120.0) -> list[dic
 
 
 def _run_closed_form_chunk(cfg: Config, cells) -> list[dict]:
-    from rbm_cli.models.block.closed_form import linear_run, warm_up
-    from rbm_cli.physics.assembly import model_from_config
-    from rbm_cli.physics.closed_forms import linear_rocking_parameters
-    from rbm_cli.physics.excitation import make_ground_motion
-
     warm_up()  # load the compiled closed form in this worker before timing runs
     model = model_from_config(cfg)
     alpha, p = linear_rocking_parameters(model.column)

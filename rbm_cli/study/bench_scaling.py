@@ -13,8 +13,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from rbm_cli.base.files import write_text_atomic
 from rbm_cli.config.load import parse_config
+from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.assembly import model_from_config
 from rbm_cli.study.schema import C
+from rbm_cli.study.simulate import simulate
 
 #: The paper's tapered column (5 m, 0.96 -> 0.66 m), one cell that stays elastic
 #: for all drum counts (0.05 g, 2 Hz; at 0.15 g joints of 32-50 thin drums chatter), 10 s.
@@ -45,16 +49,11 @@ def _config(drums: int = 8, k_n: float = 5e9, duration: float = 10.0, method="DO
 
 
 def _elastic_hz(cfg) -> float:
-    from rbm_cli.physics.assembly import model_from_config
-
     return max(model_from_config(cfg).elastic_frequencies_hz())
 
 
 def _time(cfg, cell=CELL, repeats: int = 3) -> dict:
     """Median time of a run of one cell [s] (after one untimed run that loads the code)."""
-    from rbm_cli.models.registry import make_runner
-    from rbm_cli.study.simulate import simulate
-
     runner = make_runner(cfg)
     res = simulate(cfg, *cell, runner=runner)
     walls = [res.wall_time_s]
@@ -88,7 +87,7 @@ def run_scaling(output: str | os.PathLike = "bench", log=print) -> pd.DataFrame:
 
     The figure (scaling.png) is drawn by the caller from the returned table
     (:func:`rbm_cli.report.bench_figures.scaling_figure`)."""
-    from rbm_cli.base.files import write_text_atomic
+    # lazy: loads joblib, pandas only where needed (docs/architecture.md, Start-up)
     from rbm_cli.study.bench import PROBLEMS, bench_cells, problem_config, run_cells
 
     rows = _series("drums", DRUMS, lambda n, m: _config(drums=n, method=m), log)

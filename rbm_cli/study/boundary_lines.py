@@ -152,6 +152,7 @@ def boundary(df: pd.DataFrame) -> pd.DataFrame:
     the same of member 0 (the rows' status). The rows are :func:`boundary_table`'s, the
     one implementation of the rule.
     """
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     columns, rows = boundary_table(df.to_dict("records"), df.columns)

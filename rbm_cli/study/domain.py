@@ -12,6 +12,7 @@ lines and, for an ensemble, the majority's rule. This module names them too.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +21,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.load import parse_config
+from rbm_cli.config.motions import holds_stored_motions
 from rbm_cli.config.types import Config
 from rbm_cli.study.boundary_lines import BOUNDARY_FIELDS as BOUNDARY_FIELDS
 from rbm_cli.study.boundary_lines import MAJORITY as MAJORITY
@@ -65,6 +68,7 @@ def csv_text(rows: list[dict], fields=CSV_FIELDS) -> str:
 def domain_frame(rows: list[dict], fields=CSV_FIELDS) -> pd.DataFrame:
     """The DataFrame of a domain's rows (dicts) with the columns ``fields`` (pandas is
     imported here, when a table is asked for)."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     return pd.DataFrame(rows, columns=list(fields))
@@ -107,6 +111,7 @@ def read_domain(path: str | Path) -> pd.DataFrame:
 def parse_domain(source, path: str | Path) -> pd.DataFrame:
     """A domain CSV read from ``source`` (a path or a text buffer), checked as
     :func:`read_domain` checks a file; ``path`` names it in an error (RbmError)."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     try:
@@ -156,6 +161,7 @@ def _set_types(df: pd.DataFrame) -> None:
     collapse: <NA>, not a float nan); real numbers as float64 (a column whose fields all
     happen to be whole, max_rotation_ratio = 1 at every collapse, stays float). A column
     that does not hold such numbers is left as read."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     for col in integer_columns():
@@ -175,6 +181,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
     finite > 0 [Hz], status one of STATUSES, and each cell once. Raises an
     RbmError naming the first bad line (the header is line 1); converts the two
     numeric columns to float in place."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     def got(value) -> str:
@@ -221,6 +228,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
 def _check_fraction(df: pd.DataFrame, path: Path, got) -> None:
     """collapse_fraction is a number in [0, 1] or empty (every member failed): the boundary
     of an ensemble is drawn from it. Converts it to float in place."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     raw = df[C.collapse_fraction]
@@ -240,6 +248,7 @@ def _check_collapsed(df: pd.DataFrame, path: Path, got) -> None:
     """collapsed is 0 or 1 on every row and says what status says (collapsed <=> 1):
     compare counts cells from collapsed and draws boundaries from status, so a row where
     they disagree would make the two disagree quietly. Converts it to int."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     raw = df[C.collapsed]
@@ -316,6 +325,7 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
     grid), so a boundary that leaves the grid counts as a finite shift. Cells are
     matched on amplitude, frequency and the values of any axes over config keys.
     """
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     def flags(df):
@@ -368,11 +378,6 @@ def domain_config(domain_csv: str | Path) -> Config | None:
     predates ``config_written``, or the config ran motions given as arrays; RbmError when
     the stored config no longer validates.
     """
-    import json
-
-    from rbm_cli.config.load import parse_config
-    from rbm_cli.config.motions import holds_stored_motions
-
     meta = Path(domain_csv).with_name("meta.json")
     try:
         stored = json.loads(meta.read_text(encoding="utf-8"))
@@ -390,6 +395,7 @@ def check_collapsed(df: pd.DataFrame, path: str | Path) -> None:
     (`rbm fragility`, which would count a failed run marked collapsed as a collapse):
     collapsed is 0 or 1 on every row, and 1 exactly when status is collapsed. Converts it
     to int in place; RbmError naming the file and the first bad line (header: line 1)."""
+    # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd
 
     def got(value) -> str:

@@ -58,6 +58,9 @@ import numpy as np
 
 from rbm_cli.config.types import MODELS, Config, G
 from rbm_cli.physics import intensity as im
+from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.physics.excitation import load_record
+from rbm_cli.physics.records import process
 
 #: How a measure goes with the factor c a cell multiplies its record by.
 SCALINGS = ("linear", "quadratic", "none")
@@ -266,8 +269,6 @@ def column_period(config: Config) -> float | None:
     """The column's first elastic period [s], None for a rigid one (module docstring)."""
     if not MODELS[config.model].beam:
         return None
-    from rbm_cli.physics.assembly import model_from_config
-
     model = model_from_config(config)
     if model.rigid:
         return None
@@ -281,9 +282,6 @@ def _record(config: Config, second: bool = False):
     horizontal component, ``excitation.file_y`` or a motion's ``acceleration_y``, if
     second), as the run reads it:
     processed as ``excitation.processing`` says (rbm_cli.physics.records.process)."""
-    from rbm_cli.physics.excitation import load_record
-    from rbm_cli.physics.records import process
-
     exc = config.excitation
     if exc.motion is not None:  # given as arrays (a pair: its y component if second)
         t, name = exc.motion.time_s, exc.motion.name

@@ -26,13 +26,17 @@ Interruption is part of the contract:
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import importlib.util
 import os
 import queue
 import signal
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, wait
+from multiprocessing import resource_tracker
 
 from rbm_cli.base.errors import RbmError
 
@@ -100,6 +104,7 @@ def run_chunks(
     if backend == "loky":
         yield from _here_then_pool(fn, args, jobs, sizes or [1] * len(args), placed)
         return
+    # lazy: joblib loads only where needed (docs/architecture.md, Start-up)
     import joblib
 
     if backend == "dask":
@@ -139,9 +144,7 @@ def _here_then_pool(fn: Callable, args: Sequence[tuple], jobs: int, sizes, place
 def _loky(fn: Callable, args: Iterable[tuple], jobs: int, placed: dict | None = None) -> Iterator:
     """fn(*a) for every a in args on a loky pool of `jobs` workers, started here and
     stopped at the end (placed["workers"] = jobs once it started)."""
-    from concurrent.futures import FIRST_COMPLETED, wait
-    from multiprocessing import resource_tracker
-
+    # lazy: joblib loads only where needed (docs/architecture.md, Start-up)
     from joblib.externals.loky import get_reusable_executor
 
     queue = iter(args)
@@ -269,8 +272,6 @@ def check_dask_installed() -> None:
     """Refuse the dask backend where dask.distributed is not installed (one line), before
     a sweep writes anything: a journal whose resume command repeats a backend that cannot
     run would be of no use."""
-    import importlib.util
-
     try:
         found = all(importlib.util.find_spec(name) for name in ("dask", "distributed"))
     except (ImportError, ValueError):
@@ -281,6 +282,7 @@ def check_dask_installed() -> None:
 
 def _dask_client(scheduler: str | None):
     try:
+        # lazy: dask is optional (an extra) (docs/architecture.md, Start-up)
         from dask.distributed import Client
     except ImportError:
         raise RbmError(NO_DASK) from None
@@ -295,9 +297,8 @@ def _dask_client(scheduler: str | None):
 
 def probe_dask(address: str) -> None:
     """Connect and complete distributed's handshake within DASK_PROBE_TIMEOUT_S."""
-    import asyncio
-
     try:
+        # lazy: dask is optional (an extra) (docs/architecture.md, Start-up)
         from distributed.comm import connect
     except ImportError:
         raise RbmError(NO_DASK) from None

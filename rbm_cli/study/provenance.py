@@ -13,6 +13,8 @@ import subprocess
 from functools import lru_cache
 from pathlib import Path
 
+import numpy
+
 import rbm_cli
 from rbm_cli import __version__
 from rbm_cli.study.robustness import RULE
@@ -53,6 +55,7 @@ def _cpu_model() -> str:
 
 def _numba_target() -> str:
     """The CPU name numba compiles for (NUMBA_CPU_NAME, else the host's)."""
+    # lazy: llvmlite loads only where needed (docs/architecture.md, Start-up)
     import llvmlite.binding as llvm
 
     return os.environ.get("NUMBA_CPU_NAME") or llvm.get_host_cpu_name()
@@ -62,9 +65,13 @@ def _numba_target() -> str:
 def provenance() -> dict:
     """rbm's version and commit, Python and the numerical libraries, the CPU and
     numba's target, and the robustness rule (rbm_cli.study.robustness)."""
+    # lazy: llvmlite loads only where needed (docs/architecture.md, Start-up)
     import llvmlite
+
+    # lazy: numba loads only where needed (docs/architecture.md, Start-up)
     import numba
-    import numpy
+
+    # lazy: scipy loads only where needed (docs/architecture.md, Start-up)
     import scipy
 
     libc = platform.libc_ver()

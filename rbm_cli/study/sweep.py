@@ -16,7 +16,9 @@ order, so the same config gives the same ``domain.csv`` whatever the number of w
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
+import numbers
 import os
 import time
 from collections.abc import Callable
@@ -28,7 +30,11 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.grid import MAX_CELLS as GRID_MAX_CELLS
 from rbm_cli.config.points import GridPoint
 from rbm_cli.config.types import MODELS, Config
+from rbm_cli.models.compile_ahead import compile_once, needs_compile
 from rbm_cli.models.methods import compiled_codes
+from rbm_cli.models.registry import make_runner
+from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.physics.similarity import rocking_scales
 from rbm_cli.study.cells import (
     Cell,
     add_point,
@@ -53,6 +59,7 @@ from rbm_cli.study.robustness import (
     summarise,
 )
 from rbm_cli.study.schema import ENSEMBLE_COLUMNS, C, domain_columns
+from rbm_cli.study.simulate import simulate
 from rbm_cli.study.store import JOURNAL, SweepStore
 from rbm_cli.study.sweep_folder import (
     as_started,
@@ -94,8 +101,6 @@ class SweepSummary:
 
 
 def _run_cell(config: Config, a: float, f: float | None, runner) -> dict:
-    from rbm_cli.study.simulate import simulate
-
     try:
         return simulate(config, a, f, runner=runner).row()
     except Exception as exc:  # a sweep goes on past one bad cell
@@ -124,9 +129,6 @@ def run_chunk(config: Config, cells: list[Cell], ensemble: int = 1) -> list[dict
     NaN if all failed), robust (1 when all members agree, none failed and the solver
     check agrees: the robustness rule) and sensitive_to (why not: inputs, solver, both;
     none when robust)."""
-    from rbm_cli.models.registry import make_runner
-    from rbm_cli.physics.similarity import rocking_scales
-
     runner = make_runner(config)  # the column assembled once for every cell and member
     scales = rocking_scales(config)
     period = column_period(config) if has_records(config) else None
@@ -213,8 +215,6 @@ class SweepRows:
     def frame(self) -> pd.DataFrame:
         """The DataFrame rbm_cli.study.domain.read_domain gives for domain.csv's text: read
         from :meth:`csv` by the same reader, so that the types are those of a stored domain's."""
-        import io
-
         return parse_domain(io.StringIO(self.csv()), "the sweep's rows")
 
 
@@ -304,6 +304,7 @@ def _check_request(
     if not isinstance(backend, str) or backend not in BACKENDS:
         raise RbmError(f"unknown backend {backend!r} (allowed: {', '.join(BACKENDS)})")
     if backend == "dask":
+        # lazy: loads joblib only where needed (docs/architecture.md, Start-up)
         from rbm_cli.study.parallel import check_dask_installed, probe_dask
 
         check_dask_installed()
@@ -314,16 +315,12 @@ def _check_request(
 
 def _is_int(value) -> bool:
     """A whole number: an int or a numpy integer, not a boolean."""
-    import numbers
-
     return isinstance(value, numbers.Integral) and not isinstance(value, bool)
 
 
 def _check_points(points: list[GridPoint]) -> list[GridPoint]:
     """The points, once every point's RBM has finite derived quantities (or one line
     naming the point)."""
-    from rbm_cli.physics.assembly import model_from_config
-
     for point in points:
         if MODELS[point.config.model].beam:
             try:
@@ -557,8 +554,6 @@ def warm_up(points: list[GridPoint], todo: list, backend: str, scheduler: str | 
     codes = sorted({code for p in points for code in compiled_codes(p.config)})
     if not (todo and codes):
         return 0.0, ""
-    from rbm_cli.models.compile_ahead import compile_once, needs_compile
-
     if backend == "dask" and scheduler and all(needs_compile(c) is False for c in codes):
         return 0.0, ""  # no cell runs here, and the workers find it in numba's cache
     spent = [compile_once(code, note) for code in codes]

@@ -16,12 +16,14 @@ import platform
 import sys
 from collections import Counter
 from collections.abc import Callable
+from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
 
 from rbm_cli import __version__
 from rbm_cli.base.errors import RbmError
+from rbm_cli.base.files import json_ready
 from rbm_cli.config.motions import named, storable
 from rbm_cli.config.types import Config
 from rbm_cli.study.cells import grid_points, key, max_drums
@@ -201,8 +203,6 @@ def publish_result(store, figure, config, rows, fields, meta, resume_command) ->
         return lambda path: path.write_text(texts[name], encoding="utf-8")
 
     def meta_json(path: Path) -> None:
-        from rbm_cli.base.files import json_ready
-
         meta["files"] = {
             name: hashlib.sha256((path.parent / name).read_bytes()).hexdigest()
             for name in FINALS
@@ -267,12 +267,11 @@ def _version(name: str) -> str:
     module = sys.modules.get(name)
     if module is not None:
         return module.__version__
-    from importlib.metadata import version
-
     return version(name)
 
 
 def _versions() -> dict:
+    # lazy: scipy loads only where needed (docs/architecture.md, Start-up)
     import scipy
 
     return {

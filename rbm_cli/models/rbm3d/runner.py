@@ -68,7 +68,7 @@ import numpy as np
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
-from rbm_cli.config.types import SolverConfig
+from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
 from rbm_cli.models.outcome import EnergyAccount, Outcome
 from rbm_cli.models.plan import as_line, from_ground, to_ground, turned_start, wrapped
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
@@ -83,6 +83,8 @@ from rbm_cli.models.status import (
     end_by_budget,
     stop_level,
 )
+from rbm_cli.physics.column import build_column
+from rbm_cli.physics.equations import build_model
 from rbm_cli.physics.excitation import GroundMotion
 from rbm_cli.physics.ground import as_samples
 
@@ -214,10 +216,6 @@ def needs_compile() -> bool | None:
 
 def warm_up() -> None:
     """Compile (or load from the cache) the run in two directions once."""
-    from rbm_cli.config.types import ColumnConfig, InterfaceConfig
-    from rbm_cli.physics.column import build_column
-    from rbm_cli.physics.equations import build_model
-
     geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=(2.0,),
                             section="circular")  # fmt: skip
     model = build_model(build_column(geometry, InterfaceConfig()))

@@ -17,6 +17,7 @@ import numpy as np
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
+from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig, StiffnessConfig
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.rbm.exact.piece import new_cache
@@ -31,7 +32,8 @@ from rbm_cli.models.status import (
     end_by_budget,
 )
 from rbm_cli.physics.arrays import ColumnArrays, column_arrays
-from rbm_cli.physics.equations import Model
+from rbm_cli.physics.column import build_column
+from rbm_cli.physics.equations import Model, build_model
 from rbm_cli.physics.excitation import GroundMotion
 
 #: Points of the pool (3 for the run loop, the rest for the refinement of peaks) and
@@ -153,10 +155,6 @@ def warm_up() -> None:
     """Compile (or load from the cache) the exact integrator once, e.g. in a worker: a
     rigid monolith and an elastic 2-drum column (their model arrays type differently),
     under a harmonic and a record (a harmonic and a linear forcing)."""
-    from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig, StiffnessConfig
-    from rbm_cli.physics.column import build_column
-    from rbm_cli.physics.equations import build_model
-
     knots = np.array([0.0, 0.05, 0.1])
     record = GroundMotion("record", 5.0, 0.0, 0.0, 0.1, 0.1, gain=1.0, knots=knots,
                           values=np.array([0.0, 5.0, -5.0]))  # fmt: skip

@@ -43,6 +43,7 @@ import numpy as np
 from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm, poll
 from rbm_cli.base.jit import plain
+from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
 from rbm_cli.models.outcome import EnergyAccount, Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.models.rbm.step.inputs import (
@@ -60,7 +61,8 @@ from rbm_cli.models.status import (
     end_by_budget,
     stop_level,
 )
-from rbm_cli.physics.equations import Model
+from rbm_cli.physics.column import build_column
+from rbm_cli.physics.equations import Model, build_model
 from rbm_cli.physics.excitation import GroundMotion
 
 
@@ -170,10 +172,6 @@ def needs_compile() -> bool | None:
 
 def warm_up() -> None:
     """Compile (or load from the cache) the kernel once, e.g. in a worker."""
-    from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
-    from rbm_cli.physics.column import build_column
-    from rbm_cli.physics.equations import build_model
-
     geometry = ColumnConfig(height=2.0, base_width=0.5, top_width=0.5, drum_heights=(2.0,))
     col = build_column(geometry, InterfaceConfig())
     model = build_model(col)

@@ -33,3 +33,13 @@ def tool_script(name: str):
     finally:
         sys.path.remove(str(TOOLS))
     return module
+
+
+def docs_extension(name: str):
+    """A Sphinx extension of docs/_ext (e.g. rbm_reference) as a module, in sys.modules
+    under its name, without Sphinx."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "docs" / "_ext" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module

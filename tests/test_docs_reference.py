@@ -5,24 +5,16 @@ default the code has, and the generated text is valid reStructuredText."""
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
-import sys
-from pathlib import Path
 
 import click
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from .paths import docs_extension
 
 
 @pytest.fixture(scope="module")
 def ref():
-    path = ROOT / "docs" / "_ext" / "rbm_reference.py"
-    spec = importlib.util.spec_from_file_location("rbm_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["rbm_reference"] = module
-    spec.loader.exec_module(module)
-    return module
+    return docs_extension("rbm_reference")
 
 
 def _parses_cleanly(text: str) -> None:

@@ -11,7 +11,6 @@ under a change of scale of x).
 
 from __future__ import annotations
 
-import importlib.util
 import io
 import json
 import os
@@ -34,7 +33,7 @@ from rbm_cli.study import intensities, schema
 from rbm_cli.study.domain import read_domain
 from rbm_cli.study.intensities import IntensityMeasure, measure_of
 
-from .paths import CONFIGS, ROOT
+from .paths import CONFIGS, ROOT, docs_extension
 
 RECORDS = [CONFIGS / "records" / "synthetic" / f"rdk_0{k}.AT2" for k in (1, 2, 3)]
 
@@ -69,12 +68,7 @@ def _sweep(tmp_path: Path, config: Path, *extra) -> Path:
 
 
 def _reference():
-    path = ROOT / "docs" / "_ext" / "rbm_reference.py"
-    spec = importlib.util.spec_from_file_location("rbm_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["rbm_reference"] = module
-    spec.loader.exec_module(module)
-    return module
+    return docs_extension("rbm_reference")
 
 
 def _check_dtypes(df: pd.DataFrame, text: str) -> None:

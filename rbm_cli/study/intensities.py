@@ -121,12 +121,17 @@ class IntensityMeasure:
         return value
 
 
-def _pga(t, a, period_s=None) -> float:
-    return im.peak_acceleration(t, a)
+def _of_record(measure):
+    """A measure of the record alone (times, accelerations), as the registry calls it."""
+
+    def compute(t, a, period_s=None) -> float:
+        return measure(t, a)
+
+    return compute
 
 
-def _pgv(t, a, period_s=None) -> float:
-    return im.peak_velocity(t, a)
+_pga = _of_record(im.peak_acceleration)
+_pgv = _of_record(im.peak_velocity)
 
 
 def _sa(t, a, period_s) -> float:
@@ -153,26 +158,26 @@ MEASURES: tuple[IntensityMeasure, ...] = (
         "pgd_m",
         "peak ground displacement PGD",
         "m",
-        lambda t, a, period_s=None: im.peak_displacement(t, a),
+        _of_record(im.peak_displacement),
     ),  # fmt: skip
     IntensityMeasure(
         "arias_m_s",
         "Arias intensity",
         "m/s",
-        lambda t, a, period_s=None: im.arias_intensity(t, a),
+        _of_record(im.arias_intensity),
         scaling="quadratic",
     ),  # fmt: skip
     IntensityMeasure(
         "cav_m_s",
         "cumulative absolute velocity CAV",
         "m/s",
-        lambda t, a, period_s=None: im.cumulative_absolute_velocity(t, a),
+        _of_record(im.cumulative_absolute_velocity),
     ),  # fmt: skip
     IntensityMeasure(
         "d5_95_s",
         "significant duration D5-95",
         "s",
-        lambda t, a, period_s=None: im.significant_duration(t, a),
+        _of_record(im.significant_duration),
         scaling="none",
     ),  # fmt: skip
     IntensityMeasure(

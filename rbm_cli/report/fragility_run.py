@@ -45,7 +45,7 @@ from rbm_cli.study.fragility_states import (
 )
 from rbm_cli.study.fragility_states import damage_states as fit_every_state
 from rbm_cli.study.intensities import label as measure_label
-from rbm_cli.study.intensity_choice import IntensityComparison
+from rbm_cli.study.intensity_choice import IntensityComparison, check_carries_measures
 from rbm_cli.study.intensity_choice import compare_intensities as fit_every_measure
 from rbm_cli.study.outcomes import (
     ENSEMBLE_OUTCOMES,
@@ -156,6 +156,8 @@ def run_fragility(
     prepare_outcomes(df, intensity_column, ensemble_outcome, members)
     if thresholds:
         prepare_outcomes(state_domain(df, thresholds[0]), intensity_column, "member0")
+    if compare_intensities:
+        check_carries_measures(df)
     if isinstance(compare, str | os.PathLike):
         compare = (compare,)
     frames = [(Path(p), read_suite_domain_hashed(Path(p))[0]) for p in compare]

@@ -78,6 +78,17 @@ def carried_measures(df: pd.DataFrame) -> list[str]:
     return [c for c in df.columns if isinstance(c, str) and measure_of(c) in wanted]
 
 
+def check_carries_measures(df: pd.DataFrame) -> list[str]:
+    """:func:`carried_measures`, or RbmError (one line) when there is none."""
+    columns = carried_measures(df)
+    if not columns:
+        raise RbmError(
+            "fragility: the domain carries no intensity measure of the records (pga_g,"
+            " pgv_m_s, ...): nothing to compare"
+        )
+    return columns
+
+
 def _unusable(df: pd.DataFrame, column: str) -> str:
     """Why a measure's column cannot be an intensity of this domain (one phrase), or ""."""
     ok = df[C.status].astype(str) != "failed" if C.status in df.columns else slice(None)
@@ -109,12 +120,7 @@ def compare_intensities(
     RbmError  One line: the domain carries no intensity measure (a domain of an older rbm,
         or of a user's table without them)
     """
-    columns = carried_measures(df)
-    if not columns:
-        raise RbmError(
-            "fragility: the domain carries no intensity measure of the records (pga_g,"
-            " pgv_m_s, ...): nothing to compare"
-        )
+    columns = check_carries_measures(df)
     rows, results = [], {}
     for k, column in enumerate(columns):
         part = None if progress is None else _part(progress, k, len(columns))
@@ -195,6 +201,7 @@ __all__ = [
     "TABLE_COLUMNS",
     "IntensityComparison",
     "carried_measures",
+    "check_carries_measures",
     "compare_intensities",
     "statement",
 ]

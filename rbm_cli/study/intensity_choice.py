@@ -12,8 +12,9 @@ for one column (PGA / (g tan alpha) to PGA, PGV p / (g tan alpha) to PGV) has th
 beta on a domain of one column; the two differ across columns.
 
 The best is the measure of the lowest beta; :attr:`IntensityComparison.statement` says so
-and names the measures whose bootstrap interval of beta overlaps its own (which the
-suite does not tell apart from it). A measure the domain carries but cannot be fitted on
+(with any measure of the same beta to :data:`TIE_DIGITS` decimals, ranked in the
+domain's order) and names the measures whose bootstrap interval of beta overlaps its own
+(which the suite does not tell apart from it). A measure the domain carries but cannot be fitted on
 (an empty column: Sa(T1) of a rigid column; values not > 0; outcomes that allow no fit)
 is listed with the reason, last.
 
@@ -52,6 +53,11 @@ TABLE_COLUMNS = (
     "n_runs",
     "note",
 )
+
+
+#: Decimals to which two betas are the same: PGA / (g tan alpha) is PGA times a constant on
+#: a domain of one column, and their fits agree to the optimiser's tolerance only.
+TIE_DIGITS = 6
 
 
 @dataclass(frozen=True)
@@ -139,7 +145,10 @@ def compare_intensities(
             why = why or ("no fit: " + res.note if res.fit is None else "")
         rows.append(_row(column, res, why))
     table = pd.DataFrame(rows, columns=[c for c in TABLE_COLUMNS if c != "rank"])
-    table = table.sort_values("beta", kind="stable", na_position="last").reset_index(drop=True)
+    # betas equal to TIE_DIGITS (a measure times a constant) keep the domain's order
+    table["_key"] = table["beta"].round(TIE_DIGITS)
+    table = table.sort_values("_key", kind="stable", na_position="last")
+    table = table.drop(columns="_key").reset_index(drop=True)
     fitted = table["beta"].notna().to_numpy()
     table.insert(0, "rank", np.where(fitted, np.arange(1, len(table) + 1), np.nan))
     best = str(table["intensity_column"].iat[0]) if fitted.any() else ""
@@ -182,13 +191,18 @@ def statement(table: pd.DataFrame, results: dict, best: str) -> str:
     interval = ""
     if math.isfinite(row["beta_ci_low"]):
         interval = f" ({lo:g}-{hi:g} %: {row['beta_ci_low']:.3g}-{row['beta_ci_high']:.3g})"
-    text = f"lowest dispersion (most efficient): {best}, beta {row['beta']:.3g}{interval}"
+    key = round(float(row["beta"]), TIE_DIGITS)
+    same = [str(c) for c, b in zip(table["intensity_column"].iloc[1:], table["beta"].iloc[1:],
+                                   strict=True) if round(float(b), TIE_DIGITS) == key]  # fmt: skip
+    tied = f" (and {', '.join(same)}: the same beta, a constant times it here)" if same else ""
+    text = f"lowest dispersion (most efficient): {best}{tied}, beta {row['beta']:.3g}{interval}"
     if not interval:
         return text + "; no bootstrap intervals to tell the measures apart"
     near = [
         str(r["intensity_column"])
         for _, r in table.iloc[1:].iterrows()
-        if math.isfinite(r["beta"])
+        if str(r["intensity_column"]) not in same
+        and math.isfinite(r["beta"])
         and math.isfinite(r["beta_ci_low"])
         and r["beta_ci_low"] <= row["beta_ci_high"]
     ]
@@ -199,6 +213,7 @@ def statement(table: pd.DataFrame, results: dict, best: str) -> str:
 
 __all__ = [
     "TABLE_COLUMNS",
+    "TIE_DIGITS",
     "IntensityComparison",
     "carried_measures",
     "check_carries_measures",

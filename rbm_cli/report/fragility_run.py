@@ -6,10 +6,13 @@ fragility and IDA figures (:mod:`rbm_cli.report.fragility_report`) and publishes
 
     fragility.png, ida.png, fragility.csv, fragility_curve.csv, fragility.json
 
-into the output folder (default: the domain's folder) as one step: the options and the
+(with ``damage_states`` also fragility_states.csv and fragility_states.png, the thresholds
+marked in ida.png: :mod:`rbm_cli.study.fragility_states`; with ``compare_intensities``
+also fragility_intensities.csv: :mod:`rbm_cli.study.intensity_choice`; these before the
+five) into the output folder (default: the domain's folder) as one step: the options and the
 domains are checked first (a refusal writes nothing); then, with the folder locked against
 another fragility run, everything is computed and rendered in memory, staged whole in a
-hidden folder and moved onto the five names together, fragility.json last
+hidden folder and moved onto their names together, fragility.json last
 (:class:`rbm_cli.report.fragility_store.FragilityFolder`: a Ctrl-C or a kill leaves the
 old set or the new one, never a mix; what a killed run leaves is removed by the next).
 No other file is touched, none deleted. fragility.json names the domain and the SHA-256

@@ -260,3 +260,24 @@ def test_api_refuses_bad_thresholds_in_one_line(value):
     with pytest.raises(RbmError) as info:
         rbm.fragility(suite(n_records=5), damage_states=value, n_resamples=0)
     assert "damage_states" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_a_run_without_states_removes_the_states_of_the_set_it_replaces(tmp_path):
+    """The folder never holds one run's damage states beside another run's fit: the states'
+    files of the set being replaced go with it; a file of that name that no fragility.json
+    claims is not the set's, and stays."""
+    domain = write(tmp_path / "s", suite(n_records=30))
+    out = tmp_path / "o"
+    run = invoke(domain, "-o", out, "--resamples", 0, "--damage-states", "0.3,1.0")
+    assert run.exit_code == 0, run.output
+    assert (out / "fragility_states.csv").is_file() and (out / "fragility_states.png").is_file()
+    run = invoke(domain, "-o", out, "--resamples", 0)
+    assert run.exit_code == 0, run.output
+    assert not (out / "fragility_states.csv").exists()
+    assert not (out / "fragility_states.png").exists()
+    assert "damage_states" not in json.loads((out / "fragility.json").read_text())
+    mine = out / "fragility_states.csv"
+    mine.write_text("the user's own table\n")
+    run = invoke(domain, "-o", out, "--resamples", 0)
+    assert run.exit_code == 0, run.output
+    assert mine.read_text() == "the user's own table\n"

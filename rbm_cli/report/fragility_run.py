@@ -15,7 +15,10 @@ another fragility run, everything is computed and rendered in memory, staged who
 hidden folder and moved onto their names together, fragility.json last
 (:class:`rbm_cli.report.fragility_store.FragilityFolder`: a Ctrl-C or a kill leaves the
 old set or the new one, never a mix; what a killed run leaves is removed by the next).
-No other file is touched, none deleted. fragility.json names the domain and the SHA-256
+The optional files of the set being replaced (its fragility.json names them: damage
+states, intensities compared) that the new set does not have are removed with it, so the
+folder never holds one run's states beside another run's fit. No other file is touched,
+none deleted. fragility.json names the domain and the SHA-256
 of the bytes fitted, so files left beside a domain swept again show whose they are. The
 CLI calls this; the API can call the same.
 """
@@ -198,7 +201,8 @@ def run_fragility(
         source |= extra_summary(states, comparison)
         label, contents = _contents(domain, df, result, others, source, thresholds or ())
         contents |= extra_contents(states, comparison, label)
-        paths = store.publish({name: contents[name] for name in extra_files(contents) + FILES})
+        paths = store.publish({name: contents[name] for name in extra_files(contents) + FILES},
+                              retire=superseded(folder, contents))  # fmt: skip
     return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label,
                         states=states, intensities=comparison)  # fmt: skip
 
@@ -211,6 +215,25 @@ def extra_files(contents: dict) -> tuple[str, ...]:
     """The names of ``contents`` beyond the fragility set's :data:`FILES` (the damage
     states' and the intensities' files), published before them."""
     return tuple(name for name in contents if name not in FILES)
+
+
+#: The optional files of a fragility set and the fragility.json entry that claims them.
+OPTIONAL_FILES = {"fragility_states.png": "damage_states", "fragility_states.csv": "damage_states",
+                  "fragility_intensities.csv": "intensity_statement"}  # fmt: skip
+
+
+def superseded(folder: Path, contents: dict) -> tuple[str, ...]:
+    """The optional files in ``folder`` that the fragility set there (its fragility.json)
+    wrote and the new set (``contents``) does not: they go with the old set. A file of such
+    a name that no fragility.json claims is not the set's, and stays."""
+    try:
+        old = json.loads((folder / "fragility.json").read_text())
+    except (OSError, ValueError):
+        return ()
+    if not isinstance(old, dict):
+        return ()
+    return tuple(name for name, key in OPTIONAL_FILES.items()
+                 if key in old and name not in contents and (folder / name).is_file())  # fmt: skip
 
 
 def extra_summary(states: DamageStates | None, comparison: IntensityComparison | None) -> dict:

@@ -18,11 +18,13 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from rbm_cli.study.fragility import FragilityResult
+    from rbm_cli.study.fragility_states import DamageStates
 
 __all__ = [
     "MAX_RESAMPLES",  # noqa: F822 (read on first use)
     "check_intensity",
     "check_members",
+    "damage_states_of",
     "fragility",
     "intensity_help",
     "intensity_names",
@@ -97,6 +99,32 @@ def check_members(n_members) -> int | None:
     return int(n_members)
 
 
+def damage_states_of(text, where: str = "--damage-states") -> tuple[float, ...] | None:
+    """The thresholds of max_rotation_ratio written as ``text`` ("0.1,0.3,1.0"; None:
+    none), checked (rbm_cli.study.fragility_states.check_damage_states).
+
+    Raises
+    ------
+    RbmError  One line naming ``where``: a part that is not a number, a threshold not
+        finite, not > 0 or above 1, thresholds not strictly increasing
+    """
+    if text is None:
+        return None
+    values = []
+    for part in str(text).split(","):
+        try:
+            values.append(float(part))
+        except ValueError:
+            raise RbmError(
+                f"{where} must be thresholds of max_rotation_ratio separated by commas (such"
+                f" as 0.1,0.3,1.0), got {part.strip()[:40]!r} in {str(text)[:60]!r}"
+            ) from None
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
+    from rbm_cli.study.fragility_states import check_damage_states
+
+    return check_damage_states(values, where)
+
+
 def __getattr__(name: str):
     if name == "run_fragility":
         # lazy: loads matplotlib and pandas only where needed (docs/architecture.md, Start-up)
@@ -121,7 +149,8 @@ def fragility(
     intensity: str | None = None,
     ensemble_outcome: str = "members",
     n_members: int | None = None,
-) -> FragilityResult:
+    damage_states=None,
+) -> FragilityResult | DamageStates:
     """The lognormal fragility of a record-suite domain, as data (what ``rbm fragility``
     computes and writes to fragility.csv, fragility_curve.csv and fragility.json; no file
     is written here).
@@ -147,6 +176,12 @@ def fragility(
         own run); ``result.outcome`` says which
     n_members : int, optional  Members per cell of an ensemble domain given as a
         DataFrame, a whole number >= 1 (a domain.csv's meta.json says it for a path)
+    damage_states : sequence of float, optional  Thresholds of max_rotation_ratio [-],
+        each finite, 0 < t <= 1 (1: collapse), strictly increasing: a fragility curve
+        per damage state (a run exceeds a state when its peak rotation ratio reaches the
+        threshold or it collapsed; an ensemble domain's member 0 runs), returned as a
+        ``DamageStates`` (rbm_cli.study.fragility_states: ``thresholds``, ``results``, one
+        FragilityResult per state, ``crossings``, ``table()``) instead of one result
 
     Returns
     -------
@@ -191,6 +226,11 @@ def fragility(
     n_members = check_members(n_members)
     check_intensity(intensity, "fragility: intensity")
     check_intensity(intensity_column, "fragility: intensity_column")
+    if damage_states is not None:
+        # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
+        from rbm_cli.study.fragility_states import check_damage_states
+
+        damage_states = check_damage_states(damage_states)
     if intensity is not None and intensity_column is not None and intensity != intensity_column:
         raise RbmError(f"fragility: intensity {intensity!r} and intensity_column "
                        f"{intensity_column!r} name two columns: give one")  # fmt: skip
@@ -204,6 +244,12 @@ def fragility(
         domain = domain.copy()
     # checked (one line) before the fit
     prepare_outcomes(domain, column, ensemble_outcome, n_members)
+    if damage_states is not None:
+        # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
+        from rbm_cli.study.fragility_states import damage_states as fit_states
+
+        return fit_states(domain, damage_states, n_resamples=n_resamples, seed=seed,
+                          ci_percentiles=ci_percentiles, intensity_column=column)  # fmt: skip
     return fit(domain, n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
                intensity_column=column, ensemble_outcome=ensemble_outcome,
                n_members=n_members)  # fmt: skip

@@ -56,8 +56,15 @@ class MeasureOption(click.Option):
 @click.option("--compare", "others", multiple=True, metavar="OTHER.csv",
               help="Another record-suite domain whose fragility is drawn in fragility.png "
               "beside this one (repeatable; its own files are not written).")  # fmt: skip
+@click.option("--damage-states", "damage_states", default=None, metavar="T1,T2,...",
+              help="Thresholds of max_rotation_ratio (0 < t <= 1, increasing; 1 is "
+              "collapse): a fragility curve per damage state, in fragility_states.csv and "
+              "fragility_states.png, marked in ida.png.")  # fmt: skip
+@click.option("--compare-intensities", is_flag=True, default=False,
+              help="Also fit the suite on every intensity measure the domain carries and "
+              "rank them by dispersion beta (fragility_intensities.csv).")  # fmt: skip
 def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcome, ci,
-              others) -> None:  # fmt: skip
+              others, damage_states, compare_intensities) -> None:  # fmt: skip
     """Fit a lognormal fragility curve to a record-suite domain and draw its IDA.
 
     DOMAIN.csv is the domain.csv of a sweep over records x intensities (one row
@@ -72,6 +79,13 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
     instead of the amplitude. An ensemble domain (rbm sweep --ensemble) counts
     every member of a cell as a trial, or its majority (--ensemble-outcome).
 
+    --damage-states fits a curve per threshold of the peak rotation ratio (a run
+    exceeds a state when its max_rotation_ratio reaches the threshold or it
+    collapsed), each as the plain fit of its own outcomes; curves that cross
+    within the intensities tested are reported, not adjusted.
+    --compare-intensities fits the same runs on every intensity measure the
+    domain carries and ranks them by beta (lower: more efficient).
+
     Writes fragility.csv, fragility_curve.csv, fragility.json, fragility.png and
     ida.png (intensity against peak rotation ratio, a curve per record, flat from
     its first collapse, the records named), all moved into place together at the
@@ -82,14 +96,22 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
     Example:
         rbm fragility out/suite/domain.csv
         rbm fragility out/suite/domain.csv -o out/suite_fragility --resamples 2000
+        rbm fragility out/suite/domain.csv --damage-states 0.1,0.3,1.0
+        rbm fragility out/suite/domain.csv --compare-intensities -o /tmp/ims
         rbm fragility results/suite_multidrum/domain.csv \
             --compare results/suite_monolithic/domain.csv -o docs/figures/suite
     """
     # lazy: loaded when a command runs, not for `rbm --help` (docs/architecture.md, Start-up)
-    from rbm_cli.api.fragility_curves import MAX_RESAMPLES, check_intensity, run_fragility
+    from rbm_cli.api.fragility_curves import (
+        MAX_RESAMPLES,
+        check_intensity,
+        damage_states_of,
+        run_fragility,
+    )
 
     try:
         check_intensity(intensity_column, "--intensity")
+        thresholds = damage_states_of(damage_states, "--damage-states")
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     if resamples > MAX_RESAMPLES:
@@ -101,7 +123,8 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         made = run_fragility(domain, output, n_resamples=resamples, seed=seed,
                              intensity_column=intensity_column, ci_percentiles=tuple(ci),
                              compare=others, progress=progress,
-                             ensemble_outcome=ensemble_outcome)  # fmt: skip
+                             ensemble_outcome=ensemble_outcome, damage_states=thresholds,
+                             compare_intensities=compare_intensities)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except KeyboardInterrupt:
@@ -131,8 +154,49 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
             click.echo(f"warning: {res.fit_warning}")
         if res.resamples_note:
             click.echo(f"note: {res.resamples_note}")
+    if made.states is not None:
+        _echo_states(made.states)
+    if made.intensities is not None:
+        _echo_intensities(made.intensities)
     folder = made.paths[0].parent
     click.echo(f"output: {folder}/ " + ", ".join(p.name for p in made.paths))
+
+
+def _echo_states(states) -> None:
+    """One line per damage state (median, beta and their intervals), then the crossings."""
+    click.echo(f"damage states (max_rotation_ratio, {states.intensity_column}):")
+    for t, res in zip(states.thresholds, states.results, strict=True):
+        lo, hi = res.ci_percentiles
+        if res.fit is None:
+            click.echo(f"  {t:g}: no fit: {res.note}")
+            continue
+        unit = f" {res.intensity_unit}"
+        median = f"{res.fit.median_g:.4g}{unit}" + _interval(res.median_ci_g, lo, hi, unit)
+        beta = f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
+        click.echo(f"  {t:g}: median {median}, beta {beta}")
+        if res.fit_warning:
+            click.echo(f"    warning: {res.fit_warning}")
+    for line in states.crossings:
+        click.echo(f"warning: {line}")
+    if states.note:
+        click.echo(f"note: {states.note}")
+
+
+def _echo_intensities(comparison) -> None:
+    """The intensity measures ranked by beta, a line each, then the best."""
+    click.echo("intensity measures by dispersion beta (lower: more efficient):")
+    for _, row in comparison.table.iterrows():
+        rank = f"{row['rank']:.0f}" if math.isfinite(row["rank"]) else "-"
+        if math.isfinite(row["beta"]):
+            ci = ""
+            if math.isfinite(row["beta_ci_low"]):
+                ci = f" ({row['beta_ci_low']:.3g}-{row['beta_ci_high']:.3g})"
+            median = f"median {row['median']:.4g} {row['unit']}"
+            click.echo(f"  {rank:>2} {row['intensity_column']:<24} beta {row['beta']:.3f}{ci}"
+                       f", {median}")  # fmt: skip
+        else:
+            click.echo(f"  {rank:>2} {row['intensity_column']:<24} {row['note']}")
+    click.echo(comparison.statement)
 
 
 def _interval(ci: tuple[float, float], lo: float, hi: float, unit: str) -> str:

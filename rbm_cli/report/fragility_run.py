@@ -6,13 +6,19 @@ fragility and IDA figures (:mod:`rbm_cli.report.fragility_report`) and publishes
 
     fragility.png, ida.png, fragility.csv, fragility_curve.csv, fragility.json
 
-into the output folder (default: the domain's folder) as one step: the options and the
+(with ``damage_states`` also fragility_states.csv and fragility_states.png, the thresholds
+marked in ida.png: :mod:`rbm_cli.study.fragility_states`; with ``compare_intensities``
+also fragility_intensities.csv: :mod:`rbm_cli.study.intensity_choice`; these before the
+five) into the output folder (default: the domain's folder) as one step: the options and the
 domains are checked first (a refusal writes nothing); then, with the folder locked against
 another fragility run, everything is computed and rendered in memory, staged whole in a
-hidden folder and moved onto the five names together, fragility.json last
+hidden folder and moved onto their names together, fragility.json last
 (:class:`rbm_cli.report.fragility_store.FragilityFolder`: a Ctrl-C or a kill leaves the
 old set or the new one, never a mix; what a killed run leaves is removed by the next).
-No other file is touched, none deleted. fragility.json names the domain and the SHA-256
+The optional files of the set being replaced (its fragility.json names them: damage
+states, intensities compared) that the new set does not have are removed with it, so the
+folder never holds one run's states beside another run's fit. No other file is touched,
+none deleted. fragility.json names the domain and the SHA-256
 of the bytes fitted, so files left beside a domain swept again show whose they are. The
 CLI calls this; the API can call the same.
 """
@@ -30,9 +36,23 @@ import pandas as pd
 
 from rbm_cli.base.files import check_writable_dir
 from rbm_cli.report.fragility_report import fragility_texts, plot_fragility, plot_ida
+from rbm_cli.report.fragility_states import (
+    intensities_csv,
+    mark_thresholds,
+    states_csv,
+    states_figure,
+)
 from rbm_cli.report.fragility_store import FILES, FragilityFolder
 from rbm_cli.study.fragility import FragilityResult, check_options, fragility
+from rbm_cli.study.fragility_states import (
+    DamageStates,
+    check_damage_states,
+    state_domain,
+)
+from rbm_cli.study.fragility_states import damage_states as fit_every_state
 from rbm_cli.study.intensities import label as measure_label
+from rbm_cli.study.intensity_choice import IntensityComparison, check_carries_measures
+from rbm_cli.study.intensity_choice import compare_intensities as fit_every_measure
 from rbm_cli.study.outcomes import (
     ENSEMBLE_OUTCOMES,
     is_ensemble,
@@ -53,12 +73,17 @@ class FragilityRun:
     domain : pathlib.Path  The domain CSV read
     paths : list of pathlib.Path  The files written (:data:`FILES`, in the output folder)
     intensity_label : str  Axis label of the intensity (its quantity and unit)
+    states : DamageStates or None  The damage states' fits (``damage_states`` given)
+    intensities : IntensityComparison or None  The fits on every intensity measure
+        (``compare_intensities``)
     """
 
     result: FragilityResult
     domain: Path
     paths: list[Path]
     intensity_label: str
+    states: DamageStates | None = None
+    intensities: IntensityComparison | None = None
 
 
 def run_fragility(
@@ -72,6 +97,8 @@ def run_fragility(
     compare: tuple[str | os.PathLike, ...] = (),
     progress: Callable[[int, int], None] | None = None,
     ensemble_outcome: str = ENSEMBLE_OUTCOMES[0],
+    damage_states: tuple[float, ...] | None = None,
+    compare_intensities: bool = False,
 ) -> FragilityRun:
     """Fragility of a record-suite domain: fit, files and figures.
 
@@ -105,6 +132,13 @@ def run_fragility(
         How an ensemble domain's cells count: ``members`` (every member a trial; their
         number per cell from meta.json beside the domain), ``majority`` or ``member0``
         (rbm_cli.study.outcomes)
+    damage_states : sequence of float, optional
+        Thresholds of ``max_rotation_ratio`` (0 < t <= 1, strictly increasing; 1 is
+        collapse): a fragility curve per state (rbm_cli.study.fragility_states), written
+        to fragility_states.csv and fragility_states.png, and marked in ida.png
+    compare_intensities : bool
+        Also fit the suite on every intensity measure the domain carries and rank them by
+        beta (rbm_cli.study.intensity_choice), written to fragility_intensities.csv
 
     Returns
     -------
@@ -120,11 +154,16 @@ def run_fragility(
         writing. The folder's fragility files are as they were then.
     """
     check_options(n_resamples, seed, ci_percentiles)
+    thresholds = None if damage_states is None else check_damage_states(damage_states)
     domain = Path(domain_csv)
     df, digest = read_suite_domain_hashed(domain)
     members = n_members(domain, df)
     # its rows, checked before anything is made
     prepare_outcomes(df, intensity_column, ensemble_outcome, members)
+    if thresholds:
+        prepare_outcomes(state_domain(df, thresholds[0]), intensity_column, "member0")
+    if compare_intensities:
+        check_carries_measures(df)
     if isinstance(compare, str | os.PathLike):
         compare = (compare,)
     frames = [(Path(p), read_suite_domain_hashed(Path(p))[0]) for p in compare]
@@ -136,20 +175,91 @@ def run_fragility(
     options = dict(n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
                    intensity_column=intensity_column,
                    ensemble_outcome=ensemble_outcome)  # fmt: skip
-    parts = len(frames) + 1
+    parts = len(frames) + 1 + bool(thresholds) + bool(compare_intensities)
+    states = comparison = None
     with FragilityFolder(folder) as store:
         result = fragility(df, **options, n_members=members, progress=_part(progress, 0, parts))
         others = []
         for k, (path, frame, m) in enumerate(frames, start=1):
             fit = fragility(frame, **options, n_members=m, progress=_part(progress, k, parts))
             others.append((path, _name(path), fit))
+        part = len(frames) + 1
+        if thresholds:
+            states = fit_every_state(df, thresholds, n_resamples=n_resamples, seed=seed,
+                                     ci_percentiles=ci_percentiles,
+                                     intensity_column=intensity_column,
+                                     progress=_part(progress, part, parts))  # fmt: skip
+            part += 1
+        if compare_intensities:
+            comparison = fit_every_measure(df, **_without(options, "intensity_column"),
+                                           n_members=members,
+                                           progress=_part(progress, part, parts))  # fmt: skip
         source = {
             "domain": os.path.relpath(domain.resolve(), folder.resolve()),
             "domain_sha256": digest,  # of the bytes fitted: which domain.csv these are of
         }
-        label, contents = _contents(domain, df, result, others, source)
-        paths = store.publish({name: contents[name] for name in FILES})
-    return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label)
+        source |= extra_summary(states, comparison)
+        label, contents = _contents(domain, df, result, others, source, thresholds or ())
+        contents |= extra_contents(states, comparison, label)
+        paths = store.publish({name: contents[name] for name in extra_files(contents) + FILES},
+                              retire=superseded(folder, contents))  # fmt: skip
+    return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label,
+                        states=states, intensities=comparison)  # fmt: skip
+
+
+def _without(options: dict, key: str) -> dict:
+    return {k: v for k, v in options.items() if k != key}
+
+
+def extra_files(contents: dict) -> tuple[str, ...]:
+    """The names of ``contents`` beyond the fragility set's :data:`FILES` (the damage
+    states' and the intensities' files), published before them."""
+    return tuple(name for name in contents if name not in FILES)
+
+
+#: The optional files of a fragility set and the fragility.json entry that claims them.
+OPTIONAL_FILES = {"fragility_states.png": "damage_states", "fragility_states.csv": "damage_states",
+                  "fragility_intensities.csv": "intensity_statement"}  # fmt: skip
+
+
+def superseded(folder: Path, contents: dict) -> tuple[str, ...]:
+    """The optional files in ``folder`` that the fragility set there (its fragility.json)
+    wrote and the new set (``contents``) does not: they go with the old set. A file of such
+    a name that no fragility.json claims is not the set's, and stays."""
+    try:
+        old = json.loads((folder / "fragility.json").read_text())
+    except (OSError, ValueError):
+        return ()
+    if not isinstance(old, dict):
+        return ()
+    return tuple(name for name, key in OPTIONAL_FILES.items()
+                 if key in old and name not in contents and (folder / name).is_file())  # fmt: skip
+
+
+def extra_summary(states: DamageStates | None, comparison: IntensityComparison | None) -> dict:
+    """fragility.json's entries on the damage states and the intensities compared (which
+    files of the folder belong to this set)."""
+    out: dict = {}
+    if states is not None:
+        out["damage_states"] = list(states.thresholds)
+        out["damage_states_crossings"] = list(states.crossings)
+        out["damage_states_note"] = states.note
+    if comparison is not None:
+        out["intensity_best"] = comparison.best or None
+        out["intensity_statement"] = comparison.statement
+    return out
+
+
+def extra_contents(states, comparison, label: str) -> dict:
+    """The damage states' and the intensities' files, by name (``label``: the intensity's
+    axis label)."""
+    out: dict = {}
+    if states is not None:
+        out["fragility_states.png"] = _png(states_figure(states, label))
+        out["fragility_states.csv"] = states_csv(states)
+    if comparison is not None:
+        out["fragility_intensities.csv"] = intensities_csv(comparison)
+    return out
 
 
 def n_members(domain: Path, df: pd.DataFrame) -> int | None:
@@ -169,7 +279,8 @@ def _part(progress, k: int, parts: int):
     return lambda done, total: progress(k * total + done, parts * total)
 
 
-def _contents(domain: Path, df, result, others, source: dict) -> tuple[str, dict]:
+def _contents(domain: Path, df, result, others, source: dict,
+              thresholds=()) -> tuple[str, dict]:  # fmt: skip
     """The intensity's label and the set's files, by name (figures rendered to PNG bytes;
     ``source``: fragility.json's entries naming the domain)."""
     meta = _meta(domain)
@@ -188,7 +299,7 @@ def _contents(domain: Path, df, result, others, source: dict) -> tuple[str, dict
                 result, label, frag_title, _name(domain), [(n, r) for _, n, r in others]
             )
         ),
-        "ida.png": _png(ida_figure(df, result.intensity_column, label, title)),
+        "ida.png": _png(ida_figure(df, result.intensity_column, label, title, thresholds)),
     }
     contents.update(fragility_texts(result, extra=source))
     return label, contents
@@ -263,13 +374,15 @@ def fragility_figure(
     return ax.figure
 
 
-def ida_figure(df: pd.DataFrame, column: str, label: str, title: str = ""):
-    """A new figure (no pyplot) with :func:`plot_ida` of the domain's rows."""
+def ida_figure(df: pd.DataFrame, column: str, label: str, title: str = "", thresholds=()):
+    """A new figure (no pyplot) with :func:`plot_ida` of the domain's rows (and the
+    damage states' ``thresholds`` marked)."""
     # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
     ax = Figure(figsize=(7, 5)).subplots()
     plot_ida(df, ax, intensity_column=column)
+    mark_thresholds(ax, thresholds)
     ax.set_ylabel(label)
     ax.set_title(f"IDA, {title}" if title else "IDA", fontsize=9)
     return ax.figure

@@ -71,10 +71,11 @@ class FragilityFolder:
             removed.append(name)
         return removed
 
-    def publish(self, contents: dict[str, str | bytes]) -> list[Path]:
+    def publish(self, contents: dict[str, str | bytes], retire: tuple[str, ...] = ()) -> list[Path]:
         """Write ``contents`` (file name: text or bytes, in :data:`FILES` order) into a
         staging folder, then move the files onto their names together (signals held,
-        the last one last). Returns their paths.
+        the last one last) and remove the files named in ``retire`` (files of the set
+        being replaced that the new set does not have). Returns their paths.
 
         Raises
         ------
@@ -96,6 +97,8 @@ class FragilityFolder:
             fsync_dir(staging)
             with signals_held():
                 move_together([(staging / n, self.folder / n) for n in contents], self.folder)
+                for name in retire:
+                    (self.folder / name).unlink(missing_ok=True)
         except OSError as exc:
             raise OutputError(
                 f"{self.folder}: cannot write the fragility files ({exc.strerror or exc})"

@@ -73,11 +73,11 @@ def test_a_schema1_domain_migrates_to_the_hash_of_its_config(tmp_path):
     old = _meta(folder)["config_hash"]
     res = _migrate(folder)
     assert res.exit_code == 0, res.output
-    assert len(res.output.strip().splitlines()) == 1 and "schema 1 -> 2" in res.output
+    assert len(res.output.strip().splitlines()) == 1 and "schema 1 -> 3" in res.output
     meta = _meta(folder)
     # the hash of the shipped config, as a sweep of it computes it today
     assert meta["config_hash"] == config_hash(load_config(CONFIGS / f"{NAME}.yaml")) + "-ensemble16"
-    assert meta["schema"] == SCHEMA == 2 and meta["solver_method"] == "closed-form"
+    assert meta["schema"] == SCHEMA == 3 and meta["solver_method"] == "closed-form"
     assert meta["migrated"]["from_schema"] == 1 and meta["migrated"]["from_hash"] == old
     assert {name: (folder / name).read_bytes() for name in FILES} == before  # rows untouched
     text = (folder / "meta.json").read_bytes()
@@ -132,7 +132,7 @@ def _changed_setting(folder, meta):
 
 
 def _newer(folder, meta):
-    meta["schema"] = 3
+    meta["schema"] = 4
 
 
 @pytest.mark.parametrize(
@@ -142,7 +142,7 @@ def _newer(folder, meta):
         (_changed_file, "its boundary.csv is not the file meta.json names"),
         (_changed_setting, "a setting differs: interface.restitution"),
         (_budget_row, "1 cell(s) ran out of a step or event budget"),
-        (_newer, "stored under schema 3: made by a newer rbm"),
+        (_newer, "stored under schema 4: made by a newer rbm"),
     ],
 )
 def test_migrate_refuses_a_domain_it_cannot_vouch_for(tmp_path, tamper, says):

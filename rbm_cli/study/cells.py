@@ -49,8 +49,10 @@ def grid_cells(config: Config, points: list[GridPoint] | None = None) -> list[Ce
 
 
 def count_cells(config: Config) -> int:
-    """The number of cells, counted without listing them."""
-    return config.grid.n_cells
+    """The number of cells, counted without listing them: a cell per sample of the
+    uncertain keys (rbm_cli.config.uncertain)."""
+    samples = 1 if config.uncertain is None else config.uncertain.samples
+    return config.grid.n_cells * samples
 
 
 def key(cell: Cell) -> tuple[str, ...]:

@@ -24,6 +24,7 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import holds_stored_motions
 from rbm_cli.config.types import Config
+from rbm_cli.config.uncertain import SAMPLE
 from rbm_cli.study.boundary_lines import BOUNDARY_FIELDS as BOUNDARY_FIELDS
 from rbm_cli.study.boundary_lines import MAJORITY as MAJORITY
 from rbm_cli.study.boundary_lines import MEMBER0_FIELDS as MEMBER0_FIELDS
@@ -93,9 +94,16 @@ def row_key(row, paths: tuple[str, ...] = ()) -> tuple[str, ...]:
     return cell_key(row.get(C.amplitude_g), row.get(C.frequency_hz), *(row.get(p) for p in paths))
 
 
+def identity_columns(columns) -> tuple[str, ...]:
+    """The columns besides amplitude and frequency that tell a domain's rows apart: its
+    axes, and ``sample`` where it has samples of uncertain keys (rbm_cli.config.uncertain)."""
+    return (*axis_columns(columns), *(c for c in columns if c == SAMPLE))
+
+
 def keys_of(df: pd.DataFrame) -> list[tuple[str, ...]]:
-    """The cell identity of every row of a domain table (its axis columns included)."""
-    paths = axis_columns(df.columns)
+    """The cell identity of every row of a domain table (its axis columns and its sample
+    included)."""
+    paths = identity_columns(df.columns)
     cols = [df[C.amplitude_g], df[C.frequency_hz], *(df[p] for p in paths)]
     return [cell_key(*vals) for vals in zip(*cols, strict=True)]
 
@@ -214,7 +222,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
     if C.collapse_fraction in df.columns:
         _check_fraction(df, path, got)
     seen: dict[tuple[str, ...], int] = {}
-    paths = axis_columns(df.columns)
+    paths = identity_columns(df.columns)
     for i, key in enumerate(keys_of(df)):
         if key in seen:
             point = "".join(f", {p} {v}" for p, v in zip(paths, key[2:], strict=False))

@@ -301,12 +301,10 @@ def _check_uncertain(config: Config, base_dir: str) -> None:
     if config.uncertain is None:
         return
     for path, distribution in config.uncertain.keys:
-        for k, value in enumerate(probe_values(distribution)):
+        for value in probe_values(distribution):
             try:
                 _config(point_written(config.written, ((path, value),)), base_dir)
             except ConfigError as exc:
-                if k == 0:  # the median: the key is not one that takes this number
-                    raise ConfigError(f"uncertain.keys.{path}: {exc}") from None
                 raise ConfigError(
                     f"uncertain.keys.{path}: {distribution.text} can draw {fmt(value)}, which"
                     f" the key refuses ({exc}): bound it to the values the key takes"

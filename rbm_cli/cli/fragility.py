@@ -56,8 +56,11 @@ class MeasureOption(click.Option):
 @click.option("--compare", "others", multiple=True, metavar="OTHER.csv",
               help="Another record-suite domain whose fragility is drawn in fragility.png "
               "beside this one (repeatable; its own files are not written).")  # fmt: skip
+@click.option("--by", "by", default=None, metavar="KEY",
+              help="A domain over samples of uncertain keys: a curve per tercile of KEY's "
+              "sampled values (fragility_by.png, fragility_by.csv).")  # fmt: skip
 def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcome, ci,
-              others) -> None:  # fmt: skip
+              others, by) -> None:  # fmt: skip
     """Fit a lognormal fragility curve to a record-suite domain and draw its IDA.
 
     DOMAIN.csv is the domain.csv of a sweep over records x intensities (one row
@@ -71,6 +74,9 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
     intensities or more. --intensity fits on a record's intensity measure
     instead of the amplitude. An ensemble domain (rbm sweep --ensemble) counts
     every member of a cell as a trial, or its majority (--ensemble-outcome).
+    A domain over samples of uncertain keys (the config's uncertain section) fits
+    every run of every sample, and splits the dispersion into the records'
+    (beta_RTR) and the keys' (beta_U); --by KEY draws a curve per tercile of a key.
 
     Writes fragility.csv, fragility_curve.csv, fragility.json, fragility.png and
     ida.png (intensity against peak rotation ratio, a curve per record, flat from
@@ -101,7 +107,7 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         made = run_fragility(domain, output, n_resamples=resamples, seed=seed,
                              intensity_column=intensity_column, ci_percentiles=tuple(ci),
                              compare=others, progress=progress,
-                             ensemble_outcome=ensemble_outcome)  # fmt: skip
+                             ensemble_outcome=ensemble_outcome, by=by)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except KeyboardInterrupt:
@@ -131,8 +137,24 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
             click.echo(f"warning: {res.fit_warning}")
         if res.resamples_note:
             click.echo(f"note: {res.resamples_note}")
+    if res.dispersion is not None:
+        click.echo(_dispersion(res.dispersion))
     folder = made.paths[0].parent
     click.echo(f"output: {folder}/ " + ", ".join(p.name for p in made.paths))
+
+
+def _dispersion(split) -> str:
+    """The records' and the uncertain keys' dispersion, one line."""
+
+    def shown(x: float) -> str:
+        return "n/a" if not math.isfinite(x) else f"{x:.3g}"
+
+    return (
+        f"dispersion over {split.n_samples} samples ({split.n_fitted} fitted alone):"
+        f" beta_RTR {shown(split.beta_rtr)}, beta_U {shown(split.beta_u)}, total"
+        f" sqrt(RTR^2 + U^2) {shown(split.beta_total)} (one fit of every run:"
+        f" {shown(split.beta_pooled)})"
+    )
 
 
 def _interval(ci: tuple[float, float], lo: float, hi: float, unit: str) -> str:

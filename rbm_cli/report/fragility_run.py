@@ -29,9 +29,11 @@ from pathlib import Path
 import pandas as pd
 
 from rbm_cli.base.files import check_writable_dir
+from rbm_cli.report.fragility_by import BY_FILES, tercile_figure
 from rbm_cli.report.fragility_report import fragility_texts, plot_fragility, plot_ida
 from rbm_cli.report.fragility_store import FILES, FragilityFolder
 from rbm_cli.study.fragility import FragilityResult, check_options, fragility
+from rbm_cli.study.fragility_samples import by_tercile
 from rbm_cli.study.intensities import label as measure_label
 from rbm_cli.study.outcomes import (
     ENSEMBLE_OUTCOMES,
@@ -72,6 +74,7 @@ def run_fragility(
     compare: tuple[str | os.PathLike, ...] = (),
     progress: Callable[[int, int], None] | None = None,
     ensemble_outcome: str = ENSEMBLE_OUTCOMES[0],
+    by: str | None = None,
 ) -> FragilityRun:
     """Fragility of a record-suite domain: fit, files and figures.
 
@@ -105,6 +108,10 @@ def run_fragility(
         How an ensemble domain's cells count: ``members`` (every member a trial; their
         number per cell from meta.json beside the domain), ``majority`` or ``member0``
         (rbm_cli.study.outcomes)
+    by : str, optional
+        An uncertain key of a domain over samples (its dotted path): a fit per tercile of
+        its sampled values, written as fragility_by.csv and fragility_by.png with the set
+        (rbm_cli.study.fragility_samples.by_tercile)
 
     Returns
     -------
@@ -131,6 +138,8 @@ def run_fragility(
     frames = [(p, frame, n_members(p, frame)) for p, frame in frames]
     for _, frame, m in frames:
         prepare_outcomes(frame, intensity_column, ensemble_outcome, m)
+    terciles = None if by is None else by_tercile(df, by, intensity_column, ensemble_outcome,
+                                                  members)  # fmt: skip
     folder = Path(output) if output is not None else domain.parent
     check_writable_dir(folder)
     options = dict(n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
@@ -148,7 +157,11 @@ def run_fragility(
             "domain_sha256": digest,  # of the bytes fitted: which domain.csv these are of
         }
         label, contents = _contents(domain, df, result, others, source)
-        paths = store.publish({name: contents[name] for name in FILES})
+        names = FILES
+        if terciles is not None:
+            contents.update(_by_contents(terciles, by, label, result))
+            names = (*BY_FILES, *FILES)  # fragility.json last
+        paths = store.publish({name: contents[name] for name in names})
     return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label)
 
 
@@ -192,6 +205,15 @@ def _contents(domain: Path, df, result, others, source: dict) -> tuple[str, dict
     }
     contents.update(fragility_texts(result, extra=source))
     return label, contents
+
+
+def _by_contents(terciles: pd.DataFrame, key: str, label: str, result) -> dict:
+    """fragility_by.csv and fragility_by.png of the fits per tercile of ``key``."""
+    top = 1.1 * float(result.table["intensity_g"].max())
+    return {
+        "fragility_by.csv": terciles.to_csv(index=False, float_format="%.12g"),
+        "fragility_by.png": _png(tercile_figure(terciles, key, label, top)),
+    }
 
 
 def intensity_label(column: str, meta: dict | None = None) -> str:

@@ -89,12 +89,12 @@ class DispersionSplit:
             "n_fitted": self.n_fitted,
             "per_sample": [
                 {
-                    "sample": int(r.sample),
-                    "median": num(r.median),
-                    "beta": num(r.beta),
-                    "note": r.note,
+                    SAMPLE: int(r[SAMPLE]),
+                    "median": num(r["median"]),
+                    "beta": num(r["beta"]),
+                    "note": r["note"],
                 }  # fmt: skip
-                for r in self.per_sample.itertuples()
+                for _, r in self.per_sample.iterrows()
             ],
         }
 
@@ -134,7 +134,7 @@ def dispersion_split(
         fit, note = _fit(runs)
         per.append((sample, fit.median_g if fit else math.nan, fit.beta if fit else math.nan,
                     note))  # fmt: skip
-    table = pd.DataFrame(per, columns=["sample", "median", "beta", "note"])
+    table = pd.DataFrame(per, columns=[SAMPLE, "median", "beta", "note"])
     fitted = table.dropna(subset=["median", "beta"])
     beta_rtr = math.sqrt(float(np.mean(fitted["beta"] ** 2))) if len(fitted) else math.nan
     beta_u = float(np.std(np.log(fitted["median"]), ddof=1)) if len(fitted) > 1 else math.nan

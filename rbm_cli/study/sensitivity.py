@@ -10,7 +10,8 @@ and ``collapsed``) this module gives, over the rows whose run did not fail:
 - the partial rank correlation coefficient (PRCC): the Pearson correlation of the ranks of
   the key and of the outcome once both are cleared (least squares) of the ranks of every
   other input that varies: the other keys, the amplitude (the intensity), the frequency and
-  the grid's axes over config keys. The cells of a domain span the intensity, which moves
+  the grid's axes over config keys (a record, or any axis of text, by an indicator per
+  value). The cells of a domain span the intensity, which moves
   the outcome more than any key: Spearman's coefficient of a key is diluted by it, the
   PRCC is not. Its p-value is that of a Pearson correlation of n - 2 - k degrees of
   freedom with k inputs cleared (t = r sqrt((n - 2 - k) / (1 - r^2))).
@@ -92,6 +93,20 @@ def _p_value(r: float, dof: int) -> float:
     return float(2.0 * student.sf(abs(t), dof))
 
 
+def _categories(df: pd.DataFrame, columns: list[str]) -> dict:
+    """Indicator columns (0/1, the first value left out) of the columns that hold text (a
+    record, a record file): cleared as the numeric inputs are, they take out each record's
+    own level of the outcome."""
+    out = {}
+    for column in columns:
+        if column not in df.columns or not np.isnan(_numeric(df, column)).all():
+            continue
+        values = df[column].astype(str).to_numpy()
+        for value in list(dict.fromkeys(values))[1:]:
+            out[f"{column}={value}"] = (values == value).astype(float)
+    return out
+
+
 def sensitivity(df: pd.DataFrame) -> pd.DataFrame:
     """The rank correlations of each uncertain key with each outcome (module docstring).
 
@@ -121,6 +136,7 @@ def sensitivity(df: pd.DataFrame) -> pd.DataFrame:
     controls = [C.amplitude_g, C.frequency_hz, *axis_columns(df.columns)]
     inputs = {c: _numeric(ok, c) for c in [*keys, *controls] if c in ok.columns}
     inputs = {c: v for c, v in inputs.items() if _varies(v)}
+    inputs.update(_categories(ok, [C.record, *axis_columns(df.columns)]))
     rows = []
     for outcome in OUTCOMES:
         if outcome not in ok.columns:

@@ -133,3 +133,19 @@ def test_by_a_key_the_domain_does_not_have_is_one_line(uncertain_suite, tmp_path
     assert "column.height is not an uncertain key of the domain" in res.output
     assert len(res.output.strip().splitlines()) == 1
     assert not list(tmp_path.glob("fragility*"))
+
+
+def test_a_stored_suite_of_samples_draws_and_compares_as_its_sweep_did(uncertain_suite, tmp_path):
+    """Read back from domain.csv (a record's frequency an empty field), the domain is drawn
+    and compared as the samples' majority, as the sweep drew domain.png and boundary.csv."""
+    folder = pd.io.common.Path(uncertain_suite).parent
+    png = tmp_path / "again.png"
+    res = CliRunner().invoke(cli, ["plot-domain", uncertain_suite, "-o", str(png)])
+    assert res.exit_code == 0, res.output
+    assert png.read_bytes() == (folder / "domain.png").read_bytes()
+    lines = pd.read_csv(folder / "boundary.csv")
+    shifts = rbm.compare(uncertain_suite, uncertain_suite).shifts
+    # (compare takes a line without collapse one grid step above the grid)
+    has = lines["lowest_unsafe_g"].notna().to_numpy()
+    assert has.any() and len(shifts) == len(lines)
+    assert list(shifts["boundary_a_g"][has]) == list(lines["lowest_unsafe_g"][has])

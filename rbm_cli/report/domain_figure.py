@@ -15,14 +15,13 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.config.load import parse_config
-from rbm_cli.config.points import point_written
 from rbm_cli.config.types import MODELS, Config
 from rbm_cli.physics.column import build_column
 from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
 from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.report.plot_polar import ANGLE_AXIS, draw_polar, has_angle_axis
+from rbm_cli.study.cells import nominal_config
 from rbm_cli.study.domain import axis_columns
 from rbm_cli.study.samples import majority_frame
 from rbm_cli.study.schema import C
@@ -55,7 +54,7 @@ def column_note(config: Config, model: bool = True) -> str:
     if config.uncertain is not None:
         samples = config.uncertain.samples
         varying = {p for p, d in config.uncertain.keys if d.point_mass is None}
-        config = _first_sample(config)
+        config = nominal_config(config)
     col, itf = config.column, config.interface
 
     def value(path: str, text: str) -> str:
@@ -95,15 +94,6 @@ def column_note(config: Config, model: bool = True) -> str:
     return "column: " + ", ".join(parts)
 
 
-def _first_sample(config: Config) -> Config:
-    """The config of the first sample of its uncertain keys (their values set), whose
-    column the note describes."""
-    if config.written is None:
-        return config
-    written = point_written(config.written, config.uncertain.point(0))
-    return parse_config(written, base_dir=config.base_dir)
-
-
 def _plain(df: pd.DataFrame, dimensionless: bool, layout: str) -> bool:
     """Today's plot: physical axes, a domain with no axis beside amplitude and frequency."""
     return not dimensionless and layout == "auto" and not axis_columns(df.columns)
@@ -140,9 +130,11 @@ def _polar_axes(ax, df: pd.DataFrame, config: Config | None, compare, where: str
 
 
 def _config_options(config: Config | None) -> dict:
-    """plot_domain's column, excitation type and uplift level of a config."""
+    """plot_domain's column, excitation type and uplift level of a config (of its nominal
+    config where it has uncertain keys: rbm_cli.study.cells.nominal_config)."""
     if config is None:
         return {}
+    config = nominal_config(config)
     level, label = uplift_level(config)
     return {
         "column": build_column(config.column, config.interface),

@@ -33,6 +33,7 @@ from rbm_cli.study.boundary_lines import boundary as boundary
 from rbm_cli.study.boundary_lines import boundary_table as boundary_table
 from rbm_cli.study.boundary_lines import line_ident, line_order, line_row
 from rbm_cli.study.result import CSV_FIELDS, STATUSES
+from rbm_cli.study.samples import majority_frame
 from rbm_cli.study.schema import C, columns
 
 if TYPE_CHECKING:
@@ -308,8 +309,10 @@ class Comparison:
 
 
 def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
-    """The boundary amplitude [g] of each boundary line (compare's rule), by its key."""
-    by, groups = _groups(df)
+    """The boundary amplitude [g] of each boundary line (compare's rule), by its key; of a
+    domain over samples of uncertain keys, its samples' majority's (rbm_cli.study.samples),
+    as boundary.csv and domain.png have it."""
+    by, groups = _groups(majority_frame(df))
     out = {}
     for values, grp in groups:
         values = values if isinstance(values, tuple) else (values,)
@@ -331,7 +334,8 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
     Where one domain has no collapsed cell at a frequency, its boundary is
     taken as one grid step above its highest amplitude there (just above the
     grid), so a boundary that leaves the grid counts as a finite shift. Cells are
-    matched on amplitude, frequency and the values of any axes over config keys.
+    matched on amplitude, frequency, the values of any axes over config keys and the
+    sample of uncertain keys; boundaries are the samples' majority's.
     """
     # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd

@@ -15,6 +15,7 @@ Plain Python over rows (dicts): a sweep draws and writes without pandas.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from rbm_cli.config.uncertain import SAMPLE, is_sample_column
@@ -34,7 +35,10 @@ def has_samples(columns) -> bool:
 
 
 def _cell(row: dict, paths: tuple[str, ...]) -> tuple:
-    return (row.get(C.amplitude_g), row.get(C.frequency_hz), *(row.get(p) for p in paths))
+    """A row's cell: amplitude, frequency and axis values (an empty field, None or NaN as
+    a table reads it, as None: NaN equals nothing, itself included)."""
+    values = (row.get(C.amplitude_g), row.get(C.frequency_hz), *(row.get(p) for p in paths))
+    return tuple(None if isinstance(v, float) and math.isnan(v) else v for v in values)
 
 
 def majority_rows(

@@ -39,8 +39,9 @@ def _stored_design(path: Path) -> dict | None:
 def read_design(source: Config | str | os.PathLike | Mapping[str, Any]) -> pd.DataFrame | None:
     """The design of a config's uncertain keys: a row per sample, the columns of domain.csv
     (``sample``, ``uncertain.<key>``: the value each key takes in that sample, in the key's
-    unit in the config); ``.attrs["uncertain"]`` holds the keys' distributions, the seed and
-    the number of samples. None for a config without an uncertain section.
+    unit in the config: ``column.height`` [m], ``interface.stiffness.normal`` [Pa/m],
+    ``interface.restitution`` [-]); ``.attrs["uncertain"]`` holds the keys' distributions,
+    the seed and the number of samples. None for a config without an uncertain section.
 
     Parameters
     ----------
@@ -80,8 +81,9 @@ def read_design(source: Config | str | os.PathLike | Mapping[str, Any]) -> pd.Da
 def sensitivity(domain: str | os.PathLike | pd.DataFrame) -> pd.DataFrame:
     """Which uncertain key moves a domain's outcome most: per key and outcome (the peak
     rotation ratio, collapsed), Spearman's rank correlation and the partial rank
-    correlation coefficient (PRCC, the intensity and the grid's other inputs cleared), with
-    their p-values (rbm_cli.study.sensitivity). ``domain``: a domain.csv or its table.
+    correlation coefficient (PRCC, the intensity and the grid's other inputs cleared), each
+    in [-1, 1] [-], with their p-values [-] (rbm_cli.study.sensitivity). ``domain``: a
+    domain.csv or its table (amplitudes [g], frequencies [Hz]).
 
     Examples
     --------

@@ -19,6 +19,9 @@ docstring with its units and an example (``help(rbm.run)``).
 - :func:`compare` two domains, as ``rbm compare`` (a :class:`DomainComparison`);
   :func:`fragility` the lognormal fragility of a suite's domain with its bootstrap band,
   as ``rbm fragility`` fits it (no files)
+- :func:`read_design` the design of a config's uncertain keys (a row per sample: the value
+  each key takes), or of a domain swept with them; :func:`sensitivity` which uncertain key
+  moves a domain's outcome most (rank correlations, as ``rbm sensitivity``)
 - :func:`migrate` brings a domain stored by an earlier rbm to this version's config hash,
   once it has checked that the domain was made by the config this version reads from it
 - :func:`plot_domain`, :func:`plot_history` draw on a matplotlib axes and return it
@@ -57,8 +60,10 @@ from rbm_cli.api import (
     motion_from_arrays,
     plot_domain,
     plot_history,
+    read_design,
     read_domain,
     run,
+    sensitivity,
     sweep,
     with_value,
     with_values,
@@ -82,8 +87,10 @@ __all__ = [
     "motion_from_arrays",
     "plot_domain",
     "plot_history",
+    "read_design",
     "read_domain",
     "run",
+    "sensitivity",
     "sweep",
     "with_value",
     "with_values",

@@ -69,6 +69,7 @@ def test_every_config_key_is_in_the_config_reference(ref):
     expected |= {f"interface.stiffness.{k}" for k in STIFFNESS_KEYS}
     expected |= {f"excitation.initial.{k}" for k in INITIAL_KEYS}
     expected |= {f"grid.{k}" for k in (*EXCITATION_AXES, LINKED, *VIRTUAL_PATHS)}
+    expected |= {"uncertain.samples", "uncertain.seed", "uncertain.keys.<key path>"}
     assert set(TOP_KEYS) <= {k.split(".")[0] for k in expected} | {"grid"}
     for key in sorted(expected):
         assert f"``{key}``" in text, key

@@ -235,6 +235,7 @@ def config_keys() -> list[str]:
         TOP_KEYS,
         TOP_MASS_KEYS,
     )
+    from rbm_cli.config.uncertain import UNCERTAIN_KEYS
 
     nested = {
         "column": COLUMN_KEYS,
@@ -243,6 +244,7 @@ def config_keys() -> list[str]:
         "collapse": COLLAPSE_KEYS,
         "solver": SOLVER_KEYS,
         "grid": (*EXCITATION_AXES, LINKED, *(p for p in VIRTUAL_PATHS), "<key path>"),
+        "uncertain": (*(k for k in UNCERTAIN_KEYS if k != "keys"), "keys.<key path>"),
     }
     sub = {
         "interface.stiffness": STIFFNESS_KEYS,
@@ -314,7 +316,7 @@ def _ranges() -> dict[str, str]:
         Y_PHASE_RANGE_DEG,
         Y_RATIO_MAX,
     )
-    from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, MAX_CELLS
+    from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, MAX_CELLS, MAX_POINTS
     from rbm_cli.config.interface import FRICTION_MAX, NORMAL_RANGE, ROTATIONAL_RANGE
     from rbm_cli.config.load import (
         CAPITAL_RANGE,
@@ -328,6 +330,7 @@ def _ranges() -> dict[str, str]:
         TOP_MASS_RANGE,
         WALL_TIME_RANGE,
     )
+    from rbm_cli.config.uncertain import MAX_SAMPLES
 
     def one_of(values) -> str:
         return ", ".join(f"``{v}``" for v in values)
@@ -380,6 +383,9 @@ def _ranges() -> dict[str, str]:
         "grid.amplitudes": f"[{fmt(AMPLITUDE_RANGE_G[0])}, {fmt(AMPLITUDE_RANGE_G[1])}]",
         "grid.frequencies": f"[{fmt(FREQUENCY_RANGE_HZ[0])}, {fmt(FREQUENCY_RANGE_HZ[1])}]",
         "grid.<key path>": f"at most {MAX_CELLS:,} cells in all",
+        "uncertain.samples": f"an integer 1-{MAX_SAMPLES:,}; samples x grid points at most"
+        f" {MAX_POINTS:,}",
+        "uncertain.seed": "an integer 0-4,294,967,295",
         "solver.method": one_of(t.METHODS),
         "solver.max_steps": f"auto ({t.BUDGET_PER_JOINT_SECOND['max_steps']:,} a second of "
         f"motion and a joint, at least {t.BUDGET_FLOOR['max_steps']:,}), or an integer "
@@ -713,6 +719,29 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "``interface.restitution``, ``column.drums``, ``excitation.file`` "
         "...); values as amplitudes, a range may add ``spacing: log``. "
         "``name`` and ``model`` cannot vary.",
+    ),
+    "uncertain.samples": (
+        "",
+        "",
+        "Samples of the uncertain keys per cell of the grid: a sweep runs every cell once per"
+        " sample (a row each). Required.",
+    ),
+    "uncertain.seed": (
+        "",
+        "",
+        "Seed of the Latin hypercube (scipy.stats.qmc.LatinHypercube): the same seed draws"
+        " the same design.",
+    ),
+    "uncertain.keys.<key path>": (
+        "the key's",
+        "",
+        "A numeric config key by its dotted path (``interface.stiffness.normal``,"
+        " ``interface.restitution``, ``column.density``, ``column.size`` ...) and one"
+        " distribution: ``{lognormal: {median, beta}}``, ``{normal: {mean, std, bounds: [lo,"
+        " hi]}}`` (bounds optional: truncated), ``{truncnorm: {mean, std, bounds}}``,"
+        " ``{uniform: [lo, hi]}``. A distribution that can draw a value the key refuses is"
+        " refused when the config loads. Not ``name``, ``model``, ``grid`` nor an axis of"
+        " the grid.",
     ),
     "collapse.ratio": (
         "",

@@ -31,6 +31,7 @@ _HOME = {
     "fragility": "fragility_curves", "info": "column_info",
     "Motion": "motions", "motion_from_arrays": "motions",
     "SweepInterrupted": "sweeps", "run_sweep": "sweeps", "sweep": "sweeps",
+    "read_design": "uncertain", "sensitivity": "uncertain",
 }  # fmt: skip
 
 

@@ -63,8 +63,11 @@ class MeasureOption(click.Option):
 @click.option("--compare-intensities", is_flag=True, default=False,
               help="Also fit the suite on every intensity measure the domain carries and "
               "rank them by dispersion beta (fragility_intensities.csv).")  # fmt: skip
+@click.option("--by", "by", default=None, metavar="KEY",
+              help="A domain over samples of uncertain keys: a curve per tercile of KEY's "
+              "sampled values (fragility_by.png, fragility_by.csv).")  # fmt: skip
 def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcome, ci,
-              others, damage_states, compare_intensities) -> None:  # fmt: skip
+              others, damage_states, compare_intensities, by) -> None:  # fmt: skip
     """Fit a lognormal fragility curve to a record-suite domain and draw its IDA.
 
     DOMAIN.csv is the domain.csv of a sweep over records x intensities (one row
@@ -78,6 +81,9 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
     intensities or more. --intensity fits on a record's intensity measure
     instead of the amplitude. An ensemble domain (rbm sweep --ensemble) counts
     every member of a cell as a trial, or its majority (--ensemble-outcome).
+    A domain over samples of uncertain keys (the config's uncertain section) fits
+    every run of every sample, and splits the dispersion into the records'
+    (beta_RTR) and the keys' (beta_U); --by KEY draws a curve per tercile of a key.
 
     --damage-states fits a curve per threshold of the peak rotation ratio (a run
     exceeds a state when its max_rotation_ratio reaches the threshold or it
@@ -124,7 +130,7 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
                              intensity_column=intensity_column, ci_percentiles=tuple(ci),
                              compare=others, progress=progress,
                              ensemble_outcome=ensemble_outcome, damage_states=thresholds,
-                             compare_intensities=compare_intensities)  # fmt: skip
+                             compare_intensities=compare_intensities, by=by)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except KeyboardInterrupt:
@@ -154,6 +160,8 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
             click.echo(f"warning: {res.fit_warning}")
         if res.resamples_note:
             click.echo(f"note: {res.resamples_note}")
+    if res.dispersion is not None:
+        click.echo(_dispersion(res.dispersion))
     if made.states is not None:
         _echo_states(made.states)
     if made.intensities is not None:
@@ -197,6 +205,20 @@ def _echo_intensities(comparison) -> None:
         else:
             click.echo(f"  {rank:>2} {row['intensity_column']:<24} {row['note']}")
     click.echo(comparison.statement)
+
+
+def _dispersion(split) -> str:
+    """The records' and the uncertain keys' dispersion, one line."""
+
+    def shown(x: float) -> str:
+        return "n/a" if not math.isfinite(x) else f"{x:.3g}"
+
+    return (
+        f"dispersion over {split.n_samples} samples ({split.n_fitted} fitted alone):"
+        f" beta_RTR {shown(split.beta_rtr)}, beta_U {shown(split.beta_u)}, total"
+        f" sqrt(RTR^2 + U^2) {shown(split.beta_total)} (one fit of every run:"
+        f" {shown(split.beta_pooled)})"
+    )
 
 
 def _interval(ci: tuple[float, float], lo: float, hi: float, unit: str) -> str:

@@ -93,7 +93,7 @@ def _forget_caught_keyboard_interrupts() -> None:
 def commands():
     """The `rbm` click group with every command registered (imports the command modules)."""
     # lazy: after the Ctrl-C handler is in place (module docstring)
-    from rbm_cli.cli import bench, domain, fragility, run, sweep  # noqa: F401  (register them)
+    from rbm_cli.cli import bench, domain, fragility, run, sensitivity, sweep  # noqa: F401
     from rbm_cli.cli.common import cli as group
 
     return group

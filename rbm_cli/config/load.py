@@ -28,12 +28,13 @@ from rbm_cli.config.excitation import excitation_section
 from rbm_cli.config.grid import (
     AMPLITUDE_RANGE_G,
     FREQUENCY_RANGE_HZ,
+    MAX_POINTS,
     RECORD_PATHS,
     hoist_suite,
     parse_grid,
 )
 from rbm_cli.config.interface import interface_section
-from rbm_cli.config.points import expand
+from rbm_cli.config.points import expand, point_written
 from rbm_cli.config.types import (
     IMPLEMENTATIONS,
     METHODS,
@@ -47,6 +48,7 @@ from rbm_cli.config.types import (
     SolverConfig,
     TopMassConfig,
 )
+from rbm_cli.config.uncertain import parse_uncertain, probe_values, with_design
 from rbm_cli.config.validate import (
     choice,
     describe,
@@ -71,7 +73,10 @@ __all__ = [
     "parse_config",
 ]
 
-TOP_KEYS = ("name", "model", "column", "interface", "excitation", "grid", "collapse", "solver")
+TOP_KEYS = (
+    "name", "model", "column", "interface", "excitation", "grid", "collapse", "solver",
+    "uncertain",
+)  # fmt: skip
 COLUMN_KEYS = (
     "height",
     "base_width",
@@ -276,6 +281,7 @@ def parse_config(
         config = _config(written, base_dir)
         folder = os.getcwd() if base_dir is None else os.path.abspath(base_dir)
         config = dataclasses.replace(config, written=written, base_dir=folder)
+        _check_uncertain(config, folder)
         points = expand(config, parse_config, base_dir=folder)  # each validates, or one line
         records = _axis_records(config, points)
         if records:
@@ -285,6 +291,24 @@ def parse_config(
     except ConfigError as exc:
         raise ConfigError(f"{source}: {exc}") from None
     return config
+
+
+def _check_uncertain(config: Config, base_dir: str) -> None:
+    """Each uncertain key at its distribution's median, then at the least and the largest
+    value the design can draw (rbm_cli.config.uncertain.probe_values), set in the config as
+    written and validated as a config: a key that is not one of the config, or that refuses
+    a value the distribution can draw, is refused in one line naming the key."""
+    if config.uncertain is None:
+        return
+    for path, distribution in config.uncertain.keys:
+        for value in probe_values(distribution):
+            try:
+                _config(point_written(config.written, ((path, value),)), base_dir)
+            except ConfigError as exc:
+                raise ConfigError(
+                    f"uncertain.keys.{path}: {distribution.text} can draw {fmt(value)}, which"
+                    f" the key refuses ({exc}): bound it to the values the key takes"
+                ) from None
 
 
 def _axis_records(config: Config, points) -> tuple[tuple[str, str, str], ...]:
@@ -355,6 +379,10 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         ),
         solver=_solver(top.get("solver")),
     )
+    if top.get("uncertain") is not None:
+        grid = config.grid
+        uncertain = parse_uncertain(top["uncertain"], grid.axis_paths, grid.n_points, MAX_POINTS)
+        config = dataclasses.replace(config, uncertain=with_design(uncertain))
     _check_dimensions(config)
     _check_stop(config)
     return config

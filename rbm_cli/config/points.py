@@ -17,6 +17,7 @@ from typing import Any
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.grid import EXCITATION_AXES, point_label
 from rbm_cli.config.types import Config
+from rbm_cli.config.uncertain import SAMPLE, config_path
 from rbm_cli.config.validate import describe, is_number
 
 #: Column lengths a ``column.size`` axis scales [m] (``drums`` when it lists heights).
@@ -53,14 +54,18 @@ def point_values(config: Config) -> list[tuple[tuple[str, Any], ...]]:
 
 def expand(config: Config, parse: Callable[..., Config], **parse_kw) -> list[GridPoint]:
     """Every point of the config's axes with its validated config (``parse`` is
-    rbm_cli.config.load.parse_config, passed in to keep this module below it); a config
-    without such axes is its own single point."""
-    if not config.grid.axes:
+    rbm_cli.config.load.parse_config, passed in to keep this module below it), each point
+    once per sample of the ``uncertain`` section (rbm_cli.config.uncertain: the point's
+    values then ``sample`` and the sample's value of each key, by domain.csv's column); a
+    config without such axes and without uncertain keys is its own single point."""
+    uncertain = config.uncertain
+    if not config.grid.axes and uncertain is None:
         return [GridPoint((), config)]
     if config.written is None:
         raise ConfigError("a config with grid axes needs the mapping it was written as")
+    samples = [()] if uncertain is None else [uncertain.point(s) for s in range(uncertain.samples)]
     out = []
-    for values in point_values(config):
+    for values in (v + s for v in point_values(config) for s in samples):
         label = point_label(tuple(p for p, _ in values), tuple(v for _, v in values))
         try:
             data = point_written(config.written, values)
@@ -71,9 +76,11 @@ def expand(config: Config, parse: Callable[..., Config], **parse_kw) -> list[Gri
 
 
 def point_written(written: Mapping[str, Any], values: tuple[tuple[str, Any], ...]) -> dict:
-    """A copy of the written config with the point's values set and the grid reduced to
-    the excitation's axes."""
+    """A copy of the written config with the point's values set, the grid reduced to
+    the excitation's axes and no uncertain section (a sample's values are among the
+    point's: ``sample`` sets nothing, ``uncertain.<path>`` sets the path)."""
     data = copy.deepcopy(dict(written))
+    data.pop("uncertain", None)
     grid = data.get("grid")
     grid = grid if isinstance(grid, Mapping) else {}
     data["grid"] = {k: grid[k] for k in EXCITATION_AXES if k in grid}
@@ -81,6 +88,9 @@ def point_written(written: Mapping[str, Any], values: tuple[tuple[str, Any], ...
         del data["grid"]
     virtual = {}
     for path, value in values:
+        if path == SAMPLE:
+            continue
+        path = config_path(path) or path
         if path in ("column.size", "column.slenderness"):
             virtual[path] = value
         else:

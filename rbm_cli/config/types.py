@@ -12,6 +12,8 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
+from rbm_cli.config.uncertain import UncertainConfig
+
 #: Acceleration of gravity [m/s^2] (g = 9.81, the value the paper and the reference blocks use).
 G = 9.81
 
@@ -519,6 +521,8 @@ class Config:
     grid: GridConfig = field(default_factory=GridConfig)
     collapse: CollapseConfig = field(default_factory=CollapseConfig)
     solver: SolverConfig = field(default_factory=SolverConfig)
+    #: Config keys drawn from distributions, a sample per cell (rbm_cli.config.uncertain).
+    uncertain: UncertainConfig | None = None
     written: dict | None = field(default=None, compare=False, repr=False)
     base_dir: str | None = field(default=None, compare=False, repr=False)
 

@@ -21,7 +21,9 @@ from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
 from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.report.plot_polar import ANGLE_AXIS, draw_polar, has_angle_axis
+from rbm_cli.study.cells import nominal_config
 from rbm_cli.study.domain import axis_columns
+from rbm_cli.study.samples import majority_frame
 from rbm_cli.study.schema import C
 
 __all__ = ["POLAR_SIZE", "column_note", "domain_figure", "draw_domain_on", "uplift_level"]
@@ -43,13 +45,22 @@ def column_note(config: Config, model: bool = True) -> str:
     top width where they differ), drums, the joint stiffness (k_n, K_M or rigid), the
     restitution e, the joints' damping zeta where there is some, and interface.friction where
     model rbm's demand is checked against it.
-    A grid over one of these says so ("over the grid") instead of one value. ``model``
-    False leaves the model out (a title that names it already)."""
-    col, itf = config.column, config.interface
+    A grid over one of these says so ("over the grid") instead of one value, and an
+    uncertain key ("uncertain", and the cells are said to be the majority of the samples:
+    rbm_cli.study.samples), unless its distribution draws one value, which is shown.
+    ``model`` False leaves the model out (a title that names it already)."""
     axes = set(config.grid.axis_paths)
+    varying, samples = set(), 0
+    if config.uncertain is not None:
+        samples = config.uncertain.samples
+        varying = {p for p, d in config.uncertain.keys if d.point_mass is None}
+        config = nominal_config(config)
+    col, itf = config.column, config.interface
 
     def value(path: str, text: str) -> str:
         sized = "column.size" in axes and path in ("column.height", "column.base_width")
+        if path in varying:
+            return "uncertain"
         return "over the grid" if path in axes or sized else text
 
     width = _metres(col.base_width)
@@ -74,6 +85,8 @@ def column_note(config: Config, model: bool = True) -> str:
     ]
     if model:
         parts.append(f"model {config.model}")
+    if varying:
+        parts.append(f"each cell the majority of {samples} samples")
     if itf.damping > 0 or "interface.damping" in axes:
         parts.insert(5, f"damping zeta = {value('interface.damping', f'{itf.damping:.3g}')}")
     if MODELS[config.model].beam and itf.friction_limit is not None:
@@ -117,9 +130,11 @@ def _polar_axes(ax, df: pd.DataFrame, config: Config | None, compare, where: str
 
 
 def _config_options(config: Config | None) -> dict:
-    """plot_domain's column, excitation type and uplift level of a config."""
+    """plot_domain's column, excitation type and uplift level of a config (of its nominal
+    config where it has uncertain keys: rbm_cli.study.cells.nominal_config)."""
     if config is None:
         return {}
+    config = nominal_config(config)
     level, label = uplift_level(config)
     return {
         "column": build_column(config.column, config.interface),
@@ -176,7 +191,9 @@ def draw_domain_on(
     False: panels of an ensemble leave their colour bar to the caller. A domain over
     excitation.angle in physical axes with layout 'auto' is drawn in polar axes
     (rbm_cli.report.plot_polar), on ``ax`` if it is polar, else on a polar axes that takes
-    its place; the polar axes is returned."""
+    its place; the polar axes is returned. A domain over samples of uncertain keys is
+    drawn as its samples' majority (rbm_cli.study.samples)."""
+    df, compare = majority_frame(df), [majority_frame(c) for c in compare]
     if _plain(df, dimensionless, layout):
         options = {**_config_options(config), **options}
         return plot_domain(df, ax=ax, compare=compare, labels=labels, **options)
@@ -249,7 +266,12 @@ def domain_figure(
         and frequency (rbm_cli.report.domain_view: the rule of 'auto')
     compare_configs : sequence  The configs of ``compare`` (dimensionless axes of old domains)
     where : str  How messages name the domain (its file)
+
+    A domain over samples of uncertain keys is drawn as its samples' majority, a cell per
+    point of the grid (rbm_cli.study.samples: collapsed where half its samples or more
+    collapsed).
     """
+    df, compare = majority_frame(df), [majority_frame(c) for c in compare]
     if _plain(df, dimensionless, layout):
         return _plain_figure(df, config, compare, labels)
     if _polar(df, dimensionless, layout):

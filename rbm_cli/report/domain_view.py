@@ -46,7 +46,7 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.grid import RECORD_PATHS
 from rbm_cli.config.types import Config
 from rbm_cli.physics.similarity import rocking_scales
-from rbm_cli.study.cells import grid_points
+from rbm_cli.study.cells import grid_points, nominal_config
 from rbm_cli.study.domain import axis_columns, cell_key, keys_of
 from rbm_cli.study.schema import SCALE_COLUMNS, C, scale_values
 from rbm_cli.study.schema import label as column_label
@@ -200,12 +200,14 @@ def axis_groups(df: pd.DataFrame) -> list[tuple[str, ...]]:
 
 def point_configs(df: pd.DataFrame, config: Config | None) -> dict:
     """{point_key: Config} of every point of the domain's axes, from the config it was
-    swept with ({} without one); an RbmError if the config lacks a point of the domain."""
+    swept with ({} without one); an RbmError if the config lacks a point of the domain.
+    A config with uncertain keys: its nominal config's points (rbm_cli.study.cells
+    .nominal_config; the domain drawn is its samples' majority, rbm_cli.study.samples)."""
     if config is None:
         return {}
     paths = axis_columns(df.columns)
     configs = {}
-    for point in grid_points(config):
+    for point in grid_points(nominal_config(config)):
         values = dict(point.values)
         if set(values) != set(paths):
             raise RbmError(

@@ -65,6 +65,7 @@ def fragility_summary(result: FragilityResult) -> dict:
         "fit_warning": result.fit_warning,
         "resamples_dropped": dict(result.resamples_dropped),
         "resamples_note": result.resamples_note,
+        "dispersion": result.dispersion.summary() if result.dispersion is not None else None,
     }
 
 

@@ -35,6 +35,7 @@ from pathlib import Path
 import pandas as pd
 
 from rbm_cli.base.files import check_writable_dir
+from rbm_cli.report.fragility_by import tercile_figure
 from rbm_cli.report.fragility_report import fragility_texts, plot_fragility, plot_ida
 from rbm_cli.report.fragility_states import (
     intensities_csv,
@@ -44,6 +45,7 @@ from rbm_cli.report.fragility_states import (
 )
 from rbm_cli.report.fragility_store import FILES, FragilityFolder
 from rbm_cli.study.fragility import FragilityResult, check_options, fragility
+from rbm_cli.study.fragility_samples import by_tercile
 from rbm_cli.study.fragility_states import (
     DamageStates,
     check_damage_states,
@@ -99,6 +101,7 @@ def run_fragility(
     ensemble_outcome: str = ENSEMBLE_OUTCOMES[0],
     damage_states: tuple[float, ...] | None = None,
     compare_intensities: bool = False,
+    by: str | None = None,
 ) -> FragilityRun:
     """Fragility of a record-suite domain: fit, files and figures.
 
@@ -139,6 +142,10 @@ def run_fragility(
     compare_intensities : bool
         Also fit the suite on every intensity measure the domain carries and rank them by
         beta (rbm_cli.study.intensity_choice), written to fragility_intensities.csv
+    by : str, optional
+        An uncertain key of a domain over samples (its dotted path): a fit per tercile of
+        its sampled values, written as fragility_by.csv and fragility_by.png with the set
+        (rbm_cli.study.fragility_samples.by_tercile)
 
     Returns
     -------
@@ -170,6 +177,8 @@ def run_fragility(
     frames = [(p, frame, n_members(p, frame)) for p, frame in frames]
     for _, frame, m in frames:
         prepare_outcomes(frame, intensity_column, ensemble_outcome, m)
+    terciles = None if by is None else by_tercile(df, by, intensity_column, ensemble_outcome,
+                                                  members)  # fmt: skip
     folder = Path(output) if output is not None else domain.parent
     check_writable_dir(folder)
     options = dict(n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
@@ -199,8 +208,12 @@ def run_fragility(
             "domain_sha256": digest,  # of the bytes fitted: which domain.csv these are of
         }
         source |= extra_summary(states, comparison)
+        if terciles is not None:
+            source["by"] = by
         label, contents = _contents(domain, df, result, others, source, thresholds or ())
         contents |= extra_contents(states, comparison, label)
+        if terciles is not None:
+            contents |= _by_contents(terciles, by, label, result)
         paths = store.publish({name: contents[name] for name in extra_files(contents) + FILES},
                               retire=superseded(folder, contents))  # fmt: skip
     return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label,
@@ -213,13 +226,14 @@ def _without(options: dict, key: str) -> dict:
 
 def extra_files(contents: dict) -> tuple[str, ...]:
     """The names of ``contents`` beyond the fragility set's :data:`FILES` (the damage
-    states' and the intensities' files), published before them."""
+    states', the intensities' and the terciles' files), published before them."""
     return tuple(name for name in contents if name not in FILES)
 
 
 #: The optional files of a fragility set and the fragility.json entry that claims them.
 OPTIONAL_FILES = {"fragility_states.png": "damage_states", "fragility_states.csv": "damage_states",
-                  "fragility_intensities.csv": "intensity_statement"}  # fmt: skip
+                  "fragility_intensities.csv": "intensity_statement",
+                  "fragility_by.csv": "by", "fragility_by.png": "by"}  # fmt: skip
 
 
 def superseded(folder: Path, contents: dict) -> tuple[str, ...]:
@@ -303,6 +317,15 @@ def _contents(domain: Path, df, result, others, source: dict,
     }
     contents.update(fragility_texts(result, extra=source))
     return label, contents
+
+
+def _by_contents(terciles: pd.DataFrame, key: str, label: str, result) -> dict:
+    """fragility_by.csv and fragility_by.png of the fits per tercile of ``key``."""
+    top = 1.1 * float(result.table["intensity_g"].max())
+    return {
+        "fragility_by.csv": terciles.to_csv(index=False, float_format="%.12g"),
+        "fragility_by.png": _png(tercile_figure(terciles, key, label, top)),
+    }
 
 
 def intensity_label(column: str, meta: dict | None = None) -> str:

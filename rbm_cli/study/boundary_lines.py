@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rbm_cli.config.uncertain import is_sample_column
 from rbm_cli.study.schema import C
 
 if TYPE_CHECKING:
@@ -40,8 +41,9 @@ MAJORITY = 0.5
 
 
 def axis_columns(columns) -> tuple[str, ...]:
-    """The columns of a domain that hold its point's axes: named by a dotted config path."""
-    return tuple(c for c in columns if "." in str(c))
+    """The columns of a domain that hold its point's axes: named by a dotted config path
+    (not a sample's ``uncertain.<key>``, rbm_cli.config.uncertain)."""
+    return tuple(c for c in columns if "." in str(c) and not is_sample_column(str(c)))
 
 
 def line_row(by: list[str], values) -> dict:

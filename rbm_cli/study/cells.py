@@ -11,13 +11,15 @@ record, the record's intensity measures (rbm_cli.study.intensities).
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import Motion
-from rbm_cli.config.points import GridPoint, expand
+from rbm_cli.config.points import GridPoint, expand, point_written
 from rbm_cli.config.types import Config
 from rbm_cli.physics.similarity import rocking_scales
 from rbm_cli.study.domain import cell_key, row_key
@@ -30,6 +32,23 @@ Cell = tuple  # (amplitude_g, frequency_hz or None, ((path, value), ...))
 def grid_points(config: Config) -> list[GridPoint]:
     """The points of a config's axes over config keys, each with its validated config."""
     return expand(config, parse_config, base_dir=config.base_dir)
+
+
+def nominal_config(config: Config) -> Config:
+    """The config without its uncertain section, each uncertain key whose distribution
+    draws one value (a point mass) set to it, the others as written: the column a figure
+    of a domain over samples draws its levels for (rbm_cli.report.domain_figure)."""
+    if config.uncertain is None:
+        return config
+    fixed = tuple(
+        (path, d.point_mass) for path, d in config.uncertain.keys if d.point_mass is not None
+    )
+    if config.written is None:
+        return dataclasses.replace(config, uncertain=None)
+    written = point_written(config.written, fixed)
+    if isinstance(config.written.get("grid"), Mapping):
+        written["grid"] = config.written["grid"]
+    return parse_config(written, base_dir=config.base_dir)
 
 
 def frequencies(config: Config) -> tuple:
@@ -49,8 +68,10 @@ def grid_cells(config: Config, points: list[GridPoint] | None = None) -> list[Ce
 
 
 def count_cells(config: Config) -> int:
-    """The number of cells, counted without listing them."""
-    return config.grid.n_cells
+    """The number of cells, counted without listing them: a cell per sample of the
+    uncertain keys (rbm_cli.config.uncertain)."""
+    samples = 1 if config.uncertain is None else config.uncertain.samples
+    return config.grid.n_cells * samples
 
 
 def key(cell: Cell) -> tuple[str, ...]:
@@ -134,6 +155,7 @@ __all__ = [
     "has_records",
     "key",
     "max_drums",
+    "nominal_config",
     "record_name",
     "row_key",
     "tasks",

@@ -24,6 +24,7 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import holds_stored_motions
 from rbm_cli.config.types import Config
+from rbm_cli.config.uncertain import SAMPLE
 from rbm_cli.study.boundary_lines import BOUNDARY_FIELDS as BOUNDARY_FIELDS
 from rbm_cli.study.boundary_lines import MAJORITY as MAJORITY
 from rbm_cli.study.boundary_lines import MEMBER0_FIELDS as MEMBER0_FIELDS
@@ -32,6 +33,7 @@ from rbm_cli.study.boundary_lines import boundary as boundary
 from rbm_cli.study.boundary_lines import boundary_table as boundary_table
 from rbm_cli.study.boundary_lines import line_ident, line_order, line_row
 from rbm_cli.study.result import CSV_FIELDS, STATUSES
+from rbm_cli.study.samples import majority_frame
 from rbm_cli.study.schema import C, columns
 
 if TYPE_CHECKING:
@@ -93,9 +95,16 @@ def row_key(row, paths: tuple[str, ...] = ()) -> tuple[str, ...]:
     return cell_key(row.get(C.amplitude_g), row.get(C.frequency_hz), *(row.get(p) for p in paths))
 
 
+def identity_columns(columns) -> tuple[str, ...]:
+    """The columns besides amplitude and frequency that tell a domain's rows apart: its
+    axes, and ``sample`` where it has samples of uncertain keys (rbm_cli.config.uncertain)."""
+    return (*axis_columns(columns), *(c for c in columns if c == SAMPLE))
+
+
 def keys_of(df: pd.DataFrame) -> list[tuple[str, ...]]:
-    """The cell identity of every row of a domain table (its axis columns included)."""
-    paths = axis_columns(df.columns)
+    """The cell identity of every row of a domain table (its axis columns and its sample
+    included)."""
+    paths = identity_columns(df.columns)
     cols = [df[C.amplitude_g], df[C.frequency_hz], *(df[p] for p in paths)]
     return [cell_key(*vals) for vals in zip(*cols, strict=True)]
 
@@ -214,7 +223,7 @@ def _check_cells(df: pd.DataFrame, path: Path) -> None:
     if C.collapse_fraction in df.columns:
         _check_fraction(df, path, got)
     seen: dict[tuple[str, ...], int] = {}
-    paths = axis_columns(df.columns)
+    paths = identity_columns(df.columns)
     for i, key in enumerate(keys_of(df)):
         if key in seen:
             point = "".join(f", {p} {v}" for p, v in zip(paths, key[2:], strict=False))
@@ -300,8 +309,10 @@ class Comparison:
 
 
 def _edges(df: pd.DataFrame) -> tuple[list[str], dict]:
-    """The boundary amplitude [g] of each boundary line (compare's rule), by its key."""
-    by, groups = _groups(df)
+    """The boundary amplitude [g] of each boundary line (compare's rule), by its key; of a
+    domain over samples of uncertain keys, its samples' majority's (rbm_cli.study.samples),
+    as boundary.csv and domain.png have it."""
+    by, groups = _groups(majority_frame(df))
     out = {}
     for values, grp in groups:
         values = values if isinstance(values, tuple) else (values,)
@@ -323,7 +334,8 @@ def compare(a: pd.DataFrame, b: pd.DataFrame) -> Comparison:
     Where one domain has no collapsed cell at a frequency, its boundary is
     taken as one grid step above its highest amplitude there (just above the
     grid), so a boundary that leaves the grid counts as a finite shift. Cells are
-    matched on amplitude, frequency and the values of any axes over config keys.
+    matched on amplitude, frequency, the values of any axes over config keys and the
+    sample of uncertain keys; boundaries are the samples' majority's.
     """
     # lazy: pandas loads only where needed (docs/architecture.md, Start-up)
     import pandas as pd

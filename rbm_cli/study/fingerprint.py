@@ -27,6 +27,13 @@ version's): :func:`migrate` rewrites its meta.json with today's hash once it has
   that does not name it is refused where ``auto`` does not run DOP853 now).
 
 Anything else is refused in one line, naming what differs: re-make the domain.
+
+Schema 2 took the hash of the same form as schema 3 before the config had an ``uncertain``
+section (rbm_cli.config.uncertain): schema 3's resolved form holds ``uncertain`` (None
+without one), which changed every config's hash and nothing else. A domain stored under
+schema 2 has no uncertain keys, so its rows stand: :func:`migrate` rewrites its meta.json
+with today's hash once its files are those meta.json names and its hash is the schema-2
+hash (:func:`schema2_hash`) of the config read back from it, as this version reads it.
 """
 
 from __future__ import annotations
@@ -50,7 +57,7 @@ from rbm_cli.study.schema import C
 from rbm_cli.study.store import JOURNAL
 
 #: The form of the config hash (written as meta.json's ``schema``).
-SCHEMA = 2
+SCHEMA = 3
 #: Settings left out of the hash: they fail a run, never change a finished one.
 NOT_SETTINGS = (("solver", "max_wall_time"),)
 #: Settings schema 1 left out of its hash where they had these (default) values: they came
@@ -74,6 +81,7 @@ SCHEMA1_LEFT_OUT = {
     ("excitation", "y"): None,
     ("excitation", "initial", "rotations_across"): [],
     ("excitation", "initial", "velocities_across"): [],
+    ("uncertain",): None,
 }
 #: Schema 1's step and event budgets of one run (fixed then; ``auto`` now, never less).
 SCHEMA1_BUDGETS = {"max_steps": 2_000_000, "max_events": 200_000}
@@ -126,6 +134,39 @@ def hash_form(config: Config, points: list | None = None) -> dict:
 def config_hash(config: Config, points: list | None = None) -> str:
     """Fingerprint of everything that changes a domain (:func:`hash_form`), 16 hex digits."""
     return _digest(hash_form(config, points))
+
+
+def schema2_hash(config: Config, points: list | None = None) -> str | None:
+    """The hash schema 2 took of a config (the module's docstring): today's form without
+    ``uncertain``, under the number 2; None for a config with uncertain keys, which
+    schema 2 could not hold."""
+    if config.uncertain is not None:
+        return None
+    form = hash_form(config, points)
+    form.pop("uncertain", None)
+    form["schema"] = 2
+    return _digest(form)
+
+
+def _files_problem(folder: Path, meta: dict) -> str | None:
+    """Which file of a domain is not the one its meta.json names (SHA-256), or None."""
+    for name, sha in (meta.get("files") or {}).items():
+        path = folder / name
+        if not path.is_file() or hashlib.sha256(path.read_bytes()).hexdigest() != sha:
+            return f"its {name} is not the file meta.json names"
+    return None
+
+
+def schema2_problem(folder: Path, meta: dict, config: Config) -> str | None:
+    """Why the domain in ``folder``, stored under schema 2 with this ``meta``, is not the
+    domain ``config`` gives today, or None."""
+    problem = _files_problem(folder, meta)
+    if problem:
+        return problem
+    stored = str(meta.get("config_hash", ""))[:16]
+    if schema2_hash(config) != stored:
+        return "its config hash is not the schema-2 hash of the config it holds"
+    return None
 
 
 def schema1_hash(stored: dict) -> str:
@@ -201,10 +242,9 @@ def schema1_problem(folder: Path, meta: dict, config: Config) -> str | None:
     digest = str(meta.get("config_hash", "")).split("-")[0]
     if not isinstance(stored, dict) or schema1_hash(stored) != digest:
         return "its meta.json's config is not the one its hash was taken of"
-    for name, sha in (meta.get("files") or {}).items():
-        path = folder / name
-        if not path.is_file() or hashlib.sha256(path.read_bytes()).hexdigest() != sha:
-            return f"its {name} is not the file meta.json names"
+    problem = _files_problem(folder, meta)
+    if problem:
+        return problem
     current = _plain(named(config.resolved()))
     differs = _setting_difference(stored, current, config)
     if differs:
@@ -241,10 +281,13 @@ def _read_meta(folder: Path) -> dict:
 def same_domain(folder: Path, meta: dict, config: Config, digest: str) -> bool:
     """Whether the finished domain in ``folder`` (its ``meta``) is the one ``config`` gives
     under ``digest`` (its hash, with the ensemble's suffix): the same hash under this
-    schema, or a schema-1 domain that :func:`migrate` would take."""
+    schema, or a schema-1 or schema-2 domain that :func:`migrate` would take."""
     schema = meta.get("schema", 1)
     if schema == SCHEMA:
         return meta.get("config_hash") == digest
+    if schema == 2:
+        stored = str(meta.get("config_hash", ""))
+        return _suffix(stored) == _suffix(digest) and stored[:16] == schema2_hash(config)
     if schema != 1 or _suffix(str(meta.get("config_hash", ""))) != _suffix(digest):
         return False
     try:
@@ -258,7 +301,7 @@ def _suffix(digest: str) -> str:
 
 
 def migrate(folder: str | Path) -> str:
-    """Rewrite the meta.json of a domain stored under schema 1 with today's hash and
+    """Rewrite the meta.json of a domain stored under schema 1 or 2 with today's hash and
     schema, once the module's checks hold; its other files are not touched. Returns a
     one-line note; RbmError (one line) when it cannot or need not be done."""
     folder = Path(folder)
@@ -266,21 +309,26 @@ def migrate(folder: str | Path) -> str:
     schema = meta.get("schema", 1)
     if schema == SCHEMA:
         return f"{folder}: already stored under schema {SCHEMA}, nothing to do"
-    if schema != 1:
+    if schema not in (1, 2):
         raise RbmError(f"{folder} was stored under schema {schema!r}: made by a newer rbm")
     if (folder / JOURNAL).exists() or not (folder / "domain.csv").is_file():
         raise RbmError(f"{folder} holds no finished domain: finish it with the rbm that started it")
     config = domain_config(folder / "domain.csv")
     if config is None:
         raise RbmError(f"{folder}: its meta.json holds no config this rbm can read")
-    problem = schema1_problem(folder, meta, config)
+    check = schema1_problem if schema == 1 else schema2_problem
+    problem = check(folder, meta, config)
     if problem:
         raise RbmError(f"cannot migrate {folder}: {problem}; re-make it")
     old = meta["config_hash"]
     meta["config_hash"] = config_hash(config) + _suffix(str(old))
     meta["schema"] = SCHEMA
-    meta["solver_method"] = methods_that_run(config)
-    meta["migrated"] = {"from_schema": 1, "from_hash": old, "rbm": __version__}
+    if schema == 1:
+        meta["solver_method"] = methods_that_run(config)
+    earlier = meta.get("migrated")
+    meta["migrated"] = {"from_schema": schema, "from_hash": old, "rbm": __version__}
+    if isinstance(earlier, dict):
+        meta["migrated"]["before"] = earlier
     text = json.dumps(json_ready(meta), indent=2, allow_nan=False) + "\n"
     write_text_atomic(folder / "meta.json", text)
-    return f"{folder}: schema 1 -> {SCHEMA}, hash {old} -> {meta['config_hash']}"
+    return f"{folder}: schema {schema} -> {SCHEMA}, hash {old} -> {meta['config_hash']}"

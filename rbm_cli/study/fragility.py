@@ -51,6 +51,7 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.uncertain import SAMPLE
 from rbm_cli.study.fragility_fit import (
     NO_FIT_REASONS,
     LognormalFit,
@@ -59,6 +60,7 @@ from rbm_cli.study.fragility_fit import (
     fit_counts,
     fit_lognormal,
 )
+from rbm_cli.study.fragility_samples import DispersionSplit, dispersion_split
 from rbm_cli.study.outcomes import (
     ENSEMBLE_OUTCOMES,
     intensity_unit,
@@ -128,6 +130,9 @@ class FragilityResult:
     fit_warning: str = ""
     resamples_dropped: tuple[tuple[str, int], ...] = ()
     resamples_note: str = ""
+    #: A domain over samples of uncertain keys: the records' and the keys' dispersion
+    #: (rbm_cli.study.fragility_samples.DispersionSplit), else None
+    dispersion: DispersionSplit | None = None
 
     @property
     def intensity_unit(self) -> str:
@@ -283,6 +288,9 @@ def fragility(
         fit_warning=fit_warning(fit, table, intensity_unit(column)),
         resamples_dropped=dropped,
         resamples_note=resamples_note(n_resamples if fit is not None else 0, dropped),
+        dispersion=dispersion_split(df, intensity_column, ensemble_outcome, n_members)
+        if SAMPLE in df.columns
+        else None,
     )
 
 

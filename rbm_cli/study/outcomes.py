@@ -41,6 +41,7 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.config.uncertain import SAMPLE
 from rbm_cli.study.domain import check_collapsed
 from rbm_cli.study.schema import DEFAULT_INTENSITIES, C
 from rbm_cli.study.schema import unit as schema_unit
@@ -141,7 +142,11 @@ def prepare_outcomes(
     if is_ensemble(df) and ensemble_outcome != "member0":
         _ensemble_trials(rows, df, ensemble_outcome, n_members)
         failed = rows["failed"].to_numpy()
-    dup = rows.duplicated([C.record, "x"])
+    # a domain over samples of uncertain keys has a run per record, intensity and sample
+    sample = [SAMPLE] if SAMPLE in df.columns else []
+    if sample:
+        rows[SAMPLE] = df[SAMPLE].to_numpy()
+    dup = rows.duplicated([C.record, "x", *sample])
     if dup.any():
         i = int(np.argmax(dup.to_numpy()))
         raise RbmError(
@@ -225,10 +230,11 @@ def worst_angle(df: pd.DataFrame) -> pd.DataFrame:
         if column in df.columns:
             keys[column] = pd.to_numeric(df[column], errors="coerce").fillna(-np.inf)
     order = keys.sort_values(list(keys.columns), ascending=False, kind="stable").index
-    worst = df.loc[order].drop_duplicates([C.record, C.amplitude_g], keep="first")
-    cells = list(zip(df[C.record], df[C.amplitude_g], strict=True))
+    by = [C.record, C.amplitude_g, *(c for c in df.columns if c == SAMPLE)]  # and a sample
+    worst = df.loc[order].drop_duplicates(by, keep="first")
+    cells = list(zip(*(df[c] for c in by), strict=True))
     position = {cell: i for i, cell in enumerate(dict.fromkeys(cells))}  # first rows' order
-    at = [position[cell] for cell in zip(worst[C.record], worst[C.amplitude_g], strict=True)]
+    at = [position[cell] for cell in zip(*(worst[c] for c in by), strict=True)]
     return worst.iloc[np.argsort(at, kind="stable")].reset_index(drop=True)
 
 

@@ -1,7 +1,9 @@
 """The schema of domain.csv: every column's name, dtype, unit and label, in the order the
 writer writes them, and when a domain has it.
 
-A domain's row is one cell of a sweep (rbm_cli.study.cells): its point's axes, then the
+A domain's row is one cell of a sweep (rbm_cli.study.cells): its point's axes, the
+sample of a config's uncertain keys (rbm_cli.config.uncertain: ``sample`` and one column
+per key, ``uncertain.<key>``, the value the run used: :func:`point_columns`), then the
 run's result (rbm_cli.study.result), the column's scales (rbm_cli.physics.similarity), a
 record's intensity measures (their registry: rbm_cli.study.intensities) and an ensemble's
 verdict (rbm_cli.study.robustness). :func:`columns` lists them (the measures as the
@@ -25,6 +27,7 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 from rbm_cli.config.types import MODELS, Config
+from rbm_cli.config.uncertain import PREFIX, SAMPLE
 from rbm_cli.study import intensities
 from rbm_cli.study.intensities import label as measure_label
 from rbm_cli.study.intensities import measure_fields, measure_of
@@ -33,7 +36,7 @@ from rbm_cli.study.intensities import measure_fields, measure_of
 #: (empty: none), 0/1, or text.
 DTYPES = ("float", "int", "0/1", "str")
 #: The groups of columns, in domain.csv's order.
-GROUPS = ("record", "result", "scale", "measure", "ensemble")
+GROUPS = ("sample", "record", "result", "scale", "measure", "ensemble")
 
 
 def _always(config: Config, ensemble: int) -> bool:
@@ -50,6 +53,10 @@ def _three_d(config: Config, ensemble: int) -> bool:
 
 def _friction_checked(config: Config, ensemble: int) -> bool:
     return bool(MODELS[config.model].beam and config.interface.friction_limit is not None)
+
+
+def _uncertain(config: Config, ensemble: int) -> bool:
+    return config.uncertain is not None
 
 
 def _ensemble(config: Config, ensemble: int) -> bool:
@@ -97,9 +104,30 @@ def _scale(name, unit, quantity) -> Column:
 
 
 _RECORD_ONLY = "record excitations (excitation.type: record)"
+_UNCERTAIN_ONLY = "configs with uncertain keys (the uncertain section)"
+#: The name the schema gives the columns of the uncertain keys' values, one per key.
+UNCERTAIN_PATTERN = PREFIX + "<key>"
 
 #: domain.csv's columns after the grid's axes and before the record's measures, in order.
 _BEFORE: tuple[Column, ...] = (
+    Column(
+        SAMPLE,
+        "int",
+        "",
+        "sample of the uncertain keys (0, 1, ...; a row per cell and sample)",
+        "sample",
+        _UNCERTAIN_ONLY,
+        _uncertain,
+    ),  # fmt: skip
+    Column(
+        UNCERTAIN_PATTERN,
+        "float",
+        "",
+        "the value of an uncertain key the sample's run used (the key's unit in the config)",
+        "sample",
+        _UNCERTAIN_ONLY + ": one column per key, uncertain.<dotted key>",
+        _uncertain,
+    ),  # fmt: skip
     Column(
         "record", "str", "", "record", "record", _RECORD_ONLY + ": the record's name", _records
     ),  # fmt: skip
@@ -241,6 +269,8 @@ def column(name: str) -> Column | None:
     measure = measure_of(name)
     if measure is not None:
         name = measure.column
+    elif str(name).startswith(PREFIX):
+        name = UNCERTAIN_PATTERN
     return next((c for c in columns() if c.name == name), None)
 
 
@@ -258,18 +288,29 @@ def unit(name: str) -> str | None:
     return None if entry is None else entry.unit
 
 
+def point_columns(config: Config) -> tuple[str, ...]:
+    """The columns that tell a row's point (rbm_cli.config.points): the grid's axis paths,
+    then a sample's (``sample``, ``uncertain.<key>`` per key) where the config has
+    uncertain keys. With amplitude and frequency they are a row's identity."""
+    sample = () if config.uncertain is None else config.uncertain.columns
+    return (*config.grid.axis_paths, *sample)
+
+
 def domain_columns(config: Config, ensemble: int = 1, result=None) -> tuple[str, ...]:
     """domain.csv's columns for a sweep of ``config`` with ``ensemble`` runs per cell, in
     order: the axis paths, then :data:`COLUMNS` that this domain has (a measure per period
-    once per period of excitation.im_periods). ``result``: the result's columns to keep
-    (None: all; the columns that depend on the model are kept where the domain has them)."""
+    once per period of excitation.im_periods, an uncertain key's value once per key).
+    ``result``: the result's columns to keep (None: all; the columns that depend on the
+    model are kept where the domain has them)."""
     keep = None if result is None else set(result)
     out = list(config.grid.axis_paths)
     measures = measure_fields(config)
     for entry in columns():
         if not entry.when(config, ensemble):
             continue
-        if entry.group == "measure":
+        if entry.group == "sample":
+            out.extend(c for c in config.uncertain.columns if column(c) is entry)
+        elif entry.group == "measure":
             out.extend(m for m in measures if measure_of(m).column == entry.name)
         elif keep is not None and entry.name in COMMON_RESULT_COLUMNS and entry.name not in keep:
             continue
@@ -295,6 +336,7 @@ __all__ = [
     "SCALE_COLUMNS",
     "COMMON_RESULT_COLUMNS",
     "DEFAULT_INTENSITIES",
+    "UNCERTAIN_PATTERN",
     "C",
     "Column",
     "column",
@@ -302,6 +344,7 @@ __all__ = [
     "domain_columns",
     "label",
     "measure_columns",
+    "point_columns",
     "scale_values",
     "unit",
 ]

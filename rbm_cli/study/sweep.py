@@ -58,7 +58,7 @@ from rbm_cli.study.robustness import (
     solver_checks,
     summarise,
 )
-from rbm_cli.study.schema import ENSEMBLE_COLUMNS, C, domain_columns
+from rbm_cli.study.schema import ENSEMBLE_COLUMNS, C, domain_columns, point_columns
 from rbm_cli.study.simulate import simulate
 from rbm_cli.study.store import JOURNAL, SweepStore
 from rbm_cli.study.sweep_folder import (
@@ -255,7 +255,7 @@ def sweep_rows(
     _check_request(config, jobs, ensemble, backend, scheduler, force)
     points = _check_points(grid_points(config))
     cells = grid_cells(config, points)
-    paths = config.grid.axis_paths
+    paths = point_columns(config)
     done: dict = {}
 
     def keep(rows: list[dict]) -> None:
@@ -451,14 +451,14 @@ class _Run:
         chunk's write and its count."""
         read = self.store.read_journal(self.digest, {key(c) for c in self.cells},
                                        max_drums(self.points), self.ensemble,
-                                       self.config.grid.axis_paths)  # fmt: skip
+                                       point_columns(self.config))  # fmt: skip
         return max(len(self.done), len(read.rows))
 
     def run(self, todo, jobs, backend, scheduler, progress, stop_after) -> tuple[float, float]:
         """Run the cells still to do (:func:`run_cells`), each finished chunk's rows into the
         journal (fsync'ed), then into ``done``; (compile time, wall time) [s]."""
         n_cells = len(self.cells)
-        paths = self.config.grid.axis_paths
+        paths = point_columns(self.config)
 
         def journal(rows: list[dict]) -> None:
             self.store.append(rows, self.digest)

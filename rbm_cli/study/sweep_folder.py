@@ -31,7 +31,8 @@ from rbm_cli.study.domain import boundary_table, csv_text, domain_frame
 from rbm_cli.study.fingerprint import SCHEMA, hash_form, methods_that_run, same_domain
 from rbm_cli.study.provenance import provenance
 from rbm_cli.study.robustness import RULE as ROBUSTNESS_RULE
-from rbm_cli.study.schema import C
+from rbm_cli.study.samples import majority_rows
+from rbm_cli.study.schema import C, point_columns
 from rbm_cli.study.store import FINALS, JOURNAL, STATE
 
 
@@ -44,7 +45,7 @@ def prepare_folder(store, config, points, cells, digest, ensemble, resume, force
     if store.journal.exists():
         grid = {key(c) for c in cells}
         read = store.read_journal(digest, grid, max_drums(points), ensemble,
-                                  config.grid.axis_paths)  # fmt: skip
+                                  point_columns(config))  # fmt: skip
         ours = digest in read.hashes or store.state_hash() == digest
         n = len(read.rows) if ours else read.rejected  # rows of the other config
         if not read.rows and not read.rejected and (ours or not read.hashes):
@@ -185,11 +186,12 @@ def as_started(config, points, method: str | None, note) -> tuple:
 
 
 def publish_result(store, figure, config, rows, fields, meta, resume_command) -> None:
-    """domain.png (the sweep's ``figure`` of the rows: :func:`draw_figure`), boundary.csv,
+    """domain.png (the sweep's ``figure`` of the rows: :func:`draw_figure`), boundary.csv
+    (of the samples' majority where the config has uncertain keys: rbm_cli.study.samples),
     domain.csv and meta.json (with the others' SHA-256), published in one step; a failure
     keeps the journal and says how to finish. The CSV files are written from the rows
     (dicts with the columns ``fields``), without pandas."""
-    columns, lines = boundary_table(rows, fields)
+    columns, lines = boundary_table(*majority_rows(rows, fields))
     texts = {
         "domain.csv": csv_text(rows, fields),
         "boundary.csv": csv_text(lines, columns),
@@ -314,6 +316,9 @@ def sweep_meta(
         "n_resumed": n_cells - n_run,
         "status_counts": counts,
         "ensemble": {"members": ensemble, "rule": ROBUSTNESS_RULE if ensemble > 1 else None},
+        # the design of the uncertain keys (rbm_cli.config.uncertain): keys, distributions,
+        # seed, samples and the values drawn, a row per sample
+        "uncertain": None if config.uncertain is None else config.uncertain.design(),
         "provenance": provenance(),
         "cpu_count": os.cpu_count(),
     }

@@ -177,10 +177,14 @@ def test_domain_csv_and_summary_json_carry_the_residual_of_the_engine_only(tmp_p
     res = runner.invoke(cli, ["run", str(_yaml(tmp_path, "bullet")), "-a", "0.6", "-f", "2",
                               "-o", str(tmp_path / "run")])  # fmt: skip
     assert res.exit_code == 0, res.output
+    assert "residual:" in res.output and "top offset" in res.output
     (summary,) = (tmp_path / "run").rglob("summary.json")
     values = json.loads(summary.read_text())
     assert values["residual_slip_m"] == pytest.approx(expected, rel=5e-3)
     assert values["residual_tilt_ratio"] < 1e-6
+    res = runner.invoke(cli, ["run", str(_yaml(tmp_path, "rbm")), "-a", "0.6", "-f", "2",
+                              "-o", str(tmp_path / "run_rbm")])  # fmt: skip
+    assert res.exit_code == 0 and "residual:" not in res.output, res.output
     res = runner.invoke(cli, ["sweep", str(_yaml(tmp_path, "rbm")), "-o", str(tmp_path)])
     assert res.exit_code == 0, res.output
     header = pd.read_csv(tmp_path / "rbm" / "domain.csv", nrows=0).columns

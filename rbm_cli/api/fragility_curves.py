@@ -127,8 +127,12 @@ def residual_states_of(text, where: str = "--residual-states") -> tuple[float, .
 def _thresholds_of(text, where: str, residual: bool) -> tuple[float, ...] | None:
     if text is None:
         return None
-    column, example = ("residual_slip_m [m]", "0.005,0.02,0.05") if residual \
-        else ("max_rotation_ratio", "0.1,0.3,1.0")  # fmt: skip
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
+    from rbm_cli.study.fragility_states import PEAK, RESIDUAL, check_damage_states
+
+    measure = RESIDUAL if residual else PEAK
+    example = "0.005,0.02,0.05" if residual else "0.1,0.3,1.0"
+    column = measure.column + (f" [{measure.unit}]" if measure.unit != "-" else "")
     values = []
     for part in str(text).split(","):
         try:
@@ -138,10 +142,7 @@ def _thresholds_of(text, where: str, residual: bool) -> tuple[float, ...] | None
                 f"{where} must be thresholds of {column} separated by commas (such"
                 f" as {example}), got {part.strip()[:40]!r} in {str(text)[:60]!r}"
             ) from None
-    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
-    from rbm_cli.study.fragility_states import PEAK, RESIDUAL, check_damage_states
-
-    return check_damage_states(values, where, RESIDUAL if residual else PEAK)
+    return check_damage_states(values, where, measure)
 
 
 def __getattr__(name: str):

@@ -27,7 +27,7 @@ from rbm_cli.report.run_folder import (
     vertical_history,
     write_run,
 )
-from rbm_cli.study.result import CSV_FIELDS, THREE_D_FIELDS, RunResult
+from rbm_cli.study.result import CSV_FIELDS, RESIDUAL_FIELDS, THREE_D_FIELDS, RunResult
 from rbm_cli.study.schema import C
 from rbm_cli.study.simulate import simulate
 
@@ -55,7 +55,13 @@ class CellResult(Mapping):
     ``max_rotation_ratio`` [-] (the largest rotation over its collapse limit),
     ``max_top_displacement_m`` [m], for a run in three dimensions (as domain.csv)
     ``collapse_azimuth_deg`` [deg from x, in (-180, 180]; nan if it did not collapse] and
-    ``wobble_turns`` [-], then ``n_uplifts``, ``n_impacts``, ``n_steps``, ``n_rhs`` (int),
+    ``wobble_turns`` [-], for the contact engine (model bullet, as domain.csv)
+    ``residual_slip_m`` [m] (the largest |slip| of a joint where the run ended: the motion
+    and its free time over, or at rest after the pulse), ``residual_top_offset_m`` [m] (the
+    top's offset in plan from its start there) and ``residual_tilt_ratio`` [-] (the largest
+    |relative rotation| / alpha_i of a joint there), nan if it collapsed or failed (an
+    attribute of every model's result, nan for the others), then ``n_uplifts``,
+    ``n_impacts``, ``n_steps``, ``n_rhs`` (int),
     ``message``, then ``friction_demand`` (per interface, the largest |T/N| held in
     one direction for 0.03 s [-]), ``friction_demand_peak`` (per interface, its
     instantaneous peak [-]; empty for the models without the RBM's joints),
@@ -87,6 +93,8 @@ class CellResult(Mapping):
             values[k] = getattr(run, k)
             if k == C.max_top_displacement_m and run.three_d:  # where domain.csv has them
                 values.update({extra: float(getattr(run, extra)) for extra in THREE_D_FIELDS})
+            if k == C.max_top_displacement_m and run.residual:
+                values.update({extra: float(getattr(run, extra)) for extra in RESIDUAL_FIELDS})
         interface = values[C.collapse_interface]
         values[C.collapse_interface] = None if interface is None else int(interface)
         for k in (C.n_uplifts, C.n_impacts, C.n_steps, C.n_rhs):

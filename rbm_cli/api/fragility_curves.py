@@ -28,6 +28,7 @@ __all__ = [
     "fragility",
     "intensity_help",
     "intensity_names",
+    "residual_states_of",
     "run_fragility",  # noqa: F822 (read on first use)
 ]
 
@@ -108,21 +109,40 @@ def damage_states_of(text, where: str = "--damage-states") -> tuple[float, ...] 
     RbmError  One line naming ``where``: a part that is not a number, a threshold not
         finite, not > 0 or above 1, thresholds not strictly increasing
     """
+    return _thresholds_of(text, where, residual=False)
+
+
+def residual_states_of(text, where: str = "--residual-states") -> tuple[float, ...] | None:
+    """The thresholds of residual_slip_m [m] written as ``text`` ("0.005,0.02,0.05"; None:
+    none), checked (rbm_cli.study.fragility_states.check_damage_states of RESIDUAL).
+
+    Raises
+    ------
+    RbmError  One line naming ``where``: a part that is not a number, a threshold not
+        finite or not > 0, thresholds not strictly increasing
+    """
+    return _thresholds_of(text, where, residual=True)
+
+
+def _thresholds_of(text, where: str, residual: bool) -> tuple[float, ...] | None:
     if text is None:
         return None
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
+    from rbm_cli.study.fragility_states import PEAK, RESIDUAL, check_damage_states
+
+    measure = RESIDUAL if residual else PEAK
+    example = "0.005,0.02,0.05" if residual else "0.1,0.3,1.0"
+    column = measure.column + (f" [{measure.unit}]" if measure.unit != "-" else "")
     values = []
     for part in str(text).split(","):
         try:
             values.append(float(part))
         except ValueError:
             raise RbmError(
-                f"{where} must be thresholds of max_rotation_ratio separated by commas (such"
-                f" as 0.1,0.3,1.0), got {part.strip()[:40]!r} in {str(text)[:60]!r}"
+                f"{where} must be thresholds of {column} separated by commas (such"
+                f" as {example}), got {part.strip()[:40]!r} in {str(text)[:60]!r}"
             ) from None
-    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
-    from rbm_cli.study.fragility_states import check_damage_states
-
-    return check_damage_states(values, where)
+    return check_damage_states(values, where, measure)
 
 
 def __getattr__(name: str):
@@ -150,6 +170,7 @@ def fragility(
     ensemble_outcome: str = "members",
     n_members: int | None = None,
     damage_states=None,
+    residual_states=None,
 ) -> FragilityResult | DamageStates:
     """The lognormal fragility of a record-suite domain, as data (what ``rbm fragility``
     computes and writes to fragility.csv, fragility_curve.csv and fragility.json; no file
@@ -182,6 +203,11 @@ def fragility(
         threshold or it collapsed; an ensemble domain's member 0 runs), returned as a
         ``DamageStates`` (rbm_cli.study.fragility_states: ``thresholds``, ``results``, one
         FragilityResult per state, ``crossings``, ``table()``) instead of one result
+    residual_states : sequence of float, optional  Thresholds of residual_slip_m [m], each
+        finite, > 0, strictly increasing: a fragility curve per residual state of a domain
+        of the contact engine (model bullet: a run exceeds a state when its residual slip
+        reaches the threshold or it collapsed), returned as a ``DamageStates`` as
+        ``damage_states`` are (``measure`` says of which column); give one of the two
 
     Returns
     -------
@@ -226,11 +252,19 @@ def fragility(
     n_members = check_members(n_members)
     check_intensity(intensity, "fragility: intensity")
     check_intensity(intensity_column, "fragility: intensity_column")
-    if damage_states is not None:
-        # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
-        from rbm_cli.study.fragility_states import check_damage_states
+    if damage_states is not None and residual_states is not None:
+        raise RbmError("fragility: damage_states and residual_states are two sets of curves:"
+                       " give one per call")  # fmt: skip
+    # lazy: loads pandas only where needed (docs/architecture.md, Start-up)
+    from rbm_cli.study.fragility_states import PEAK, RESIDUAL, check_damage_states
 
+    measure = PEAK
+    if damage_states is not None:
         damage_states = check_damage_states(damage_states)
+    elif residual_states is not None:
+        measure = RESIDUAL
+        damage_states = check_damage_states(residual_states, "fragility: residual_states",
+                                            RESIDUAL)  # fmt: skip
     if intensity is not None and intensity_column is not None and intensity != intensity_column:
         raise RbmError(f"fragility: intensity {intensity!r} and intensity_column "
                        f"{intensity_column!r} name two columns: give one")  # fmt: skip
@@ -249,7 +283,8 @@ def fragility(
         from rbm_cli.study.fragility_states import damage_states as fit_states
 
         return fit_states(domain, damage_states, n_resamples=n_resamples, seed=seed,
-                          ci_percentiles=ci_percentiles, intensity_column=column)  # fmt: skip
+                          ci_percentiles=ci_percentiles, intensity_column=column,
+                          measure=measure)  # fmt: skip
     return fit(domain, n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
                intensity_column=column, ensemble_outcome=ensemble_outcome,
                n_members=n_members)  # fmt: skip

@@ -60,6 +60,10 @@ class MeasureOption(click.Option):
               help="Thresholds of max_rotation_ratio (0 < t <= 1, increasing; 1 is "
               "collapse): a fragility curve per damage state, in fragility_states.csv and "
               "fragility_states.png, marked in ida.png.")  # fmt: skip
+@click.option("--residual-states", "residual_states", default=None, metavar="S1,S2,...",
+              help="Thresholds of residual_slip_m in metres (> 0, increasing), a domain of "
+              "the contact engine (model bullet): a fragility curve per residual state, in "
+              "fragility_residual.csv and fragility_residual.png.")  # fmt: skip
 @click.option("--compare-intensities", is_flag=True, default=False,
               help="Also fit the suite on every intensity measure the domain carries and "
               "rank them by dispersion beta (fragility_intensities.csv).")  # fmt: skip
@@ -67,7 +71,8 @@ class MeasureOption(click.Option):
               help="A domain over samples of uncertain keys: a curve per tercile of KEY's "
               "sampled values (fragility_by.png, fragility_by.csv).")  # fmt: skip
 def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcome, ci,
-              others, damage_states, compare_intensities, by) -> None:  # fmt: skip
+              others, damage_states, residual_states, compare_intensities,
+              by) -> None:  # fmt: skip
     """Fit a lognormal fragility curve to a record-suite domain and draw its IDA.
 
     DOMAIN.csv is the domain.csv of a sweep over records x intensities (one row
@@ -89,6 +94,9 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
     exceeds a state when its max_rotation_ratio reaches the threshold or it
     collapsed), each as the plain fit of its own outcomes; curves that cross
     within the intensities tested are reported, not adjusted.
+    --residual-states does the same with thresholds of the residual slip [m]
+    that the contact engine (model bullet) writes to domain.csv: a run exceeds
+    a state when its residual_slip_m reaches the threshold or it collapsed.
     --compare-intensities fits the same runs on every intensity measure the
     domain carries and ranks them by beta (lower: more efficient).
 
@@ -103,6 +111,7 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         rbm fragility out/suite/domain.csv
         rbm fragility out/suite/domain.csv -o out/suite_fragility --resamples 2000
         rbm fragility out/suite/domain.csv --damage-states 0.1,0.3,1.0
+        rbm fragility out/suite_bullet/domain.csv --residual-states 0.005,0.02,0.05
         rbm fragility out/suite/domain.csv --compare-intensities -o /tmp/ims
         rbm fragility results/suite_multidrum/domain.csv \
             --compare results/suite_monolithic/domain.csv -o docs/figures/suite
@@ -112,12 +121,14 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
         MAX_RESAMPLES,
         check_intensity,
         damage_states_of,
+        residual_states_of,
         run_fragility,
     )
 
     try:
         check_intensity(intensity_column, "--intensity")
         thresholds = damage_states_of(damage_states, "--damage-states")
+        slips = residual_states_of(residual_states, "--residual-states")
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     if resamples > MAX_RESAMPLES:
@@ -130,7 +141,8 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
                              intensity_column=intensity_column, ci_percentiles=tuple(ci),
                              compare=others, progress=progress,
                              ensemble_outcome=ensemble_outcome, damage_states=thresholds,
-                             compare_intensities=compare_intensities, by=by)  # fmt: skip
+                             compare_intensities=compare_intensities, by=by,
+                             residual_states=slips)  # fmt: skip
     except RbmError as exc:
         raise UserError(one_line(exc)) from None
     except KeyboardInterrupt:
@@ -162,8 +174,9 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
             click.echo(f"note: {res.resamples_note}")
     if res.dispersion is not None:
         click.echo(_dispersion(res.dispersion))
-    if made.states is not None:
-        _echo_states(made.states)
+    for states in (made.states, made.residual):
+        if states is not None:
+            _echo_states(states)
     if made.intensities is not None:
         _echo_intensities(made.intensities)
     folder = made.paths[0].parent
@@ -171,17 +184,20 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
 
 
 def _echo_states(states) -> None:
-    """One line per damage state (median, beta and their intervals), then the crossings."""
-    click.echo(f"damage states (max_rotation_ratio, {states.intensity_column}):")
+    """One line per damage or residual state (median, beta and their intervals), then the
+    crossings."""
+    measure = states.measure
+    click.echo(f"{measure.name} ({measure.column}, {states.intensity_column}):")
+    unit = f" {measure.unit}" if measure.unit != "-" else ""
     for t, res in zip(states.thresholds, states.results, strict=True):
         lo, hi = res.ci_percentiles
         if res.fit is None:
-            click.echo(f"  {t:g}: no fit: {res.note}")
+            click.echo(f"  {t:g}{unit}: no fit: {res.note}")
             continue
-        unit = f" {res.intensity_unit}"
-        median = f"{res.fit.median_g:.4g}{unit}" + _interval(res.median_ci_g, lo, hi, unit)
+        im = f" {res.intensity_unit}"
+        median = f"{res.fit.median_g:.4g}{im}" + _interval(res.median_ci_g, lo, hi, im)
         beta = f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
-        click.echo(f"  {t:g}: median {median}, beta {beta}")
+        click.echo(f"  {t:g}{unit}: median {median}, beta {beta}")
         if res.fit_warning:
             click.echo(f"    warning: {res.fit_warning}")
     for line in states.crossings:

@@ -64,6 +64,21 @@ def _demand_text(result) -> str:
     return text
 
 
+def _residual_lines(result) -> list[tuple[str, str]]:
+    """The contact engine's residual state where the run ended (none for the other
+    models; n/a where it collapsed or failed)."""
+    if "residual_slip_m" not in result:
+        return []
+    if not math.isfinite(result["residual_slip_m"]):
+        return [("residual", "n/a (the run did not survive)")]
+    return [(
+        "residual",
+        f"slip {result['residual_slip_m']:.4g} m (largest joint), top offset"
+        f" {result['residual_top_offset_m']:.4g} m, tilt"
+        f" {result['residual_tilt_ratio']:.3g} alpha (where the run ended)",
+    )]  # fmt: skip
+
+
 def _print_summary(result, folder: Path) -> None:
     lines = [("status", result.status), ("method", result.method or "-")]
     if result.collapsed:
@@ -72,6 +87,7 @@ def _print_summary(result, folder: Path) -> None:
     lines += [
         ("max rotation ratio", f"{result.max_rotation_ratio:.4g}"),
         ("max top displacement", f"{result.max_top_displacement_m:.4g} m (relative to base)"),
+        *_residual_lines(result),
         ("friction demand", _demand_text(result)),
         *_slide_lines(result),
         ("uplifts / impacts", f"{result.n_uplifts} / {result.n_impacts}"),

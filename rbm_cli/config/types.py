@@ -72,15 +72,17 @@ class ModelEntry:
     whether it takes more than one drum, whether it moves in three dimensions (a
     circular section only, a motion in any direction: excitation.angle), whether it moves
     in three dimensions when its motion is given a direction or a second component and in
-    the plane otherwise (``any_direction``: Config.three_d), and whether its joints are the
+    the plane otherwise (``any_direction``: Config.three_d), whether its joints are the
     Rigid Beam Model's (their laws, stiffness and damping, a capital or a top mass, the
-    friction demand)."""
+    friction demand), and whether its drums may slide for good (``residual``: its runs
+    give a residual slip, top offset and tilt, Outcome.residual_slip and the like)."""
 
     runner: str
     multi_drum: bool
     three_d: bool = False
     beam: bool = False
     any_direction: bool = False
+    residual: bool = False
 
 
 #: The model registry, name -> runner (rbm_cli.models.registry resolves it). rbm: the
@@ -100,7 +102,10 @@ MODELS = {
         "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False
     ),
     "bullet": ModelEntry(
-        "rbm_cli.models.bullet.run:BulletRunner", multi_drum=True, any_direction=True
+        "rbm_cli.models.bullet.run:BulletRunner",
+        multi_drum=True,
+        any_direction=True,
+        residual=True,
     ),
     "housner-3d": ModelEntry(
         "rbm_cli.models.housner3d.runner:Housner3dRunner", multi_drum=False, three_d=True

@@ -89,6 +89,14 @@ class Outcome:
     #: limit or more (a wobble), in turns [-] (the largest over the joints)
     azimuth: float = math.nan
     turns: float = math.nan
+    #: the contact engine's residual state where a run that survived ended (the motion
+    #: and its free time over, or at rest after the pulse): the largest |slip| of a joint
+    #: [m], the top's offset in plan from its start [m] and the largest |relative
+    #: rotation| of a joint over its alpha_i [-]; nan for the other models, and for a
+    #: run that collapsed or failed
+    residual_slip: float = math.nan
+    residual_top: float = math.nan
+    residual_tilt: float = math.nan
     top_plan: np.ndarray | None = None  # a recorded 3D run: the top in plan per sample [m]
     across: np.ndarray | None = None  # ... and the rotations seen across the motion's plane
 

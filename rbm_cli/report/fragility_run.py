@@ -7,7 +7,8 @@ fragility and IDA figures (:mod:`rbm_cli.report.fragility_report`) and publishes
     fragility.png, ida.png, fragility.csv, fragility_curve.csv, fragility.json
 
 (with ``damage_states`` also fragility_states.csv and fragility_states.png, the thresholds
-marked in ida.png: :mod:`rbm_cli.study.fragility_states`; with ``compare_intensities``
+marked in ida.png: :mod:`rbm_cli.study.fragility_states`; with ``residual_states`` also
+fragility_residual.csv and fragility_residual.png; with ``compare_intensities``
 also fragility_intensities.csv: :mod:`rbm_cli.study.intensity_choice`; these before the
 five) into the output folder (default: the domain's folder) as one step: the options and the
 domains are checked first (a refusal writes nothing); then, with the folder locked against
@@ -16,9 +17,9 @@ hidden folder and moved onto their names together, fragility.json last
 (:class:`rbm_cli.report.fragility_store.FragilityFolder`: a Ctrl-C or a kill leaves the
 old set or the new one, never a mix; what a killed run leaves is removed by the next).
 The optional files of the set being replaced (its fragility.json names them: damage
-states, intensities compared) that the new set does not have are removed with it, so the
-folder never holds one run's states beside another run's fit. No other file is touched,
-none deleted. fragility.json names the domain and the SHA-256
+states, residual states, intensities compared) that the new set does not have are removed
+with it, so the folder never holds one run's states beside another run's fit. No other
+file is touched, none deleted. fragility.json names the domain and the SHA-256
 of the bytes fitted, so files left beside a domain swept again show whose they are. The
 CLI calls this; the API can call the same.
 """
@@ -47,6 +48,7 @@ from rbm_cli.report.fragility_store import FILES, FragilityFolder
 from rbm_cli.study.fragility import FragilityResult, check_options, fragility
 from rbm_cli.study.fragility_samples import by_tercile
 from rbm_cli.study.fragility_states import (
+    RESIDUAL,
     DamageStates,
     check_damage_states,
     state_domain,
@@ -78,6 +80,7 @@ class FragilityRun:
     states : DamageStates or None  The damage states' fits (``damage_states`` given)
     intensities : IntensityComparison or None  The fits on every intensity measure
         (``compare_intensities``)
+    residual : DamageStates or None  The residual states' fits (``residual_states`` given)
     """
 
     result: FragilityResult
@@ -86,6 +89,7 @@ class FragilityRun:
     intensity_label: str
     states: DamageStates | None = None
     intensities: IntensityComparison | None = None
+    residual: DamageStates | None = None
 
 
 def run_fragility(
@@ -102,6 +106,7 @@ def run_fragility(
     damage_states: tuple[float, ...] | None = None,
     compare_intensities: bool = False,
     by: str | None = None,
+    residual_states: tuple[float, ...] | None = None,
 ) -> FragilityRun:
     """Fragility of a record-suite domain: fit, files and figures.
 
@@ -139,6 +144,11 @@ def run_fragility(
         Thresholds of ``max_rotation_ratio`` (0 < t <= 1, strictly increasing; 1 is
         collapse): a fragility curve per state (rbm_cli.study.fragility_states), written
         to fragility_states.csv and fragility_states.png, and marked in ida.png
+    residual_states : sequence of float, optional
+        Thresholds of ``residual_slip_m`` [m] (t > 0, strictly increasing), a domain of the
+        contact engine's: a fragility curve per residual state (a run exceeds it when its
+        residual slip reaches t or it collapsed), written to fragility_residual.csv and
+        fragility_residual.png
     compare_intensities : bool
         Also fit the suite on every intensity measure the domain carries and rank them by
         beta (rbm_cli.study.intensity_choice), written to fragility_intensities.csv
@@ -162,6 +172,9 @@ def run_fragility(
     """
     check_options(n_resamples, seed, ci_percentiles)
     thresholds = None if damage_states is None else check_damage_states(damage_states)
+    slips = None
+    if residual_states is not None:
+        slips = check_damage_states(residual_states, "fragility: residual_states", RESIDUAL)
     domain = Path(domain_csv)
     df, digest = read_suite_domain_hashed(domain)
     members = n_members(domain, df)
@@ -169,6 +182,8 @@ def run_fragility(
     prepare_outcomes(df, intensity_column, ensemble_outcome, members)
     if thresholds:
         prepare_outcomes(state_domain(df, thresholds[0]), intensity_column, "member0")
+    if slips:
+        prepare_outcomes(state_domain(df, slips[0], RESIDUAL), intensity_column, "member0")
     if compare_intensities:
         check_carries_measures(df)
     if isinstance(compare, str | os.PathLike):
@@ -184,8 +199,8 @@ def run_fragility(
     options = dict(n_resamples=n_resamples, seed=seed, ci_percentiles=ci_percentiles,
                    intensity_column=intensity_column,
                    ensemble_outcome=ensemble_outcome)  # fmt: skip
-    parts = len(frames) + 1 + bool(thresholds) + bool(compare_intensities)
-    states = comparison = None
+    parts = len(frames) + 1 + bool(thresholds) + bool(slips) + bool(compare_intensities)
+    states = comparison = residual = None
     with FragilityFolder(folder) as store:
         result = fragility(df, **options, n_members=members, progress=_part(progress, 0, parts))
         others = []
@@ -199,6 +214,13 @@ def run_fragility(
                                      intensity_column=intensity_column,
                                      progress=_part(progress, part, parts))  # fmt: skip
             part += 1
+        if slips:
+            residual = fit_every_state(df, slips, n_resamples=n_resamples, seed=seed,
+                                       ci_percentiles=ci_percentiles,
+                                       intensity_column=intensity_column,
+                                       progress=_part(progress, part, parts),
+                                       measure=RESIDUAL)  # fmt: skip
+            part += 1
         if compare_intensities:
             comparison = fit_every_measure(df, **_without(options, "intensity_column"),
                                            n_members=members,
@@ -207,17 +229,18 @@ def run_fragility(
             "domain": os.path.relpath(domain.resolve(), folder.resolve()),
             "domain_sha256": digest,  # of the bytes fitted: which domain.csv these are of
         }
-        source |= extra_summary(states, comparison)
+        source |= extra_summary(states, comparison, residual)
         if terciles is not None:
             source["by"] = by
         label, contents = _contents(domain, df, result, others, source, thresholds or ())
-        contents |= extra_contents(states, comparison, label)
+        contents |= extra_contents(states, comparison, label, residual)
         if terciles is not None:
             contents |= _by_contents(terciles, by, label, result)
         paths = store.publish({name: contents[name] for name in extra_files(contents) + FILES},
                               retire=superseded(folder, contents))  # fmt: skip
     return FragilityRun(result=result, domain=domain, paths=paths, intensity_label=label,
-                        states=states, intensities=comparison)  # fmt: skip
+                        states=states, intensities=comparison,
+                        residual=residual)  # fmt: skip
 
 
 def _without(options: dict, key: str) -> dict:
@@ -225,13 +248,15 @@ def _without(options: dict, key: str) -> dict:
 
 
 def extra_files(contents: dict) -> tuple[str, ...]:
-    """The names of ``contents`` beyond the fragility set's :data:`FILES` (the damage
-    states', the intensities' and the terciles' files), published before them."""
+    """The names of ``contents`` beyond the fragility set's :data:`FILES` (the damage and
+    residual states', the intensities' and the terciles' files), published before them."""
     return tuple(name for name in contents if name not in FILES)
 
 
 #: The optional files of a fragility set and the fragility.json entry that claims them.
 OPTIONAL_FILES = {"fragility_states.png": "damage_states", "fragility_states.csv": "damage_states",
+                  "fragility_residual.png": "residual_states",
+                  "fragility_residual.csv": "residual_states",
                   "fragility_intensities.csv": "intensity_statement",
                   "fragility_by.csv": "by", "fragility_by.png": "by"}  # fmt: skip
 
@@ -250,27 +275,33 @@ def superseded(folder: Path, contents: dict) -> tuple[str, ...]:
                  if key in old and name not in contents and (folder / name).is_file())  # fmt: skip
 
 
-def extra_summary(states: DamageStates | None, comparison: IntensityComparison | None) -> dict:
-    """fragility.json's entries on the damage states and the intensities compared (which
-    files of the folder belong to this set)."""
+def extra_summary(
+    states: DamageStates | None,
+    comparison: IntensityComparison | None,
+    residual: DamageStates | None = None,
+) -> dict:
+    """fragility.json's entries on the damage states, the residual states and the
+    intensities compared (which files of the folder belong to this set)."""
     out: dict = {}
-    if states is not None:
-        out["damage_states"] = list(states.thresholds)
-        out["damage_states_crossings"] = list(states.crossings)
-        out["damage_states_note"] = states.note
+    for key, fits in (("damage_states", states), ("residual_states", residual)):
+        if fits is not None:
+            out[key] = list(fits.thresholds)
+            out[f"{key}_crossings"] = list(fits.crossings)
+            out[f"{key}_note"] = fits.note
     if comparison is not None:
         out["intensity_best"] = comparison.best or None
         out["intensity_statement"] = comparison.statement
     return out
 
 
-def extra_contents(states, comparison, label: str) -> dict:
-    """The damage states' and the intensities' files, by name (``label``: the intensity's
-    axis label)."""
+def extra_contents(states, comparison, label: str, residual=None) -> dict:
+    """The damage states', the residual states' and the intensities' files, by name
+    (``label``: the intensity's axis label)."""
     out: dict = {}
-    if states is not None:
-        out["fragility_states.png"] = _png(states_figure(states, label))
-        out["fragility_states.csv"] = states_csv(states)
+    for stem, fits in (("fragility_states", states), ("fragility_residual", residual)):
+        if fits is not None:
+            out[f"{stem}.png"] = _png(states_figure(fits, label))
+            out[f"{stem}.csv"] = states_csv(fits)
     if comparison is not None:
         out["fragility_intensities.csv"] = intensities_csv(comparison)
     return out

@@ -5,6 +5,8 @@
   median and beta with their bootstrap intervals, counts, notes);
 - ``fragility_states.png``: every state's observed fractions, fitted curve and band in one
   figure (:func:`plot_states`);
+- ``fragility_residual.csv`` and ``fragility_residual.png``: the same of the residual
+  states (thresholds of ``residual_slip_m``);
 - ``fragility_intensities.csv``: one row per intensity measure, ranked by beta;
 - the IDA's thresholds: a dotted vertical line per state below collapse
   (:func:`mark_thresholds`).
@@ -16,7 +18,7 @@ from __future__ import annotations
 
 import textwrap
 
-from rbm_cli.study.fragility_states import DamageStates
+from rbm_cli.study.fragility_states import PEAK, DamageStates, StateMeasure
 from rbm_cli.study.intensity_choice import IntensityComparison
 
 #: Float format of the CSV files (12 significant digits, as domain.csv).
@@ -43,9 +45,13 @@ def _new_axes():
     return Figure(figsize=(7, 5)).subplots()
 
 
-def state_label(threshold: float) -> str:
-    """A damage state's name in the figures."""
-    return "collapse" if threshold >= 1.0 else f"max_rotation_ratio >= {threshold:g}"
+def state_label(threshold: float, measure: StateMeasure = PEAK) -> str:
+    """A state's name in the figures: collapse at the measure's upper bound (a peak
+    rotation ratio of 1), else its column >= the threshold (with its unit)."""
+    if measure.upper is not None and threshold >= measure.upper:
+        return "collapse"
+    unit = f" {measure.unit}" if measure.unit != "-" else ""
+    return f"{measure.column} >= {threshold:g}{unit}"
 
 
 def plot_states(states: DamageStates, ax=None, *, xlabel: str = "intensity"):
@@ -57,7 +63,7 @@ def plot_states(states: DamageStates, ax=None, *, xlabel: str = "intensity"):
     unit = states.intensity_unit
     for k, (t, res) in enumerate(zip(states.thresholds, states.results, strict=True)):
         color = STATE_COLOURS[k % len(STATE_COLOURS)]
-        name = state_label(t)
+        name = state_label(t, states.measure)
         table = res.table
         (points,) = ax.plot(table["intensity_g"], table["fraction"], "o", ms=4, color=color,
                             label=f"{name}: observed fraction")  # fmt: skip
@@ -95,7 +101,8 @@ def plot_states(states: DamageStates, ax=None, *, xlabel: str = "intensity"):
 def states_figure(states: DamageStates, label: str, title: str = ""):
     """A new figure (no pyplot) with :func:`plot_states`."""
     ax = plot_states(states, xlabel=label)
-    ax.set_title(f"damage states, {title}" if title else "damage states", fontsize=9)
+    name = states.measure.name
+    ax.set_title(f"{name}, {title}" if title else name, fontsize=9)
     return ax.figure
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from rbm_cli.config.types import MODELS
 from rbm_cli.models.history import History
-from rbm_cli.study.schema import COMMON_RESULT_COLUMNS, C
+from rbm_cli.study.schema import COMMON_RESULT_COLUMNS, RESIDUAL_COLUMNS, C
 
 STATUSES = ("collapsed", "survived", "failed")
 
@@ -22,6 +22,10 @@ SLIDES_FIELD = C.slides
 #: the azimuth its lean pointed to at collapse [deg from x, in (-180, 180]; empty if it
 #: survived], and the angle its lean's direction swept while it rolled [turns].
 THREE_D_FIELDS = (C.collapse_azimuth_deg, C.wobble_turns)
+#: The columns a domain of the contact engine (model bullet) adds after those: the
+#: residual slip [m], the top's residual offset [m] and the residual tilt ratio [-] where a
+#: run that survived ended (empty if it collapsed or failed).
+RESIDUAL_FIELDS = RESIDUAL_COLUMNS
 
 
 @dataclass(frozen=True)
@@ -62,6 +66,14 @@ class RunResult:
         while it rolled [turns] (nan for a planar model)
     three_d : bool  The run moved in three dimensions (Config.three_d): domain.csv keeps
         the collapse azimuth and the wobbling turns
+    residual_slip_m : float  The contact engine's residual slip: the largest |slip| of a
+        joint where the run ended [m] (the motion and its free time over, or at rest after
+        the pulse; nan if it collapsed or failed, and for the other models)
+    residual_top_offset_m : float  The top's offset in plan from its start there [m]
+    residual_tilt_ratio : float  The largest |relative rotation| / alpha_i of a joint
+        there [-]
+    residual : bool  The model gives the residual state (MODELS' ``residual``):
+        domain.csv keeps the three
     energy : dict or None  A recorded run's energy account [J] (models.outcome.EnergyAccount
         as_dict: start, end, the ground's work, what damping and impacts took, the residual
         of the balance); None where the method keeps none (not in domain.csv)
@@ -92,6 +104,10 @@ class RunResult:
     three_d: bool = False
     friction_demand_peak: tuple[float, ...] = ()
     friction_duration_s: float | None = None
+    residual_slip_m: float = float("nan")
+    residual_top_offset_m: float = float("nan")
+    residual_tilt_ratio: float = float("nan")
+    residual: bool = False
 
     @property
     def collapsed(self) -> bool:
@@ -132,6 +148,8 @@ class RunResult:
             out[SLIDES_FIELD] = self.slides
         if self.three_d:
             out.update({k: getattr(self, k) for k in THREE_D_FIELDS})
+        if self.residual:
+            out.update({k: getattr(self, k) for k in RESIDUAL_FIELDS})
         return out
 
     def summary(self) -> dict:

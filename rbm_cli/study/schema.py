@@ -55,6 +55,10 @@ def _friction_checked(config: Config, ensemble: int) -> bool:
     return bool(MODELS[config.model].beam and config.interface.friction_limit is not None)
 
 
+def _residual(config: Config, ensemble: int) -> bool:
+    return bool(MODELS[config.model].residual)
+
+
 def _uncertain(config: Config, ensemble: int) -> bool:
     return config.uncertain is not None
 
@@ -104,6 +108,7 @@ def _scale(name, unit, quantity) -> Column:
 
 
 _RECORD_ONLY = "record excitations (excitation.type: record)"
+_RESIDUAL_ONLY = "model bullet; empty if it collapsed or failed"
 _UNCERTAIN_ONLY = "configs with uncertain keys (the uncertain section)"
 #: The name the schema gives the columns of the uncertain keys' values, one per key.
 UNCERTAIN_PATTERN = PREFIX + "<key>"
@@ -172,6 +177,30 @@ _BEFORE: tuple[Column, ...] = (
         "angle the lean's direction swept while it rolled",
         "models in three dimensions",
         _three_d,
+    ),  # fmt: skip
+    _result(
+        "residual_slip_m",
+        "float",
+        "m",
+        "residual slip: the largest |slip| of a joint where the run ended",
+        _RESIDUAL_ONLY,
+        _residual,
+    ),  # fmt: skip
+    _result(
+        "residual_top_offset_m",
+        "float",
+        "m",
+        "residual top offset: the top's offset in plan from its start where the run ended",
+        _RESIDUAL_ONLY,
+        _residual,
+    ),  # fmt: skip
+    _result(
+        "residual_tilt_ratio",
+        "float",
+        "-",
+        "residual tilt: the largest |relative rotation| / alpha_i of a joint where the run ended",
+        _RESIDUAL_ONLY,
+        _residual,
     ),  # fmt: skip
     _result("n_uplifts", "int", "", "uplifts"),
     _result("n_impacts", "int", "", "impacts"),
@@ -260,6 +289,9 @@ RESULT_COLUMNS = tuple(c.name for c in COLUMNS if c.group == "result")
 #: The result's columns every domain has (the others depend on the model and the config).
 COMMON_RESULT_COLUMNS = tuple(c.name for c in COLUMNS if c.group == "result" and c.when is _always)
 SCALE_COLUMNS = tuple(c.name for c in COLUMNS if c.group == "scale")
+#: The result's columns of a model whose drums may slide for good (MODELS' ``residual``:
+#: the contact engine): the residual slip [m], top offset [m] and tilt ratio [-].
+RESIDUAL_COLUMNS = tuple(c.name for c in COLUMNS if c.when is _residual)
 ENSEMBLE_COLUMNS = tuple(c.name for c in COLUMNS if c.group == "ensemble")
 
 
@@ -332,6 +364,7 @@ __all__ = [
     "DTYPES",
     "ENSEMBLE_COLUMNS",
     "GROUPS",
+    "RESIDUAL_COLUMNS",
     "RESULT_COLUMNS",
     "SCALE_COLUMNS",
     "COMMON_RESULT_COLUMNS",

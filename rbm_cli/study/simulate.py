@@ -104,6 +104,10 @@ def _result(config, out, amplitude_g, frequency_hz, history, start) -> RunResult
         collapse_azimuth_deg=math.degrees(math.remainder(out.azimuth, 2.0 * math.pi)),
         wobble_turns=float(out.turns),
         three_d=config.three_d,
+        residual_slip_m=float(out.residual_slip),
+        residual_top_offset_m=float(out.residual_top),
+        residual_tilt_ratio=float(out.residual_tilt),
+        residual=MODELS[config.model].residual,
         friction_demand_peak=tuple(float(v) for v in out.friction_peak)
         if out.friction_peak is not None and MODELS[config.model].beam
         else (),

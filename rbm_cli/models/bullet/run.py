@@ -73,6 +73,7 @@ from rbm_cli.models.bullet.watch import (
     FRICTION_DT,
     OPEN_FRACTION,
     REST_ANGULAR_RATE,
+    REST_SPEED,
     REST_TIME,
     RunWatch,
 )
@@ -90,6 +91,7 @@ __all__ = [
     "MAX_FRICTION",
     "OPEN_FRACTION",
     "REST_ANGULAR_RATE",
+    "REST_SPEED",
     "REST_TIME",
     "EngineSettings",
     "PhysicsClient",
@@ -236,7 +238,10 @@ def bullet_run(
         largest mobilised friction |T| / N of the joint's mean force over each
         FRICTION_DT interval (:func:`rbm_cli.models.bullet.scene.joint_friction`; nan
         if never loaded);
-        the message gives the largest slips. A vertical record reaching -g ends
+        the message gives the largest slips; residual_slip [m], residual_top [m] and
+        residual_tilt [-] the state where the run ended (RunWatch.residual; nan unless
+        it survived; 0 where the ground's acceleration stays below the uplift and
+        sliding levels, the stack moving with it). A vertical record reaching -g ends
         the run there, 'failed' (unless it collapsed before).
     """
     solids = drum_solids(config.column)
@@ -258,7 +263,10 @@ def bullet_run(
         out.message = "at rest: ground acceleration below the uplift and sliding levels"
         if config.three_d:
             out.turns = 0.0
-        return out.stop("survived", out.message, motion.t_end).lifted_off(t_lift), None
+        out.stop("survived", out.message, motion.t_end).lifted_off(t_lift)
+        if out.status == "survived":  # nothing moved on the ground
+            out.residual_slip = out.residual_top = out.residual_tilt = 0.0
+        return out, None
 
     dt = settings.time_step
     sample = max(1, int(round(output_dt / dt))) if record else 0
@@ -283,6 +291,7 @@ def bullet_run(
         space,
     )
     out.lifted_off(t_lift)
+    watch.residual(out)
     if space:
         out.turns = float(np.max(watch.swept)) / (2.0 * math.pi)
         out.message += "; " + _slip_text(watch.slid, "slid") + "; " + _twist_text(watch.max_twist)

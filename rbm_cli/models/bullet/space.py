@@ -40,6 +40,10 @@ class Joints3d:
         from the centre of drum i's bottom face to their centre of mass [rad]
     bottoms : (n, 3) centres of the drums' bottom faces (ground axes) [m]
     top : (3,) centre of the top face of the top drum (ground axes) [m]
+    slip : (n, 2) sliding of drum i on its support, in plan (ground axes) [m]: the offset
+        of its bottom face's centre from its support's top face's centre, less the offset
+        b_i (1 - cos relative) along its lean that rocking on its rim gives without sliding
+        (the planar joint_state's slip in any direction)
     """
 
     relative: np.ndarray
@@ -50,6 +54,7 @@ class Joints3d:
     azimuth: np.ndarray
     bottoms: np.ndarray
     top: np.ndarray
+    slip: np.ndarray
 
 
 def _supports(rot: np.ndarray) -> np.ndarray:
@@ -157,6 +162,7 @@ def joint_state_3d(frame: Frame, stack: StackGeometry, alpha: np.ndarray) -> Joi
         reach = np.where(size[:, None] > 0.0, down / size[:, None], 0.0)
     pivot_s = b + stack.half_bottom[:, None] * reach
     pivots = origin + np.einsum("nij,nj->ni", rot_s, pivot_s)
+    rocked = (stack.half_bottom * (1.0 - np.cos(relative)))[:, None] * lean_s
     return Joints3d(
         relative=relative,
         pivots=pivots,
@@ -166,6 +172,7 @@ def joint_state_3d(frame: Frame, stack: StackGeometry, alpha: np.ndarray) -> Joi
         azimuth=np.arctan2(azimuth_v[:, 1], azimuth_v[:, 0]),
         bottoms=bottoms,
         top=tops[-1],
+        slip=_plan(rot_s, b[:, :2] - rocked),
     )
 
 

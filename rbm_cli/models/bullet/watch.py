@@ -47,10 +47,15 @@ NEAR_FRACTION = WOBBLE_LEVEL
 LANDING_FRACTION = 0.5
 #: Drop of a drum's centre of mass, as a fraction of its height, that is collapse.
 DROP_FRACTION = 0.5
-#: Half-sine/free early stop: every rate below this [rad/s] and every joint
-#: closed for REST_TIME [s] after the pulse.
+#: Half-sine/free early stop: every rate below this [rad/s], every drum's speed below
+#: REST_SPEED [m/s] and every joint closed for REST_TIME [s] after the pulse.
 REST_ANGULAR_RATE = 1e-4
 REST_TIME = 0.2
+#: A drum sliding on its support at rest in rotation (a block sliding to a stop) is not
+#: at rest: stopped there the run would cut its slip short (measured: a 1 m block with
+#: friction 0.2 under a 0.6 g, 2 Hz half-sine stopped with 117.4 mm of the 119.0 mm it
+#: slides). From this speed friction stops it within 1e-8 m.
+REST_SPEED = 1e-4
 #: A drum faster than this [m/s or rad/s] means the engine blew up.
 BLOWUP = 1e3
 
@@ -110,7 +115,9 @@ class RunWatch:
         self.friction_steps = max(1, int(round(FRICTION_DT / dt)))
         self.k_prev = 0
         self.frame_prev = frame
+        self.frame_last = frame  # the last frame checked (see): the run's state at its end
         self.space = space
+        self.top_start = self.joints(frame).top.copy()
         if space:
             self.faces = [normals(frame)]
             self.lean_last = np.zeros((n, 2))
@@ -134,6 +141,7 @@ class RunWatch:
     def see(self, frame: Frame) -> Joints | Joints3d:
         """The joints of a checked frame; widens the friction window's range of normals."""
         joints = self.joints(frame)
+        self.frame_last = frame
         if self.space:
             self.faces.append(normals(frame))
             return joints
@@ -141,6 +149,29 @@ class RunWatch:
         self.tilt_lo = np.minimum(self.tilt_lo, tilts)
         self.tilt_hi = np.maximum(self.tilt_hi, tilts)
         return joints
+
+    def residual(self, out: Outcome) -> None:
+        """The run's residual state, read from the last frame checked (where the run
+        ended: the motion and its free time over, or at rest after the pulse), into
+        ``out``: the largest |slip| over the joints [m], the top's offset in plan from its
+        start [m] and the largest |relative rotation| / alpha_i over the joints [-]. Left
+        NaN for a run that collapsed or failed (the column is down, or its state is not
+        the engine's). Notes: :func:`rbm_cli.models.bullet.scene.joint_state` (the slip in
+        the plane) and :func:`rbm_cli.models.bullet.space.joint_state_3d` (in three
+        dimensions, its magnitude in plan)."""
+        if out.status != "survived":
+            return
+        joints = self.joints(self.frame_last)
+        offset = joints.top - self.top_start
+        if self.space:
+            slip = np.hypot(joints.slip[:, 0], joints.slip[:, 1])
+            top = float(np.hypot(offset[0], offset[1]))
+        else:
+            slip = np.abs(joints.slip)
+            top = abs(float(offset[0]))
+        out.residual_slip = float(np.max(slip))
+        out.residual_top = top
+        out.residual_tilt = float(np.max(np.abs(joints.relative) / self.alpha))
 
     def check(
         self,
@@ -264,10 +295,11 @@ class RunWatch:
         return False
 
     def _at_rest(self, out: Outcome, k: int, t: float, frame: Frame, is_open) -> bool:
-        """After the pulse: at rest (every rate below REST_ANGULAR_RATE, every joint
-        closed) for REST_TIME."""
+        """After the pulse: at rest (every rate below REST_ANGULAR_RATE, every speed
+        below REST_SPEED, every joint closed) for REST_TIME."""
         rates = np.linalg.norm(frame.angular, axis=1) if self.space else np.abs(frame.rates)
-        still = np.max(rates) < REST_ANGULAR_RATE and not np.any(is_open)
+        moving = np.max(rates) >= REST_ANGULAR_RATE or np.max(frame.speeds) >= REST_SPEED
+        still = not moving and not np.any(is_open)
         quiet = self.quiet_since
         self.quiet_since = (quiet if quiet is not None else t) if still else None
         if self.quiet_since is not None and t - self.quiet_since >= REST_TIME:

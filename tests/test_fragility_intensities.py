@@ -16,9 +16,8 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
-from click.testing import CliRunner
 
-from rbm_cli.cli.main import cli
+from tests.fragility_domains import invoke, write
 
 from .paths import RESULTS
 
@@ -56,16 +55,6 @@ def suite(n_records=120, seed=2):
                 "pga_over_g_tan_alpha": x / TAN_ALPHA,
             })  # fmt: skip
     return pd.DataFrame(rows)
-
-
-def write(folder, df):
-    folder.mkdir(parents=True, exist_ok=True)
-    df.to_csv(folder / "domain.csv", index=False, float_format="%.12g")
-    return str(folder / "domain.csv")
-
-
-def invoke(*args):
-    return CliRunner().invoke(cli, ["fragility", *[str(a) for a in args]])
 
 
 def test_every_measure_ranked_by_beta_each_the_plain_fit(tmp_path):

@@ -18,11 +18,10 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
-from click.testing import CliRunner
 
 import rbm
 from rbm_cli.base.errors import RbmError
-from rbm_cli.cli.main import cli
+from tests.fragility_domains import invoke, write
 
 THETA, BETA = 0.4, 0.35
 #: The residual slip a run reaches just below its collapse [m].
@@ -64,16 +63,6 @@ def exceeding(df, threshold):
     out["collapsed"] = hit.astype(int)
     out["status"] = np.where(~ok, "failed", np.where(hit, "collapsed", "survived"))
     return out
-
-
-def write(folder, df):
-    folder.mkdir(parents=True, exist_ok=True)
-    df.to_csv(folder / "domain.csv", index=False, float_format="%.12g")
-    return str(folder / "domain.csv")
-
-
-def invoke(*args):
-    return CliRunner().invoke(cli, ["fragility", *[str(a) for a in args]])
 
 
 def test_each_residual_state_is_the_plain_fit_of_its_own_outcomes(tmp_path):

@@ -17,14 +17,13 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
-from click.testing import CliRunner
 from scipy.stats import norm
 
 import rbm
 from rbm_cli.base.errors import RbmError
-from rbm_cli.cli.main import cli
 from rbm_cli.report import fragility_run
 from rbm_cli.study.fragility_states import crossing_intensity
+from tests.fragility_domains import invoke, write
 
 THETA, BETA = 0.4, 0.35
 LEVELS = np.round(np.arange(0.05, 1.0001, 0.05), 10)
@@ -66,16 +65,6 @@ def exceeding(df, threshold):
     out["collapsed"] = hit.astype(int)
     out["status"] = np.where(~ok, "failed", np.where(hit, "collapsed", "survived"))
     return out
-
-
-def write(folder, df):
-    folder.mkdir(parents=True, exist_ok=True)
-    df.to_csv(folder / "domain.csv", index=False, float_format="%.12g")
-    return str(folder / "domain.csv")
-
-
-def invoke(*args):
-    return CliRunner().invoke(cli, ["fragility", *[str(a) for a in args]])
 
 
 def states_table(folder):

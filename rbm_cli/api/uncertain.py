@@ -4,7 +4,6 @@ stored domain (rbm_cli.config.uncertain), and which key moves a domain's outcome
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -16,6 +15,7 @@ from rbm_cli.base.files import save_figure_atomic, write_text_atomic
 from rbm_cli.config.types import Config
 from rbm_cli.report.sensitivity_figure import tornado_figure
 from rbm_cli.study.domain import csv_text, read_domain
+from rbm_cli.study.fingerprint import read_meta
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -24,16 +24,7 @@ __all__ = ["read_design", "sensitivity", "write_sensitivity"]
 
 
 def _stored_design(path: Path) -> dict | None:
-    meta = path / "meta.json" if path.is_dir() else path.with_name("meta.json")
-    try:
-        data = json.loads(meta.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise RbmError(f"{path} holds no finished domain (no meta.json beside it)") from None
-    except (OSError, ValueError) as exc:
-        raise RbmError(f"cannot read {meta}: {' '.join(str(exc).split())}") from None
-    if not isinstance(data, dict):
-        raise RbmError(f"{meta} is not a domain's meta.json (not a JSON object)")
-    return data.get("uncertain")
+    return read_meta(path if path.is_dir() else path.parent).get("uncertain")
 
 
 def read_design(source: Config | str | os.PathLike | Mapping[str, Any]) -> pd.DataFrame | None:

@@ -161,10 +161,7 @@ def fragility(domain, output, resamples, seed, intensity_column, ensemble_outcom
     if res.fit is None:
         click.echo(f"no fit: {res.note}")
     else:
-        lo, hi = res.ci_percentiles
-        unit = f" {res.intensity_unit}"
-        median = f"{res.fit.median_g:.4g}{unit}" + _interval(res.median_ci_g, lo, hi, unit)
-        beta = f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
+        median, beta = _fit_texts(res)
         click.echo(f"median {median}, dispersion beta {beta}")
         if res.note:
             click.echo(f"note: {res.note}")
@@ -190,13 +187,10 @@ def _echo_states(states) -> None:
     click.echo(f"{measure.name} ({measure.column}, {states.intensity_column}):")
     unit = f" {measure.unit}" if measure.unit != "-" else ""
     for t, res in zip(states.thresholds, states.results, strict=True):
-        lo, hi = res.ci_percentiles
         if res.fit is None:
             click.echo(f"  {t:g}{unit}: no fit: {res.note}")
             continue
-        im = f" {res.intensity_unit}"
-        median = f"{res.fit.median_g:.4g}{im}" + _interval(res.median_ci_g, lo, hi, im)
-        beta = f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
+        median, beta = _fit_texts(res)
         click.echo(f"  {t:g}{unit}: median {median}, beta {beta}")
         if res.fit_warning:
             click.echo(f"    warning: {res.fit_warning}")
@@ -235,6 +229,14 @@ def _dispersion(split) -> str:
         f" sqrt(RTR^2 + U^2) {shown(split.beta_total)} (one fit of every run:"
         f" {shown(split.beta_pooled)})"
     )
+
+
+def _fit_texts(res) -> tuple[str, str]:
+    """A fit's median (in the intensity's unit) and beta, each with its interval."""
+    lo, hi = res.ci_percentiles
+    unit = f" {res.intensity_unit}"
+    median = f"{res.fit.median_g:.4g}{unit}" + _interval(res.median_ci_g, lo, hi, unit)
+    return median, f"{res.fit.beta:.3g}" + _interval(res.beta_ci, lo, hi, "")
 
 
 def _interval(ci: tuple[float, float], lo: float, hi: float, unit: str) -> str:

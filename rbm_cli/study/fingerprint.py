@@ -265,7 +265,9 @@ def schema1_problem(folder: Path, meta: dict, config: Config) -> str | None:
     return None
 
 
-def _read_meta(folder: Path) -> dict:
+def read_meta(folder: Path) -> dict:
+    """The meta.json of the finished domain in ``folder``, a dict; RbmError in one line
+    when there is none or it is not a JSON object."""
     path = folder / "meta.json"
     try:
         meta = json.loads(path.read_text(encoding="utf-8"))
@@ -305,7 +307,7 @@ def migrate(folder: str | Path) -> str:
     schema, once the module's checks hold; its other files are not touched. Returns a
     one-line note; RbmError (one line) when it cannot or need not be done."""
     folder = Path(folder)
-    meta = _read_meta(folder)
+    meta = read_meta(folder)
     schema = meta.get("schema", 1)
     if schema == SCHEMA:
         return f"{folder}: already stored under schema {SCHEMA}, nothing to do"

@@ -2,7 +2,7 @@
 answers as every later use (first use and a correct cache).
 
 numba checks a cached function only against its own file: a change to a callee in another
-module (step/rk.py, detmath.py) once left the cached run_kernel in use, and
+module (numerics/rk.py, then step/rk.py; detmath.py) once left the cached run_kernel in use, and
 needs_compile() said nothing needed compiling. Here a copy of the package is run in
 subprocesses (the copy first on PYTHONPATH, numba's cache in a fresh folder):
 
@@ -227,7 +227,7 @@ def test_the_digest_moves_with_the_compiled_sources_only(tmp_path):
 
     cli = root / "cli" / "main.py"
     assert not changed(cli, cli.read_text() + "\n# a comment\n")
-    rk = root / "models" / "rbm" / "step" / "rk.py"
+    rk = root / "numerics" / "rk.py"
     assert changed(rk, rk.read_text().replace("SAFETY, MIN_FACTOR", "SAFETY,  MIN_FACTOR"))
     events = root / "base" / "events.py"
     assert changed(events, events.read_text() + "\n# EVENT_EPS is read by run_kernel\n")

@@ -10,7 +10,7 @@ from scipy.integrate._ivp import dop853_coefficients as dop
 from scipy.integrate._ivp.rk import RK23, RK45
 
 from rbm_cli.base import rk_tableaux as tb
-from rbm_cli.models.rbm.step import rk
+from rbm_cli.numerics import rk
 
 
 def padded(rows, shape) -> np.ndarray:

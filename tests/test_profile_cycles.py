@@ -14,18 +14,21 @@ def _script():
 def test_the_counters_go_into_todays_run_loops(tmp_path):
     script = _script()
     script.instrumented(ROOT, tmp_path)
-    for f, parts in ((script.STEPPER, script.STEP_PARTS), (script.EXACT_RUN, script.EXACT_PARTS)):
-        text = (tmp_path / f).read_text()
-        ast.parse(text)
-        assert "from rbm_cli.base.cycles import cycles" in text
+    step_files, exact_files = (script.LOOP, script.STEPPER), (script.EXACT_RUN,)
+    for files, parts in ((step_files, script.STEP_PARTS), (exact_files, script.EXACT_PARTS)):
+        texts = [(tmp_path / f).read_text() for f in files]
+        for text in texts:
+            ast.parse(text)
+            assert "from rbm_cli.base.cycles import cycles" in text
+        text = "".join(texts)
         assert text.count("print('CYCLES'") >= 1
         # every part has its counter: prof[i] (the step kernel) or s.cnt[8 + i] (exact)
         for i in range(len(parts)):
-            assert (f"prof[{i}] +=" in text) or (f"s.cnt[{8 + i}] +=" in text), (f, i)
+            assert (f"prof[{i}] +=" in text) or (f"s.cnt[{8 + i}] +=" in text), (files, i)
     ast.parse((tmp_path / "rbm_cli" / "base" / "cycles.py").read_text())
-    # the package copied is untouched but for the two files
-    original = (ROOT / "rbm_cli" / "models" / "rbm" / "step" / "rk.py").read_text()
-    assert (tmp_path / "rbm_cli" / "models" / "rbm" / "step" / "rk.py").read_text() == original
+    # the package copied is untouched but for the three files
+    original = (ROOT / "rbm_cli" / "numerics" / "rk.py").read_text()
+    assert (tmp_path / "rbm_cli" / "numerics" / "rk.py").read_text() == original
 
 
 def test_a_changed_run_loop_stops_the_script_in_one_line(tmp_path, monkeypatch):

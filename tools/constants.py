@@ -283,7 +283,7 @@ RBM3D = "rbm_cli/models/rbm3d/kernel.py"
 H3D = "rbm_cli/models/housner3d/runner.py"
 ARRAYS = "rbm_cli/physics/arrays.py"
 REST_NOW = "REST_RATE = math.sqrt(200.0 * EVENT_EPS)"
-RK = "rbm_cli/models/rbm/step/rk.py"
+RK = "rbm_cli/numerics/rk.py"
 
 VARIANTS: dict[str, Variant] = {
     "NUDGE": Variant(

@@ -6,11 +6,12 @@ per part of the run loop, per event (docs/performance.md, "Record suites: inside
 The compiled code cannot be profiled by Python's profilers, and the uncompiled code spends
 its time elsewhere. So this script copies the package to a temporary folder, adds a read of
 the processor's cycle counter (LLVM's readcyclecounter: the time-stamp counter on x86-64)
-around each part of the run loops of the step kernel (models.rbm.step.stepper) and of the
-exact integrator (models.rbm.exact.run), compiles that copy (its own numba cache: two
-compiles, about 3 min) and runs the 40 runs of `configs/ci/suite_multidrum_ci.yaml` with
-each method, one at a time in one process, after one run that compiles. It prints, for
-each part, the cycles it took per event of the runs and its share of the runs' cycles.
+around each part of the run loops of the step kernel (numerics.loop with the planar column's
+functions, models.rbm.step.stepper) and of the exact integrator (models.rbm.exact.run),
+compiles that copy (its own numba cache: two compiles, about 3 min) and runs the 40 runs of
+`configs/ci/suite_multidrum_ci.yaml` with each method, one at a time in one process, after
+one run that compiles. It prints, for each part, the cycles it took per event of the runs
+and its share of the runs' cycles.
 The package itself is not changed. The counters cost a few percent: the shares, not the
 totals, are the result. Say the load.
 
@@ -29,6 +30,7 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+LOOP = Path("rbm_cli/numerics/loop.py")
 STEPPER = Path("rbm_cli/models/rbm/step/stepper.py")
 EXACT_RUN = Path("rbm_cli/models/rbm/exact/run.py")
 
@@ -59,61 +61,69 @@ EXACT_PARTS = ["certified search (next_point)", "peak intervals (note_interval)"
 
 #: (file, anchor, replacement): each anchor must occur once in its file.
 ANCHORS = [
-    (STEPPER, "from rbm_cli.base.jit import jit\n",
+    (LOOP, "from rbm_cli.base.jit import jit\n",
      "from rbm_cli.base.jit import jit\nfrom rbm_cli.base.cycles import cycles\n"),
-    (STEPPER, "    n = theta0.size\n    n_out = 0\n",
-     "    n = theta0.size\n    prof = np.zeros(11)\n    c_all = cycles()\n    n_out = 0\n"),
-    (STEPPER, "            system(side, k, intercepts",
-     "            c0 = cycles()\n            system(side, k, intercepts"),
-    (STEPPER, "            event = False\n            running = True\n",
+    (LOOP, "    n_upl, n_imp, n_steps, n_rhs, n_ev, t = 0, 0, 0, 0, 0, 0.0\n",
+     "    n_upl, n_imp, n_steps, n_rhs, n_ev, t = 0, 0, 0, 0, 0, 0.0\n"
+     "    prof = np.zeros(11)\n    c_all = cycles()\n"),
+    (LOOP, "            # a new stepper from (t, y)",
+     "            c0 = cycles()\n            # a new stepper from (t, y)"),
+    (LOOP, "            event = False\n            running = True\n",
      f"            prof[9] += {TICK}\n            event = False\n            running = True\n"),
-    (STEPPER, "                taken, t_new, h, h_abs, calls = attempt_step(",
+    (LOOP, "                taken, t_new, h, h_abs, calls = attempt_step(",
      "                c0 = cycles()\n"
      "                taken, t_new, h, h_abs, calls = attempt_step("),
-    (STEPPER, "                n_rhs += calls\n",
-     f"                n_rhs += calls\n                prof[0] += {TICK}\n"
-     "                c0 = cycles()\n"),
-    (STEPPER, "                event_row = -1\n                t_e = t_new\n",
-     f"                prof[1] += {TICK}\n                c0 = cycles()\n"
-     "                event_row = -1\n                t_e = t_new\n"),
-    (STEPPER, "                if within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, "
-     "t_new - t_old, near):\n                    n_rhs += dense_prepare(mc, t_old, h, y_old, "
-     "y_new, K, F, tmp, n, As,\n                                            cs, es, gr)  # fmt: "
-     "skip\n",
-     "                reach = within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, "
-     f"t_new - t_old, near)\n                prof[2] += {TICK}\n                c0 = cycles()\n"
-     "                if reach:\n                    n_rhs += dense_prepare(mc, t_old, h, "
-     "y_old, y_new, K, F, tmp, n, As,\n                                            cs, es, gr)"
-     f"  # fmt: skip\n                    prof[3] += {TICK}\n                    c0 = cycles()\n"),
-    (STEPPER, "                if event_row >= 0:\n                    dense_eval(",
-     f"                prof[4] += {TICK}\n                c0 = cycles()\n"
-     "                if event_row >= 0:\n                    dense_eval("),
-    (STEPPER, "                if any_silent:\n",
-     f"                prof[5] += {TICK}\n                c0 = cycles()\n"
-     "                if any_silent:\n"),
-    (STEPPER, "                shear_ratios(g_new,",
-     f"                prof[6] += {TICK}\n                c0 = cycles()\n"
-     "                shear_ratios(g_new,"),
-    (STEPPER, "                z_prev, z_old, z_new = z_old, z_new, z_prev\n",
-     f"                prof[7] += {TICK}\n"
-     "                z_prev, z_old, z_new = z_old, z_new, z_prev\n"),
-    (STEPPER, "            # ---- the event at (t, y)\n",
-     "            # ---- the event at (t, y)\n            c0 = cycles()\n"),
-    (STEPPER, "            if what == UPLIFT:\n                n_upl += 1\n",
-     f"            prof[8] += {TICK}\n"
-     "            if what == UPLIFT:\n                n_upl += 1\n"),
-    (STEPPER, "                return (COLLAPSED, t,",
+    (LOOP, "                code, n_steps = step_verdict(",
+     f"                prof[0] += {TICK}\n                code, n_steps = step_verdict("),
+    (LOOP, "find_event(W, mc, t_old, t_new, h, gr)",
+     "find_event(W, mc, t_old, t_new, h, gr, prof)"),
+    (LOOP, "                if hit >= 0:\n",
+     "                c0 = cycles()\n                if hit >= 0:\n"),
+    (LOOP, "                    event = True\n                # the structure's figures",
+     f"                    event = True\n                prof[5] += {TICK}\n"
+     "                # the structure's figures"),
+    (LOOP, "W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out, next_out\n",
+     "W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out, next_out, prof\n"),
+    (LOOP, "            code, uplifts, impacts, at_rest, which, angle = at_event(",
+     "            c0 = cycles()\n"
+     "            code, uplifts, impacts, at_rest, which, angle = at_event("),
+    (LOOP, "            n_upl += uplifts\n",
+     f"            prof[8] += {TICK}\n            n_upl += uplifts\n"),
+    (LOOP, "                return run_end(W, COLLAPSED,",
      "                prof[10] += float(cycles() - c_all)\n"
      "                print('CYCLES', prof[0], prof[1], prof[2], prof[3], prof[4], prof[5], "
      "prof[6], prof[7], prof[8], prof[9], prof[10], n_ev)\n"
-     "                return (COLLAPSED, t,"),
-    (STEPPER, "    return (status, t, t_col, c_if, max_ratio, max_top, friction, slip,\n"
-     "            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip\n",
+     "                return run_end(W, COLLAPSED,"),
+    (LOOP, "    return run_end(W, SURVIVED,",
      "    prof[10] += float(cycles() - c_all)\n"
      "    print('CYCLES', prof[0], prof[1], prof[2], prof[3], prof[4], prof[5], prof[6], "
      "prof[7], prof[8], prof[9], prof[10], n_ev)\n"
-     "    return (status, t, t_col, c_if, max_ratio, max_top, friction, slip,\n"
-     "            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip\n"),
+     "    return run_end(W, SURVIVED,"),
+    (STEPPER, "from rbm_cli.base.jit import jit\n",
+     "from rbm_cli.base.jit import jit\nfrom rbm_cli.base.cycles import cycles\n"),
+    (STEPPER, "def find_event(W, mc, t_old, t_new, h, gr):\n",
+     "def find_event(W, mc, t_old, t_new, h, gr, prof):\n"),
+    (STEPPER, "    W.acc_old[:] = W.acc\n", "    c0 = cycles()\n    W.acc_old[:] = W.acc\n"),
+    (STEPPER, "    if not within_reach(W.d_old, W.d_new, W.dd_old, W.dd_new, W.d2_old, W.d2_new, "
+     "t_new - t_old,\n                        W.near):  # fmt: skip\n",
+     f"    prof[1] += {TICK}\n    c0 = cycles()\n"
+     "    reach = within_reach(W.d_old, W.d_new, W.dd_old, W.dd_new, W.d2_old, W.d2_new, "
+     f"t_new - t_old, W.near)\n    prof[2] += {TICK}\n    c0 = cycles()\n    if not reach:\n"),
+    (STEPPER, "    t_e, row = first_crossing(",
+     f"    prof[3] += {TICK}\n    c0 = cycles()\n    t_e, row = first_crossing("),
+    (STEPPER, "    return t_e, row, True, calls\n",
+     f"    prof[4] += {TICK}\n    return t_e, row, True, calls\n"),
+    (STEPPER, "def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out, "
+     "next_out):\n",
+     "def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out, "
+     "next_out, prof):\n"),
+    (STEPPER, "    affine(W.track, W.y_new, 0, W.no_offset, W.z_new)\n",
+     "    c0 = cycles()\n    affine(W.track, W.y_new, 0, W.no_offset, W.z_new)\n"),
+    (STEPPER, "    shear_ratios(g_new, 0.0, gam_new,",
+     f"    prof[6] += {TICK}\n    c0 = cycles()\n    shear_ratios(g_new, 0.0, gam_new,"),
+    (STEPPER, "    # the step's end is the next step's start\n    W.z_prev[:] = W.z_old\n",
+     f"    prof[7] += {TICK}\n"
+     "    # the step's end is the next step's start\n    W.z_prev[:] = W.z_old\n"),
     (EXACT_RUN, "from rbm_cli.base.jit import jit\n",
      "from rbm_cli.base.jit import jit\nfrom rbm_cli.base.cycles import cycles\n"),
     (EXACT_RUN,
@@ -155,7 +165,7 @@ def instrumented(source: Path, target: Path) -> None:
     shutil.copytree(source / "rbm_cli", target / "rbm_cli",
                     ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
     (target / "rbm_cli" / "base" / "cycles.py").write_text(CYCLES)
-    texts = {f: (target / f).read_text() for f in (STEPPER, EXACT_RUN)}
+    texts = {f: (target / f).read_text() for f in (LOOP, STEPPER, EXACT_RUN)}
     for f, anchor, replacement in ANCHORS:
         if texts[f].count(anchor) != 1:
             sys.exit(f"profile_cycles: {f} changed: this line is not found once: "

@@ -176,7 +176,7 @@ def after_events(seconds: float = 10.0, pga_g: float = 0.2) -> dict:
     step kernel's source run uncompiled (the module's names wrapped while it runs)."""
     from rbm_cli.models.rbm.pieces import IMPACT, KINK, UPLIFT
     from rbm_cli.models.rbm.step import stepper
-    from rbm_cli.models.rbm.step.rk import TAB_NS
+    from rbm_cli.numerics.rk import TAB_NS
 
     config = load_config(CONFIG)
     name, cfg = next(points(config))

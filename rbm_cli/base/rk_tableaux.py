@@ -2,7 +2,7 @@
 coefficients (scipy.integrate._ivp.dop853_coefficients and rk.RK23 / rk.RK45), written
 out here so that the compiled path does not import scipy.integrate (~0.3-0.9 s at every
 start). Each number is the repr of scipy's float (exact); rows and vectors
-drop their trailing zeros (padded back by the step integrator, rbm_cli.models.rbm.step.rk).
+drop their trailing zeros (padded back by the compiled engine, rbm_cli.numerics.rk).
 tests/test_kernel_tableaux.py holds every entry, bit for bit, to the installed scipy's.
 Generated from scipy 1.17.1."""
 

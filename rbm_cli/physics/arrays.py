@@ -79,6 +79,72 @@ class ColumnArrays(NamedTuple):
     damped: bool  #: any joint damped
 
 
+#: The types of a ColumnArrays' fields as a run's record declares them (numbers as numba
+#: spells them; rbm_cli.numerics.records): a run's record holds the column's fields.
+COLUMN_TYPES = {
+    "mass": "float64[:, ::1]", "chol": "float64[:, ::1]", "linv": "float64[:, ::1]",
+    "argmap": "float64[:, ::1]", "arg_inv": "float64[:, ::1]", "gravity": "float64[:, ::1]",
+    "ground_load": "float64[::1]", "diff_t": "float64[:, ::1]", "edges": "float64[:, ::1]",
+    "nedges": "int64[::1]", "intercepts": "float64[:, ::1]", "slopes": "float64[:, ::1]",
+    "rigid": "bool[::1]", "silent": "bool[::1]", "tu": "float64[::1]", "c_ratio": "float64",
+    "e_rest": "float64", "literal_impact": "bool", "impulse_dir": "float64[:, ::1]",
+    "impulse_w": "float64[::1]", "centre_map": "float64[:, ::1]", "masses": "float64[::1]",
+    "normal_forces": "float64[::1]", "rigid_mono": "bool", "uplift_level": "float64",
+    "rest_rate": "float64", "barrier": "float64", "survival": "float64",
+    "families": "float64[:, ::1]", "gx": "float64[:, ::1]", "gc": "float64[:, ::1]",
+    "same": "bool", "md": "float64[:, ::1]", "mg": "float64[:, ::1]",
+    "track": "float64[:, ::1]", "es": "float64[::1]", "slope_parts": "float64[:, :, ::1]",
+    "edge_w": "float64[:, ::1]", "damp": "float64[::1]", "damped": "bool",
+}  # fmt: skip
+#: ColumnArrays' fields with their types, in order (a field without a type fails here).
+COLUMN_FIELDS = [(name, COLUMN_TYPES[name]) for name in ColumnArrays._fields]
+
+
+@jit
+def column_into(W, col):
+    """Set the fields of a run's record W (numerics.records) that a ColumnArrays col has."""
+    W.mass = col.mass
+    W.chol = col.chol
+    W.linv = col.linv
+    W.argmap = col.argmap
+    W.arg_inv = col.arg_inv
+    W.gravity = col.gravity
+    W.ground_load = col.ground_load
+    W.diff_t = col.diff_t
+    W.edges = col.edges
+    W.nedges = col.nedges
+    W.intercepts = col.intercepts
+    W.slopes = col.slopes
+    W.rigid = col.rigid
+    W.silent = col.silent
+    W.tu = col.tu
+    W.c_ratio = col.c_ratio
+    W.e_rest = col.e_rest
+    W.literal_impact = col.literal_impact
+    W.impulse_dir = col.impulse_dir
+    W.impulse_w = col.impulse_w
+    W.centre_map = col.centre_map
+    W.masses = col.masses
+    W.normal_forces = col.normal_forces
+    W.rigid_mono = col.rigid_mono
+    W.uplift_level = col.uplift_level
+    W.rest_rate = col.rest_rate
+    W.barrier = col.barrier
+    W.survival = col.survival
+    W.families = col.families
+    W.gx = col.gx
+    W.gc = col.gc
+    W.same = col.same
+    W.md = col.md
+    W.mg = col.mg
+    W.track = col.track
+    W.es = col.es
+    W.slope_parts = col.slope_parts
+    W.edge_w = col.edge_w
+    W.damp = col.damp
+    W.damped = col.damped
+
+
 def rest_levels(model: Model) -> tuple[float | None, float, float]:
     """The levels a run compares with, made once per model.
 
@@ -171,4 +237,13 @@ def column_arrays(model: Model) -> ColumnArrays:
     )  # fmt: skip
 
 
-__all__ = ["REST_RATE", "ColumnArrays", "column_arrays", "rest_levels", "survival_barrier"]
+__all__ = [
+    "COLUMN_FIELDS",
+    "COLUMN_TYPES",
+    "REST_RATE",
+    "ColumnArrays",
+    "column_arrays",
+    "column_into",
+    "rest_levels",
+    "survival_barrier",
+]

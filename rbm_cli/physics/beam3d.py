@@ -31,7 +31,7 @@ direction c (the side the joint rocks onto), as a base flat to that side, and m 
 the rotation, solver.atol theta_u).
 
 The equations are compiled (numba) as the planar kernel's are, into the same slots of its
-right-hand side (rbm_cli.models.rbm.step.rk.rhs: a state of 4n values is this model's):
+right-hand side (rbm_cli.physics.rates.rhs: a state of 4n values is this model's):
 
 - ``As`` (n, 3n): [M^-1 D^T | M^-1 K_g | the argument map];
 - ``cs`` (9n): per joint, the piece it is on: intercept, weight slope, elastic slope, its

@@ -144,9 +144,7 @@ def check_config(config: Config, solver: SolverConfig) -> Config:
     return dataclasses.replace(config, solver=solver)
 
 
-def summarise(
-    outcomes: list[int | None], checks: list[int | None] = ()
-) -> tuple[float, int, str]:
+def summarise(outcomes: list[int | None], checks: list[int | None] = ()) -> tuple[float, int, str]:
     """(collapse_fraction, robust, sensitive_to) of a cell from its members' outcomes
     (member 0 first) and its solver check's: 1 collapsed, 0 survived, None failed.
 

@@ -1,7 +1,7 @@
 """The compiled run of `rbm-3d` (numba; the rules: rbm_cli.models.rbm3d.runner).
 
 One call runs a whole motion. The Runge-Kutta steps are the planar step kernel's
-(rbm_cli.models.rbm.step.rk: scipy's tableaux, error norm, step control and dense output,
+(rbm_cli.numerics.rk: scipy's tableaux, error norm, step control and dense output,
 whose right-hand side takes a state of 4n values as this model's, physics.beam3d); the
 events are located on each step's dense output: the watched distances are evaluated at
 CHECK_INTERVALS + 1 points of the step, and in the first sub-interval where one ends below
@@ -17,7 +17,6 @@ import numpy as np
 
 from rbm_cli.base.brent import brent_step
 from rbm_cli.base.events import EVENT_EPS
-from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.models.outcome import WOBBLE_LEVEL
@@ -29,32 +28,23 @@ from rbm_cli.models.rbm.pieces import (
     law_potential,
     shear_ratios,
 )
-from rbm_cli.models.rbm.step.rk import (
-    NS_MAX,
-    STEP_TAKEN,
-    STEP_TOO_SMALL,
+from rbm_cli.models.rbm.step.inputs import Excitation, SolverSettings, motion_into
+from rbm_cli.models.rbm3d.work import COLUMN3D
+from rbm_cli.models.status import (
+    COLLAPSED,
+    GOING,
+)
+from rbm_cli.numerics.loop import RunEnd, loop_for, loop_into
+from rbm_cli.numerics.quadrature import GL_NODES, GL_WEIGHTS
+from rbm_cli.numerics.records import new_record
+from rbm_cli.numerics.rk import (
     TAB_EST,
     TAB_NS,
-    attempt_step,
     dense_eval,
     dense_prepare,
     initial_step,
-    rhs,
 )
-from rbm_cli.models.rbm.step.stepper import GL_NODES, GL_WEIGHTS
-from rbm_cli.models.status import (
-    COLLAPSED,
-    FAILED_EVENTS,
-    FAILED_NONFINITE,
-    FAILED_STEP,
-    FAILED_STEPS,
-    GOING,
-    STOP_NEVER,
-    STOPPED_EARLY,
-    SURVIVED,
-    guard_code,
-)
-from rbm_cli.physics.arrays import ColumnArrays
+from rbm_cli.physics.arrays import ColumnArrays, column_into
 from rbm_cli.physics.beam3d import CS_PER_JOINT, ES_EXTRA, horizontal, pack_pieces
 from rbm_cli.physics.ground import (
     LINE,
@@ -67,6 +57,7 @@ from rbm_cli.physics.ground import (
     rest_shear,
     vertical_factor,
 )
+from rbm_cli.physics.rates import rhs
 
 #: A rigid joint's direction is pinned within a distance of closure (c[i, 2], solver.atol
 #: theta_u: the runner's notes) and after an uplift or an impact, until LEAVE_FACTOR times
@@ -469,6 +460,202 @@ def in_plane(y, n):
     return True
 
 
+@jit(inline=True)
+def system3d(col, n, d0, d1, values_y, gy):
+    """The column's system in two directions (physics.beam3d): As (n, 3n) of its mass,
+    stiffness and argument maps, cs (the current pieces' constants, packed at each restart)
+    and es (the ground's factors, the motion's direction (d0, d1) and its second component's
+    formula)."""
+    As = np.empty((n, 3 * n))
+    for i in range(n):
+        for j in range(n):
+            As[i, j] = col.md[i, j]
+            As[i, n + j] = col.mg[i, j]
+            As[i, 2 * n + j] = col.argmap[i, j]
+    cs = np.zeros(CS_PER_JOINT * n)
+    es = np.zeros(n + ES_EXTRA)
+    es[:n] = col.es
+    es[n], es[n + 1] = d0, d1
+    es[n + 8] = 1.0 if np.any(col.mg != 0.0) else 0.0
+    es[n + 9] = LINE if values_y.size > 0 else gy[0]
+    return As, cs, es
+
+
+@jit
+def start3d(y, n, col, k, pending, phase, c):
+    """The pieces and phases of the initial state y (4n,); returns whether a rigid monolith
+    starts at rest."""
+    for i in range(n):
+        px, py, vx, vy = _phi(i, y, n, col.argmap)
+        r = math.sqrt(px * px + py * py)
+        q = 0
+        while q < col.nedges[i] and col.edges[i, q] <= r:
+            q += 1
+        k[i] = q
+        pending[i] = q > 0 and not col.rigid[i]
+    at_rest = False
+    if col.rigid_mono:
+        at_rest = True
+        for j in range(4 * n):
+            if y[j] != 0.0:
+                at_rest = False
+        px, py, vx, vy = _phi(0, y, n, col.argmap)
+        r = math.sqrt(px * px + py * py)
+        if not at_rest and r <= LEAVE_FACTOR * c[0, 2]:
+            if r > 0.0:
+                c[0, 0], c[0, 1] = px / r, py / r
+            else:
+                s = math.sqrt(vx * vx + vy * vy)
+                c[0, 0], c[0, 1] = vx / s, vy / s
+            phase[0] = LEAVING
+    return at_rest
+
+
+@jit
+def lean_azimuth(i, y, n, col):
+    """Where joint i's collapse quantity points [rad from the motion's direction]."""
+    vx_, vy_ = 0.0, 0.0
+    for j in range(n):
+        vx_ += col.families[n + i, j] * y[j]
+        vy_ += col.families[n + i, j] * y[n + j]
+    return math.atan2(vy_, vx_)
+
+
+@jit
+def rest3d(t, seg_end, last, col, amplitude, gr_full, pair_args, friction, held, rx, ry, slip,
+           mu, sampling, n_out, next_out, y, c, phase, rising):  # fmt: skip
+    """A rigid monolith at rest from t [s] in a forced segment (to seg_end [s]): its friction
+    demand at rest (under a pair: pair_rest_demand), the held demand's samples, where it
+    first exceeds mu, its samples, and where it lifts (no later than last [s]), leaving
+    closure along the ground's acceleration then.
+
+    Returns
+    -------
+    (lifted, t, n_out, next_out)  lifted: the column lifts at t; else it rests to seg_end.
+    """
+    gy, knots, values, values_y, knots_y, vertical, pair_on, d0, d1 = pair_args
+    record, mc, F, yq, samples, output_dt = sampling
+    n = y.size // 4
+    if pair_on:
+        t_up = pair_uplift(t, col.uplift_level / G, min(last, seg_end), gr_full, gy, knots,
+                           values, values_y, knots_y, vertical)  # fmt: skip
+    else:
+        t_up = next_uplift(t, col.uplift_level, amplitude, gr_full, knots, values, vertical,
+                           last)  # fmt: skip
+    # the friction demand at rest (as the planar kernel), and where it first exceeds the limit
+    t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
+    if pair_on:
+        d_rest = pair_rest_demand(t, t_rest, gr_full, gy, knots, values, values_y, knots_y,
+                                  vertical)  # fmt: skip
+    else:
+        d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
+    if d_rest > friction[0]:
+        friction[0] = d_rest
+    while held_time(held) <= t_rest:
+        t_k = held_time(held)
+        rx[0] = rest_shear(t_k, gr_full, knots, values, vertical)
+        ry[0] = rest_shear(t_k, gy, knots, values_y, vertical) if pair_on else 0.0
+        held_push(held, rx, ry, friction)
+    if slip[1] == 0.0 and d_rest > mu:
+        if pair_on:
+            slip[0] = pair_uplift(t, mu, t_rest, gr_full, gy, knots, values, values_y, knots_y,
+                                  vertical)  # fmt: skip
+        else:
+            slip[0] = next_uplift(t, mu * G, amplitude, gr_full, knots, values, vertical, t_rest)
+        slip[1] = 1.0
+    if t_up < 0.0 or t_up >= seg_end:
+        if record:
+            n_out, next_out = _emit(mc, seg_end, t, 0.0, y, F, yq, samples, n_out, next_out,
+                                    output_dt, n, d0, d1, col)  # fmt: skip
+        return False, seg_end, n_out, next_out
+    if record:
+        n_out, next_out = _emit(mc, t_up - 1e-15, t, 0.0, y, F, yq, samples, n_out, next_out,
+                                output_dt, n, d0, d1, col)  # fmt: skip
+    t = t_up
+    y[:] = 0.0
+    a_d = ground_at(t, gr_full, knots, values)
+    a_y = ground_at(t, gy, knots, values_y) if pair_on else 0.0
+    ax, ay = a_d * d0 - a_y * d1, a_d * d1 + a_y * d0
+    size = math.sqrt(ax * ax + ay * ay)
+    c[0, 0], c[0, 1] = -ax / size, -ay / size
+    phase[0], rising[0] = LEAVING, True
+    return True, t, n_out, next_out
+
+
+@jit
+def event3d(kind, i, t, y, n, col, gr, pieces, account, ledger):
+    """The state change at a watched event of joint i at (t, y) (the module's notes): at a
+    kink its piece, near closure its pinned direction, at closure the impact (a rigid
+    monolith slow enough comes to rest). Returns (uplifts, impacts, at rest) of it."""
+    k, pending, phase, rising, c = pieces
+    n_upl, n_imp, at_rest = 0, 0, False
+    px, py, vx, vy = _phi(i, y, n, col.argmap)
+    r = math.sqrt(px * px + py * py)
+    if kind == UP or kind == DOWN:
+        q = k[i] if kind == UP else k[i] - 1
+        e = _edge(i, q, gravity_factor(t, gr), col.edges, col.nedges, col.edge_w)
+        if r > 0.0:
+            _move(i, y, n, col.arg_inv, px * (e / r - 1.0), py * (e / r - 1.0))
+        if kind == UP:
+            # an uplift: a closed joint opens; one back on its elastic branch that
+            # opens again before it closed goes on with its excursion
+            if k[i] == 0 and not col.rigid[i] and not pending[i] and phase[i] != APPROACH:
+                n_upl += 1
+            if not col.rigid[i]:
+                pending[i] = True
+                if phase[i] == APPROACH:
+                    phase[i] = FREE
+            k[i] += 1
+        else:
+            k[i] -= 1
+            if k[i] == 0 and pending[i]:
+                phase[i] = APPROACH
+                c[i, 0], c[i, 1] = px / r, py / r
+                # a silent closure (e = 1) is counted, not stopped at: back on its
+                # elastic branch the joint is closed, as in the plane
+                pending[i] = col.e_rest != 1.0
+    elif kind == NEAR:
+        phase[i] = APPROACH
+        c[i, 0], c[i, 1] = px / r, py / r
+    elif kind == LEFT:
+        phase[i], rising[i] = FREE, False
+    else:  # ACROSS or TURNED: the joint closes
+        rising[i] = False
+        cx, cy = c[i, 0], c[i, 1]
+        if col.rigid[i]:
+            _move(i, y, n, col.arg_inv, -px, -py)
+        else:
+            along = px * cx + py * cy
+            _move(i, y, n, col.arg_inv, -along * cx, -along * cy)
+        xdot = vx * cx + vy * cy
+        e_rest = col.e_rest
+        for j in range(n):
+            if col.literal_impact:
+                dv = col.arg_inv[j, i] * (e_rest - 1.0) * xdot
+            else:
+                dv = col.impulse_dir[j, i] * ((e_rest - 1.0) * xdot / col.impulse_w[i])
+            y[2 * n + j] += dv * cx
+            y[3 * n + j] += dv * cy
+        n_imp += 1
+        pending[i], phase[i] = False, FREE
+        if col.rigid[i]:
+            _, _, vx, vy = _phi(i, y, n, col.argmap)
+            speed = math.sqrt(vx * vx + vy * vy)
+            if col.rigid_mono and speed < col.rest_rate:
+                y[:] = 0.0
+                at_rest = True
+            else:
+                phase[i] = LEAVING
+                if speed > 0.0:
+                    c[i, 0], c[i, 1] = vx / speed, vy / speed
+    if account:
+        after = energy3d(y, n, col)
+        if kind == ACROSS or kind == TURNED:
+            ledger[4] += ledger[1] - after
+        ledger[1] = after
+    return n_upl, n_imp, at_rest
+
+
 @jit
 def run3d(col, motion, solver, task, pair):
     """Run one motion of one column in two directions.
@@ -488,429 +675,295 @@ def run3d(col, motion, solver, task, pair):
 
     Returns
     -------
-    tuple  (code, t_end, t_collapse, collapsed joint (from 0; -1), max_ratio (n), max_top,
-        friction (n), slip (2), n_uplifts, n_impacts, n_steps, n_rhs, n_events, n_samples,
-        azimuth [rad], swept (n) [rad], ledger (5)). ledger: the energy account of a
-        recorded run without a vertical record [J] (zeros otherwise), as the planar
-        kernel's: the energy at the start and at the end (energy3d), the ground's work,
-        the energy the joints' damping and the impacts took.
+    RunEnd  (numerics.loop; the collapsed joint from 0, -1 for none; azimuth [rad], swept
+        (n) [rad]). ledger: the energy account of a recorded run without a vertical record
+        [J] (zeros otherwise), as the planar kernel's: the energy at the start and at the end
+        (energy3d), the ground's work, the energy the joints' damping and the impacts took.
     """
-    col = ColumnArrays(*col)
-    y0, record, output_dt, samples, mu, stop, pin, held = task
-    d0, d1, values_y, gy, knots_y = pair
-    mc, rtol, atol = solver[0], solver[1], solver[2]
-    max_steps, max_events, deadline = solver[3], solver[4], solver[5]
-    form, gain, center, gamma = motion[6], motion[7], motion[8], motion[9]
-    knots, values, vertical, clipped = motion[10], motion[11], motion[12], motion[13]
-    bounds, forced, pulse_end, t_end = motion[14], motion[15], motion[4], motion[5]
-    gr_full = (form, gain, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
-    gr_free = (form, 0.0, motion[2], motion[3], center, gamma, 0.0, 0.0, 0.0)
-    pair_on = values_y.size > 0 or gy[1] != 0.0
-    formula_y = values_y.size == 0 and gy[1] != 0.0  # an analytic second component
-    pulse = motion[16]
-    account = record and vertical.size == 0  # the energy account (see Returns)
-    ledger = np.zeros(5)
+    col, motion, solver = ColumnArrays(*col), Excitation(*motion), SolverSettings(*solver)
+    y0, pin = task[0], task[6]
+    account = task[1] and motion.vertical.size == 0  # the energy account (see Returns)
     n = col.tu.size
-    m4 = 4 * n
-    nrow_max = 5 * n
-    weight, elastic = col.slope_parts[0], col.slope_parts[1]
-    As = np.empty((n, 3 * n))
+    W = column3d_record(col, motion, task, pair)
+    c = W.c
     for i in range(n):
-        for j in range(n):
-            As[i, j] = col.md[i, j]
-            As[i, n + j] = col.mg[i, j]
-            As[i, 2 * n + j] = col.argmap[i, j]
-    cs = np.zeros(CS_PER_JOINT * n)
-    es = np.zeros(n + ES_EXTRA)
-    es[:n] = col.es
-    es[n], es[n + 1] = d0, d1
-    es[n + 8] = 1.0 if np.any(col.mg != 0.0) else 0.0
-    es[n + 9] = LINE if values_y.size > 0 else gy[0]
-
-    k = np.zeros(n, dtype=np.int64)
-    pending = np.zeros(n, dtype=np.bool_)
-    phase = np.zeros(n, dtype=np.int64)
-    # leaving closure from phi = 0 exactly (an uplift from rest): pinned at phi = 0 alone
-    rising = np.zeros(n, dtype=np.bool_)
-    c = np.zeros((n, 3))  # per joint: the pinned direction (x, y), the pinned distance [rad]
-    for i in range(n):
-        c[i, 0], c[i, 1], c[i, 2] = d0, d1, pin * col.tu[i]
-    kinds, joints = np.zeros(nrow_max, dtype=np.int64), np.zeros(nrow_max, dtype=np.int64)
-    d_old, r_old = np.empty(nrow_max), np.empty(nrow_max)
-    d_new, r_new = np.empty(nrow_max), np.empty(nrow_max)
-    near = np.zeros(nrow_max, dtype=np.bool_)
-    D, R = np.empty((nrow_max, CHECK_INTERVALS + 1)), np.empty((nrow_max, CHECK_INTERVALS + 1))
-    max_ratio, friction, swept = np.zeros(n), np.zeros(n), np.zeros(n)
-    slip = np.array([np.nan, 0.0])
-    rx, ry, acc_k = np.zeros(n), np.zeros(n), np.zeros(2 * n)  # a held demand's sample
-    between = np.zeros(n)  # its peak between step ends (interpolated: not the run's peak)
-    max_top, azimuth = 0.0, np.nan
-    n_upl, n_imp, n_steps, n_rhs, n_ev, n_out = 0, 0, 0, 0, 0, 0
-    next_out = 0.0
-    t_col, c_if = np.nan, -1
-    K = np.empty((NS_MAX, m4))
-    F = np.empty((8, m4))
-    f, ynew, tmp, work, scale = (np.empty(m4), np.empty(m4), np.empty(m4), np.empty(m4),
-                                 np.empty(m4))  # fmt: skip
-    yq, y_new = np.empty(m4), np.empty(m4)
-    est_order = TAB_EST[mc]
-    err_exp = -1.0 / (est_order + 1)
-    ns = TAB_NS[mc]
-    top_row = col.families[2 * n]
-
-    t = 0.0
+        c[i, 0], c[i, 1], c[i, 2] = W.d0, W.d1, pin * col.tu[i]
     y = y0  # the state, in place: the caller reads where the run ended
-    # the pieces and phases of the initial state
-    for i in range(n):
-        px, py, vx, vy = _phi(i, y, n, col.argmap)
-        r = math.sqrt(px * px + py * py)
-        q = 0
-        while q < col.nedges[i] and col.edges[i, q] <= r:
-            q += 1
-        k[i] = q
-        pending[i] = q > 0 and not col.rigid[i]
-    at_rest = False
-    if col.rigid_mono:
-        at_rest = True
-        for j in range(m4):
-            if y[j] != 0.0:
-                at_rest = False
-        px, py, vx, vy = _phi(0, y, n, col.argmap)
-        r = math.sqrt(px * px + py * py)
-        if not at_rest and r <= LEAVE_FACTOR * c[0, 2]:
-            if r > 0.0:
-                c[0, 0], c[0, 1] = px / r, py / r
-            else:
-                s = math.sqrt(vx * vx + vy * vy)
-                c[0, 0], c[0, 1] = vx / s, vy / s
-            phase[0] = LEAVING
+    at_rest = start3d(y, n, W, W.k, W.pending, W.phase, c)
+    max_ratio = W.max_ratio
     for i in range(n):
         v, _ = _magnitude(col.families[n + i], y, n)
         max_ratio[i] = v
         if v >= col.c_ratio:
-            vx_, vy_ = 0.0, 0.0
-            for j in range(n):
-                vx_ += col.families[n + i, j] * y[j]
-                vy_ += col.families[n + i, j] * y[n + j]
-            azimuth = math.atan2(vy_, vx_)
             max_ratio[i] = max(v, col.c_ratio)
-            return (COLLAPSED, 0.0, 0.0, i, max_ratio, max_top, friction, slip, n_upl,
-                    n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip
-    max_top = _magnitude(top_row, y, n)[0]
+            return RunEnd(COLLAPSED, 0.0, 0.0, i, max_ratio, 0.0, W.friction, W.slip, 0, 0,
+                          0, 0, 0, 0, lean_azimuth(i, y, n, W), W.swept, W.ledger)  # fmt: skip
     if account:
-        ledger[0] = energy3d(y, n, col)
-        ledger[1] = ledger[0]
+        W.ledger[0] = energy3d(y, n, W)
+        W.ledger[1] = W.ledger[0]
+    W.top[0] = _magnitude(col.families[2 * n], y, n)[0]
+    stops = (task[5], -1, False, n == 1)
+    loop_into(W, y, system3d(W, n, W.d0, W.d1, W.values_y, W.gy))
+    return run_3d(W, motion, solver, n, at_rest, stops, account)
 
-    for seg in range(bounds.size - 1):
-        seg_end = bounds[seg + 1]
-        if t >= seg_end:
-            continue
-        free_seg = not forced[seg]
-        gr = gr_free if free_seg else gr_full
-        seg_gain = gr[1]
-        if formula_y:  # its formula in es, 0 on a free segment
-            es[n + 2], es[n + 3], es[n + 4] = 1.0, 0.0 if free_seg else gy[1], gy[2]
-            es[n + 5], es[n + 6], es[n + 7] = gy[3], gy[4], gy[5]
-        # solver.stop: a monolith past a peak of free motion after a pulse or a record, below
-        # its collapse barrier, in the motion's plane (there the planar model's stop)
-        can_stop = stop != STOP_NEVER and free_seg and pulse and n == 1
-        h_carry = -1.0
-        while t < seg_end:
-            if at_rest:
-                if free_seg:  # no ground motion from here on: rests to the end
-                    if record:
-                        n_out, next_out = _emit(mc, t_end, t, 0.0, y, F, yq, samples, n_out,
-                                                next_out, output_dt, n, d0, d1, col)  # fmt: skip
-                    return (AT_REST, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
-                            ledger)  # fmt: skip
-                last = min(pulse_end, t_end)
-                if pair_on:
-                    t_up = pair_uplift(t, col.uplift_level / G, min(last, seg_end), gr_full, gy,
-                                       knots, values, values_y, knots_y, vertical)  # fmt: skip
-                else:
-                    t_up = next_uplift(t, col.uplift_level, motion[1], gr_full, knots, values,
-                                       vertical, last)  # fmt: skip
-                # the friction demand at rest (as the planar kernel), and where it first
-                # exceeds the limit
-                t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
-                if pair_on:
-                    d_rest = pair_rest_demand(t, t_rest, gr_full, gy, knots, values, values_y,
-                                              knots_y, vertical)  # fmt: skip
-                else:
-                    d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
-                if d_rest > friction[0]:
-                    friction[0] = d_rest
-                while held_time(held) <= t_rest:
-                    t_k = held_time(held)
-                    rx[0] = rest_shear(t_k, gr_full, knots, values, vertical)
-                    ry[0] = rest_shear(t_k, gy, knots, values_y, vertical) if pair_on else 0.0
-                    held_push(held, rx, ry, friction)
-                if slip[1] == 0.0 and d_rest > mu:
-                    if pair_on:
-                        slip[0] = pair_uplift(t, mu, t_rest, gr_full, gy, knots, values,
-                                              values_y, knots_y, vertical)  # fmt: skip
-                    else:
-                        slip[0] = next_uplift(t, mu * G, motion[1], gr_full, knots, values,
-                                              vertical, t_rest)  # fmt: skip
-                    slip[1] = 1.0
-                if t_up < 0.0 or t_up >= seg_end:
-                    if record:
-                        n_out, next_out = _emit(mc, seg_end, t, 0.0, y, F, yq, samples, n_out,
-                                                next_out, output_dt, n, d0, d1, col)  # fmt: skip
-                    t = seg_end
-                    break
-                if record:
-                    n_out, next_out = _emit(mc, t_up - 1e-15, t, 0.0, y, F, yq, samples,
-                                            n_out, next_out, output_dt, n, d0, d1, col)  # fmt: skip
-                t = t_up
-                y[:] = 0.0
-                a_d = ground_at(t, gr_full, knots, values)
-                a_y = ground_at(t, gy, knots, values_y) if pair_on else 0.0
-                ax, ay = a_d * d0 - a_y * d1, a_d * d1 + a_y * d0
-                size = math.sqrt(ax * ax + ay * ay)
-                c[0, 0], c[0, 1] = -ax / size, -ay / size
-                phase[0], rising[0] = LEAVING, True
-                at_rest = False
-                n_upl += 1
-                h_carry = -1.0
 
-            # a new stepper from (t, y), its pieces packed
-            pinned = np.zeros(n, dtype=np.int64)  # beam3d.pack_pieces
-            for i in range(n):
-                if phase[i] != FREE and col.rigid[i]:
-                    pinned[i] = 2 if rising[i] else 1
-            pack_pieces(k, pinned, c, col.intercepts, weight, elastic, col.damp, col.rigid, cs)
-            m = watch(n, k, phase, pending, col, kinds, joints)
-            t_bound = seg_end
-            if clipped:
-                gr, t_bound = _pieces(t, knots, values, values_y, vertical, seg_gain, seg_end, es)
-            rows_at(y, gravity_factor(t, gr), n, col, k, c, kinds, joints, m, d_old, r_old)
-            rhs(t, y, n, As, cs, es, gr, f)
-            if h_carry > 0.0:
-                h_abs = min(h_carry, seg_end - t)
-                n_rhs += 1
-            else:
-                h_abs = initial_step(t, y, f, t_bound, est_order, rtol, atol, n, As, cs, es,
-                                     gr, work)  # fmt: skip
-                n_rhs += 2
-            event = False
-            running = True
-            while running:
-                bound = seg_end
-                if clipped:
-                    gr, bound = _pieces(t, knots, values, values_y, vertical, seg_gain, seg_end, es)
-                taken, t_new, h, h_abs, calls = attempt_step(
-                    mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
-                    scale, err_exp)  # fmt: skip
-                n_rhs += calls
-                if taken != STEP_TAKEN:
-                    code = FAILED_STEP if taken == STEP_TOO_SMALL else FAILED_NONFINITE
-                    return (code, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl,
-                            n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip
-                n_steps += 1
-                if n_steps > max_steps:
-                    return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
-                            ledger)  # fmt: skip
-                if n_steps % POLL_STEPS == 0:
-                    code = guard_code(deadline)
-                    if code != GOING:
-                        return (code, t, t_col, c_if, max_ratio, max_top, friction,
-                                slip, n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth,
-                                swept, ledger)  # fmt: skip
-                if t_new - seg_end >= 0:
-                    running = False
-                t_old = t
-                rows_at(ynew, gravity_factor(t_new, gr), n, col, k, c, kinds, joints, m, d_new,
-                        r_new)  # fmt: skip
-                dense_ready = False
-                hit = -1
-                if within_reach(d_old, r_old, d_new, r_new, t_new - t_old, kinds, m, near):
-                    n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs, es, gr)
-                    dense_ready = True
-                    t_e, hit = first_event(mc, t_old, t_new, h, y, F, yq, n, col, k, c, gr,
-                                           kinds, joints, m, D, R, near)  # fmt: skip
-                if record and not dense_ready:
-                    n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs, es, gr)
-                    dense_ready = True
-                if hit >= 0:
-                    t_new = t_e
-                    dense_eval(mc, t_new, t_old, h, y, F, y_new)
-                    event = True
-                    rhs(t_new, y_new, n, As, cs, es, gr, work)
-                    n_rhs += 1
-                    fr = _friction(t_new, work, n, col, es, gr, friction, rx, ry)
-                else:
-                    y_new[:] = ynew
-                    fr = _friction(t_new, K[ns], n, col, es, gr, friction, rx, ry)
-                if slip[1] == 0.0 and fr > mu:
-                    best = 0
-                    for i in range(n):
-                        if friction[i] > friction[best]:
-                            best = i
-                    slip[0], slip[1] = t_new, best + 1.0
-                # the held demand's samples in (t_old, t_new]: theta'' on the step's quintic
-                f_new = work if hit >= 0 else K[ns]
-                while held_time(held) <= t_new:
-                    t_k = held_time(held)
-                    h_k = t_new - t_old
-                    for j in range(2 * n):
-                        q = 2 * n + j
-                        acc_k[j] = f_new[q] if h_k <= 0.0 else hermite_accel(
-                            (t_k - t_old) / h_k, h_k, y[j], y[q], f[q], y_new[j], y_new[q],
-                            f_new[q])  # fmt: skip
-                    ax_k, ay_k = horizontal(t_k, es, n, gr)
-                    shear_ratios(ax_k, ay_k, gravity_factor(t_k, gr), col.centre_map,
-                                 acc_k[:n], acc_k[n:], col.masses, col.normal_forces, rx, ry,
-                                 between)  # fmt: skip
-                    held_push(held, rx, ry, between)
-                if record:
-                    n_out, next_out = _emit(mc, t_new, t_old, h, y, F, yq, samples, n_out,
-                                            next_out, output_dt, n, d0, d1, col)  # fmt: skip
-                if account:  # the step's dense output is ready (recorded runs always are)
-                    account_step3d(mc, t_old, t_new, h, y, F, yq, n, col, k, es, gr, ledger)
-                    ledger[1] = energy3d(y_new, n, col)
-                # peaks: at the end, and where a magnitude's rate turns inside the step
-                turned = False  # the first joint's ratio passed a peak in this step
-                for i in range(n + 1):
-                    row = col.families[n + i] if i < n else top_row
-                    v1, r1 = _magnitude(row, y_new, n)
-                    _, r0 = _magnitude(row, y, n)
-                    if i == 0:
-                        turned = r0 > 0.0 >= r1
-                    if r0 > 0.0 and r1 < 0.0:
-                        if not dense_ready:
-                            n_rhs += dense_prepare(mc, t_old, h, y, ynew, K, F, tmp, n, As, cs,
-                                                   es, gr)  # fmt: skip
-                            dense_ready = True
-                        v1 = max(v1, _peak_in(row, t_old, t_new, mc, t_old, h, y, F, yq, n))
-                    if i < n:
-                        max_ratio[i] = max(max_ratio[i], v1)
-                    else:
-                        max_top = max(max_top, v1)
-                # the angle each joint's lean turned, where it leans by WOBBLE_LEVEL of its
-                # collapse limit or more at both ends of the step (a wobble)
-                for i in range(n):
-                    row = col.families[n + i]
-                    ax_, ay_, bx_, by_ = 0.0, 0.0, 0.0, 0.0
-                    for j in range(n):
-                        ax_ += row[j] * y[j]
-                        ay_ += row[j] * y[n + j]
-                        bx_ += row[j] * y_new[j]
-                        by_ += row[j] * y_new[n + j]
-                    if (ax_ * ax_ + ay_ * ay_ >= WOBBLE_LEVEL * WOBBLE_LEVEL
-                            and bx_ * bx_ + by_ * by_ >= WOBBLE_LEVEL * WOBBLE_LEVEL):  # fmt: skip
-                        cr, dt_ = ax_ * by_ - ay_ * bx_, ax_ * bx_ + ay_ * by_
-                        swept[i] += abs(math.atan2(cr, dt_))
-                # silent closures (e = 1, elastic joints): counted at the step's end
-                if col.e_rest == 1.0:
-                    for i in range(n):
-                        if phase[i] == APPROACH and not col.rigid[i]:
-                            px, py, _, _ = _phi(i, y_new, n, col.argmap)
-                            if px * c[i, 0] + py * c[i, 1] <= 0.0:
-                                n_imp += 1
-                                pending[i], phase[i] = False, FREE
-                t = t_new
-                y[:] = y_new
-                if event:
-                    break
-                # free motion past a peak below the collapse barrier, in the plane: every
-                # figure final (the planar kernel's stop, its energy of the state in the plane)
-                if (can_stop and turned and in_plane(y, n)
-                        and below_barrier(y[:n], y[2 * n : 3 * n], col.mass, col.argmap,
-                                          col.gravity, col.edges, col.nedges, col.intercepts,
-                                          col.slopes, col.barrier)):  # fmt: skip
-                    return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
-                            ledger)  # fmt: skip
-                f[:] = K[ns]
-                d_old, d_new = d_new, d_old
-                r_old, r_new = r_new, r_old
-            if not event:
-                t = seg_end if not running else t
-                continue
+@jit(inline=True)
+def column3d_record(col, motion, task, pair):
+    """The run's record (rbm3d.work.COLUMN3D) of a column col (ColumnArrays) under motion
+    (Excitation), with run3d's task and pair; c's pinned distance not yet set."""
+    W = new_record(COLUMN3D)
+    column_into(W, col)
+    motion_into(W, motion)
+    n = col.tu.size
+    nrow_max = 5 * n
+    # max_ratio, friction, slip, swept, the energy account (run3d's Returns), the top's peak
+    W.max_ratio, W.friction, W.slip = np.zeros(n), np.zeros(n), np.array([np.nan, 0.0])
+    W.swept, W.ledger, W.top = np.zeros(n), np.zeros(5), np.zeros(1)
+    W.k, W.pending = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.bool_)
+    W.phase = np.zeros(n, dtype=np.int64)
+    # leaving closure from phi = 0 exactly (an uplift from rest): pinned at phi = 0 alone
+    W.rising, W.c = np.zeros(n, dtype=np.bool_), np.zeros((n, 3))
+    W.kinds, W.joints = np.zeros(nrow_max, dtype=np.int64), np.zeros(nrow_max, dtype=np.int64)
+    W.count = np.zeros(1, dtype=np.int64)
+    W.d_old, W.r_old, W.d_new, W.r_new = (
+        np.empty(nrow_max),
+        np.empty(nrow_max),
+        np.empty(nrow_max),
+        np.empty(nrow_max),
+    )
+    W.near = np.zeros(nrow_max, dtype=np.bool_)
+    W.D, W.R = np.empty((nrow_max, CHECK_INTERVALS + 1)), np.empty((nrow_max, CHECK_INTERVALS + 1))
+    W.rx, W.ry, W.acc_k, W.between = np.zeros(n), np.zeros(n), np.zeros(2 * n), np.zeros(n)
+    W.turned = np.zeros(1, dtype=np.bool_)
+    W.samples, W.held, W.record, W.output_dt, W.mu = task[3], task[7], task[1], task[2], task[4]
+    d0, d1, values_y, gy, knots_y = pair
+    W.d0, W.d1, W.values_y, W.gy, W.knots_y = d0, d1, values_y, gy, knots_y
+    pair_on = values_y.size > 0 or gy[1] != 0.0
+    formula_y = values_y.size == 0 and gy[1] != 0.0
+    W.pair_on, W.formula_y = pair_on, formula_y
+    return W
 
-            # ---- the event at (t, y)
-            h_carry = h_abs
-            n_ev += 1
-            if n_ev > max_events:
-                return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, azimuth, swept,
-                        ledger)  # fmt: skip
-            kind, i = kinds[hit], joints[hit]
-            px, py, vx, vy = _phi(i, y, n, col.argmap)
-            r = math.sqrt(px * px + py * py)
-            if kind == COLLAPSE:
-                vx_, vy_ = 0.0, 0.0
-                for j in range(n):
-                    vx_ += col.families[n + i, j] * y[j]
-                    vy_ += col.families[n + i, j] * y[n + j]
-                azimuth = math.atan2(vy_, vx_)
-                max_ratio[i] = max(max_ratio[i], col.c_ratio)
-                return (COLLAPSED, t, t, i, max_ratio, max_top, friction, slip, n_upl, n_imp,
-                        n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip
-            if kind == UP or kind == DOWN:
-                q = k[i] if kind == UP else k[i] - 1
-                e = _edge(i, q, gravity_factor(t, gr), col.edges, col.nedges, col.edge_w)
-                if r > 0.0:
-                    _move(i, y, n, col.arg_inv, px * (e / r - 1.0), py * (e / r - 1.0))
-                if kind == UP:
-                    # an uplift: a closed joint opens; one back on its elastic branch that
-                    # opens again before it closed goes on with its excursion
-                    if k[i] == 0 and not col.rigid[i] and not pending[i] and phase[i] != APPROACH:
-                        n_upl += 1
-                    if not col.rigid[i]:
-                        pending[i] = True
-                        if phase[i] == APPROACH:
-                            phase[i] = FREE
-                    k[i] += 1
-                else:
-                    k[i] -= 1
-                    if k[i] == 0 and pending[i]:
-                        phase[i] = APPROACH
-                        c[i, 0], c[i, 1] = px / r, py / r
-                        # a silent closure (e = 1) is counted, not stopped at: back on its
-                        # elastic branch the joint is closed, as in the plane
-                        pending[i] = col.e_rest != 1.0
-            elif kind == NEAR:
-                phase[i] = APPROACH
-                c[i, 0], c[i, 1] = px / r, py / r
-            elif kind == LEFT:
-                phase[i], rising[i] = FREE, False
-            else:  # ACROSS or TURNED: the joint closes
-                rising[i] = False
-                cx, cy = c[i, 0], c[i, 1]
-                if col.rigid[i]:
-                    _move(i, y, n, col.arg_inv, -px, -py)
-                else:
-                    along = px * cx + py * cy
-                    _move(i, y, n, col.arg_inv, -along * cx, -along * cy)
-                xdot = vx * cx + vy * cy
-                e_rest = col.e_rest
-                for j in range(n):
-                    if col.literal_impact:
-                        dv = col.arg_inv[j, i] * (e_rest - 1.0) * xdot
-                    else:
-                        dv = col.impulse_dir[j, i] * ((e_rest - 1.0) * xdot / col.impulse_w[i])
-                    y[2 * n + j] += dv * cx
-                    y[3 * n + j] += dv * cy
-                n_imp += 1
-                pending[i], phase[i] = False, FREE
-                if col.rigid[i]:
-                    _, _, vx, vy = _phi(i, y, n, col.argmap)
-                    speed = math.sqrt(vx * vx + vy * vy)
-                    if col.rigid_mono and speed < col.rest_rate:
-                        y[:] = 0.0
-                        at_rest = True
-                    else:
-                        phase[i] = LEAVING
-                        if speed > 0.0:
-                            c[i, 0], c[i, 1] = vx / speed, vy / speed
-            if account:
-                after = energy3d(y, n, col)
-                if kind == ACROSS or kind == TURNED:
-                    ledger[4] += ledger[1] - after
-                ledger[1] = after
-    return (SURVIVED, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl, n_imp,
-            n_steps, n_rhs, n_ev, n_out, azimuth, swept, ledger)  # fmt: skip
+
+# ---- the column in two directions' part of the run loop (numerics.loop.run_motion): its
+# run record (W: rbm3d.work.COLUMN3D)
+
+
+@jit
+def enter_segment(W, free_seg):
+    """A formula's second component: its form in W.sys_e, 0 on a free segment."""
+    if W.formula_y:
+        gy = W.gy
+        n = W.sys_e.size - ES_EXTRA
+        W.sys_e[n + 2], W.sys_e[n + 3], W.sys_e[n + 4] = 1.0, 0.0 if free_seg else gy[1], gy[2]
+        W.sys_e[n + 5], W.sys_e[n + 6], W.sys_e[n + 7] = gy[3], gy[4], gy[5]
+
+
+@jit
+def rest_to_end(W, t, t_end, mc, n_out, next_out):
+    """At rest from t to t_end [s] (no ground motion from here on): its samples; ends
+    AT_REST."""
+    if W.record:
+        n_out, next_out = _emit(mc, t_end, t, 0.0, W.y, W.F, W.yq, W.samples, n_out, next_out,
+                                W.output_dt, W.tu.size, W.d0, W.d1, W)  # fmt: skip
+    return AT_REST, n_out, next_out
+
+
+@jit
+def rest(W, t, seg_end, gr_full, mc, n_out, next_out):
+    """A rigid monolith at rest in a forced segment (rest3d)."""
+    pair_args = (W.gy, W.knots, W.values, W.values_y, W.knots_y, W.vertical,
+                 W.pair_on, W.d0, W.d1)  # fmt: skip
+    return rest3d(t, seg_end, min(W.pulse_end, W.t_end), W, W.amplitude, gr_full, pair_args,
+                  W.friction, W.held, W.rx, W.ry, W.slip, W.mu,
+                  (W.record, mc, W.F, W.yq, W.samples, W.output_dt), n_out, next_out, W.y, W.c,
+                  W.phase, W.rising)  # fmt: skip
+
+
+@jit
+def restart(W, t, seg_end, seg_gain, h_carry, gr, mc, rtol, atol):
+    """A new stepper from (t, W.y): the current pieces packed (beam3d.pack_pieces), the watched
+    events (watch) and their distances at t, the first step's size (h_carry, the one proposed
+    before an event, or numerics.rk.initial_step's). Returns the step size [s], the
+    right-hand side's calls and the ground."""
+    values_y = W.values_y
+    k, phase, rising, c = W.k, W.phase, W.rising, W.c
+    n = k.size
+    pinned = np.zeros(n, dtype=np.int64)  # beam3d.pack_pieces
+    for i in range(n):
+        if phase[i] != FREE and W.rigid[i]:
+            pinned[i] = 2 if rising[i] else 1
+    pack_pieces(k, pinned, c, W.intercepts, W.slope_parts[0], W.slope_parts[1], W.damp,
+                W.rigid, W.sys_c)  # fmt: skip
+    m = watch(n, k, phase, W.pending, W, W.kinds, W.joints)
+    W.count[0] = m
+    t_bound = seg_end
+    if W.clipped:
+        gr, t_bound = _pieces(t, W.knots, W.values, values_y, W.vertical,
+                              seg_gain, seg_end, W.sys_e)  # fmt: skip
+    rows_at(W.y, gravity_factor(t, gr), n, W, k, c, W.kinds, W.joints, m, W.d_old, W.r_old)
+    rhs(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.f)
+    if h_carry > 0.0:
+        return min(h_carry, seg_end - t), 1, gr
+    h_abs = initial_step(
+        t, W.y, W.f, t_bound, TAB_EST[mc], rtol, atol, n, W.sys_A, W.sys_c, W.sys_e, gr, W.work
+    )
+    return h_abs, 2, gr
+
+
+@jit
+def ground_piece(W, t, seg_gain, seg_end):
+    """A record's straight piece from t and the time a step ends at, a pair's second record's
+    in W.sys_e (_pieces)."""
+    return _pieces(t, W.knots, W.values, W.values_y, W.vertical, seg_gain,
+                   seg_end, W.sys_e)  # fmt: skip
+
+
+@jit
+def find_event(W, mc, t_old, t_new, h, gr):
+    """The first watched event in the step [t_old, t_new]: the rows at the step's end, then,
+    where one may cross within reach, the step's dense output prepared and the crossing found
+    on it (first_event). Returns (t_e, the row crossed or -1, the dense output ready,
+    right-hand side calls)."""
+    n, m = W.k.size, W.count[0]
+    rows_at(W.y_new, gravity_factor(t_new, gr), n, W, W.k, W.c, W.kinds, W.joints, m, W.d_new,
+            W.r_new)  # fmt: skip
+    if not within_reach(W.d_old, W.r_old, W.d_new, W.r_new, t_new - t_old, W.kinds, m, W.near):
+        return t_new, -1, False, 0
+    calls = dense_prepare(
+        mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
+    )
+    t_e, hit = first_event(mc, t_old, t_new, h, W.y, W.F, W.yq, n, W, W.k, W.c, gr, W.kinds,
+                           W.joints, m, W.D, W.R, W.near)  # fmt: skip
+    return t_e, hit, True, calls
+
+
+@jit
+def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out, next_out):
+    """The figures of the step [t_old, t_new] (cut at an event): the friction demand at its
+    end and the held demand's samples inside it, samples, the energy account, the peaks (at
+    the end, and where a magnitude's rate turns inside the step), the angle each joint's lean
+    turned, silent closures. Returns (right-hand side calls, n_out, next_out, impacts
+    counted)."""
+    record, held = W.record, W.held
+    friction, slip = W.friction, W.slip
+    n = W.k.size
+    ns = TAB_NS[mc]
+    calls, impacts = 0, 0
+    if record and not dense_ready:
+        calls += dense_prepare(
+            mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
+        )
+        dense_ready = True
+    if event:
+        rhs(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.work)
+        calls += 1
+        f_new = W.work
+    else:
+        f_new = W.K[ns]
+    fr = _friction(t_new, f_new, n, W, W.sys_e, gr, friction, W.rx, W.ry)
+    if slip[1] == 0.0 and fr > W.mu:
+        best = 0
+        for i in range(n):
+            if friction[i] > friction[best]:
+                best = i
+        slip[0], slip[1] = t_new, best + 1.0
+    # the held demand's samples in (t_old, t_new]: theta'' on the step's quintic
+    acc_k = W.acc_k
+    while held_time(held) <= t_new:
+        t_k = held_time(held)
+        h_k = t_new - t_old
+        for j in range(2 * n):
+            q = 2 * n + j
+            acc_k[j] = f_new[q] if h_k <= 0.0 else hermite_accel(
+                (t_k - t_old) / h_k, h_k, W.y[j], W.y[q], W.f[q], W.y_new[j], W.y_new[q],
+                f_new[q])  # fmt: skip
+        ax_k, ay_k = horizontal(t_k, W.sys_e, n, gr)
+        shear_ratios(ax_k, ay_k, gravity_factor(t_k, gr), W.centre_map, acc_k[:n], acc_k[n:],
+                     W.masses, W.normal_forces, W.rx, W.ry, W.between)  # fmt: skip
+        held_push(held, W.rx, W.ry, W.between)
+    if record:
+        n_out, next_out = _emit(mc, t_new, t_old, h, W.y, W.F, W.yq, W.samples, n_out, next_out,
+                                W.output_dt, n, W.d0, W.d1, W)  # fmt: skip
+    if account:  # the step's dense output is ready (recorded runs always are)
+        account_step3d(mc, t_old, t_new, h, W.y, W.F, W.yq, n, W, W.k, W.sys_e, gr, W.ledger)
+        W.ledger[1] = energy3d(W.y_new, n, W)
+    # peaks: at the end, and where a magnitude's rate turns inside the step
+    top_row, max_ratio, top, swept = W.families[2 * n], W.max_ratio, W.top, W.swept
+    for i in range(n + 1):
+        row = W.families[n + i] if i < n else top_row
+        v1, r1 = _magnitude(row, W.y_new, n)
+        _, r0 = _magnitude(row, W.y, n)
+        if i == 0:
+            W.turned[0] = r0 > 0.0 >= r1  # the first joint's ratio passed a peak
+        if r0 > 0.0 and r1 < 0.0:
+            if not dense_ready:
+                calls += dense_prepare(
+                    mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
+                )
+                dense_ready = True
+            v1 = max(v1, _peak_in(row, t_old, t_new, mc, t_old, h, W.y, W.F, W.yq, n))
+        if i < n:
+            max_ratio[i] = max(max_ratio[i], v1)
+        else:
+            top[0] = max(top[0], v1)
+    # the angle each joint's lean turned, where it leans by WOBBLE_LEVEL of its collapse
+    # limit or more at both ends of the step (a wobble)
+    for i in range(n):
+        row = W.families[n + i]
+        ax_, ay_, bx_, by_ = 0.0, 0.0, 0.0, 0.0
+        for j in range(n):
+            ax_ += row[j] * W.y[j]
+            ay_ += row[j] * W.y[n + j]
+            bx_ += row[j] * W.y_new[j]
+            by_ += row[j] * W.y_new[n + j]
+        if (ax_ * ax_ + ay_ * ay_ >= WOBBLE_LEVEL * WOBBLE_LEVEL
+                and bx_ * bx_ + by_ * by_ >= WOBBLE_LEVEL * WOBBLE_LEVEL):  # fmt: skip
+            cr, dt_ = ax_ * by_ - ay_ * bx_, ax_ * bx_ + ay_ * by_
+            swept[i] += abs(math.atan2(cr, dt_))
+    # silent closures (e = 1, elastic joints): counted at the step's end
+    if W.e_rest == 1.0:
+        for i in range(n):
+            if W.phase[i] == APPROACH and not W.rigid[i]:
+                px, py, _, _ = _phi(i, W.y_new, n, W.argmap)
+                if px * W.c[i, 0] + py * W.c[i, 1] <= 0.0:
+                    impacts += 1
+                    W.pending[i], W.phase[i] = False, FREE
+    # the step's end is the next step's start
+    W.d_old[:] = W.d_new
+    W.r_old[:] = W.r_new
+    return calls, n_out, next_out, impacts
+
+
+@jit
+def may_stop(W, can_stop, sure_stop):
+    """Free motion past a peak below the collapse barrier, in the motion's plane: every
+    figure final (the planar column's stop, its energy of the state in the plane)."""
+    n = W.k.size
+    return (can_stop and W.turned[0] and in_plane(W.y, n)
+            and below_barrier(W.y[:n], W.y[2 * n : 3 * n], W.mass, W.argmap, W.gravity,
+                              W.edges, W.nedges, W.intercepts, W.slopes,
+                              W.barrier))  # fmt: skip
+
+
+@jit
+def at_event(W, row, t, gr, account):
+    """The state change at the watched event row at (t, W.y): a collapse, else event3d.
+    Returns (GOING or COLLAPSED, uplifts, impacts, at rest, the collapsed joint from 0, the
+    azimuth of its lean [rad])."""
+    n = W.k.size
+    kind, i = W.kinds[row], W.joints[row]
+    if kind == COLLAPSE:
+        W.max_ratio[i] = max(W.max_ratio[i], W.c_ratio)
+        return COLLAPSED, 0, 0, False, i, lean_azimuth(i, W.y, n, W)
+    up, imp, at_rest = event3d(kind, i, t, W.y, n, W, gr, (W.k, W.pending, W.phase, W.rising,
+                               W.c), account, W.ledger)  # fmt: skip
+    return GOING, up, imp, at_rest, -1, np.nan
+
+
+#: The column in two directions' run loop (numerics.loop.run_motion with the functions above).
+run_3d = loop_for(
+    "column3d",
+    {"enter_segment": enter_segment, "rest_to_end": rest_to_end, "rest": rest,
+     "restart": restart, "ground_piece": ground_piece, "find_event": find_event,
+     "step_figures": step_figures, "may_stop": may_stop, "at_event": at_event},
+)  # fmt: skip

@@ -168,8 +168,7 @@ def integrate3d(
                      task, pair)  # fmt: skip
     finally:
         disarm(armed)
-    (code, t_end, t_col, c_if, max_ratio, max_top, friction, slip, n_upl, n_imp, n_steps,
-     n_rhs, n_ev, n_out, azimuth, swept, ledger) = res  # fmt: skip
+    code, t_end, n_out = res.code, res.t_end, res.n_samples
     if end is not None:
         y_end = task[0].copy()
         for part in (0, 2 * n):
@@ -177,12 +176,13 @@ def integrate3d(
                                        1), angle)  # fmt: skip
             y_end[part : part + n], y_end[part + n : part + 2 * n] = pairs[:, 0], pairs[:, 1]
         end.append(y_end)
-    demand, first = held_result(held, friction, slip)
+    demand, first = held_result(held, res.friction, res.slip)
     out = Outcome(
-        t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=demand,
-        friction_peak=friction, n_uplifts=int(n_upl), n_impacts=int(n_imp),
-        n_steps=int(n_steps), n_rhs=int(n_rhs), n_events=int(n_ev), slip=first,
-        azimuth=float(azimuth) + angle, turns=float(swept.max()) / (2.0 * math.pi),
+        t_end=float(t_end), max_ratio=res.max_ratio, max_top=float(res.max_top),
+        friction=demand, friction_peak=res.friction, n_uplifts=int(res.n_uplifts),
+        n_impacts=int(res.n_impacts), n_steps=int(res.n_steps), n_rhs=int(res.n_rhs),
+        n_events=int(res.n_events), slip=first, azimuth=float(res.azimuth) + angle,
+        turns=float(res.swept.max()) / (2.0 * math.pi),
     )  # fmt: skip
     if record:
         rows = samples[:n_out]
@@ -191,9 +191,9 @@ def integrate3d(
         out.top_plan = to_ground(rows[:, 1 + 2 * n : 3 + 2 * n].copy(), angle)
         out.across = rows[:, 3 + 2 * n :].copy()
         if motion.vertical is None:
-            out.energy = EnergyAccount(*(float(v) for v in ledger))
+            out.energy = EnergyAccount(*(float(v) for v in res.ledger))
     if code == COLLAPSED:
-        out.collapse(float(t_col), int(c_if) + 1)
+        out.collapse(float(res.t_collapse), int(res.collapsed) + 1)
     elif code == AT_REST:
         out.message = "at rest in free motion: stopped"
     elif code == STOPPED_EARLY:

@@ -61,6 +61,7 @@ from rbm_cli.models.status import (
     end_by_budget,
     stop_level,
 )
+from rbm_cli.numerics.loop import RunEnd
 from rbm_cli.physics.column import build_column
 from rbm_cli.physics.equations import Model, build_model
 from rbm_cli.physics.excitation import GroundMotion
@@ -127,7 +128,7 @@ def prepare(model: Model):
 
 
 def _outcome(
-    res: tuple,
+    res: RunEnd,
     samples: np.ndarray,
     n: int,
     record: bool,
@@ -135,23 +136,23 @@ def _outcome(
     account: bool,
     held: np.ndarray,
 ) -> Outcome:
-    """The Outcome of what run_kernel returned (samples: its output rows; account: its
-    energy account is kept, a recorded run without a vertical record; held: the held
-    friction demand it took, pieces.held_array)."""
-    (code, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
-     n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger) = res  # fmt: skip
-    demand, first = held_result(held, friction, slip)
+    """The Outcome of what run_kernel returned (a numerics.loop.RunEnd; samples: its output
+    rows; account: its energy account is kept, a recorded run without a vertical record;
+    held: the held friction demand it took, pieces.held_array)."""
+    code, t_end = res.code, res.t_end
+    demand, first = held_result(held, res.friction, res.slip)
     out = Outcome(
-        t_end=float(t_end), max_ratio=max_ratio, max_top=float(max_top), friction=demand,
-        friction_peak=friction, n_uplifts=int(n_upl), n_impacts=int(n_imp),
-        n_steps=int(n_steps), n_rhs=int(n_rhs), n_events=int(n_ev), slip=first,
+        t_end=float(t_end), max_ratio=res.max_ratio, max_top=float(res.max_top),
+        friction=demand, friction_peak=res.friction, n_uplifts=int(res.n_uplifts),
+        n_impacts=int(res.n_impacts), n_steps=int(res.n_steps), n_rhs=int(res.n_rhs),
+        n_events=int(res.n_events), slip=first,
     )  # fmt: skip
     if record:
-        out.samples = sample_rows(samples, n_out, n)
+        out.samples = sample_rows(samples, res.n_samples, n)
         if account:
-            out.energy = EnergyAccount(*(float(v) for v in ledger))
+            out.energy = EnergyAccount(*(float(v) for v in res.ledger))
     if code == COLLAPSED:
-        out.collapse(float(t_col), int(c_if))
+        out.collapse(float(res.t_collapse), int(res.collapsed))
     elif code == STOPPED_EARLY:
         out.stopped_early(solver.stop == "outcome")
     elif code == FAILED_STEP:

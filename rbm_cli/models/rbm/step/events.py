@@ -13,8 +13,8 @@ import numpy as np
 
 from rbm_cli.base.brent import brent_step
 from rbm_cli.base.jit import jit
-from rbm_cli.models.rbm.step.rk import TAB_NP
 from rbm_cli.models.rbm.step.vertical import add_moving, moving_rate, moving_value
+from rbm_cli.numerics.rk import TAB_NP
 
 
 @jit

@@ -19,8 +19,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from rbm_cli.base.jit import jit
 from rbm_cli.models.methods import step_method
-from rbm_cli.models.rbm.step.rk import METHOD_CODES
+from rbm_cli.numerics.rk import METHOD_CODES
 from rbm_cli.physics.arrays import ColumnArrays, column_arrays
 from rbm_cli.physics.equations import Model
 from rbm_cli.physics.excitation import GroundMotion
@@ -60,6 +61,27 @@ class Excitation(NamedTuple):
     bounds: np.ndarray  #: segment boundaries, from 0 to t_end [s]
     forced: np.ndarray  #: whether a_g acts on each segment (bool)
     pulse: bool  #: free motion after a pulse or record (may stop early)
+
+
+#: What a structure's functions read of the motion, as a run's record declares it
+#: (rbm_cli.numerics.records; motion_into sets them): the record's knots, samples and
+#: vertical samples, the peak, the ends of the pulse and of the run, whether steps end at
+#: knots.
+MOTION_FIELDS = [("knots", "float64[::1]"), ("values", "float64[::1]"),
+                 ("vertical", "float64[::1]"), ("amplitude", "float64"), ("pulse_end", "float64"),
+                 ("t_end", "float64"), ("clipped", "bool")]  # fmt: skip
+
+
+@jit
+def motion_into(W, motion):
+    """Set the fields of a run's record W that MOTION_FIELDS names, from an Excitation."""
+    W.knots = motion.knots
+    W.values = motion.values
+    W.vertical = motion.vertical
+    W.amplitude = motion.amplitude
+    W.pulse_end = motion.pulse_end
+    W.t_end = motion.t_end
+    W.clipped = motion.clipped
 
 
 class SolverSettings(NamedTuple):
@@ -138,11 +160,13 @@ def solver_settings(solver, atol_scale: np.ndarray, deadline: float) -> tuple:
 
 __all__ = [
     "KIND_CODES",
+    "MOTION_FIELDS",
     "Excitation",
     "PreparedModel",
     "RunTask",
     "SolverSettings",
     "excitation",
+    "motion_into",
     "prepare_kernel",
     "solver_settings",
 ]

@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from rbm_cli.base.detmath import matvec
-from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
 from rbm_cli.models.rbm.pieces import (
@@ -34,38 +33,20 @@ from rbm_cli.models.rbm.step.events import (
     system,
     within_reach,
 )
-from rbm_cli.models.rbm.step.inputs import Excitation, RunTask, SolverSettings
-from rbm_cli.models.rbm.step.rk import (
-    NS_MAX,
-    STEP_TAKEN,
-    STEP_TOO_SMALL,
-    TAB_EST,
-    TAB_NS,
-    acc_of,
-    attempt_step,
-    dense_eval,
-    dense_prepare,
-    emit,
-    emit_rest,
-    initial_step,
-    rhs,
-)
+from rbm_cli.models.rbm.step.inputs import Excitation, RunTask, SolverSettings, motion_into
 from rbm_cli.models.rbm.step.state import REST, switch
 from rbm_cli.models.rbm.step.vertical import bound_now, moving_rows
+from rbm_cli.models.rbm.step.work import PLANE
 from rbm_cli.models.status import (
     COLLAPSED,
-    FAILED_EVENTS,
-    FAILED_NONFINITE,
-    FAILED_STEP,
-    FAILED_STEPS,
     GOING,
-    STOP_NEVER,
-    STOP_OUTCOME,
-    STOPPED_EARLY,
     SURVIVED,
-    guard_code,
 )
-from rbm_cli.physics.arrays import ColumnArrays
+from rbm_cli.numerics.loop import loop_for, loop_into
+from rbm_cli.numerics.quadrature import GL_NODES, GL_WEIGHTS
+from rbm_cli.numerics.records import new_record
+from rbm_cli.numerics.rk import TAB_EST, dense_eval, dense_prepare, emit, emit_rest, initial_step
+from rbm_cli.physics.arrays import ColumnArrays, column_into
 from rbm_cli.physics.ground import (
     gravity_factor,
     ground,
@@ -75,12 +56,7 @@ from rbm_cli.physics.ground import (
     rest_demand,
     rest_shear,
 )
-
-#: Gauss-Legendre nodes on [0, 1] and weights (5 points: exact for polynomials of degree 9).
-GL_NODES = np.array([0.04691007703066802, 0.23076534494715845, 0.5, 0.7692346550528415,
-                     0.9530899229693319])  # fmt: skip
-GL_WEIGHTS = np.array([0.11846344252809454, 0.23931433524968324, 0.28444444444444444,
-                       0.23931433524968324, 0.11846344252809454])  # fmt: skip
+from rbm_cli.physics.rates import acc_of, rhs
 
 
 @jit
@@ -110,6 +86,110 @@ def account_step(mc, t_old, t_new, h, y_old, F, gr, ground_load, argmap, damp, k
 
 
 @jit
+def rest_until(t, seg_end, last, uplift_level, amplitude, gr_full, knots, values, vertical,
+               friction, held, rx, ry, slip, mu, record, samples, n_out, next_out, output_dt,
+               y, side, k):  # fmt: skip
+    """A rigid monolith at rest from t [s] in a forced segment (to seg_end [s]): its friction
+    demand at rest (physics.ground.rest_demand, exact; the held demand's samples; where it
+    first exceeds mu), its samples, and where it lifts (no later than last [s]).
+
+    Returns
+    -------
+    (lifted, t, n_out, next_out)  lifted: the column lifts at t (its state zeroed, the
+        lifting side's pieces set); else it rests to t = seg_end.
+    """
+    t_up = next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical, last)
+    t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
+    d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
+    if d_rest > friction[0]:
+        friction[0] = d_rest
+    while held_time(held) <= t_rest:
+        rx[0] = rest_shear(held_time(held), gr_full, knots, values, vertical)
+        held_push(held, rx, ry, friction)
+    if slip[1] == 0.0 and d_rest > mu:
+        slip[0] = next_uplift(t, mu * G, amplitude, gr_full, knots, values, vertical, t_rest)
+        slip[1] = 1.0
+    if t_up < 0.0 or t_up >= seg_end:
+        if record:
+            n_out, next_out = emit_rest(seg_end, samples, n_out, next_out, output_dt)
+        return False, seg_end, n_out, next_out
+    if record:
+        n_out, next_out = emit_rest(t_up - 1e-15, samples, n_out, next_out, output_dt)
+    t = t_up
+    for i in range(y.size):
+        y[i] = 0.0
+    side[0] = -1 if ground_at(t, gr_full, knots, values) > 0.0 else 1
+    k[0] = 0
+    return True, t, n_out, next_out
+
+
+@jit(inline=True)
+def start(theta0, rate0, W, account):
+    """The initial state y = (theta0, rate0), its pieces (pieces.locate) and its energy in
+    the run's ledger; returns y and whether a rigid monolith starts at rest."""
+    n = theta0.size
+    y = np.empty(2 * n)
+    y[:n] = theta0
+    y[n:] = rate0
+    at_rest = W.uplift_level >= 0.0
+    for i in range(2 * n):
+        if y[i] != 0.0:
+            at_rest = False
+    x0 = matvec(W.argmap, y[:n], np.empty(n))
+    r0 = matvec(W.argmap, y[n:], np.empty(n))
+    locate(x0, r0, W.side, W.k, W.pending, W.rigid, W.edges, W.nedges)
+    if account:
+        ledger = W.ledger
+        ledger[0] = energy(y[:n], y[n:], W.mass, W.argmap, W.gravity, W.edges, W.nedges,
+                           W.intercepts, W.slopes)  # fmt: skip
+        ledger[1] = ledger[0]
+    return y, at_rest
+
+
+@jit(inline=True)
+def plane_record(model, motion, task, n, vert):
+    """The run's record (step.work.PLANE) of a column of n joints: model its ColumnArrays,
+    motion the Excitation, task the RunTask; vert: under a vertical record."""
+    W = new_record(PLANE)
+    column_into(W, model)
+    motion_into(W, motion)
+    # max_ratio, friction, slip, swept (none), the energy account (run_kernel's Returns), the
+    # top's peak
+    W.max_ratio, W.friction, W.slip = np.zeros(n), np.zeros(n), np.array([np.nan, 0.0])
+    W.swept, W.ledger, W.top = np.zeros(0), np.zeros(5), np.zeros(1)
+    nrow, nt, nv = 4 * n, n + 1, 2 * n if vert else 0
+    W.side, W.k = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+    W.pending, W.awaiting = np.zeros(n, dtype=np.bool_), np.zeros(n, dtype=np.bool_)
+    W.lo, W.hi, W.h0, W.mv_e, W.mv_w = (
+        np.empty(n),
+        np.empty(n),
+        np.empty(4 * n),
+        np.zeros(nv),
+        np.ones(nv),
+    )
+    W.peaks, W.coef, W.zero_t, W.no_offset = np.zeros(nt), np.empty(7), np.zeros(nt), np.empty(0)
+    W.z_old, W.z_new, W.z_prev = np.empty(nt), np.empty(nt), np.empty(nt)
+    W.dz_old, W.dz_new, W.dz_prev = np.empty(nt), np.empty(nt), np.empty(nt)
+    W.d_old, W.d_new, W.dd_old = np.empty(nrow), np.empty(nrow), np.empty(nrow)
+    W.dd_new, W.d2_old, W.d2_new = np.empty(nrow), np.empty(nrow), np.empty(nrow)
+    W.near = np.zeros(nrow, dtype=np.bool_)
+    W.Dq, W.Rq = np.empty((nrow, CHECK_INTERVALS + 1)), np.empty((nrow, CHECK_INTERVALS + 1))
+    W.dc0, W.dc1, W.rc0, W.rc1 = np.empty(nrow), np.empty(nrow), np.empty(nrow), np.empty(nrow)
+    W.CP, W.BP, W.CR, W.BR = (
+        np.empty((nrow, 7)),
+        np.empty(nrow),
+        np.empty((nrow, 7)),
+        np.empty(nrow),
+    )
+    W.acc, W.acc_old, W.acc_k = np.empty(n), np.empty(n), np.empty(n)
+    W.rx, W.ry, W.between, W.ends = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(2)
+    W.samples, W.held, W.record = task.samples, task.held, task.record
+    W.output_dt, W.mu, W.vert = task.output_dt, task.friction_limit, vert
+    W.any_silent = model.silent.any()
+    return W
+
+
+@jit
 def run_kernel(model, motion, solver, task):
     """Run one motion of one model.
 
@@ -126,357 +206,260 @@ def run_kernel(model, motion, solver, task):
 
     Returns
     -------
-    tuple  (status code (rbm_cli.models.status), t_end [s], t_collapse [s], collapsed interface,
-        max_ratio (n,), max_top, friction (n,), slip (2,), n_uplifts, n_impacts, n_steps,
-        n_rhs, n_events, n_samples, ledger). friction: the largest |T_i / N_i| of each
-        interface [-] (its peak), at rest (physics.ground.rest_demand, exact) and at step
-        ends in motion (the held demand's samples between them, on the step's interpolant,
-        go to task.held only, changed in place: pieces.held_push); slip: where the peak
-        first exceeded task.friction_limit, (t [s], interface from 1),
-        (nan, 0) if not: at rest the exceedance time itself (physics.ground.next_uplift at the
-        limit), in motion the end of the first step whose demand exceeds it. ledger: the
-        energy account of a recorded run without a vertical record [J] (zeros otherwise): the
-        energy at the start and at the end (pieces.energy), the ground's work, the energy the
-        joints' damping and the impacts took. Their balance: end - start = work - damping -
-        impacts, to the integration's accuracy (the work and the damping are integrated over
-        each step's dense output by Gauss-Legendre quadrature, the impacts counted exactly at
+    RunEnd  (numerics.loop; azimuth nan and swept empty). friction: the largest |T_i / N_i|
+        of each interface [-] (its peak), at rest (physics.ground.rest_demand, exact) and at
+        step ends in motion (the held demand's samples between them, on the step's
+        interpolant, go to task.held only, changed in place: pieces.held_push); slip: where
+        the peak first exceeded task.friction_limit, (t [s], interface from 1), (nan, 0) if
+        not: at rest the exceedance time itself (physics.ground.next_uplift at the limit), in
+        motion the end of the first step whose demand exceeds it. ledger: the energy account
+        of a recorded run without a vertical record [J] (zeros otherwise): the energy at the
+        start and at the end (pieces.energy), the ground's work, the energy the joints'
+        damping and the impacts took. Their balance: end - start = work - damping - impacts,
+        to the integration's accuracy (the work and the damping are integrated over each
+        step's dense output by Gauss-Legendre quadrature, the impacts counted exactly at
         each one).
     """
     model, motion = ColumnArrays(*model), Excitation(*motion)
     solver, task = SolverSettings(*solver), RunTask(*task)
-    mass, argmap, gravity = model.mass, model.argmap, model.gravity
-    edges, nedges, intercepts, slopes = model.edges, model.nedges, model.intercepts, model.slopes
-    parts, edge_w = model.slope_parts, model.edge_w
-    damp, ground_load = model.damp, model.ground_load
-    rigid, silent, tu, c_ratio = model.rigid, model.silent, model.tu, model.c_ratio
-    centre_map, masses, normal_forces = model.centre_map, model.masses, model.normal_forces
-    uplift_level, barrier, survival = model.uplift_level, model.barrier, model.survival
-    amplitude, pulse_end, t_end = motion.amplitude, motion.pulse_end, motion.t_end
-    knots, values, vertical, clipped = motion.knots, motion.values, motion.vertical, motion.clipped
-    bounds, forced = motion.bounds, motion.forced
-    # the ground (rbm_cli.physics.ground): of the motion, and nothing (a free segment); a record
-    # one straight piece a step (record_piece)
-    gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
-               motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip
-    gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center, motion.gamma,
-               0.0, 0.0, 0.0)  # fmt: skip
-    mc, rtol, atol, deadline = solver.mc, solver.rtol, solver.atol, solver.deadline
-    max_steps, max_events = solver.max_steps, solver.max_events
-    theta0, rate0, early_stop = task.theta0, task.rate0, task.early_stop
-    record, output_dt, samples = task.record, task.output_dt, task.samples
-    mu = task.friction_limit
-    held = task.held
-
-    n = theta0.size
-    n_out = 0
-    next_out = 0.0
-    m = 2 * n
-    max_ratio = np.zeros(n)
-    friction = np.zeros(n)
-    slip = np.array([np.nan, 0.0])
-    max_top = 0.0
-    n_upl, n_imp, n_steps, n_rhs, n_ev = 0, 0, 0, 0, 0
-    status = SURVIVED
-    t_col, c_if = np.nan, -1
-
-    side = np.ones(n, dtype=np.int64)
-    k = np.zeros(n, dtype=np.int64)
-    pending = np.zeros(n, dtype=np.bool_)
-    # silent impacts (Model.silent_impacts): counted at step ends, not stopped at
-    any_silent = silent.any()
-    awaiting = np.zeros(n, dtype=np.bool_)
-    lo, hi = np.empty(n), np.empty(n)
-    nt = n + 1
-    gx, gc, same = model.gx, model.gc, model.same
-    md, mg, track, es = model.md, model.mg, model.track, model.es
-    peaks = np.zeros(nt)
-    # As[:, n:2n]: the joints' stiffness, As[:, 2n:]: their damping (step.events.system)
-    As, cs = np.empty((n, 3 * n if model.damped else 2 * n)), np.empty(n)
-    vert = vertical.size > 0  # a vertical record: kinks that move with it (step.vertical)
-    # the energy account of a recorded run (see Returns): start, end, work, damping, impacts
-    account = record and not vert
-    ledger = np.zeros(5)
-    yq = np.empty(2 * n)
-    mv_e, mv_w = np.zeros(2 * n if vert else 0), np.ones(2 * n if vert else 0)
-    h0 = np.empty(4 * n)
-    K = np.empty((NS_MAX, m))
-    F = np.empty((8, m))
-    f = np.empty(m)
-    ynew = np.empty(m)
-    tmp = np.empty(m)
-    work = np.empty(m)
-    scale = np.empty(m)
-    nrow = 4 * n
-    d_old, d_new = np.empty(nrow), np.empty(nrow)
-    dd_old, dd_new = np.empty(nrow), np.empty(nrow)
-    d2_old, d2_new = np.empty(nrow), np.empty(nrow)
-    Dq, Rq = np.empty((nrow, CHECK_INTERVALS + 1)), np.empty((nrow, CHECK_INTERVALS + 1))
-    dc0, dc1, rc0, rc1 = np.empty(nrow), np.empty(nrow), np.empty(nrow), np.empty(nrow)
-    near = np.zeros(nrow, dtype=np.bool_)
-    CP, CR = np.empty((nrow, 7)), np.empty((nrow, 7))
-    BP, BR = np.empty(nrow), np.empty(nrow)
-    coef = np.empty(7)
-    zero_t = np.zeros(nt)
-    z_old, z_new, z_prev = np.empty(nt), np.empty(nt), np.empty(nt)
-    dz_old, dz_new, dz_prev = np.empty(nt), np.empty(nt), np.empty(nt)
-    acc = np.empty(n)
-    acc_old, acc_k = np.empty(n), np.empty(n)  # theta'' at a step's start, at a sample
-    rx, ry = np.zeros(n), np.zeros(n)  # the shear ratios at a sample of the held demand
-    between = np.zeros(n)  # their peak between step ends (interpolated: not the run's peak)
-    no_offset = np.empty(0)
-    y_new = np.empty(m)
-    est_order = TAB_EST[mc]
-    err_exp = -1.0 / (est_order + 1)
-    ns = TAB_NS[mc]
-
-    t = 0.0
-    y = np.empty(m)
-    y[:n] = theta0
-    y[n:] = rate0
-    rigid_mono = uplift_level >= 0.0
-    at_rest = rigid_mono
-    for i in range(m):
-        if y[i] != 0.0:
-            at_rest = False
-    x0 = matvec(argmap, y[:n], np.empty(n))
-    r0 = matvec(argmap, y[n:], np.empty(n))
-    locate(x0, r0, side, k, pending, rigid, edges, nedges)
-    if account:
-        ledger[0] = energy(y[:n], y[n:], mass, argmap, gravity, edges, nedges, intercepts,
-                           slopes)  # fmt: skip
-        ledger[1] = ledger[0]
-
+    n = task.theta0.size
+    vert = motion.vertical.size > 0  # a vertical record: kinks that move with it (step.vertical)
+    W = plane_record(model, motion, task, n, vert)
+    # the system's arrays: As[:, n:2n] the joints' stiffness, As[:, 2n:] their damping
+    # (step.events.system), cs the rows' offsets, es the model's
+    system = (np.empty((n, 3 * n if model.damped else 2 * n)), np.empty(n), model.es)
+    account = task.record and not vert
+    y, at_rest = start(task.theta0, task.rate0, W, account)
     last_forced = -1  # the last segment with forcing (solver.stop: outcome stops after it)
-    for seg in range(bounds.size - 1):
-        if forced[seg]:
+    for seg in range(motion.bounds.size - 1):
+        if motion.forced[seg]:
             last_forced = seg
-    outcome_bound = survival == survival and not vert  # a survival barrier that applies
-    for seg in range(bounds.size - 1):
-        seg_end = bounds[seg + 1]
-        if t >= seg_end:
-            continue
-        free_seg = not forced[seg]
-        gr = gr_free if free_seg else gr_full
-        seg_gain = gr[1]
-        can_stop = early_stop != STOP_NEVER and free_seg and motion.pulse and n == 1
-        # solver.stop: outcome: free motion from here to the end, below the survival barrier
-        sure_stop = early_stop == STOP_OUTCOME and seg > last_forced and outcome_bound
-        h_carry = -1.0  # the step size proposed before an event, carried over it
-        while t < seg_end:
-            if at_rest:
-                if free_seg:
-                    if record:
-                        n_out, next_out = emit_rest(t_end, samples, n_out, next_out, output_dt)
-                    return (status, t_end, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-                last = min(pulse_end, t_end)
-                t_up = next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical,
-                                    last)  # fmt: skip
-                t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
-                d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
-                if d_rest > friction[0]:
-                    friction[0] = d_rest
-                while held_time(held) <= t_rest:
-                    rx[0] = rest_shear(held_time(held), gr_full, knots, values, vertical)
-                    held_push(held, rx, ry, friction)
-                if slip[1] == 0.0 and d_rest > mu:
-                    slip[0] = next_uplift(t, mu * G, amplitude, gr_full, knots, values,
-                                          vertical, t_rest)  # fmt: skip
-                    slip[1] = 1.0
-                if t_up < 0.0 or t_up >= seg_end:
-                    if record:
-                        n_out, next_out = emit_rest(seg_end, samples, n_out, next_out, output_dt)
-                    t = seg_end
-                    break
-                if record:
-                    n_out, next_out = emit_rest(t_up - 1e-15, samples, n_out, next_out, output_dt)
-                t = t_up
-                for i in range(m):
-                    y[i] = 0.0
-                side[0] = -1 if ground_at(t, gr_full, knots, values) > 0.0 else 1
-                k[0] = 0
-                at_rest = False
-                n_upl += 1
-                h_carry = -1.0
+    outcome_bound = model.survival == model.survival and not vert  # a barrier that applies
+    stops = (task.early_stop, last_forced, outcome_bound, n == 1)
+    loop_into(W, y, system)
+    return run_plane(W, motion, solver, n, at_rest, stops, account)
 
-            system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, cs)
-            bound_rows(side, k, pending, rigid, edges, nedges, tu, c_ratio, lo, hi, h0)
-            if vert:
-                moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv_w)
 
-            # a new stepper from (t, y)
-            t_bound = seg_end
-            if clipped:
-                gr, t_bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
-            rhs(t, y, n, As, cs, es, gr, f)
-            if h_carry > 0.0:
-                h_abs = min(h_carry, seg_end - t)
-                n_rhs += 1
-            else:
-                h_abs = initial_step(t, y, f, t_bound, est_order, rtol, atol, n, As, cs, es,
-                                      gr, work)  # fmt: skip
-                n_rhs += 2
-            affine(track, y, 0, no_offset, z_old)
-            affine(track, y, n, no_offset, dz_old)
-            acc_of(t, y, n, As, cs, es, gr, acc)
-            surfaces(gx, gc, same, y, acc, h0, d_old, dd_old, d2_old, t, gr, mv_e, mv_w)
-            event = False
-            running = True
-            while running:
-                # ---- one accepted step (scipy RungeKutta._step_impl)
-                bound = seg_end  # a record's steps end at its samples (python.Stepper's)
-                if clipped:
-                    gr, bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
-                taken, t_new, h, h_abs, calls = attempt_step(
-                    mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
-                    scale, err_exp)  # fmt: skip
-                n_rhs += calls
-                if taken != STEP_TAKEN:
-                    code = FAILED_STEP if taken == STEP_TOO_SMALL else FAILED_NONFINITE
-                    return (code, t, t_col, c_if, max_ratio, max_top, friction, slip, n_upl,
-                            n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-                n_steps += 1
-                if n_steps > max_steps:
-                    return (FAILED_STEPS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-                if n_steps % POLL_STEPS == 0:  # the wall-clock budget and Ctrl-C
-                    code = guard_code(deadline)
-                    if code != GOING:
-                        return (code, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                                n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-                if t_new - seg_end >= 0:
-                    running = False
-                t_old = t
-                y_old = y
-                y_new[:] = ynew
-                dense_ready = False
-                acc_old[:] = acc
-                g_new, gam_new = acc_of(t_new, y_new, n, As, cs, es, gr, acc)
-                surfaces(gx, gc, same, y_new, acc, h0, d_new, dd_new, d2_new, t_new, gr, mv_e,
-                          mv_w)  # fmt: skip
-                event_row = -1
-                t_e = t_new
-                if within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
-                    n_rhs += dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
-                                            cs, es, gr)  # fmt: skip
-                    dense_ready = True
-                    t_e, event_row = first_crossing(mc, t_old, t_new, y_old, F, gx, gc, same,
-                                                     h0, n, Dq, Rq, dc0, dc1, rc0, rc1, near,
-                                                     CP, BP, CR, BR, gr, mv_e, mv_w)  # fmt: skip
-                if event_row >= 0:
-                    dense_eval(mc, t_e, t_old, h, y_old, F, y_new)
-                    t_new = t_e
-                    event = True
-                    g_new, gam_new = acc_of(t_new, y_new, n, As, cs, es, gr, acc)
-                    if record:
-                        n_out, next_out = emit(mc, t_e, t_old, h, y_old, F, samples, n_out,
-                                                next_out, output_dt)  # fmt: skip
-                elif record:
-                    if not dense_ready:
-                        n_rhs += dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As,
-                                                cs, es, gr)  # fmt: skip
-                        dense_ready = True
-                    n_out, next_out = emit(mc, t_new, t_old, h, y_old, F, samples, n_out,
-                                            next_out, output_dt)  # fmt: skip
-                if account:  # the step's dense output is ready (recorded runs always are)
-                    account_step(mc, t_old, t_new, h, y_old, F, gr, ground_load, argmap, damp,
-                                 k, yq, ledger)  # fmt: skip
-                    ledger[1] = energy(y_new[:n], y_new[n:], mass, argmap, gravity, edges,
-                                       nedges, intercepts, slopes)  # fmt: skip
-                if any_silent:
-                    n_imp += settle(awaiting, argmap, y_new, side)
-                # peaks and friction demand over [t_old, t_new]
-                affine(track, y_new, 0, no_offset, z_new)
-                affine(track, y_new, n, no_offset, dz_new)
-                # peaks inside the step: at the root of the rate, on the dense output
-                for r in range(nt):
-                    v = max(abs(z_old[r]), abs(z_new[r]))
-                    # a turn inside the step that may beat the running maximum: the
-                    # step's cubic Hermite exceeds its end values by at most
-                    # 4/27 h (|rate0| + |rate1|); the margin used is 1/2 (the dense
-                    # output is of higher order than the Hermite)
-                    reach = v + 0.5 * (t_new - t_old) * (abs(dz_old[r]) + abs(dz_new[r]))
-                    if dz_old[r] * dz_new[r] < 0.0 and reach > peaks[r]:
-                        if not dense_ready:
-                            n_rhs += dense_prepare(mc, t_old, h, y_old, ynew, K, F, tmp, n,
-                                                    As, cs, es, gr)  # fmt: skip
-                            dense_ready = True
-                        base = row_poly(mc, F, y_old, track, r, zero_t, n, True, coef)
-                        t_pk = brentq(mc, t_old, t_new, t_old, h, coef, base, (0.0, 1.0, gr))
-                        base = row_poly(mc, F, y_old, track, r, zero_t, n, False, coef)
-                        v = max(v, abs(poly_val(mc, t_pk, t_old, h, coef, base)))
-                    if v > peaks[r]:
-                        peaks[r] = v
-                for i in range(n):
-                    if peaks[i] > max_ratio[i]:
-                        max_ratio[i] = peaks[i]
-                if peaks[n] > max_top:
-                    max_top = peaks[n]
-                shear_ratios(g_new, 0.0, gam_new, centre_map, acc, no_offset, masses,
-                             normal_forces, rx, ry, friction)  # fmt: skip
-                if slip[1] == 0.0:
-                    first_over(friction, mu, t_new, slip)
-                # the held demand's samples in (t_old, t_new]: theta'' on the step's quintic
-                while held_time(held) <= t_new:
-                    t_k = held_time(held)
-                    h_k = t_new - t_old
-                    for j in range(n):
-                        acc_k[j] = acc[j] if h_k <= 0.0 else hermite_accel(
-                            (t_k - t_old) / h_k, h_k, y_old[j], y_old[n + j], acc_old[j],
-                            y_new[j], y_new[n + j], acc[j])  # fmt: skip
-                    shear_ratios(ground(t_k, gr), 0.0, gravity_factor(t_k, gr), centre_map,
-                                 acc_k, no_offset, masses, normal_forces, rx, ry,
-                                 between)  # fmt: skip
-                    held_push(held, rx, ry, between)
-                z_prev, z_old, z_new = z_old, z_new, z_prev
-                dz_prev, dz_old, dz_new = dz_old, dz_new, dz_prev
-                d_old, d_new = d_new, d_old
-                dd_old, dd_new = dd_new, dd_old
-                d2_old, d2_new = d2_new, d2_old
-                t = t_new
-                y, y_new = y_new, y
-                f[:] = K[ns]
-                if event:
-                    break
-                # free motion below a barrier: a column's survival certain (solver.stop:
-                # outcome), or a monolith past a peak (every figure final)
-                peak = can_stop and z_prev[0] * dz_prev[0] > 0 >= z_old[0] * dz_old[0]
-                if (sure_stop or peak) and below_barrier(
-                        y[:n], y[n:], mass, argmap, gravity, edges, nedges, intercepts, slopes,
-                        survival if sure_stop else barrier):  # fmt: skip
-                    return (STOPPED_EARLY, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-            if not event:
-                t = seg_end if not running else t
-                continue
+# ---- the planar column's part of the run loop (numerics.loop.run_motion): its
+# run record (W: step.work.PLANE)
 
-            # ---- the event at (t, y)
-            h_carry = h_abs
-            n_ev += 1
-            if n_ev > max_events:
-                return (FAILED_EVENTS, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-            which, i = event_row // n, event_row % n
-            if which >= 2:
-                t_col, c_if = t, i + 1
-                if c_ratio > max_ratio[i]:
-                    max_ratio[i] = c_ratio
-                return (COLLAPSED, t, t_col, c_if, max_ratio, max_top, friction, slip,
-                        n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
-            going_up = which == 1
-            bound = bound_now(i, going_up, n, lo, hi, tu, t, gr, mv_e, mv_w) if vert else (
-                hi[i] if going_up else lo[i])  # fmt: skip
-            what = switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
-            if account:
-                after = energy(y[:n], y[n:], mass, argmap, gravity, edges, nedges, intercepts,
-                               slopes)  # fmt: skip
-                if what >= IMPACT:
-                    ledger[4] += ledger[1] - after
-                ledger[1] = after
-            if what == UPLIFT:
-                n_upl += 1
-            elif what >= IMPACT:
-                n_imp += 1
-                at_rest = what == REST
-    return (status, t, t_col, c_if, max_ratio, max_top, friction, slip,
-            n_upl, n_imp, n_steps, n_rhs, n_ev, n_out, ledger)  # fmt: skip
+
+@jit
+def enter_segment(W, free_seg):
+    """Nothing to set at a segment's start."""
+    return
+
+
+@jit
+def rest_to_end(W, t, t_end, mc, n_out, next_out):
+    """At rest from t to t_end [s]: its samples; ends SURVIVED."""
+    if W.record:
+        n_out, next_out = emit_rest(t_end, W.samples, n_out, next_out, W.output_dt)
+    return SURVIVED, n_out, next_out
+
+
+@jit
+def rest(W, t, seg_end, gr_full, mc, n_out, next_out):
+    """A rigid monolith at rest in a forced segment (rest_until)."""
+    return rest_until(t, seg_end, min(W.pulse_end, W.t_end), W.uplift_level,
+                      W.amplitude, gr_full, W.knots, W.values, W.vertical,
+                      W.friction, W.held, W.rx, W.ry, W.slip, W.mu, W.record, W.samples,
+                      n_out, next_out, W.output_dt, W.y, W.side,
+                      W.k)  # fmt: skip
+
+
+@jit
+def restart(W, t, seg_end, seg_gain, h_carry, gr, mc, rtol, atol):
+    """A new stepper from (t, W.y): the system of the current pieces (step.events.system), the
+    watched rows' bounds (and their moving parts), the rows and their distances at t, the
+    first step's size (h_carry, the one proposed before an event, or numerics.rk's
+    initial_step). Returns the step size [s], the right-hand side's calls and the ground."""
+    vert = W.vert
+    n = W.y.size // 2
+    system(W.side, W.k, W.intercepts, W.slopes, W.slope_parts, vert, W.md,
+           W.mg, W.argmap, W.damp, W.sys_A, W.sys_c)  # fmt: skip
+    bound_rows(W.side, W.k, W.pending, W.rigid, W.edges, W.nedges, W.tu,
+               W.c_ratio, W.lo, W.hi, W.h0)  # fmt: skip
+    if vert:
+        moving_rows(W.side, W.k, W.pending, W.rigid, W.edges, W.nedges,
+                    W.edge_w, W.tu, W.h0, W.mv_e, W.mv_w)  # fmt: skip
+    t_bound = seg_end
+    if W.clipped:
+        gr, t_bound = record_piece(t, W.knots, W.values, W.vertical, seg_gain,
+                                   seg_end)  # fmt: skip
+    rhs(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.f)
+    if h_carry > 0.0:
+        h_abs, calls = min(h_carry, seg_end - t), 1
+    else:
+        h_abs = initial_step(
+            t, W.y, W.f, t_bound, TAB_EST[mc], rtol, atol, n, W.sys_A, W.sys_c, W.sys_e, gr, W.work
+        )
+        calls = 2
+    affine(W.track, W.y, 0, W.no_offset, W.z_old)
+    affine(W.track, W.y, n, W.no_offset, W.dz_old)
+    acc_of(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
+    surfaces(W.gx, W.gc, W.same, W.y, W.acc, W.h0, W.d_old, W.dd_old, W.d2_old, t, gr,
+             W.mv_e, W.mv_w)  # fmt: skip
+    return h_abs, calls, gr
+
+
+@jit
+def ground_piece(W, t, seg_gain, seg_end):
+    """A record's straight piece from t and the time a step ends at (record_piece)."""
+    return record_piece(t, W.knots, W.values, W.vertical, seg_gain, seg_end)
+
+
+@jit
+def find_event(W, mc, t_old, t_new, h, gr):
+    """The first watched row's crossing in the step [t_old, t_new] (step.events): theta''
+    and the rows at the step's end, then, where a crossing may lie within reach, the step's
+    dense output prepared and the crossing found on it. Returns (t_e, the row crossed or -1,
+    the dense output ready, right-hand side calls)."""
+    n = W.y.size // 2
+    W.acc_old[:] = W.acc
+    W.ends[0], W.ends[1] = acc_of(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
+    surfaces(W.gx, W.gc, W.same, W.y_new, W.acc, W.h0, W.d_new, W.dd_new, W.d2_new,
+             t_new, gr, W.mv_e, W.mv_w)  # fmt: skip
+    if not within_reach(W.d_old, W.d_new, W.dd_old, W.dd_new, W.d2_old, W.d2_new, t_new - t_old,
+                        W.near):  # fmt: skip
+        return t_new, -1, False, 0
+    calls = dense_prepare(
+        mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
+    )
+    t_e, row = first_crossing(mc, t_old, t_new, W.y, W.F, W.gx, W.gc, W.same, W.h0, n,
+                              W.Dq, W.Rq, W.dc0, W.dc1, W.rc0, W.rc1, W.near, W.CP, W.BP, W.CR,
+                              W.BR, gr, W.mv_e, W.mv_w)  # fmt: skip
+    return t_e, row, True, calls
+
+
+@jit
+def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out, next_out):
+    """The figures of the step [t_old, t_new] (cut at an event): samples, the energy account,
+    silent impacts, the peaks of the tracked rows (at the root of a rate inside the step, on
+    the dense output), the friction demand at the step's end and the held demand's samples
+    inside it. Returns (right-hand side calls, n_out, next_out, impacts counted)."""
+    n = W.y.size // 2
+    calls, impacts = 0, 0
+    if event:
+        g_new, gam_new = acc_of(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
+        if W.record:
+            n_out, next_out = emit(mc, t_new, t_old, h, W.y, W.F, W.samples, n_out, next_out,
+                                   W.output_dt)  # fmt: skip
+    else:
+        g_new, gam_new = W.ends[0], W.ends[1]
+        if W.record:
+            if not dense_ready:
+                calls += dense_prepare(
+                    mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
+                )
+                dense_ready = True
+            n_out, next_out = emit(mc, t_new, t_old, h, W.y, W.F, W.samples, n_out, next_out,
+                                   W.output_dt)  # fmt: skip
+    if account:  # the step's dense output is ready (recorded runs always are)
+        account_step(mc, t_old, t_new, h, W.y, W.F, gr, W.ground_load, W.argmap,
+                     W.damp, W.k, W.yq, W.ledger)  # fmt: skip
+        W.ledger[1] = energy(W.y_new[:n], W.y_new[n:], W.mass, W.argmap, W.gravity,
+                           W.edges, W.nedges, W.intercepts, W.slopes)  # fmt: skip
+    if W.any_silent:
+        impacts += settle(W.awaiting, W.argmap, W.y_new, W.side)
+    # peaks and friction demand over [t_old, t_new]
+    affine(W.track, W.y_new, 0, W.no_offset, W.z_new)
+    affine(W.track, W.y_new, n, W.no_offset, W.dz_new)
+    # peaks inside the step: at the root of the rate, on the dense output
+    for r in range(n + 1):
+        v = max(abs(W.z_old[r]), abs(W.z_new[r]))
+        # a turn inside the step that may beat the running maximum: the step's cubic
+        # Hermite exceeds its end values by at most 4/27 h (|rate0| + |rate1|); the margin
+        # used is 1/2 (the dense output is of higher order than the Hermite)
+        reach = v + 0.5 * (t_new - t_old) * (abs(W.dz_old[r]) + abs(W.dz_new[r]))
+        if W.dz_old[r] * W.dz_new[r] < 0.0 and reach > W.peaks[r]:
+            if not dense_ready:
+                calls += dense_prepare(
+                    mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
+                )
+                dense_ready = True
+            base = row_poly(mc, W.F, W.y, W.track, r, W.zero_t, n, True, W.coef)
+            t_pk = brentq(mc, t_old, t_new, t_old, h, W.coef, base, (0.0, 1.0, gr))
+            base = row_poly(mc, W.F, W.y, W.track, r, W.zero_t, n, False, W.coef)
+            v = max(v, abs(poly_val(mc, t_pk, t_old, h, W.coef, base)))
+        if v > W.peaks[r]:
+            W.peaks[r] = v
+    for i in range(n):
+        if W.peaks[i] > W.max_ratio[i]:
+            W.max_ratio[i] = W.peaks[i]
+    if W.peaks[n] > W.top[0]:
+        W.top[0] = W.peaks[n]
+    shear_ratios(g_new, 0.0, gam_new, W.centre_map, W.acc, W.no_offset, W.masses,
+                 W.normal_forces, W.rx, W.ry, W.friction)  # fmt: skip
+    if W.slip[1] == 0.0:
+        first_over(W.friction, W.mu, t_new, W.slip)
+    # the held demand's samples in (t_old, t_new]: theta'' on the step's quintic
+    while held_time(W.held) <= t_new:
+        t_k = held_time(W.held)
+        h_k = t_new - t_old
+        for j in range(n):
+            W.acc_k[j] = W.acc[j] if h_k <= 0.0 else hermite_accel(
+                (t_k - t_old) / h_k, h_k, W.y[j], W.y[n + j], W.acc_old[j], W.y_new[j],
+                W.y_new[n + j], W.acc[j])  # fmt: skip
+        shear_ratios(ground(t_k, gr), 0.0, gravity_factor(t_k, gr), W.centre_map, W.acc_k,
+                     W.no_offset, W.masses, W.normal_forces, W.rx, W.ry,
+                     W.between)  # fmt: skip
+        held_push(W.held, W.rx, W.ry, W.between)
+    # the step's end is the next step's start
+    W.z_prev[:] = W.z_old
+    W.z_old[:] = W.z_new
+    W.dz_prev[:] = W.dz_old
+    W.dz_old[:] = W.dz_new
+    W.d_old[:] = W.d_new
+    W.dd_old[:] = W.dd_new
+    W.d2_old[:] = W.d2_new
+    return calls, n_out, next_out, impacts
+
+
+@jit
+def may_stop(W, can_stop, sure_stop):
+    """Free motion below a barrier: a column's survival certain (sure_stop: solver.stop:
+    outcome), or a monolith past a peak (can_stop; every figure final)."""
+    n = W.y.size // 2
+    peak = can_stop and W.z_prev[0] * W.dz_prev[0] > 0 >= W.z_old[0] * W.dz_old[0]
+    return (sure_stop or peak) and below_barrier(
+        W.y[:n], W.y[n:], W.mass, W.argmap, W.gravity, W.edges, W.nedges,
+        W.intercepts, W.slopes, W.survival if sure_stop else W.barrier)  # fmt: skip
+
+
+@jit
+def at_event(W, row, t, gr, account):
+    """The state change at the crossing of a watched row at (t, W.y): a collapse (its row's
+    family 2: the column's collapse rows), else a joint's kink, uplift or impact (switch).
+    Returns (GOING or COLLAPSED, uplifts, impacts, at rest, the collapsed interface from 1,
+    nan)."""
+    n = W.y.size // 2
+    i = row % n
+    if row // n >= 2:
+        if W.c_ratio > W.max_ratio[i]:
+            W.max_ratio[i] = W.c_ratio
+        return COLLAPSED, 0, 0, False, i + 1, np.nan
+    going_up = row // n == 1
+    bound = bound_now(i, going_up, n, W.lo, W.hi, W.tu, t, gr, W.mv_e, W.mv_w) if W.vert else (
+        W.hi[i] if going_up else W.lo[i])  # fmt: skip
+    what = switch(W, i, going_up, bound, W.y, W.side, W.k, W.pending, W.awaiting, W.rigid_mono)
+    if account:
+        after = energy(W.y[:n], W.y[n:], W.mass, W.argmap, W.gravity, W.edges,
+                       W.nedges, W.intercepts, W.slopes)  # fmt: skip
+        if what >= IMPACT:
+            W.ledger[4] += W.ledger[1] - after
+        W.ledger[1] = after
+    if what == UPLIFT:
+        return GOING, 1, 0, False, -1, np.nan
+    if what >= IMPACT:
+        return GOING, 0, 1, what == REST, -1, np.nan
+    return GOING, 0, 0, False, -1, np.nan
+
+
+#: The planar column's run loop (numerics.loop.run_motion with the functions above).
+run_plane = loop_for(
+    "plane",
+    {"enter_segment": enter_segment, "rest_to_end": rest_to_end, "rest": rest,
+     "restart": restart, "ground_piece": ground_piece, "find_event": find_event,
+     "step_figures": step_figures, "may_stop": may_stop, "at_event": at_event},
+)  # fmt: skip

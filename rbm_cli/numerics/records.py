@@ -1,11 +1,11 @@
 """A run's record: the arrays and numbers a structure's run shares with the run loop, held by
 one reference.
 
-A structure's functions, inlined into the run loop, read what they need from one record W:
+A structure's functions, called by the run loop, read what they need from one record W:
 compiled, W is a numba structure reference (numba.experimental.structref), and passing it
-costs one reference count however many arrays it holds (a named tuple of arrays passed into
-an inlined function costs one for each of its arrays, at every step). Uncompiled, W is a
-plain namespace. Its fields are set one at a time after :func:`new_record`.
+costs one reference count however many arrays it holds (a named tuple of arrays costs one
+for each of its arrays, at every call). Uncompiled, W is a plain namespace. Its fields are
+set one at a time after :func:`new_record`, every one of them before the loop runs.
 
 A record's kind is declared once, in a module of its own (numba reads a structure type back
 from its on-disk cache only if the type is not defined beside the cached functions), by
@@ -41,8 +41,9 @@ def record_kind(fields: list[tuple[str, str]]):
     """The kind of a record with these fields ((name, type) pairs; see the module's notes):
     a numba structure type, or the field names when nothing is compiled."""
     names = [name for name, _ in fields]
-    if len(set(names)) != len(names):
-        raise TypeError(f"a record's fields repeat a name: {sorted(names)}")
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise TypeError(f"a record's fields repeat a name: {repeated}")
     if not ENABLED:
         return tuple(names)
     return RecordType([(name, eval(kind, {"__builtins__": {}}, TYPE_NAMES))  # noqa: S307
@@ -51,7 +52,7 @@ def record_kind(fields: list[tuple[str, str]]):
 
 def record_fields(kind) -> tuple[str, ...]:
     """The field names of a record kind (record_kind)."""
-    return tuple(kind) if not ENABLED else tuple(name for name, _ in kind.fields)
+    return tuple(kind) if not ENABLED else tuple(kind.field_dict)
 
 
 def new_record(kind):

@@ -21,7 +21,7 @@ import pytest
 
 import rbm
 from rbm_cli.base.errors import RbmError
-from tests.fragility_domains import invoke, write
+from tests.fragility_domains import exceeding, invoke, write
 
 THETA, BETA = 0.4, 0.35
 #: The residual slip a run reaches just below its collapse [m].
@@ -54,17 +54,6 @@ def suite(n_records=120, seed=3, failed=0):
     return df
 
 
-def exceeding(df, threshold):
-    """The domain with its outcomes rewritten by hand: a run that did not fail "collapses"
-    when its residual_slip_m >= threshold or it collapsed."""
-    out = df.copy()
-    ok = out["status"] != "failed"
-    hit = ok & ((out["collapsed"] == 1) | (out["residual_slip_m"] >= threshold))
-    out["collapsed"] = hit.astype(int)
-    out["status"] = np.where(~ok, "failed", np.where(hit, "collapsed", "survived"))
-    return out
-
-
 def test_each_residual_state_is_the_plain_fit_of_its_own_outcomes(tmp_path):
     """Each residual state's median, beta and intervals equal those of a separate plain
     fit of the domain whose outcomes are rewritten as 'residual slip >= t or collapsed'
@@ -83,7 +72,7 @@ def test_each_residual_state_is_the_plain_fit_of_its_own_outcomes(tmp_path):
     assert list(table["damage_state"]) == list(thresholds)
     assert set(table["state_column"]) == {"residual_slip_m"}
     for t, row in zip(thresholds, table.itertuples(), strict=True):
-        plain = write(tmp_path / f"state_{t}", exceeding(df, t))
+        plain = write(tmp_path / f"state_{t}", exceeding(df, "residual_slip_m", t))
         again = invoke(plain, "-o", tmp_path / f"plain_{t}", "--resamples", 200, "--seed", 11)
         assert again.exit_code == 0, again.output
         fit = json.loads((tmp_path / f"plain_{t}" / "fragility.json").read_text())

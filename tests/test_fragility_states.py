@@ -23,7 +23,7 @@ import rbm
 from rbm_cli.base.errors import RbmError
 from rbm_cli.report import fragility_run
 from rbm_cli.study.fragility_states import crossing_intensity
-from tests.fragility_domains import invoke, write
+from tests.fragility_domains import exceeding, invoke, write
 
 THETA, BETA = 0.4, 0.35
 LEVELS = np.round(np.arange(0.05, 1.0001, 0.05), 10)
@@ -56,17 +56,6 @@ def suite(n_records=120, seed=3, exponent=None, failed=0):
     return df
 
 
-def exceeding(df, threshold):
-    """The domain with its outcomes rewritten by hand: a run that did not fail "collapses"
-    when its max_rotation_ratio >= threshold or it collapsed."""
-    out = df.drop(columns=["collapse_fraction"], errors="ignore").copy()
-    ok = out["status"] != "failed"
-    hit = ok & ((out["collapsed"] == 1) | (out["max_rotation_ratio"] >= threshold))
-    out["collapsed"] = hit.astype(int)
-    out["status"] = np.where(~ok, "failed", np.where(hit, "collapsed", "survived"))
-    return out
-
-
 def states_table(folder):
     return pd.read_csv(folder / "fragility_states.csv")
 
@@ -84,7 +73,7 @@ def test_each_state_is_the_plain_fit_of_its_own_outcomes(tmp_path):
     table = states_table(tmp_path / "out")
     assert list(table["damage_state"]) == list(thresholds)
     for t, row in zip(thresholds, table.itertuples(), strict=True):
-        plain = write(tmp_path / f"state_{t}", exceeding(df, t))
+        plain = write(tmp_path / f"state_{t}", exceeding(df, "max_rotation_ratio", t))
         out = tmp_path / f"plain_{t}"
         again = invoke(plain, "-o", out, "--resamples", 200, "--seed", 11)
         assert again.exit_code == 0, again.output
@@ -121,7 +110,7 @@ def test_api_states_equal_the_api_fit_of_each_rewritten_domain():
     df = suite(n_records=40, exponent=(0.5, 2.0))
     res = rbm.fragility(df, damage_states=[0.2, 0.6, 1.0], n_resamples=50, seed=2)
     for t, state in zip(res.thresholds, res.results, strict=True):
-        plain = rbm.fragility(exceeding(df, t), n_resamples=50, seed=2)
+        plain = rbm.fragility(exceeding(df, "max_rotation_ratio", t), n_resamples=50, seed=2)
         assert state.fit.median_g == pytest.approx(plain.fit.median_g, rel=1e-12)
         assert state.fit.beta == pytest.approx(plain.fit.beta, rel=1e-12)
         assert state.beta_ci == pytest.approx(plain.beta_ci, rel=1e-12)

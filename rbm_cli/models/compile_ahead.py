@@ -2,12 +2,13 @@
 
 Compiling takes time, once per installation: the kernel about 90 s on two shared cores
 (less on a fast idle machine, more on a busy one), the integrator in two directions about
-100 s, the exact integrator about 80 s, the rigid block's closed form 6-10 s; numba then keeps them in its on-disk cache. The first
-`rbm run` or `rbm sweep` that needs one of them compiles it in its own process before its
-first cell (:func:`compile_once`) and answers with it: the code every later run loads from
-the cache, so the same answer the first time as every time after (a cell in chaotic motion
-is not answered the same by two integrators, whose round-off differs). The command says on
-stderr what it waits for and roughly how long (the ``notify`` of :func:`compile_once`).
+100 s, the exact integrator about 80 s, the rigid block's closed form 6-10 s; numba then
+keeps them in its on-disk cache. The first `rbm run` or `rbm sweep` that needs one of them
+compiles it in its own process before its first cell (:func:`compile_once`) and answers
+with it: the code every later run loads from the cache, so the same answer the first time
+as every time after (a cell in chaotic motion is not answered the same by two integrators,
+whose round-off differs). The command says on stderr what it waits for and roughly how
+long (the ``notify`` of :func:`compile_once`).
 
 One compile at a time: a process that finds the code missing from the cache takes an
 exclusive ``flock`` on a lock file beside the cache (:data:`LOCK_NAME`) and holds it while

@@ -252,8 +252,9 @@ STRUCTURE_FUNCTIONS = ("enter_segment", "rest_to_end", "rest", "restart", "groun
 
 def loop_for(name: str, functions: dict):
     """The run loop (run_motion) of one structure, compiled on its own: a copy of its code
-    whose names STRUCTURE_FUNCTIONS are the structure's functions (a dict of them, each
-    compiled with base.jit.jit). The copy is named ``run_motion_<name>`` (numba's on-disk
+    whose names STRUCTURE_FUNCTIONS are the structure's functions, taken by name from
+    ``functions`` (the structure module's ``globals()``; each compiled with base.jit.jit).
+    The copy is named ``run_motion_<name>`` (numba's on-disk
     cache keeps one entry per name; a function passed as an argument or closed over is not
     read back from the cache)."""
     missing = set(STRUCTURE_FUNCTIONS) - set(functions)

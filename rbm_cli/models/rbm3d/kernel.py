@@ -681,15 +681,11 @@ def run3d(col, motion, solver, task, pair):
         (energy3d), the ground's work, the energy the joints' damping and the impacts took.
     """
     col, motion, solver = ColumnArrays(*col), Excitation(*motion), SolverSettings(*solver)
-    y0, pin = task[0], task[6]
     account = task[1] and motion.vertical.size == 0  # the energy account (see Returns)
     n = col.tu.size
     W = column3d_record(col, motion, task, pair)
-    c = W.c
-    for i in range(n):
-        c[i, 0], c[i, 1], c[i, 2] = W.d0, W.d1, pin * col.tu[i]
-    y = y0  # the state, in place: the caller reads where the run ended
-    at_rest = start3d(y, n, W, W.k, W.pending, W.phase, c)
+    y = task[0]  # the state, in place: the caller reads where the run ended
+    at_rest = start3d(y, n, W, W.k, W.pending, W.phase, W.c)
     max_ratio = W.max_ratio
     for i in range(n):
         v, _ = _magnitude(col.families[n + i], y, n)
@@ -710,7 +706,7 @@ def run3d(col, motion, solver, task, pair):
 @jit(inline=True)
 def column3d_record(col, motion, task, pair):
     """The run's record (rbm3d.work.COLUMN3D) of a column col (ColumnArrays) under motion
-    (Excitation), with run3d's task and pair; c's pinned distance not yet set."""
+    (Excitation), with run3d's task and pair."""
     W = new_record(COLUMN3D)
     column_into(W, col)
     motion_into(W, motion)
@@ -741,6 +737,9 @@ def column3d_record(col, motion, task, pair):
     pair_on = values_y.size > 0 or gy[1] != 0.0
     formula_y = values_y.size == 0 and gy[1] != 0.0
     W.pair_on, W.formula_y = pair_on, formula_y
+    c, pin = W.c, task[6]  # the pieces' direction: the motion's; the pinned distance
+    for i in range(n):
+        c[i, 0], c[i, 1], c[i, 2] = d0, d1, pin * col.tu[i]
     return W
 
 
@@ -961,9 +960,4 @@ def at_event(W, row, t, gr, account):
 
 
 #: The column in two directions' run loop (numerics.loop.run_motion with the functions above).
-run_3d = loop_for(
-    "column3d",
-    {"enter_segment": enter_segment, "rest_to_end": rest_to_end, "rest": rest,
-     "restart": restart, "ground_piece": ground_piece, "find_event": find_event,
-     "step_figures": step_figures, "may_stop": may_stop, "at_event": at_event},
-)  # fmt: skip
+run_3d = loop_for("column3d", globals())

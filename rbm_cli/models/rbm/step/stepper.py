@@ -457,9 +457,4 @@ def at_event(W, row, t, gr, account):
 
 
 #: The planar column's run loop (numerics.loop.run_motion with the functions above).
-run_plane = loop_for(
-    "plane",
-    {"enter_segment": enter_segment, "rest_to_end": rest_to_end, "rest": rest,
-     "restart": restart, "ground_piece": ground_piece, "find_event": find_event,
-     "step_figures": step_figures, "may_stop": may_stop, "at_event": at_event},
-)  # fmt: skip
+run_plane = loop_for("plane", globals())

@@ -4,20 +4,19 @@ wall clock and Ctrl-C), and the named record a run returns (RunEnd)."""
 
 from __future__ import annotations
 
-import types
 from collections import namedtuple
 
 import numpy as np
 
 from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
+from rbm_cli.numerics.binding import bind
 from rbm_cli.numerics.rk import (
     NS_MAX,
     STEP_TAKEN,
     STEP_TOO_SMALL,
     TAB_EST,
     TAB_NS,
-    attempt_step,
     dense_eval,
 )
 from rbm_cli.numerics.status import (
@@ -119,7 +118,8 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
 
     What is the structure's is called by name (the structure's functions, bound by
     loop_for): enter_segment, rest_to_end, rest, restart, ground_piece, find_event,
-    step_figures, may_stop, at_event. They read and write the run's record W
+    step_figures, may_stop, at_event, and the Runge-Kutta step on its right-hand side,
+    attempt_step (numerics.rk.steps_for). They read and write the run's record W
     (numerics.records): the structure's arrays, its work, what they need of the motion and
     the task, and the run's figures (LOOP_FIELDS).
 
@@ -191,7 +191,7 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
                 bound = seg_end  # a record's steps end at its samples
                 if clipped:
                     gr, bound = ground_piece(W, t, seg_gain, seg_end)  # noqa: F821
-                taken, t_new, h, h_abs, calls = attempt_step(
+                taken, t_new, h, h_abs, calls = attempt_step(  # noqa: F821
                     mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
                     scale, err_exp)  # fmt: skip
                 n_rhs += calls
@@ -247,22 +247,18 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
 
 #: The functions a structure hands the run loop (run_motion), by name.
 STRUCTURE_FUNCTIONS = ("enter_segment", "rest_to_end", "rest", "restart", "ground_piece",
-                       "find_event", "step_figures", "may_stop", "at_event")  # fmt: skip
+                       "find_event", "step_figures", "may_stop", "at_event",
+                       "attempt_step")  # fmt: skip
 
 
 def loop_for(name: str, functions: dict):
     """The run loop (run_motion) of one structure, compiled on its own: a copy of its code
     whose names STRUCTURE_FUNCTIONS are the structure's functions, taken by name from
-    ``functions`` (the structure module's ``globals()``; each compiled with base.jit.jit).
-    The copy is named ``run_motion_<name>`` (numba's on-disk
-    cache keeps one entry per name; a function passed as an argument or closed over is not
-    read back from the cache)."""
+    ``functions`` (the structure module's ``globals()``: its event and figure functions,
+    each compiled with base.jit.jit, and its Runge-Kutta step, numerics.rk.steps_for). The
+    copy is named ``run_motion_<name>`` (numerics.binding)."""
     missing = set(STRUCTURE_FUNCTIONS) - set(functions)
     if missing:
         raise TypeError(f"structure {name!r} lacks {sorted(missing)}")
-    namespace = dict(run_motion.__globals__)
-    namespace.update({key: functions[key] for key in STRUCTURE_FUNCTIONS})
-    copy = types.FunctionType(run_motion.__code__, namespace, f"run_motion_{name}")
-    copy.__qualname__ = f"run_motion_{name}"
-    copy.__doc__, copy.__module__ = run_motion.__doc__, run_motion.__module__
-    return jit(copy)
+    given = {key: functions[key] for key in STRUCTURE_FUNCTIONS}
+    return bind({"run_motion": (run_motion, False)}, given, name)["run_motion"]

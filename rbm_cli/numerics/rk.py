@@ -2,9 +2,9 @@
 and RK23 tableaux, initial step, error norm, step-size control and dense output,
 transcribed so that a run's step sequence is the one scipy's steppers would take.
 
-Model-agnostic: the right-hand side is physics.rates.rhs, the linear system of a
-structure's current pieces (As, cs, es and the ground tuple gr) for the planar column of
-drums and, by its state's size, for the column in two directions (physics.beam3d)."""
+Model-agnostic: the steps that call a right-hand side (initial_step, rk_attempt,
+attempt_step, dense_prepare) are templates; a structure gets its own compiled copies, whose
+``rhs(t, y, n, As, cs, es, gr, out)`` is its own (:func:`steps_for`)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import numpy as np
 import rbm_cli.base.rk_tableaux as _tb
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.base.jit import jit
-from rbm_cli.physics.rates import rhs
+from rbm_cli.numerics.binding import bind
 
 #: method name -> code in the kernel
 METHOD_CODES = {"RK23": 0, "RK45": 1, "DOP853": 2}
@@ -94,7 +94,6 @@ def _rms(v):
     return math.sqrt(s / v.size)
 
 
-@jit
 def initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, work):
     """scipy.integrate._ivp.common.select_initial_step (max_step = inf)."""
     interval = abs(t_bound - t0)
@@ -109,7 +108,7 @@ def initial_step(t0, y0, f0, t_bound, order, rtol, atol, n, As, cs, es, gr, work
     y1 = np.empty(m)
     for i in range(m):
         y1[i] = y0[i] + h0 * f0[i]
-    rhs(t0 + h0, y1, n, As, cs, es, gr, work)
+    rhs(t0 + h0, y1, n, As, cs, es, gr, work)  # noqa: F821 (the structure's: steps_for)
     d2 = _rms((work - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
@@ -141,17 +140,15 @@ def _combine(w, K, count, y, h, out):
         out[i] = y[i] + h * acc
 
 
-@jit(inline=True)
 def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr):
     """Stage s from the stages before it: K[s] = f(t + c_s h, y + h sum_j a_sj K_j).
     Inlined (as detmath.sin is): a call costs a reference count of every array it takes
     (the ground's knots and values included), 12 times a step."""
     A = TAB_A[mc]
     _combine(A[s], K, s, y, h, tmp)
-    rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, gr, K[s])
+    rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, gr, K[s])  # noqa: F821
 
 
-@jit
 def rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     """One Runge-Kutta step of size h; stages in K (row ns = f(t + h, y_new))."""
     B = TAB_B[mc]
@@ -160,7 +157,7 @@ def rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     for s in range(1, ns):
         _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr)
     _combine(B, K, ns, y, h, ynew)
-    rhs(t + h, ynew, n, As, cs, es, gr, K[ns])
+    rhs(t + h, ynew, n, As, cs, es, gr, K[ns])  # noqa: F821
 
 
 @jit
@@ -200,7 +197,6 @@ def error_norm(mc, K, h, y, ynew, atol, rtol, scale):
 STEP_TAKEN, STEP_TOO_SMALL, STEP_NONFINITE = 0, 1, 2
 
 
-@jit(inline=True)
 def attempt_step(mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
                  scale, err_exp):  # fmt: skip
     """One accepted step from (t, y) (scipy's RungeKutta._step_impl): a step of h_abs [s]
@@ -242,7 +238,6 @@ def attempt_step(mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, ato
         rejected = True
 
 
-@jit
 def dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
     """Coefficients F of the step's interpolant (DOP853: extra stages)."""
     m = y_old.size
@@ -315,3 +310,22 @@ def emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
         n_out += 1
         next_out += dt
     return n_out, next_out
+
+
+#: The steps that call the right-hand side, with whether each is inlined into its callers
+#: (:func:`steps_for` copies them per structure).
+RHS_STEPS = {
+    "initial_step": (initial_step, False),
+    "_stage": (_stage, True),
+    "rk_attempt": (rk_attempt, False),
+    "attempt_step": (attempt_step, True),
+    "dense_prepare": (dense_prepare, False),
+}
+
+
+def steps_for(name: str, rhs) -> tuple:
+    """A structure's compiled steps on its right-hand side ``rhs(t, y, n, As, cs, es, gr,
+    out)`` (a function compiled with base.jit.jit): (initial_step, attempt_step,
+    dense_prepare), named ``<step>_<name>``."""
+    steps = bind(RHS_STEPS, {"rhs": rhs}, name)
+    return steps["initial_step"], steps["attempt_step"], steps["dense_prepare"]

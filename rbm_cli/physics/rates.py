@@ -1,12 +1,10 @@
-"""The right-hand side of the compiled engine's Runge-Kutta steps (numerics.rk): the rates
-of the linear system of a structure's current pieces. For the planar column of drums
-(theta'' = c + e a_g + A theta, with the joints' damping and a vertical record's factor),
-and for the column in two directions (a state of 4n values: physics.beam3d.beam_rates)."""
+"""The planar column's right-hand side for the compiled engine's Runge-Kutta steps
+(numerics.rk.steps_for): the rates of the linear system of its current pieces, theta'' = c +
+e a_g + A theta, with the joints' damping and a vertical record's factor."""
 
 from __future__ import annotations
 
 from rbm_cli.base.jit import jit
-from rbm_cli.physics.beam3d import beam_rates
 from rbm_cli.physics.ground import gravity_factor, ground
 
 
@@ -28,9 +26,6 @@ def _damping(i, y, n, As):
 
 @jit(inline=True)
 def rhs(t, y, n, As, cs, es, gr, out):
-    if y.size != 2 * n:  # a state in two directions: rbm-3d's (physics.beam3d)
-        beam_rates(t, y, n, As, cs, es, gr, out)
-        return
     g = ground(t, gr)
     damped = As.shape[1] > 2 * n
     if gr[6] == 0.0:

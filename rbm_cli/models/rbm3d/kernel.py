@@ -37,15 +37,9 @@ from rbm_cli.models.status import (
 from rbm_cli.numerics.loop import RunEnd, loop_for, loop_into
 from rbm_cli.numerics.quadrature import GL_NODES, GL_WEIGHTS
 from rbm_cli.numerics.records import new_record
-from rbm_cli.numerics.rk import (
-    TAB_EST,
-    TAB_NS,
-    dense_eval,
-    dense_prepare,
-    initial_step,
-)
+from rbm_cli.numerics.rk import TAB_EST, TAB_NS, dense_eval, steps_for
 from rbm_cli.physics.arrays import ColumnArrays, column_into
-from rbm_cli.physics.beam3d import CS_PER_JOINT, ES_EXTRA, horizontal, pack_pieces
+from rbm_cli.physics.beam3d import CS_PER_JOINT, ES_EXTRA, beam_rates, horizontal, pack_pieces
 from rbm_cli.physics.ground import (
     LINE,
     gravity_factor,
@@ -57,7 +51,6 @@ from rbm_cli.physics.ground import (
     rest_shear,
     vertical_factor,
 )
-from rbm_cli.physics.rates import rhs
 
 #: A rigid joint's direction is pinned within a distance of closure (c[i, 2], solver.atol
 #: theta_u: the runner's notes) and after an uplift or an impact, until LEAVE_FACTOR times
@@ -74,6 +67,9 @@ CHECK_INTERVALS = 8
 XTOL, RTOL, MAXITER = 1e-15, 8.881784197001252e-16, 100
 #: The run ended at rest in the free motion after the ground motion.
 AT_REST = 11
+
+#: The column's Runge-Kutta steps on its right-hand side (physics.beam3d.beam_rates).
+initial_step, attempt_step, dense_prepare = steps_for("column3d", beam_rates)
 
 
 @jit(inline=True)
@@ -800,7 +796,7 @@ def restart(W, t, seg_end, seg_gain, h_carry, gr, mc, rtol, atol):
         gr, t_bound = _pieces(t, W.knots, W.values, values_y, W.vertical,
                               seg_gain, seg_end, W.sys_e)  # fmt: skip
     rows_at(W.y, gravity_factor(t, gr), n, W, k, c, W.kinds, W.joints, m, W.d_old, W.r_old)
-    rhs(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.f)
+    beam_rates(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.f)
     if h_carry > 0.0:
         return min(h_carry, seg_end - t), 1, gr
     h_abs = initial_step(
@@ -854,7 +850,7 @@ def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out,
         )
         dense_ready = True
     if event:
-        rhs(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.work)
+        beam_rates(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.work)
         calls += 1
         f_new = W.work
     else:

@@ -45,7 +45,7 @@ from rbm_cli.models.status import (
 from rbm_cli.numerics.loop import loop_for, loop_into
 from rbm_cli.numerics.quadrature import GL_NODES, GL_WEIGHTS
 from rbm_cli.numerics.records import new_record
-from rbm_cli.numerics.rk import TAB_EST, dense_eval, dense_prepare, emit, emit_rest, initial_step
+from rbm_cli.numerics.rk import TAB_EST, dense_eval, emit, emit_rest, steps_for
 from rbm_cli.physics.arrays import ColumnArrays, column_into
 from rbm_cli.physics.ground import (
     gravity_factor,
@@ -57,6 +57,9 @@ from rbm_cli.physics.ground import (
     rest_shear,
 )
 from rbm_cli.physics.rates import acc_of, rhs
+
+#: The planar column's Runge-Kutta steps on its right-hand side (physics.rates.rhs).
+initial_step, attempt_step, dense_prepare = steps_for("plane", rhs)
 
 
 @jit

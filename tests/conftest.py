@@ -176,7 +176,7 @@ def pair_dir(tmp_path_factory):
     sampled as they are: the records of a pair (models in three dimensions)."""
     import numpy as np
 
-    from rbm_cli.physics.records import read_record
+    from rbm_cli.inputs.records import read_record
 
     records = Path(__file__).resolve().parents[1] / "configs" / "records" / "synthetic"
     folder = tmp_path_factory.mktemp("pair")

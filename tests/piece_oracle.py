@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rbm_cli.physics.equations import Model
+from rbm_cli.structures.equations import Model
 
 
 class Pieces:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from rbm_cli.config.types import G
-from rbm_cli.physics.records import write_csv
+from rbm_cli.inputs.records import write_csv
 
 
 def half_sine_csv(path, f):

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import FORMULATIONS
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 
 #: Per-example solver budget (a run beyond it is 'failed', never a hang).
 MAX_STEPS = 200_000

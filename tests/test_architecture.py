@@ -187,7 +187,7 @@ def test_the_check_sees_a_private_import(tmp_path, monkeypatch):
     monkeypatch.setattr("tests.test_architecture.modules", lambda: {"rbm_cli.physics.x": path})
     assert private_imports() == {
         ("rbm_cli.physics.x", "rbm_cli.base.files", "_fsync"),
-        ("rbm_cli.physics.x", "rbm_cli.physics.law", "_piece"),
+        ("rbm_cli.physics.x", "rbm_cli.structures.law", "_piece"),
     }
 
 

@@ -37,9 +37,9 @@ from rbm_cli.models.bullet.scene import (
     keep_in_plane,
     read_frame,
 )
-from rbm_cli.physics.block import block_geometry
-from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.restitution import block_restitution
+from rbm_cli.structures.block import block_geometry
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.structures.restitution import block_restitution
 from rbm_cli.study.simulate import simulate
 
 #: Slow (whole domains re-made, processes killed, contact-engine runs):

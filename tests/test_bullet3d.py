@@ -40,7 +40,7 @@ from rbm_cli.models.bullet.space import (
     joint_state_3d,
     normals,
 )
-from rbm_cli.physics.records import read_record
+from rbm_cli.inputs.records import read_record
 from rbm_cli.study.cells import domain_fields
 from rbm_cli.study.result import THREE_D_FIELDS
 from rbm_cli.study.simulate import simulate

@@ -32,7 +32,7 @@ from rbm_cli.models.bullet.impact import engine_restitution, measure_restitution
 from rbm_cli.models.bullet.normals import NormalCensus
 from rbm_cli.models.bullet.run import bullet_run
 from rbm_cli.models.bullet.settings import EngineSettings, settings_from_config
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.inputs.excitation import GroundMotion
 from tests.paths import tool_script
 
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}

@@ -12,7 +12,7 @@ import pytest
 import rbm
 from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.config.types import G
-from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.structures.assembly import model_from_config
 
 RHO = 2700.0
 H, B = 2.0, 0.5  # a square prism, 0.5 m x 0.5 m x 2 m

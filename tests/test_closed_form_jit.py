@@ -9,14 +9,14 @@ Expected values from other sources:
   agree (same outcome and events, peaks and collapse times within 1e-9), the same outcome
   and events, peaks and collapse times within 1e-8 of rtol 1e-12 (the two locate an impact
   differently: the kernel EVENT_EPS theta_u past zero, then projected back);
-- the RBM's mapping (physics.closed_forms.linear_rocking_parameters): the rigid monolith's
+- the RBM's mapping (structures.closed_forms.linear_rocking_parameters): the rigid monolith's
   block (closed_form.rbm_block, from the model's linear system) runs as Spanos and Koh's
   block of those (alpha, p) (closed_form.linear_block);
 - the same source run uncompiled (rbm_cli.base.jit.plain): the same bits, on a rigid RBM,
   a housner-linear block and a vertical record;
 - free rocking: the energy theta'^2/2 + p^2 (alpha |theta| - theta^2/2) is conserved
   between impacts, and the impacts come at the period of
-  physics.closed_forms.free_rocking_period;
+  structures.closed_forms.free_rocking_period;
 - a dense sampling of random pieces: the first event the scan finds is the first crossing
   of 200,001 samples (none missed, none invented).
 """
@@ -37,8 +37,8 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config, parse_config
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.registry import make_runner
-from rbm_cli.physics.closed_forms import free_rocking_period, linear_rocking_parameters
-from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.structures.closed_forms import free_rocking_period, linear_rocking_parameters
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 
 from .paths import CONFIGS
@@ -306,7 +306,7 @@ def test_auto_resolves_and_an_explicit_method_is_kept():
 
 def test_a_vertical_record_falls_back_to_the_integrator(tmp_path):
     from rbm_cli.config.types import G
-    from rbm_cli.physics.records import write_csv
+    from rbm_cli.inputs.records import write_csv
 
     t = np.linspace(0.0, 1.0, 101)
     h = write_csv(tmp_path / "h.csv", (t, 0.5 * G * np.sin(2 * np.pi * t)), units="g")
@@ -349,7 +349,7 @@ def test_compiled_and_uncompiled_give_the_same_bits(tmp_path):
     housner-linear block under a vertical record (gam per piece); the event log too."""
     from rbm_cli.config.types import G
     from rbm_cli.models.block.closed_form import linear_run
-    from rbm_cli.physics.records import write_csv
+    from rbm_cli.inputs.records import write_csv
 
     t = np.linspace(0.0, 4.0, 401)  # a_g = A g sin(2 pi t), a_v = 0.4 A g sin(6 pi t + 0.3)
     h = write_csv(tmp_path / "h.csv", (t, G * np.sin(2 * np.pi * t)), units="g")

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, StiffnessConfig
-from rbm_cli.physics.closed_forms import (
+from rbm_cli.structures.closed_forms import (
     free_rocking_period,
     halfsine_threshold_curves,
     housner_halfsine_threshold,
@@ -24,7 +24,7 @@ from rbm_cli.physics.closed_forms import (
     linear_rocking_parameters,
     rectangular_pulse_threshold,
 )
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 
 G = 9.81
 ALPHA = 0.2  # slenderness of the test block [rad]

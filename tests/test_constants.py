@@ -48,7 +48,7 @@ def test_a_copy_carries_its_edit_and_nothing_else(tool, tmp_path):
     src = tool.make_copy(edits, tmp_path / "a")
     events = (src / "rbm_cli" / "base" / "events.py").read_text()
     assert "EVENT_EPS = 1e-14" in events and "EVENT_EPS = 1e-12" not in events
-    for rel in ("rbm_cli/models/rbm/pieces.py", "rbm_cli/physics/arrays.py", "rbm/__init__.py"):
+    for rel in ("rbm_cli/models/rbm/pieces.py", "rbm_cli/structures/arrays.py", "rbm/__init__.py"):
         assert (src / rel).read_text() == (ROOT / rel).read_text()
     assert not list(src.rglob("__pycache__"))  # nothing compiled comes along
     # an edit whose text is not in the code stops the variant, naming the file
@@ -136,7 +136,7 @@ def _with_rest_rate(monkeypatch, rate):
     two that take it at import)."""
     import rbm_cli.models.block.closed_form as closed_form
     import rbm_cli.models.housner.runner as housner
-    import rbm_cli.physics.arrays as arrays
+    import rbm_cli.structures.arrays as arrays
 
     for module in (arrays, closed_form, housner):
         monkeypatch.setattr(module, "REST_RATE", rate)
@@ -154,7 +154,7 @@ def test_a_rigid_block_s_rest_does_not_move_its_answer(monkeypatch, model, recor
     same peak to 1e-9. Under rdk_14 at 0.3 g the former 1e-3 put the block to rest while
     the ground would still rock it (3 uplifts instead of 2, a peak 8 % low)."""
     import rbm
-    import rbm_cli.physics.arrays as arrays
+    import rbm_cli.structures.arrays as arrays
 
     path = str(ROOT / "configs" / "records" / "synthetic" / f"{record}.AT2")
     excitation = {**RECORD_BLOCK["excitation"], "file": path}

@@ -24,7 +24,7 @@ from rbm_cli.config.types import MODELS
 from rbm_cli.models.contract import Runner
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.registry import make_runner, model_names, runner_class
-from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 
 

@@ -28,7 +28,7 @@ from rbm_cli.api import load_config, run, run_sweep
 from rbm_cli.api.configs import with_values
 from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.models.methods import resolve_method
-from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.study.domain import read_domain
 
 from .paths import CONFIGS, RESULTS
@@ -244,7 +244,7 @@ def test_the_damping_coefficients_do_not_depend_on_the_last_bits_of_the_eigenval
     computes; its last bits follow the processor's kernels. A frequency a few ulp away (as
     another machine may give) must give the same coefficients, to the bit: the stored damped
     study is reproduced on every machine."""
-    from rbm_cli.physics.equations import Model
+    from rbm_cli.structures.equations import Model
 
     cfg = load_config(CONFIGS / "harmonic_multidrum_damped.yaml")
     reference = model_from_config(cfg).joint_damping

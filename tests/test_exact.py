@@ -40,13 +40,13 @@ from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, new_cache, po
 from rbm_cli.models.rbm.exact.search import bounds_of
 from rbm_cli.models.rbm.step import integrate
 from rbm_cli.models.registry import make_runner
-from rbm_cli.physics.arrays import column_arrays
-from rbm_cli.physics.closed_forms import (
+from rbm_cli.structures.arrays import column_arrays
+from rbm_cli.structures.closed_forms import (
     free_rocking_period,
     linear_halfsine_threshold,
     linear_rocking_parameters,
 )
-from rbm_cli.physics.excitation import GroundMotion, make_ground_motion
+from rbm_cli.inputs.excitation import GroundMotion, make_ground_motion
 from rbm_cli.study.simulate import model_from_config, simulate
 
 from .exact_forcing import Forcing, forcing_array

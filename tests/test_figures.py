@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 
 from rbm_cli.config.load import parse_config
 from rbm_cli.models.history import History
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 from rbm_cli.report.bench_figures import work_precision_figure
 from rbm_cli.report.plots import plot_joint_rotations, plot_shapes
 from rbm_cli.report.run_figures import history_figure, run_column, run_title

@@ -2,7 +2,7 @@
 
 Expected values come from the config itself (a point must equal the config written by hand
 with that value), from closed forms (the RBM's p and alpha of a rectangular block) and from
-the similarity law of rocking (rbm_cli.physics.similarity), never from the axis code.
+the similarity law of rocking (rbm_cli.structures.similarity), never from the axis code.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 Checked against what does not follow its code:
 
 - in a vertical plane its equations are Housner's (the closed form of the planar block,
-  rbm_cli.physics.block's geometry), and a whole run is `housner`'s (an independent
+  rbm_cli.structures.block's geometry), and a whole run is `housner`'s (an independent
   integrator of the planar equation) on a grid: outcome, peak and collapse time;
 - its energy is conserved in free rolling, where the cylinder moves in three dimensions;
 - a steady wobble derived by hand here (the centre of mass at rest, the axis precessing at
@@ -27,13 +27,13 @@ from scipy.integrate import solve_ivp
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.physics.cylinder import (
+from rbm_cli.structures.cylinder import (
     cylinder_energy,
     cylinder_geometry,
     rolling_rates,
     tilt,
 )
-from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 from rbm_cli.study.sweep import config_hash
 
@@ -205,7 +205,7 @@ def test_a_wobble_counts_its_turns_and_a_planar_motion_none(geo):
     (impacts and all) sweeps no angle but round-off's (a lean 2e-6 sin(alpha) from the
     vertical points within 1e-16 / 2e-6 rad of the motion's plane)."""
     from rbm_cli.models.housner3d.runner import cylinder_run
-    from rbm_cli.physics.motion import GroundMotion
+    from rbm_cli.inputs.motion import GroundMotion
 
     theta = 0.1
     m, rad, h = geo.mass, geo.radius, geo.centre_height
@@ -299,7 +299,7 @@ def test_swapping_the_components_with_the_angle_turned_gives_the_same_run(pair_d
 def test_a_pair_is_scaled_by_its_larger_pga(pair_dir):
     """scale: pga takes the larger of the two components' PGAs to the amplitude; both are
     multiplied by the same factor."""
-    from rbm_cli.physics.records import read_record
+    from rbm_cli.inputs.records import read_record
 
     x = read_record(str(pair_dir / "rdk_01.AT2")).acceleration
     y = read_record(str(pair_dir / "rdk_02.AT2")).acceleration
@@ -388,7 +388,7 @@ def test_a_pair_runs_history_and_title_name_both_records(pair_dir):
     """A recorded run of a pair keeps a_y beside a_x (history.csv's ag_y_m_s2, the y record
     as scaled), and its title names both records and the pair's PGA (the larger)."""
     import rbm
-    from rbm_cli.physics.records import read_record
+    from rbm_cli.inputs.records import read_record
     from rbm_cli.report.run_figures import record_title
     from rbm_cli.report.run_folder import record_of_run
 

@@ -23,10 +23,10 @@ import pytest
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.closed_forms import linear_rocking_parameters
-from rbm_cli.physics.column import build_column
-from rbm_cli.physics.cylinder import cylinder_geometry
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.structures.closed_forms import linear_rocking_parameters
+from rbm_cli.structures.column import build_column
+from rbm_cli.structures.cylinder import cylinder_geometry
 from rbm_cli.study.simulate import simulate
 
 COLUMN = {"height": 4.0, "base_width": 1.0, "top_width": 0.8, "section": "circular",
@@ -113,7 +113,7 @@ def test_a_monolith_of_the_rbm_started_on_its_orbit_stays_on_it():
     """The rigid monolith of rbm-3d (xi 1): its moment is central, M_u (1 - r / alpha)
     toward phi = 0, which with the planar linear block's closed form, theta'' = p^2 (theta
     - alpha) for theta > 0, makes a circle of radius r0 an orbit at Omega^2 = p^2 (alpha -
-    r0) / r0 (alpha, p: physics.closed_forms.linear_rocking_parameters). Started at r0 in
+    r0) / r0 (alpha, p: structures.closed_forms.linear_rocking_parameters). Started at r0 in
     the motion's plane (turned to 30 degrees) with r0 Omega across it, three turns: the
     peak ratio stays r0 / alpha (1e-9), three turns (1e-8), no impact, and the rotations
     seen in the plane and across it are r0 cos(Omega t), r0 sin(Omega t) (1e-7 alpha)."""

@@ -1,4 +1,4 @@
-"""Intensity measures of records (rbm_cli.physics.intensity) and a record cell's row.
+"""Intensity measures of records (rbm_cli.inputs.intensity) and a record cell's row.
 
 Expected values are closed forms of the sampled signals (a cosine's PGV A / omega, its
 Arias intensity pi A^2 T / (4 g) over whole cycles, a constant's Husid line, the steady
@@ -17,8 +17,8 @@ import pytest
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.physics import intensity as im
-from rbm_cli.physics.column import build_column
+from rbm_cli.inputs import intensity as im
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.cells import add_point, domain_fields
 from rbm_cli.study.intensities import MEASURES, column_period, measure_fields, sa_field
 from rbm_cli.study.sweep import config_hash
@@ -190,8 +190,8 @@ def test_record_row_has_the_measures_scaled():
 
 def test_a_processed_record_is_measured_as_processed():
     """With excitation.processing the rows measure the record the run sees: the processed
-    samples (rbm_cli.physics.records.process of the file's samples), scaled to the cell."""
-    from rbm_cli.physics.records import process, read_record
+    samples (rbm_cli.inputs.records.process of the file's samples), scaled to the cell."""
+    from rbm_cli.inputs.records import process, read_record
 
     cfg = _config(processing={"baseline": "quadratic"})
     raw = _config()

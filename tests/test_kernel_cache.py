@@ -296,3 +296,26 @@ def test_a_cache_that_cannot_be_written_leaves_the_function_running(tmp_path):
                          env=env, preexec_fn=limit, timeout=120)  # fmt: skip
     assert res.returncode == 0, res.stderr
     assert res.stdout.strip() == "42"
+
+
+def test_a_function_that_cannot_be_cached_still_runs(tmp_path):
+    """A keyed function numba cannot cache (here one reading a large global array, which
+    numba keeps outside the compiled code) gets numba's warning and runs: the warning names
+    the source file, which numba asks of the cache's locator (a first use under NUMBA_OPT=0
+    once ended in an AttributeError there instead of the run)."""
+    (tmp_path / "big.py").write_text(
+        "import numba\nimport numpy as np\n\nBIG = np.arange(2_000_000.0)\n\n\n"
+        "@numba.njit(cache=True)\ndef fifth():\n    return BIG[5]\n"
+    )
+    code = (
+        "import pathlib, rbm_cli.base.compile_cache as cc\n"
+        f"cc.PACKAGE = pathlib.Path({str(tmp_path)!r})\n"
+        "import rbm_cli.base.jit, big\nprint(big.fifth())"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path]),
+           "NUMBA_CACHE_DIR": str(tmp_path / "cache")}  # fmt: skip
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, timeout=120)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "5.0"
+    assert "Cannot cache compiled function" in res.stderr

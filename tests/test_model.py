@@ -18,7 +18,7 @@ from rbm_cli.config.types import (
     StiffnessConfig,
 )
 from rbm_cli.models.rbm.runner import RbmRunner
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.simulate import model_from_config, simulate
 
 from .closed_form import LinearRocking

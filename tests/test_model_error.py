@@ -23,8 +23,8 @@ import pytest
 
 from rbm_cli.api import run_sweep
 from rbm_cli.config.load import load_config, parse_config
-from rbm_cli.physics.block import block_geometry
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.block import block_geometry
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.domain import domain_config, read_domain
 from rbm_cli.study.simulate import simulate
 

@@ -65,7 +65,7 @@ def test_each_component_of_the_run_is_its_own_record(tmp_path):
 def test_the_motion_keeps_every_sample_of_both(tmp_path):
     """The run's knots are the union of both records' times; at each knot each component
     is its record's value (its own sample, or its interpolation between two)."""
-    from rbm_cli.physics.excitation import make_ground_motion
+    from rbm_cli.inputs.excitation import make_ground_motion
 
     cfg = pair_config(tmp_path)
     motion = make_ground_motion(cfg.excitation, 0.3)
@@ -88,7 +88,7 @@ def test_a_pair_on_one_time_base_is_run_as_read(tmp_path):
     """Both records on the same times: the knots are those times and the values the
     samples, scaled (nothing interpolated)."""
     import rbm
-    from rbm_cli.physics.excitation import make_ground_motion
+    from rbm_cli.inputs.excitation import make_ground_motion
 
     cfg = rbm.with_value(pair_config(tmp_path), "excitation.file_y",
                          write(tmp_path / "y_same.csv", TIMES_X, VALUES_Y))  # fmt: skip

@@ -15,9 +15,9 @@ from rbm_cli.base.events import BIG, EVENT_EPS
 from rbm_cli.base.jit import plain
 from rbm_cli.config.load import load_config
 from rbm_cli.models.rbm import pieces as compiled
-from rbm_cli.physics.arrays import rest_levels
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.law import law_arrays
+from rbm_cli.structures.arrays import rest_levels
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.structures.law import law_arrays
 
 from .paths import CONFIGS
 from .piece_oracle import Pieces

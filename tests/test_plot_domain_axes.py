@@ -3,7 +3,7 @@ the artists (gids, offsets, line data), against closed forms and the domain's ow
 
 Expected values: a rigid rectangular RBM monolith of height H and base B maps to the
 linear block with tan alpha = B / H and p^2 = 6 g H / (4 H^2 + B^2)
-(rbm_cli.physics.closed_forms.linear_rocking_parameters, its docstring), so omega / p and
+(rbm_cli.structures.closed_forms.linear_rocking_parameters, its docstring), so omega / p and
 A / (g tan alpha) of every cell follow from the grid alone; the exact half-sine threshold
 of that block is linear_halfsine_threshold, and the rigid RBM overturns at it (a size sweep
 collapses onto it in dimensionless axes).
@@ -28,12 +28,12 @@ from matplotlib.figure import Figure  # noqa: E402
 import rbm  # noqa: E402
 from rbm_cli.cli.main import cli  # noqa: E402
 from rbm_cli.config.types import G  # noqa: E402
-from rbm_cli.physics.closed_forms import (  # noqa: E402
+from rbm_cli.structures.closed_forms import (  # noqa: E402
     housner_halfsine_threshold,
     linear_halfsine_threshold,
     linear_rocking_parameters,
 )
-from rbm_cli.physics.column import build_column  # noqa: E402
+from rbm_cli.structures.column import build_column  # noqa: E402
 from rbm_cli.report.domain_figure import domain_figure  # noqa: E402
 from rbm_cli.report.domain_view import axis_groups, domain_view  # noqa: E402
 from rbm_cli.study.domain import domain_config, read_domain  # noqa: E402

@@ -20,7 +20,7 @@ from rbm_cli.base.files import (
 )
 from rbm_cli.config.load import load_config
 from rbm_cli.models.history import History
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 from rbm_cli.report.plots import (
     exaggeration_factor,
     infer_elevations,

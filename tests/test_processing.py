@@ -30,8 +30,8 @@ from rbm_cli.base.errors import ConfigError
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import METHODS, G
-from rbm_cli.physics.excitation import make_ground_motion
-from rbm_cli.physics.records import (
+from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.inputs.records import (
     band_pass,
     baseline_fit,
     displacement_at_samples,

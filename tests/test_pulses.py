@@ -12,8 +12,8 @@ import pytest
 from scipy.integrate import quad
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.physics import pulses
-from rbm_cli.physics.pulses import (
+from rbm_cli.inputs import pulses
+from rbm_cli.inputs.pulses import (
     cycloidal_pulse,
     mavroeidis_papageorgiou,
     mavroeidis_papageorgiou_duration,

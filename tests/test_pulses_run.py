@@ -4,7 +4,7 @@ mavroeidis-papageorgiou) through the config and every model.
 Expected values are independent of the code under test: below the uplift level a rigid
 block does not move; a one-sine pulse is one period of the harmonic; a ground
 acceleration of the opposite sign mirrors the rotation; the pulse formulas equal
-physics/pulses.py's; the rigid RBM (the kernel evaluating each formula) equals
+inputs/pulses.py's; the rigid RBM (the kernel evaluating each formula) equals
 housner-linear under the exact mapping (alpha = B/H, true p), which integrates a Ricker or
 MP pulse sampled at 2000 points a period, so the sampling error is shown negligible;
 uplift times agree with a brute-force scan.
@@ -23,10 +23,10 @@ from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.registry import make_runner
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.excitation import make_ground_motion
-from rbm_cli.physics.ground import next_uplift
-from rbm_cli.physics.pulses import mavroeidis_papageorgiou, ricker_wavelet
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.inputs.ground import next_uplift
+from rbm_cli.inputs.pulses import mavroeidis_papageorgiou, ricker_wavelet
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "drums": 1}
 UPLIFT_G = 0.96 / 5.0  # the rigid RBM's static multiplier B/H (housner's tan(alpha) is more)
@@ -107,7 +107,7 @@ def test_opposite_acceleration_mirrors_the_rotation(kind, extra, model, impl):
 
 
 def test_pulse_formulas_are_those_of_pulses_py():
-    """The integrators' scalar formulas (physics.ground) equal physics/pulses.py's."""
+    """The integrators' scalar formulas (inputs.ground) equal inputs/pulses.py's."""
     t = np.linspace(-0.1, 3.5, 2001)
     for kind, extra, reference in [
         ("ricker", {}, lambda tt: ricker_wavelet(tt, 0.7 * G, 1.1)),

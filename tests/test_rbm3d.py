@@ -25,8 +25,8 @@ import pytest
 
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config import parse_config
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "section": "circular",
@@ -268,7 +268,7 @@ def test_a_recorded_run_keeps_both_elevations():
     for a motion along x, round-off along 30 degrees (three elastic drums), not zero under
     a pair; history.csv has them, and shapes.png draws two elevations."""
     from rbm_cli.models.registry import make_runner
-    from rbm_cli.physics.column import build_column
+    from rbm_cli.structures.column import build_column
     from rbm_cli.report.run_figures import shapes_figure
     from rbm_cli.report.run_folder import history_columns
 
@@ -302,11 +302,11 @@ def test_a_recorded_run_keeps_both_elevations():
 def test_a_pairs_intensity_measures_are_its_larger_components(pair_dir):
     """A pair is scaled by one factor (its larger PGA to the amplitude) and each measure of
     its row is the larger of its two components' measured on the records scaled so, here
-    by physics.intensity on the arrays: PGA is then the amplitude."""
+    by inputs.intensity on the arrays: PGA is then the amplitude."""
     from rbm_cli.config.types import G
-    from rbm_cli.physics.intensity import record_measures
-    from rbm_cli.physics.records import read_record
-    from rbm_cli.physics.similarity import rocking_scales
+    from rbm_cli.inputs.intensity import record_measures
+    from rbm_cli.inputs.records import read_record
+    from rbm_cli.structures.similarity import rocking_scales
     from rbm_cli.study.intensities import column_period, measure_values
 
     cfg = pair_config(pair_dir, file="rdk_01.AT2", file_y="rdk_02.AT2", scale="pga",

@@ -23,7 +23,7 @@ import rbm
 from rbm_cli.api.cells import check_run_output, write_run_folder
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.physics.records import write_csv
+from rbm_cli.inputs.records import write_csv
 from rbm_cli.report.fragility_report import plot_fragility, plot_ida
 from rbm_cli.report.fragility_run import compare_title, fragility_figure, suite_name
 from rbm_cli.report.info import describe, format_info

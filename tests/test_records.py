@@ -12,7 +12,7 @@ import pytest
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config import record_files as record_parsers
-from rbm_cli.physics.records import G, Record, read_record, write_at2, write_csv
+from rbm_cli.inputs.records import G, Record, read_record, write_at2, write_csv
 
 HEADER = [
     "PEER NGA STRONG MOTION DATABASE RECORD",

@@ -20,10 +20,10 @@ from scipy.optimize import brentq
 from rbm_cli.config.types import ColumnConfig, SolverConfig
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.housner.runner import housner_run
-from rbm_cli.physics.arrays import REST_RATE
-from rbm_cli.physics.block import block_geometry
-from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.restitution import block_restitution
+from rbm_cli.structures.arrays import REST_RATE
+from rbm_cli.structures.block import block_geometry
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.structures.restitution import block_restitution
 
 G = 9.81
 ALPHA = 0.2  # slenderness of the linear test block [rad]

@@ -330,11 +330,11 @@ def test_case06_a_full_disk_publishes_nothing(small, tmp_path, straight):
 # ----------------------------------------------------------------- hangs
 NAN_KERNEL = """
 import numpy as np
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.rbm.step import integrate
-from rbm_cli.physics.equations import build_model
+from rbm_cli.structures.equations import build_model
 with np.errstate(all="ignore"):
     geometry = ColumnConfig(height=4.0, base_width=1.0, top_width=1.0, depth=1.0,
                             density=1e308, drum_heights=(4.0,))

@@ -26,7 +26,7 @@ from rbm_cli.config import parse_config
 from rbm_cli.models.registry import make_runner
 from rbm_cli.models.status import COLLAPSED, SURVIVED
 from rbm_cli.numerics.loop import RunEnd
-from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.inputs.excitation import make_ground_motion
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "density": 2700}
 

@@ -195,12 +195,12 @@ def test_figure_labels_are_the_schemas():
 
 
 #: String literals equal to a column's name that are not the column: the config keys of a
-#: pulse (physics/pulses.py) and of the synthetic records' model (physics/rdk_model.py,
-#: physics/synthetic.py), an argument's name (physics/closed_forms.py), the fields of the
+#: pulse (inputs/pulses.py) and of the synthetic records' model (inputs/rdk_model.py,
+#: inputs/synthetic.py), an argument's name (structures/closed_forms.py), the fields of the
 #: run loop's record (numerics/loop.py: RunEnd) and a line of `rbm run`'s text (cli/run.py).
 #: Below study/, a module cannot read the schema.
-NOT_COLUMNS = {"rbm_cli/physics/pulses.py", "rbm_cli/physics/rdk_model.py",
-               "rbm_cli/physics/synthetic.py", "rbm_cli/physics/closed_forms.py",
+NOT_COLUMNS = {"rbm_cli/inputs/pulses.py", "rbm_cli/inputs/rdk_model.py",
+               "rbm_cli/inputs/synthetic.py", "rbm_cli/structures/closed_forms.py",
                "rbm_cli/numerics/loop.py", "rbm_cli/cli/run.py"}  # fmt: skip
 #: Modules that name columns the schema reads from them: the uncertain keys' design names
 #: its sample's columns (``sample``, ``uncertain.<key>``), as the grid names its axes'.

@@ -26,8 +26,8 @@ import pytest
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.physics.excitation import make_ground_motion
-from rbm_cli.physics.pulses import mp_peak, mp_shape
+from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.inputs.pulses import mp_peak, mp_shape
 from rbm_cli.study.simulate import simulate
 
 COLUMN = {"height": 4.0, "base_width": 1.0, "top_width": 0.8, "section": "circular",

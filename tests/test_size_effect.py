@@ -4,7 +4,7 @@ configs/size_effect.yaml sweeps geometrically similar rigid blocks (H/B = 4, hei
 under half-sine pulses. The similarity law says a block feels a pulse only through
 A / (g tan alpha) and omega / p, and for the rigid RBM monolith (the linear model, alpha = B/H) the
 minimum overturning amplitude in those axes is a closed form
-(rbm_cli.physics.closed_forms.linear_halfsine_threshold, checked against an ODE bisection in
+(rbm_cli.structures.closed_forms.linear_halfsine_threshold, checked against an ODE bisection in
 tests/test_closed_forms.py). So in dimensionless axes every size must fall on that one curve.
 tests/test_regression.py re-makes the stored domain in CI; here it is checked against the
 closed form.
@@ -25,7 +25,7 @@ import pytest
 
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import G
-from rbm_cli.physics.closed_forms import linear_halfsine_threshold
+from rbm_cli.structures.closed_forms import linear_halfsine_threshold
 from rbm_cli.study.domain import read_domain
 
 from .paths import CONFIGS, RESULTS

@@ -32,9 +32,9 @@ from scipy.integrate import quad
 from rbm_cli.api import load_config, run, sweep, with_values
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.models.registry import make_runner
-from rbm_cli.physics.arrays import survival_barrier
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.excitation import make_ground_motion
+from rbm_cli.structures.arrays import survival_barrier
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.sweep import config_hash
 
 from .paths import CONFIGS, RESULTS

@@ -28,7 +28,7 @@ from rbm_cli.base.errors import ConfigError, RbmError
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import G
-from rbm_cli.physics.records import write_csv
+from rbm_cli.inputs.records import write_csv
 from rbm_cli.report.info import own_point_note
 from rbm_cli.study.store import JOURNAL
 

@@ -19,9 +19,9 @@ import pytest
 
 from rbm_cli.base import portable_math as pm
 from rbm_cli.base.errors import RbmError
-from rbm_cli.physics import synthetic
-from rbm_cli.physics.records import G, read_record
-from rbm_cli.physics.synthetic import RDKParameters
+from rbm_cli.inputs import synthetic
+from rbm_cli.inputs.records import G, read_record
+from rbm_cli.inputs.synthetic import RDKParameters
 
 from .paths import CONFIGS
 
@@ -229,7 +229,7 @@ def test_suite_same_bits_without_avx(tmp_path):
     """numpy's exp/log change bits when its AVX dispatch is off; the suite must not."""
     env = dict(os.environ, NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL AVX512_SPR")
     code = (
-        "import sys; from rbm_cli.physics import synthetic; "
+        "import sys; from rbm_cli.inputs import synthetic; "
         "synthetic.write_suite(sys.argv[1], n=2, seed=3, duration_s=8.0)"
     )
     proc = subprocess.run(

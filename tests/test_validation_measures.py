@@ -12,8 +12,8 @@ import pytest
 
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import GridConfig
-from rbm_cli.physics.closed_forms import linear_rocking_parameters
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.closed_forms import linear_rocking_parameters
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.domain import read_domain
 
 from .paths import CONFIGS, RESULTS, tool_script

@@ -281,7 +281,7 @@ BOUNDS = "rbm_cli/models/rbm/exact/bounds.py"
 BLOCK = "rbm_cli/models/block/piece.py"
 RBM3D = "rbm_cli/models/rbm3d/kernel.py"
 H3D = "rbm_cli/models/housner3d/runner.py"
-ARRAYS = "rbm_cli/physics/arrays.py"
+ARRAYS = "rbm_cli/structures/arrays.py"
 REST_NOW = "REST_RATE = math.sqrt(200.0 * EVENT_EPS)"
 RK = "rbm_cli/numerics/rk.py"
 
@@ -506,7 +506,7 @@ VARIANTS: dict[str, Variant] = {
     "BISECTION_STEPS": Variant(
         ("BISECTION_STEPS",),
         "200 -> 20000 (x100: more is stricter)",
-        (("rbm_cli/physics/ground.py", "BISECTION_STEPS = 200", "BISECTION_STEPS = 20000"),),
+        (("rbm_cli/inputs/ground.py", "BISECTION_STEPS = 200", "BISECTION_STEPS = 20000"),),
         ("ricker-step", "slender-step"),
     ),
     "SAMPLES_PER_PERIOD": Variant(
@@ -514,7 +514,7 @@ VARIANTS: dict[str, Variant] = {
         "2000 -> 200000 samples a period of a pulse made a record (x100: more is stricter)",
         (
             (
-                "rbm_cli/physics/motion.py",
+                "rbm_cli/inputs/motion.py",
                 "SAMPLES_PER_PERIOD = 2000",
                 "SAMPLES_PER_PERIOD = 200000",
             ),
@@ -524,7 +524,7 @@ VARIANTS: dict[str, Variant] = {
     "DAMPING_DIGITS": Variant(
         ("DAMPING_DIGITS",),
         "10 -> 12 significant digits (the rounding of f_1 100x finer)",
-        (("rbm_cli/physics/equations.py", "DAMPING_DIGITS = 10", "DAMPING_DIGITS = 12"),),
+        (("rbm_cli/structures/equations.py", "DAMPING_DIGITS = 10", "DAMPING_DIGITS = 12"),),
         ("damped",),
     ),
     "TIME_STEP": Variant(
@@ -557,8 +557,8 @@ VARIANTS: dict[str, Variant] = {
         ("FREE_STEPS", "INNER_POINTS"),
         "400 -> 40000 and 65 -> 6500 (x100: more is stricter)",
         (
-            ("rbm_cli/physics/intensity.py", "FREE_STEPS = 400", "FREE_STEPS = 40000"),
-            ("rbm_cli/physics/intensity.py", "INNER_POINTS = 65", "INNER_POINTS = 6500"),
+            ("rbm_cli/inputs/intensity.py", "FREE_STEPS = 400", "FREE_STEPS = 40000"),
+            ("rbm_cli/inputs/intensity.py", "INNER_POINTS = 65", "INNER_POINTS = 6500"),
         ),
         ("suite-im",),
     ),

@@ -32,7 +32,7 @@ from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids
 from rbm_cli.models.bullet.scene import build_scene, read_frame
 from rbm_cli.models.bullet.settings import EngineSettings
-from rbm_cli.physics.cylinder import cylinder_geometry
+from rbm_cli.structures.cylinder import cylinder_geometry
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "section": "circular"}
 SHAPES = (32, 64, 128, "cylinders")

@@ -56,9 +56,9 @@ from rbm_cli.models.bullet.impact import (  # noqa: E402
 from rbm_cli.models.bullet.normals import NormalCensus  # noqa: E402
 from rbm_cli.models.bullet.run import bullet_run  # noqa: E402
 from rbm_cli.models.bullet.settings import EngineSettings  # noqa: E402
-from rbm_cli.physics.block import block_geometry  # noqa: E402
-from rbm_cli.physics.excitation import make_ground_motion  # noqa: E402
-from rbm_cli.physics.restitution import block_restitution  # noqa: E402
+from rbm_cli.structures.block import block_geometry  # noqa: E402
+from rbm_cli.inputs.excitation import make_ground_motion  # noqa: E402
+from rbm_cli.structures.restitution import block_restitution  # noqa: E402
 from rbm_cli.study.domain import boundary, read_domain  # noqa: E402
 from rbm_cli.study.simulate import simulate  # noqa: E402
 

@@ -184,7 +184,7 @@ def _child(method: str) -> None:
 
     from rbm_cli.config.load import load_config
     from rbm_cli.models.registry import make_runner
-    from rbm_cli.physics.excitation import make_ground_motion
+    from rbm_cli.inputs.excitation import make_ground_motion
 
     config = load_config(CONFIG)
     first = True

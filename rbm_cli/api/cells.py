@@ -18,7 +18,7 @@ from rbm_cli.config.load import shown as shown_value
 from rbm_cli.config.types import Config
 from rbm_cli.models.compile_ahead import compile_once
 from rbm_cli.models.methods import compiled_codes
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import (
     history_frame,
@@ -317,7 +317,7 @@ def compile_ahead(config: Config, notify: Callable[[str], None]) -> None:
 
 def check_run_output(config: Config, output: str | os.PathLike):
     """Before a run: OUTPUT/<name>/ can be written, and the column can be built; returns
-    the column (rbm_cli.physics.column.build_column) that :func:`write_run_folder` draws.
+    the column (rbm_cli.structures.column.build_column) that :func:`write_run_folder` draws.
 
     Raises
     ------

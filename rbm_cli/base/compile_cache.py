@@ -165,6 +165,9 @@ def _locator_class(caching):
         def get_disambiguator(self):
             return self._inner.get_disambiguator()
 
+        def __getattr__(self, name):  # what numba reads of its own locator (_py_file: the
+            return getattr(self._inner, name)  # warning that a function cannot be cached)
+
         @classmethod
         def from_function(cls, py_func, py_file):
             if not _inside_package(py_file):

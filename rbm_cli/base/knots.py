@@ -4,7 +4,7 @@ A record's acceleration is linear between its samples, with a kink at each: a st
 a kink loses the order of the method (its error control then shrinks the step until the
 kink is resolved, at a cost of many rejected steps). The steppers here end every step at
 the next knot (a sample time) instead, as the compiled kernel does
-(rbm_cli.physics.ground.next_uplift and its record pieces): inside a step the forcing is
+(rbm_cli.inputs.ground.next_uplift and its record pieces): inside a step the forcing is
 one straight line. With no knots (every other excitation) they are scipy's steppers, step for step.
 """
 

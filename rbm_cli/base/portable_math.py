@@ -3,7 +3,7 @@
 numpy's float64 ``exp``, ``log``, ``sin`` and ``cos`` dispatch on the CPU (SIMD kernels on
 AVX-512 machines, the C library elsewhere) and may differ in the last bit; numpy's
 ``standard_normal`` calls the C library's ``exp`` and ``log`` in its ziggurat's tail. The
-synthetic record suite (:mod:`rbm_cli.physics.synthetic`) must be reproducible bit for bit from its
+synthetic record suite (:mod:`rbm_cli.inputs.synthetic`) must be reproducible bit for bit from its
 seed, so it uses these instead: each is built from IEEE 754 additions, multiplications and
 divisions (correctly rounded everywhere, one numpy ufunc at a time, so no fused
 multiply-add), exact scalings by powers of two (``ldexp``, ``frexp``, ``rint``) and the

@@ -29,7 +29,7 @@ Keys, by excitation type (a key of another type is refused, naming it):
   ``filter: {low_hz, high_hz, order}``: a zero-phase Butterworth band-pass [Hz], order
   1-8, default 4; both records processed, before scaling: see :func:`processing_section`),
   ``im_periods`` (periods [s] of the 5 %-damped spectral accelerations a domain's rows
-  report among the record's intensity measures, rbm_cli.physics.intensity; no effect on
+  report among the record's intensity measures, rbm_cli.inputs.intensity; no effect on
   a run).
   ``duration`` does not apply: the run lasts the record plus ``free_time``, and the loader
   sets ``ExcitationConfig.duration`` to that. A mapping made in Python may give a motion
@@ -472,7 +472,7 @@ def _check_pair(rec: RecordFile, rec_y: RecordFile) -> None:
 
 def filter_padding(order: int) -> int:
     """Samples the band-pass of ``order`` (a side) extends a record by at each end before
-    its forward and backward pass (rbm_cli.physics.records.band_pass gives it to scipy's
+    its forward and backward pass (rbm_cli.inputs.records.band_pass gives it to scipy's
     sosfiltfilt as padlen): 3 (2 s + 1) with s = 2 ceil(order / 2), the number of its
     second-order sections (a high-pass and a low-pass of that order), scipy's default for
     sections of second order. A record needs more samples than this."""

@@ -67,7 +67,7 @@ class Motion:
     duration_s : float  Time of the last sample [s]
 
     Between samples the acceleration is linear, and 0 before the first and after the
-    last, as a record file's (rbm_cli.physics.records).
+    last, as a record file's (rbm_cli.inputs.records).
 
     Examples
     --------

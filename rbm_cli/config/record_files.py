@@ -1,6 +1,6 @@
 """Parsers of record files (PEER NGA ``.AT2``, CSV): strict, in blocks of lines, one-line errors.
 
-Used by :func:`rbm_cli.physics.records.read_record`, which documents the formats, and by the
+Used by :func:`rbm_cli.inputs.records.read_record`, which documents the formats, and by the
 config's ``excitation.file`` check (:mod:`rbm_cli.config.excitation`), which refuses a malformed
 record when the config is loaded (so they live here, below physics). Each parser returns
 plain arrays in the file's units; every malformed file raises an

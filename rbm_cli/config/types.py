@@ -246,7 +246,7 @@ class SecondComponentConfig:
     """An analytic second horizontal component (excitation.y) of a harmonic or a pulse,
     acting at 90 degrees counter-clockwise from the motion's direction: the same formula
     scaled by amplitude_ratio and shifted in phase by phase_deg (a_y = r A sin(omega t +
-    phase + phi) for a harmonic; rbm_cli.physics.excitation says it for each pulse).
+    phase + phi) for a harmonic; rbm_cli.inputs.excitation says it for each pulse).
 
     amplitude_ratio : float  r = the second component's multiplier over the first's [-]
     phase_deg : float  phi, its phase lead [deg]
@@ -289,7 +289,7 @@ class ProcessingConfig:
 
     baseline : str  'none', 'linear' or 'quadratic': the polynomial in time removed from
         the acceleration, fitted by least squares to the record's displacement
-        (rbm_cli.physics.records.remove_baseline)
+        (rbm_cli.inputs.records.remove_baseline)
     filter : FilterConfig or None  The band-pass, applied before the baseline correction
     """
 

@@ -18,7 +18,7 @@ from typing import Protocol, runtime_checkable
 
 from rbm_cli.config.types import Config, SolverConfig
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.inputs.excitation import GroundMotion
 
 #: Sampling interval of a recorded history when the caller gives none [s].
 DEFAULT_OUTPUT_DT = 0.002

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from rbm_cli.physics.motion import GroundMotion
+from rbm_cli.inputs.motion import GroundMotion
 
 #: Multiples of 180 degrees a second component's phase may lead by (excitation.y).
 _HALF_TURNS = (-2, -1, 0, 1, 2)

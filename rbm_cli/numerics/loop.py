@@ -54,7 +54,7 @@ RunEnd = namedtuple(
 #: (numerics.records: name, type): the state y and the accepted new state y_new, the
 #: Runge-Kutta work arrays (the stages K, the dense output's coefficients F, f = y'(t), the
 #: step's end ynew, a stage's argument tmp, a right-hand side's work, the error norm's scale,
-#: a state on the dense output yq), the right-hand side's arrays (physics.rates.rhs: As, cs,
+#: a state on the dense output yq), the right-hand side's arrays (structures.rates.rhs: As, cs,
 #: es as sys_A, sys_c, sys_e), and the run's figures, filled in place: RunEnd's max_ratio,
 #: friction, slip, swept and ledger, and top (1,): the top's peak.
 LOOP_FIELDS = [
@@ -142,7 +142,7 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
     scale, As, cs, es = W.scale, W.sys_A, W.sys_c, W.sys_e
     early_stop, last_forced, outcome_bound, monolith = stops
     bounds, forced, t_end, clipped = motion.bounds, motion.forced, motion.t_end, motion.clipped
-    # the ground (physics.ground): of the motion, and nothing (a free segment)
+    # the ground (inputs.ground): of the motion, and nothing (a free segment)
     gr_full = (motion.form, motion.gain, motion.omega, motion.phase, motion.center,
                motion.gamma, 0.0, 0.0, 0.0)  # fmt: skip
     gr_free = (motion.form, 0.0, motion.omega, motion.phase, motion.center, motion.gamma,

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import MODELS, Config
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
 from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
@@ -261,7 +261,7 @@ def domain_figure(
     config : Config or None  The config it was swept with (None: the cells and boundaries only)
     compare : sequence of DataFrame  Other domains whose boundaries are drawn over it
     labels : sequence of str  Their legend labels
-    dimensionless : bool  A / (g tan alpha) against omega / p (rbm_cli.physics.similarity)
+    dimensionless : bool  A / (g tan alpha) against omega / p (rbm_cli.structures.similarity)
     layout : str  'auto', 'panels' or 'overlay' for a domain over more axes than amplitude
         and frequency (rbm_cli.report.domain_view: the rule of 'auto')
     compare_configs : sequence  The configs of ``compare`` (dimensionless axes of old domains)

@@ -2,7 +2,7 @@
 and which points are drawn as panels or as overlaid lines. No drawing here (plot_axes.py).
 
 Coordinates. Physical: amplitude [g] on y against the *line variable* on x; dimensionless:
-A / (g tan alpha) on y against omega / p on x (rbm_cli.physics.similarity), read from
+A / (g tan alpha) on y against omega / p on x (rbm_cli.structures.similarity), read from
 domain.csv's scale columns or, for domains written before them, computed from the config
 of each point.
 
@@ -45,7 +45,7 @@ import pandas as pd
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.grid import RECORD_PATHS
 from rbm_cli.config.types import Config
-from rbm_cli.physics.similarity import rocking_scales
+from rbm_cli.structures.similarity import rocking_scales
 from rbm_cli.study.cells import grid_points, nominal_config
 from rbm_cli.study.domain import axis_columns, cell_key, keys_of
 from rbm_cli.study.schema import SCALE_COLUMNS, C, scale_values

@@ -7,8 +7,8 @@ import math
 
 from rbm_cli.config.grid import VIRTUAL_PATHS
 from rbm_cli.config.types import MODELS, Config, G
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.similarity import rocking_scales
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.structures.similarity import rocking_scales
 
 
 def normal_stiffness(col, i: int) -> float:
@@ -27,7 +27,7 @@ def describe(config: Config) -> dict:
     (for n = 1: m g (H/2) / (I_G + m H^2 / 4)); a capital is one of the drums, a top
     mass part of the top drum's mass and inertia (height_m: the shaft and the capital).
     domain_p_rad_s and domain_alpha_rad are the scales a sweep writes in domain.csv's
-    p_rad_s and alpha_rad (rbm_cli.physics.similarity: the model's monolith, the true
+    p_rad_s and alpha_rad (rbm_cli.structures.similarity: the model's monolith, the true
     solid's for housner and bullet); rocking_p_is and domain_p_is say what each p is
     (:func:`p_meaning`), as `rbm info` prints them.
     Elastic frequencies are those of the elastic branches of the laws in the chosen
@@ -100,7 +100,7 @@ def p_meaning(config: Config, n: int, lever: float) -> dict[str, str]:
     """What each of the two p's is, by name: ``rocking_p_is`` (`rbm info`'s: the RBM's column
     as configured, its n drums rocking as one rigid stack on the base, p^2 = N_1 zbar_1 /
     (1^T M 1)) and ``domain_p_is`` (domain.csv's p_rad_s and alpha_rad: the similarity scales
-    of rbm_cli.physics.similarity, the model's own monolith); one line each. ``lever``:
+    of rbm_cli.structures.similarity, the model's own monolith); one line each. ``lever``:
     zbar_1, the height of the weight's resultant above the base [m]."""
     stack = (f"the RBM's {n} drums rocking as one rigid stack on the base (centre of mass at "
              f"zbar_1 = {lever:.4g} m, tan alpha = theta_u,1)" if n > 1 else

@@ -14,8 +14,8 @@ in an ensemble), 'compare-<k>',
 'linear-<k>', the k-th point's own curve in physical overlays).
 
 Closed forms (half-sine pulse, rigid monolith): in dimensionless axes the curves
-A / (g tan alpha) = f(omega / p) of rbm_cli.physics.closed_forms hold for every size at
-once (tan alpha = theta_u of the RBM, as in rbm_cli.physics.similarity); in physical axes
+A / (g tan alpha) = f(omega / p) of rbm_cli.structures.closed_forms hold for every size at
+once (tan alpha = theta_u of the RBM, as in rbm_cli.structures.similarity); in physical axes
 they are each point's own, in g: against frequency, or at the grid's frequency joined
 over an axis on x. The uplift level is the static multiplier [g], or
 static_multiplier / tan alpha (1 for a monolith) in dimensionless axes.
@@ -29,12 +29,12 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.config.types import Config
-from rbm_cli.physics.closed_forms import (
+from rbm_cli.structures.closed_forms import (
     halfsine_threshold_curves,
     housner_halfsine_threshold,
     linear_halfsine_threshold,
 )
-from rbm_cli.physics.column import build_column
+from rbm_cli.structures.column import build_column
 from rbm_cli.report.domain_view import DomainView, Point, row_configs
 from rbm_cli.report.plot_domain import (
     CURVE_POINTS,

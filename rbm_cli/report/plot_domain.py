@@ -22,8 +22,8 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from rbm_cli.physics.closed_forms import halfsine_threshold_curves
-from rbm_cli.physics.column import Column
+from rbm_cli.structures.closed_forms import halfsine_threshold_curves
+from rbm_cli.structures.column import Column
 from rbm_cli.study.domain import MAJORITY, boundary
 from rbm_cli.study.schema import C
 from rbm_cli.study.schema import label as column_label
@@ -468,7 +468,7 @@ def plot_domain(
     labels : sequence of str, optional
         Legend labels of the boundaries: labels[0] for ``df``, then one per
         ``compare`` entry
-    column : rbm_cli.physics.column.Column, optional
+    column : rbm_cli.structures.column.Column, optional
         The column of ``df``; with n = 1, a rigid law and a half-sine
         excitation, the closed-form half-sine thresholds are drawn
     excitation_type : str, optional
@@ -502,7 +502,7 @@ def plot_domain(
     0.5), labelled so, and member 0's boundary is drawn beside it, dotted in the same
     colour, labelled "member 0's boundary", where the two differ anywhere. The
     closed forms use the mapping of the RBM's rigid monolith to the linear block
-    (:func:`rbm_cli.physics.closed_forms.linear_rocking_parameters`): the rigid RBM
+    (:func:`rbm_cli.structures.closed_forms.linear_rocking_parameters`): the rigid RBM
     monolith is the piecewise-linear block with alpha = B_1/H.
     The amplitude axis starts at 0 and stops just above the largest amplitude
     of the grids, so a steep closed-form curve does not squash the domain.

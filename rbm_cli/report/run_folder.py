@@ -31,8 +31,8 @@ from rbm_cli.base.files import (
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import G
 from rbm_cli.models.history import History
-from rbm_cli.physics.excitation import make_ground_motion, pair_times
-from rbm_cli.physics.ground import as_samples, vertical_factor
+from rbm_cli.inputs.excitation import make_ground_motion, pair_times
+from rbm_cli.inputs.ground import as_samples, vertical_factor
 from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figures, here before)
     N_SHAPES,
     RUN_PNGS,
@@ -165,7 +165,7 @@ def record_of_run(config, amplitude_g: float) -> dict | None:
 def vertical_history(config, amplitude_g: float, t) -> np.ndarray | None:
     """a_v [m/s^2], the upward ground acceleration of a record run with a vertical record
     (excitation.vertical, scaled as the run scales it), at the times ``t`` [s]: as the
-    run's ground motion gives it (rbm_cli.physics.motion.GroundMotion, 0 outside the
+    run's ground motion gives it (rbm_cli.inputs.motion.GroundMotion, 0 outside the
     record); None without a vertical record."""
     excitation = config.excitation
     if excitation.type != "record" or excitation.vertical is None:

@@ -16,7 +16,7 @@ import pandas as pd
 from rbm_cli.base.files import write_text_atomic
 from rbm_cli.config.load import parse_config
 from rbm_cli.models.registry import make_runner
-from rbm_cli.physics.assembly import model_from_config
+from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.study.schema import C
 from rbm_cli.study.simulate import simulate
 

@@ -5,7 +5,7 @@ point (rbm_cli.config.points), empty for a plain amplitude x frequency grid; fre
 is None for an excitation without one (a record). Cells are listed point-major, then
 frequency-major, so a plain grid lists its cells as it always did. A domain.csv row
 carries its point as one column per path, named by the path (the dots tell them from the
-result's columns), the scales of its column (rbm_cli.physics.similarity) and, for a
+result's columns), the scales of its column (rbm_cli.structures.similarity) and, for a
 record, the record's intensity measures (rbm_cli.study.intensities).
 """
 
@@ -21,7 +21,7 @@ from rbm_cli.config.load import parse_config
 from rbm_cli.config.motions import Motion
 from rbm_cli.config.points import GridPoint, expand, point_written
 from rbm_cli.config.types import Config
-from rbm_cli.physics.similarity import rocking_scales
+from rbm_cli.structures.similarity import rocking_scales
 from rbm_cli.study.domain import cell_key, row_key
 from rbm_cli.study.intensities import column_period, measure_values
 from rbm_cli.study.schema import C, domain_columns, scale_values

@@ -10,7 +10,7 @@ processed when ``excitation.processing`` asks), each column named with its unit.
 - ``quantity`` and ``unit``: how a figure's axis and the docs name it;
 - ``compute(t, a, period_s)``: its value [SI] for the record as read (times [s],
   accelerations [m/s^2]; ``period_s`` the entry's period, None for a measure without
-  one), a function of rbm_cli.physics.intensity;
+  one), a function of rbm_cli.inputs.intensity;
 - ``scaling``: how it goes with the factor c a cell multiplies the record by, in
   :data:`SCALINGS`: ``linear`` (|c|: PGA, PGV, PGD, CAV, Sa), ``quadratic`` (c^2: Arias
   intensity) or ``none`` (D5-95, the column's period); a measure that grows with the
@@ -32,7 +32,7 @@ The measures, in domain.csv's order:
   with ``p`` for its decimal point (``sa_0p5s_g``: 0.5 s; a domain's dotted columns are
   its axes);
 - ``pga_over_g_tan_alpha`` = PGA / (g tan alpha) and ``pgv_p_over_g_tan_alpha`` =
-  PGV p / (g tan alpha) [-], alpha and p the column's scales (rbm_cli.physics.similarity).
+  PGV p / (g tan alpha) [-], alpha and p the column's scales (rbm_cli.structures.similarity).
 
 Measures are computed once per record (and per process: a worker keeps them for every
 chunk of that record it runs) and scaled to each cell: the record is multiplied by
@@ -57,10 +57,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from rbm_cli.config.types import MODELS, Config, G
-from rbm_cli.physics import intensity as im
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.excitation import load_record
-from rbm_cli.physics.records import process
+from rbm_cli.inputs import intensity as im
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.inputs.excitation import load_record
+from rbm_cli.inputs.records import process
 
 #: How a measure goes with the factor c a cell multiplies its record by.
 SCALINGS = ("linear", "quadratic", "none")
@@ -72,7 +72,7 @@ PERIODS = (None, "t1", "im_periods")
 @dataclass(frozen=True)
 class ColumnContext:
     """What a measure's column value may read of the column: tan alpha [-] and p [rad/s]
-    (rbm_cli.physics.similarity), and the first elastic period t1 [s] (None: rigid)."""
+    (rbm_cli.structures.similarity), and the first elastic period t1 [s] (None: rigid)."""
 
     tan_alpha: float
     p: float
@@ -286,7 +286,7 @@ def _record(config: Config, second: bool = False):
     """(times [s], accelerations [m/s^2]) of a record config's record (its second
     horizontal component, ``excitation.file_y`` or a motion's ``acceleration_y``, if
     second), as the run reads it:
-    processed as ``excitation.processing`` says (rbm_cli.physics.records.process)."""
+    processed as ``excitation.processing`` says (rbm_cli.inputs.records.process)."""
     exc = config.excitation
     if exc.motion is not None:  # given as arrays (a pair: its y component if second)
         t, name = exc.motion.time_s, exc.motion.name
@@ -334,7 +334,7 @@ def record_values(config: Config, t1: float | None, second: bool = False) -> dic
 
 
 def scale_factor(config: Config, amplitude_g: float, pga: float) -> float:
-    """The factor a cell multiplies its record by (as rbm_cli.physics.excitation does):
+    """The factor a cell multiplies its record by (as rbm_cli.inputs.excitation does):
     amplitude / PGA with ``scale: pga``, the amplitude with ``factor``."""
     if config.excitation.scale == "pga":
         return amplitude_g * G / pga

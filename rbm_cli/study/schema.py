@@ -4,7 +4,7 @@ writer writes them, and when a domain has it.
 A domain's row is one cell of a sweep (rbm_cli.study.cells): its point's axes, the
 sample of a config's uncertain keys (rbm_cli.config.uncertain: ``sample`` and one column
 per key, ``uncertain.<key>``, the value the run used: :func:`point_columns`), then the
-run's result (rbm_cli.study.result), the column's scales (rbm_cli.physics.similarity), a
+run's result (rbm_cli.study.result), the column's scales (rbm_cli.structures.similarity), a
 record's intensity measures (their registry: rbm_cli.study.intensities) and an ensemble's
 verdict (rbm_cli.study.robustness). :func:`columns` lists them (the measures as the
 registry holds them when called); each :class:`Column` says
@@ -353,7 +353,7 @@ def domain_columns(config: Config, ensemble: int = 1, result=None) -> tuple[str,
 
 def scale_values(scales, amplitude_g: float, frequency_hz: float | None) -> dict:
     """The scale columns of one cell (:data:`SCALE_COLUMNS`), as domain.csv holds them
-    (rbm_cli.physics.similarity.RockingScales)."""
+    (rbm_cli.structures.similarity.RockingScales)."""
     a_ratio, w_ratio = scales.dimensionless(amplitude_g, frequency_hz)
     values = (scales.alpha, scales.p, scales.static_multiplier, a_ratio, w_ratio)
     return dict(zip(SCALE_COLUMNS, values, strict=True))

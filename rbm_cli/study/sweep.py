@@ -33,8 +33,8 @@ from rbm_cli.config.types import MODELS, Config
 from rbm_cli.models.compile_ahead import compile_once, needs_compile
 from rbm_cli.models.methods import compiled_codes
 from rbm_cli.models.registry import make_runner
-from rbm_cli.physics.assembly import model_from_config
-from rbm_cli.physics.similarity import rocking_scales
+from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.structures.similarity import rocking_scales
 from rbm_cli.study.cells import (
     Cell,
     add_point,

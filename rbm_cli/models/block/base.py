@@ -1,5 +1,5 @@
 """What the two single-block reference models share as runners: the true block of the
-config's monolithic column (rbm_cli.physics.block), its restitution, its initial state and
+config's monolithic column (rbm_cli.structures.block), its restitution, its initial state and
 its history. Each model says only how it integrates one run (`_integrate`)."""
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from rbm_cli.config.types import Config, SolverConfig
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.history import history_from_samples
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.physics.block import block_geometry, block_initial
-from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.restitution import block_restitution, resolve
+from rbm_cli.structures.block import block_geometry, block_initial
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.structures.restitution import block_restitution, resolve
 
 
 class BlockRunner:

@@ -8,7 +8,7 @@ none is missed. The run loop (block.run) runs compiled, or uncompiled as written
 
 The rigid RBM monolith (one drum, a rigid joint, xi = 1: one law piece a side) is that
 equation with the coefficients of its own linear system (Model.linear_system): alpha =
-theta_u = B_1 / H and p^2 = m g (H/2) / I_0 (physics.closed_forms.linear_rocking_parameters)
+theta_u = B_1 / H and p^2 = m g (H/2) / I_0 (structures.closed_forms.linear_rocking_parameters)
 and e = -m (H/2) / I_0; its uplift level, rest rate, collapse limit, early-stop barrier and
 friction demand are the model's (as the step kernel reads them). `housner-linear` is the
 same equation with e = -p^2 / g for the true block (Spanos and Koh 1984), and linear_run
@@ -55,9 +55,9 @@ from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.modal import LINEAR
 from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings, sine_arrays
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
-from rbm_cli.physics.arrays import REST_RATE, rest_levels
-from rbm_cli.physics.equations import Model
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.structures.arrays import REST_RATE, rest_levels
+from rbm_cli.structures.equations import Model
+from rbm_cli.inputs.excitation import GroundMotion
 
 
 class Block(NamedTuple):

@@ -81,7 +81,7 @@ from rbm_cli.models.status import (
     SURVIVED,
     guard_code,
 )
-from rbm_cli.physics.ground import sine_exceedance
+from rbm_cli.inputs.ground import sine_exceedance
 
 T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG, T_SLIP = range(
     12

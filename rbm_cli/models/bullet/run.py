@@ -81,7 +81,7 @@ from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.history import History
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.plan import wrapped
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.inputs.excitation import GroundMotion
 
 __all__ = [
     "BLOWUP",

@@ -27,7 +27,7 @@ from rbm_cli.models.bullet.space import (
     normals,
 )
 from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.inputs.excitation import GroundMotion
 
 #: Interval of the collapse, sliding and contact checks [s].
 CHECK_DT = 1e-3

@@ -43,15 +43,15 @@ from rbm_cli.models.housner.steps import (
 )
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import Outcome, budget_message
-from rbm_cli.physics.arrays import REST_RATE
-from rbm_cli.physics.block import (
+from rbm_cli.structures.arrays import REST_RATE
+from rbm_cli.structures.block import (
     BlockGeometry,
     housner_energy,
     top_displacement,
 )
-from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.ground import SINE
-from rbm_cli.physics.restitution import block_restitution, resolve
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.inputs.ground import SINE
+from rbm_cli.structures.restitution import block_restitution, resolve
 
 _METHODS = {m.__name__: clip_at_knots(m) for m in (DOP853, RK45, RK23)}
 
@@ -330,7 +330,7 @@ def _fail(out: Outcome, message: str) -> Outcome:
 
 class HousnerRunner(BlockRunner):
     """`housner` (rbm_cli.models.contract.Runner): the config's monolithic column as Housner's
-    rigid block, with its true geometry (rbm_cli.physics.block)."""
+    rigid block, with its true geometry (rbm_cli.structures.block)."""
 
     def __init__(self, config) -> None:
         super().__init__(config)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.inputs.excitation import GroundMotion
 
 
 class Recorder:

@@ -1,4 +1,4 @@
-"""`housner-3d`: the rigid cylinder rocking and rolling on its rim (rbm_cli.physics.cylinder)
+"""`housner-3d`: the rigid cylinder rocking and rolling on its rim (rbm_cli.structures.cylinder)
 under a ground motion in any horizontal direction, integrated by scipy's DOP853 (RK45,
 RK23) step by step like `housner`, the events located on each step's dense output:
 
@@ -50,8 +50,8 @@ from rbm_cli.models.housner.state import BlockRun
 from rbm_cli.models.methods import step_method
 from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome, budget_message
 from rbm_cli.models.plan import as_line, from_ground, to_ground, turned_start, wrapped
-from rbm_cli.physics.arrays import REST_RATE
-from rbm_cli.physics.cylinder import (
+from rbm_cli.structures.arrays import REST_RATE
+from rbm_cli.structures.cylinder import (
     STATE_SIZE,
     CylinderGeometry,
     cylinder_energy,
@@ -64,7 +64,7 @@ from rbm_cli.physics.cylinder import (
     top_in_plan,
     uplift_level,
 )
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.inputs.excitation import GroundMotion
 
 _METHODS = {m.__name__: clip_at_knots(m) for m in (DOP853, RK45, RK23)}
 
@@ -117,7 +117,7 @@ def cylinder_run(
 
     Parameters
     ----------
-    geo : CylinderGeometry  The cylinder (rbm_cli.physics.cylinder)
+    geo : CylinderGeometry  The cylinder (rbm_cli.structures.cylinder)
     motion : GroundMotion  a_g(t) [m/s^2] along motion.direction, a_v(t), simulated time [s]
     restitution : float  e [-] in (0, 1]
     collapse_ratio : float  Collapse at a tilt of collapse_ratio alpha [-]

@@ -6,9 +6,9 @@ loss of rate, a law's potential and a state's energy, the friction demand: its p
 the demand held for a duration, which the block's closed form and rbm-3d's kernel take
 too).
 
-A law is odd and piecewise linear (rbm_cli.physics.law): on x >= 0 its piece k is
+A law is odd and piecewise linear (rbm_cli.structures.law): on x >= 0 its piece k is
 f = a_k + b_k x on [x_k, x_{k+1}), the edges x_1 < x_2 < ... padded with inf
-(rbm_cli.physics.law.law_arrays). Interface i's piece is its side s_i = +-1 (the sign of its
+(rbm_cli.structures.law.law_arrays). Interface i's piece is its side s_i = +-1 (the sign of its
 argument) and its index k_i; ``pending[i]`` marks an excursion beyond the elastic branch
 (piece 0 is then bounded by 0: the next zero crossing is an impact), ``awaiting[i]`` an
 interface back on piece 0 whose zero crossing is silent (counted, not stopped at:
@@ -192,8 +192,8 @@ def energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes
 def below_barrier(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes, barrier):
     """Whether a state's energy (:func:`energy`) is below an energy barrier [J] by more
     than 1e-9 of it (NaN: no barrier, never): the test of both early stops of free motion,
-    a monolith's at a peak (physics.arrays.rest_levels) and a column's certain survival
-    (physics.arrays.survival_barrier)."""
+    a monolith's at a peak (structures.arrays.rest_levels) and a column's certain survival
+    (structures.arrays.survival_barrier)."""
     if barrier != barrier:
         return False
     en = energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes)

@@ -2,7 +2,7 @@
 
 One call runs a whole motion. The Runge-Kutta steps are the planar step kernel's
 (rbm_cli.numerics.rk: scipy's tableaux, error norm, step control and dense output,
-whose right-hand side takes a state of 4n values as this model's, physics.beam3d); the
+whose right-hand side takes a state of 4n values as this model's, structures.column3d); the
 events are located on each step's dense output: the watched distances are evaluated at
 CHECK_INTERVALS + 1 points of the step, and in the first sub-interval where one ends below
 zero, or where its cubic Hermite dips below zero (confirmed on the dense output), each
@@ -38,9 +38,9 @@ from rbm_cli.numerics.loop import RunEnd, loop_for, loop_into
 from rbm_cli.numerics.quadrature import GL_NODES, GL_WEIGHTS
 from rbm_cli.numerics.records import new_record
 from rbm_cli.numerics.rk import TAB_EST, TAB_NS, dense_eval, steps_for
-from rbm_cli.physics.arrays import ColumnArrays, column_into
-from rbm_cli.physics.beam3d import CS_PER_JOINT, ES_EXTRA, beam_rates, horizontal, pack_pieces
-from rbm_cli.physics.ground import (
+from rbm_cli.structures.arrays import ColumnArrays, column_into
+from rbm_cli.structures.column3d import CS_PER_JOINT, ES_EXTRA, beam_rates, horizontal, pack_pieces
+from rbm_cli.inputs.ground import (
     LINE,
     gravity_factor,
     ground_at,
@@ -68,7 +68,7 @@ XTOL, RTOL, MAXITER = 1e-15, 8.881784197001252e-16, 100
 #: The run ended at rest in the free motion after the ground motion.
 AT_REST = 11
 
-#: The column's Runge-Kutta steps on its right-hand side (physics.beam3d.beam_rates).
+#: The column's Runge-Kutta steps on its right-hand side (structures.column3d.beam_rates).
 initial_step, attempt_step, dense_prepare = steps_for("column3d", beam_rates)
 
 
@@ -358,8 +358,8 @@ def _emit(mc, t_stop, t_old, h, y_old, F, yq, samples, n_out, next_out, dt, n, d
 
 @jit
 def _pieces(t, knots, values, values_y, vertical, gain, seg_end, es):
-    """A record's straight piece from t (physics.ground.record_piece) and the time its step
-    ends at; a pair's second record's piece written into es (physics.beam3d)."""
+    """A record's straight piece from t (inputs.ground.record_piece) and the time its step
+    ends at; a pair's second record's piece written into es (structures.column3d)."""
     gr, bound = record_piece(t, knots, values, vertical, gain, seg_end)
     if values_y.size > 0:
         n = es.size - ES_EXTRA
@@ -371,7 +371,7 @@ def _pieces(t, knots, values, values_y, vertical, gain, seg_end, es):
 
 @jit
 def energy3d(y, n, col):
-    """Energy [J] of a state y (4n,) (physics.beam3d): the kinetic energy of both
+    """Energy [J] of a state y (4n,) (structures.column3d): the kinetic energy of both
     directions, gravity's for `geometric` and the laws' potential of |phi_i|
     (pieces.law_potential), as the planar Model.energy in each direction."""
     e = 0.0
@@ -415,7 +415,7 @@ def pair_rest_demand(t0, t1, gr, gy, knots, values, values_y, knots_y, vertical)
     [t0, t1] [s], a_h = (a_x, a_y). A pair of records: both components and a_v are straight
     between samples, where |a_h| / (g + a_v) has no interior maximum (its sublevel sets
     are convex), so the ends and the samples between them hold it. A formula and its
-    second component (gy): the largest ratio that physics.ground.pair_uplift finds
+    second component (gy): the largest ratio that inputs.ground.pair_uplift finds
     exceeded on [t0, t1), by halving to the last bit (closed-form exceedance times)."""
     if gr[1] == 0.0 or t1 < t0:
         return 0.0
@@ -458,7 +458,7 @@ def in_plane(y, n):
 
 @jit(inline=True)
 def system3d(col, n, d0, d1, values_y, gy):
-    """The column's system in two directions (physics.beam3d): As (n, 3n) of its mass,
+    """The column's system in two directions (structures.column3d): As (n, 3n) of its mass,
     stiffness and argument maps, cs (the current pieces' constants, packed at each restart)
     and es (the ground's factors, the motion's direction (d0, d1) and its second component's
     formula)."""
@@ -658,7 +658,7 @@ def run3d(col, motion, solver, task, pair):
 
     Parameters
     ----------
-    col : ColumnArrays  The column (physics.arrays), as the planar kernel reads it
+    col : ColumnArrays  The column (structures.arrays), as the planar kernel reads it
     motion : Excitation  The motion along its direction (step.inputs)
     solver : SolverSettings  atol of 4n entries
     task : tuple  (y0 (4n), record, output_dt, samples (rows, 3 + 3n), friction_limit,
@@ -667,7 +667,7 @@ def run3d(col, motion, solver, task, pair):
         y0 and held are changed in place: the state where the run ended, the samples of
         the demand held
     pair : tuple  (d0, d1, values_y: a second record's samples, or empty; gy: the second
-        component's ground tuple, physics.ground, gain 0 for none; knots_y: its knots)
+        component's ground tuple, inputs.ground, gain 0 for none; knots_y: its knots)
 
     Returns
     -------

@@ -1,5 +1,5 @@
 """`rbm-3d`: the Rigid Beam Model of a column of circular drums in two horizontal directions
-(rbm_cli.physics.beam3d), integrated by the planar step kernel's Runge-Kutta pairs (DOP853,
+(rbm_cli.structures.column3d), integrated by the planar step kernel's Runge-Kutta pairs (DOP853,
 RK45, RK23) in a compiled run of its own (kernel.py; its source uncompiled with
 `solver.implementation: python`), the events located on each step's dense output:
 
@@ -83,10 +83,10 @@ from rbm_cli.models.status import (
     end_by_budget,
     stop_level,
 )
-from rbm_cli.physics.column import build_column
-from rbm_cli.physics.equations import build_model
-from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.ground import as_samples
+from rbm_cli.structures.column import build_column
+from rbm_cli.structures.equations import build_model
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.inputs.ground import as_samples
 
 
 def integrate3d(
@@ -110,7 +110,7 @@ def integrate3d(
 
     Parameters
     ----------
-    model : Model  The column's planar equations (rbm_cli.physics.equations)
+    model : Model  The column's planar equations (rbm_cli.structures.equations)
     motion : GroundMotion  The ground motion, in any direction, one or two components
     theta0, rate0 : (n,)  Initial drum rotations [rad] and rates [rad/s] in the motion's
         vertical plane

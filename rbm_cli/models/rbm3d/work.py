@@ -7,7 +7,7 @@ from __future__ import annotations
 from rbm_cli.models.rbm.step.inputs import MOTION_FIELDS
 from rbm_cli.numerics.loop import LOOP_FIELDS
 from rbm_cli.numerics.records import record_kind
-from rbm_cli.physics.arrays import COLUMN_FIELDS
+from rbm_cli.structures.arrays import COLUMN_FIELDS
 
 #: The column's work in a run in two directions (kernel.run3d): its pieces (each joint's
 #: piece, an excursion pending its impact, its phase, leaving closure, the pinned direction
@@ -34,6 +34,6 @@ COLUMN3D_WORK_FIELDS = [
     ("knots_y", "float64[::1]"), ("pair_on", "bool"), ("formula_y", "bool"),
 ]  # fmt: skip
 
-#: The column in two directions' run record: the column (physics.arrays.ColumnArrays), what
+#: The column in two directions' run record: the column (structures.arrays.ColumnArrays), what
 #: its functions read of the motion, the loop's arrays and the run's figures, and its work.
 COLUMN3D = record_kind(COLUMN_FIELDS + MOTION_FIELDS + LOOP_FIELDS + COLUMN3D_WORK_FIELDS)

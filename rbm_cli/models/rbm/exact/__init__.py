@@ -35,7 +35,7 @@ Modules: integrate (the entry from Python), run (the run loop), piece (law piece
 and their cache, rows and points of a linear piece), search (certified intervals, event
 roots, peak refinement), bounds (bounds of the modes and rows over an interval), peaks (the
 deferred refinement of peaks), modal (the closed forms of one mode) and motion (what it
-takes of a ground motion). The column's arrays are physics.arrays.ColumnArrays; the law
+takes of a ground motion). The column's arrays are structures.arrays.ColumnArrays; the law
 pieces, the friction demand and a state's energy are the step integrator's too
 (rbm_cli.models.rbm.pieces).
 """

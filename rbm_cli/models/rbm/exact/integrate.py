@@ -31,10 +31,10 @@ from rbm_cli.models.status import (
     STOPPED_EARLY,
     end_by_budget,
 )
-from rbm_cli.physics.arrays import ColumnArrays, column_arrays
-from rbm_cli.physics.column import build_column
-from rbm_cli.physics.equations import Model, build_model
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.structures.arrays import ColumnArrays, column_arrays
+from rbm_cli.structures.column import build_column
+from rbm_cli.structures.equations import Model, build_model
+from rbm_cli.inputs.excitation import GroundMotion
 
 #: Points of the pool (3 for the run loop, the rest for the refinement of peaks) and
 #: entries of the refinement's stack.
@@ -96,7 +96,7 @@ def integrate_exact(
 
     Parameters
     ----------
-    model : Model  The column's equations (rbm_cli.physics.equations)
+    model : Model  The column's equations (rbm_cli.structures.equations)
     motion : GroundMotion  The ground motion (its kind, end and pulse end with segments)
     theta0, rate0 : array (n,)  Initial drum rotations [rad] and rates [rad/s]
     solver : SolverConfig  Budgets (max_steps: certified intervals, max_events,

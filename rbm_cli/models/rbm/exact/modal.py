@@ -44,7 +44,7 @@ import math
 import numpy as np
 
 from rbm_cli.base.jit import jit
-from rbm_cli.physics.ground import sine_exceedance, sine_peak
+from rbm_cli.inputs.ground import sine_exceedance, sine_peak
 
 #: Terms of the power series of C, S, S2, S3 tabulated (used for |lam| tau^2 < 1: the
 #: last term is below 1e-26 of the first; _terms takes as many as a given |z| needs).

@@ -17,7 +17,7 @@ closed form would need the damped modes of every set of pieces, not written).
 from __future__ import annotations
 
 from rbm_cli.base.errors import RbmError
-from rbm_cli.physics.equations import Model
+from rbm_cli.structures.equations import Model
 
 #: Ground motions the exact integrator takes: sines (one harmonic forcing a segment) and
 #: records (one linear forcing a sample interval).

@@ -66,7 +66,7 @@ from rbm_cli.models.status import (
     SURVIVED,
     guard_code,
 )
-from rbm_cli.physics.ground import sine_exceedance
+from rbm_cli.inputs.ground import sine_exceedance
 
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT, T_SLIP, SLIP_IF = range(8)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)

@@ -26,7 +26,7 @@ Python that numba compiles: compiled by default, run by Python as written with
 ``solver.implementation: python`` (rbm_cli.base.jit.plain; the same bits, 30-100x
 slower). The modules: step.inputs (the kernel's four typed input records and
 prepare_kernel), step.stepper (the stepper), step.rk (Runge-Kutta), step.events (event
-location), step.state (the state change at an event), physics.ground (the excitation),
+location), step.state (the state change at an event), inputs.ground (the excitation),
 step.vertical (moving kinks under a vertical record), models.rbm.pieces (the law pieces, as
 the exact integrator keeps them too), models.guard (wall-clock budget and Ctrl-C); this one
 runs a model from Python.
@@ -62,9 +62,9 @@ from rbm_cli.models.status import (
     stop_level,
 )
 from rbm_cli.numerics.loop import RunEnd
-from rbm_cli.physics.column import build_column
-from rbm_cli.physics.equations import Model, build_model
-from rbm_cli.physics.excitation import GroundMotion
+from rbm_cli.structures.column import build_column
+from rbm_cli.structures.equations import Model, build_model
+from rbm_cli.inputs.excitation import GroundMotion
 
 
 def integrate(
@@ -86,7 +86,7 @@ def integrate(
 
     Parameters
     ----------
-    model : Model  The column's equations (rbm_cli.physics.equations)
+    model : Model  The column's equations (rbm_cli.structures.equations)
     motion : GroundMotion  The ground motion
     theta0, rate0 : array (n,)  Initial drum rotations [rad] and rates [rad/s]
     solver : SolverConfig  Method (a Runge-Kutta pair), tolerances, budgets, implementation

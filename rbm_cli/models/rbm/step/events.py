@@ -2,7 +2,7 @@
 and cubic Hermite dips (as rbm_cli.base.events), the event distances of a state, and the
 linear system and energy of the current law pieces (the pieces themselves:
 rbm_cli.models.rbm.pieces); the moving kinks of a vertical record are step.vertical's (the
-exact uplift time of a rigid block at rest is in physics.ground, time-history sampling in
+exact uplift time of a rigid block at rest is in inputs.ground, time-history sampling in
 step.rk)."""
 
 from __future__ import annotations

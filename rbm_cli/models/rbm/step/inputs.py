@@ -5,7 +5,7 @@ numba reads the fields of a tuple of arrays and scalars at no cost, so the stepp
 (passed as plain tuples in the order of their fields, named again inside the kernel:
 a named tuple costs more to pass, see run_kernel):
 
-- rbm_cli.physics.arrays.ColumnArrays: everything the kernel needs of a model, made once
+- rbm_cli.structures.arrays.ColumnArrays: everything the kernel needs of a model, made once
   per model by :func:`prepare_kernel` (a sweep prepares a column once, runs it many times);
 - :class:`Excitation`: the ground motion of one run;
 - :class:`SolverSettings`: method, tolerances, budgets and wall-clock deadline;
@@ -22,10 +22,10 @@ import numpy as np
 from rbm_cli.base.jit import jit
 from rbm_cli.models.methods import step_method
 from rbm_cli.numerics.rk import METHOD_CODES
-from rbm_cli.physics.arrays import ColumnArrays, column_arrays
-from rbm_cli.physics.equations import Model
-from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.ground import as_samples
+from rbm_cli.structures.arrays import ColumnArrays, column_arrays
+from rbm_cli.structures.equations import Model
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.inputs.ground import as_samples
 
 #: excitation kind -> code in the kernel
 KIND_CODES = {
@@ -41,8 +41,8 @@ KIND_CODES = {
 
 
 class Excitation(NamedTuple):
-    """The ground motion of one run (rbm_cli.physics.excitation.GroundMotion; its form's
-    numbers as rbm_cli.physics.ground and physics.ground read them)."""
+    """The ground motion of one run (rbm_cli.inputs.excitation.GroundMotion; its form's
+    numbers as rbm_cli.inputs.ground and inputs.ground read them)."""
 
     kind: int  #: KIND_CODES
     amplitude: float  #: peak |a_g| [m/s^2]
@@ -50,7 +50,7 @@ class Excitation(NamedTuple):
     phase: float  #: [rad]
     pulse_end: float  #: end of a pulse or record [s]
     t_end: float  #: end of the run [s]
-    form: int  #: physics.ground: SINE, RICKER, MP or SAMPLED
+    form: int  #: inputs.ground: SINE, RICKER, MP or SAMPLED
     gain: float  #: multiplier of the form [m/s^2]
     center: float  #: centre of a Ricker or MP pulse [s]
     gamma: float  #: MP's gamma [-]
@@ -124,7 +124,7 @@ def prepare_kernel(model: Model) -> PreparedModel:
 
     Parameters
     ----------
-    model : Model  The column's equations (rbm_cli.physics.equations).
+    model : Model  The column's equations (rbm_cli.structures.equations).
 
     Returns
     -------

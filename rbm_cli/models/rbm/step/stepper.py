@@ -46,8 +46,8 @@ from rbm_cli.numerics.loop import loop_for, loop_into
 from rbm_cli.numerics.quadrature import GL_NODES, GL_WEIGHTS
 from rbm_cli.numerics.records import new_record
 from rbm_cli.numerics.rk import TAB_EST, dense_eval, emit, emit_rest, steps_for
-from rbm_cli.physics.arrays import ColumnArrays, column_into
-from rbm_cli.physics.ground import (
+from rbm_cli.structures.arrays import ColumnArrays, column_into
+from rbm_cli.inputs.ground import (
     gravity_factor,
     ground,
     ground_at,
@@ -56,9 +56,9 @@ from rbm_cli.physics.ground import (
     rest_demand,
     rest_shear,
 )
-from rbm_cli.physics.rates import acc_of, rhs
+from rbm_cli.structures.rates import acc_of, rhs
 
-#: The planar column's Runge-Kutta steps on its right-hand side (physics.rates.rhs).
+#: The planar column's Runge-Kutta steps on its right-hand side (structures.rates.rhs).
 initial_step, attempt_step, dense_prepare = steps_for("plane", rhs)
 
 
@@ -93,7 +93,7 @@ def rest_until(t, seg_end, last, uplift_level, amplitude, gr_full, knots, values
                friction, held, rx, ry, slip, mu, record, samples, n_out, next_out, output_dt,
                y, side, k):  # fmt: skip
     """A rigid monolith at rest from t [s] in a forced segment (to seg_end [s]): its friction
-    demand at rest (physics.ground.rest_demand, exact; the held demand's samples; where it
+    demand at rest (inputs.ground.rest_demand, exact; the held demand's samples; where it
     first exceeds mu), its samples, and where it lifts (no later than last [s]).
 
     Returns
@@ -202,7 +202,7 @@ def run_kernel(model, motion, solver, task):
 
     Parameters
     ----------
-    model : tuple  A physics.arrays.ColumnArrays (step.inputs.prepare_kernel).
+    model : tuple  A structures.arrays.ColumnArrays (step.inputs.prepare_kernel).
     motion : tuple  A step.inputs.Excitation: the ground motion.
     solver : tuple  A step.inputs.SolverSettings: method, tolerances, budgets, deadline.
     task : tuple  A step.inputs.RunTask: initial state, early stop, samples (in place).
@@ -210,11 +210,11 @@ def run_kernel(model, motion, solver, task):
     Returns
     -------
     RunEnd  (numerics.loop; azimuth nan and swept empty). friction: the largest |T_i / N_i|
-        of each interface [-] (its peak), at rest (physics.ground.rest_demand, exact) and at
+        of each interface [-] (its peak), at rest (inputs.ground.rest_demand, exact) and at
         step ends in motion (the held demand's samples between them, on the step's
         interpolant, go to task.held only, changed in place: pieces.held_push); slip: where
         the peak first exceeded task.friction_limit, (t [s], interface from 1), (nan, 0) if
-        not: at rest the exceedance time itself (physics.ground.next_uplift at the limit), in
+        not: at rest the exceedance time itself (inputs.ground.next_uplift at the limit), in
         motion the end of the first step whose demand exceeds it. ledger: the energy account
         of a recorded run without a vertical record [J] (zeros otherwise): the energy at the
         start and at the end (pieces.energy), the ground's work, the energy the joints'

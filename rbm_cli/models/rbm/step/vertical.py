@@ -23,7 +23,7 @@ from __future__ import annotations
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
-from rbm_cli.physics.ground import gravity_factor
+from rbm_cli.inputs.ground import gravity_factor
 
 
 @jit(inline=True)
@@ -37,7 +37,7 @@ def _m(gam, w):
 
 @jit(inline=True)
 def _gam_rate(gr):
-    """d gam / dt [1/s] on the record's straight piece gr (rbm_cli.physics.ground)."""
+    """d gam / dt [1/s] on the record's straight piece gr (rbm_cli.inputs.ground)."""
     if gr[6] == 0.0:
         return 0.0
     return gr[8] / (gr[5] * G)

@@ -6,7 +6,7 @@ from __future__ import annotations
 from rbm_cli.models.rbm.step.inputs import MOTION_FIELDS
 from rbm_cli.numerics.loop import LOOP_FIELDS
 from rbm_cli.numerics.records import record_kind
-from rbm_cli.physics.arrays import COLUMN_FIELDS
+from rbm_cli.structures.arrays import COLUMN_FIELDS
 
 #: The planar column's work in a run (step.stepper.run_kernel): its pieces (each joint's side
 #: and piece, an excursion pending its impact, a silent impact awaited: Model.silent_impacts),
@@ -40,6 +40,6 @@ PLANE_WORK_FIELDS = [
     ("any_silent", "bool"),
 ]  # fmt: skip
 
-#: The planar column's run record: the column (physics.arrays.ColumnArrays), what its
+#: The planar column's run record: the column (structures.arrays.ColumnArrays), what its
 #: functions read of the motion, the loop's arrays and the run's figures, and its work.
 PLANE = record_kind(COLUMN_FIELDS + MOTION_FIELDS + LOOP_FIELDS + PLANE_WORK_FIELDS)

@@ -29,7 +29,7 @@ import math
 import numpy as np
 
 from rbm_cli.config.types import G
-from rbm_cli.physics.column import Column
+from rbm_cli.structures.column import Column
 
 
 def _map_scalar(func, values):
@@ -223,7 +223,7 @@ def linear_rocking_parameters(column: Column) -> tuple[float, float]:
 
     Parameters
     ----------
-    column : rbm_cli.physics.column.Column
+    column : rbm_cli.structures.column.Column
         A monolithic column (n = 1)
 
     Returns
@@ -275,7 +275,7 @@ def halfsine_threshold_curves(column: Column, frequencies_hz) -> dict[str, np.nd
 
     Parameters
     ----------
-    column : rbm_cli.physics.column.Column
+    column : rbm_cli.structures.column.Column
         A monolithic column (n = 1)
     frequencies_hz : array_like
         Pulse frequencies f [Hz] (a_g = A g sin(2 pi f t), 0 <= t <= 1 / (2 f))

@@ -1,6 +1,6 @@
 """The ground acceleration a_g(t) [m/s^2] as every integrator evaluates it (numba).
 
-A :class:`~rbm_cli.physics.motion.GroundMotion` is one of four forms, each a formula of
+A :class:`~rbm_cli.inputs.motion.GroundMotion` is one of four forms, each a formula of
 time with a few numbers (``gain`` [m/s^2], ``omega`` [rad/s], ``phase`` [rad], ``center``
 [s], ``gamma`` [-]) or a table of samples:
 
@@ -40,7 +40,7 @@ from rbm_cli.base.detmath import exp as dexp
 from rbm_cli.base.detmath import sin as dsin
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
-from rbm_cli.physics.pulses import mp_shape
+from rbm_cli.inputs.pulses import mp_shape
 
 SINE, RICKER, MP, SAMPLED = 0, 1, 2, 3
 
@@ -102,7 +102,7 @@ def ground(t, gr):
 @jit(inline=True)
 def shape_at(t, form, amp, om, ph, c, gamma):
     """a(t) [m/s^2] of a form's formula (SINE, RICKER, MP, or a record's straight piece,
-    LINE), its numbers given one by one (a pair's second component, physics.beam3d)."""
+    LINE), its numbers given one by one (a pair's second component, structures.column3d)."""
     if form == SINE:
         return amp * dsin(om * t + ph)
     return _ground_other(t, form, amp, om, ph, c, gamma)

@@ -57,7 +57,7 @@ import numpy as np
 from numpy.polynomial import Polynomial
 
 from rbm_cli.config.types import ColumnConfig, G
-from rbm_cli.physics.block import BlockGeometry, block_geometry
+from rbm_cli.structures.block import BlockGeometry, block_geometry
 
 #: Number of state components: q (2), w (3), the centre in plan (2).
 STATE_SIZE = 7
@@ -99,7 +99,7 @@ def cylinder_geometry(column: ColumnConfig) -> CylinderGeometry:
     -----
     With w(z) the diameter at height z and rho the density, exactly (polynomial
     integrals): I_a = rho int pi w^4 / 32 dz, and I_t = I_O - m |r|^2 from the planar
-    block's rotary inertia I_O about the rim's tangent (rbm_cli.physics.block).
+    block's rotary inertia I_O about the rim's tangent (rbm_cli.structures.block).
     """
     if column.section != "circular":
         raise ValueError("cylinder_geometry: a circular section only")

@@ -6,7 +6,7 @@ filter *at t_i*; the sum is normalised to unit variance (:func:`unit_process`) a
 multiplied by a gamma-shaped modulating function (:func:`modulating_function`); a
 critically damped high-pass oscillator (:func:`highpass`) then makes the residual
 velocity and displacement vanish. The seeded record suite built on it is
-:mod:`rbm_cli.physics.synthetic`.
+:mod:`rbm_cli.inputs.synthetic`.
 
 Bit for bit: the arithmetic is IEEE additions, multiplications, divisions and square roots
 applied elementwise (no matrix products, no BLAS, no reductions whose order a CPU could

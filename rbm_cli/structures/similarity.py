@@ -12,12 +12,12 @@ column sits at a larger omega / p and needs a larger amplitude to overturn.
 The scales are those of the column taken as one rigid body (its drums glued), the
 column's own first scales however many drums it has:
 
-- ``rbm``: the RBM's rigid monolith (rbm_cli.physics.closed_forms.linear_rocking_parameters:
+- ``rbm``: the RBM's rigid monolith (rbm_cli.structures.closed_forms.linear_rocking_parameters:
   tan alpha = theta_u,1, p^2 = m g (H / 2) / (I_G + m H^2 / 4)); with a capital, the shaft
   and the capital as one rigid stack: tan alpha = theta_u,1, p^2 = N_1 zbar_1 / (1^T M 1)
-  (rbm_cli.physics.equations.Model.rocking_p);
+  (rbm_cli.structures.equations.Model.rocking_p);
 - ``housner``, ``housner-linear``, ``bullet`` (true geometry, rigid blocks): the block's
-  tan alpha = b / z_c and p^2 = m g R / I_O (rbm_cli.physics.block.block_geometry).
+  tan alpha = b / z_c and p^2 = m g R / I_O (rbm_cli.structures.block.block_geometry).
 
 The static multiplier is the uniform horizontal acceleration [g] that starts the column
 rocking: min over the interfaces of theta_u,i for the RBM (the weakest stack), tan alpha
@@ -31,10 +31,10 @@ import math
 from dataclasses import dataclass
 
 from rbm_cli.config.types import MODELS, Config, InterfaceConfig, StiffnessConfig
-from rbm_cli.physics.block import block_geometry
-from rbm_cli.physics.closed_forms import linear_rocking_parameters
-from rbm_cli.physics.column import build_column
-from rbm_cli.physics.equations import build_model
+from rbm_cli.structures.block import block_geometry
+from rbm_cli.structures.closed_forms import linear_rocking_parameters
+from rbm_cli.structures.column import build_column
+from rbm_cli.structures.equations import build_model
 
 
 @dataclass(frozen=True)

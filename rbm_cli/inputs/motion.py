@@ -1,10 +1,10 @@
 """The ground motion every model integrates, SI inside: a_g [m/s^2], t [s].
 
 A :class:`GroundMotion` is a horizontal ground acceleration a_g(t) in one of the forms of
-:mod:`rbm_cli.physics.ground` (a sine, a Ricker or Mavroeidis-Papageorgiou pulse, or
+:mod:`rbm_cli.inputs.ground` (a sine, a Ricker or Mavroeidis-Papageorgiou pulse, or
 a sampled record, linear between its samples, with its upward acceleration a_v(t) if any),
 its segments (the intervals on which a_g is continuous: an integrator restarts between
-them), where the pulse or record ends and the run ends. :mod:`rbm_cli.physics.excitation`
+them), where the pulse or record ends and the run ends. :mod:`rbm_cli.inputs.excitation`
 makes one from a config (``make_ground_motion``).
 """
 
@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 
 from rbm_cli.config.types import PULSES, G
-from rbm_cli.physics.ground import (
+from rbm_cli.inputs.ground import (
     FORM_OF_KIND,
     MP,
     RICKER,
@@ -31,7 +31,7 @@ from rbm_cli.physics.ground import (
     sampled_displacement,
     vertical_factor,
 )
-from rbm_cli.physics.pulses import mavroeidis_papageorgiou, ricker_wavelet
+from rbm_cli.inputs.pulses import mavroeidis_papageorgiou, ricker_wavelet
 
 #: Kinds whose motion ends (pulse_end) before the run may: free motion follows.
 PULSE_KINDS = ("half-sine", *PULSES, "record")
@@ -53,7 +53,7 @@ class GroundMotion:
         acceleration is a cosine; nu for Mavroeidis-Papageorgiou)
     pulse_end : float  Time after which a_g = 0 [s] (the harmonic: its duration)
     t_end : float  Maximum simulated time [s]
-    gain : float or None  Multiplier of the form (physics.ground) [m/s^2]; None: amplitude
+    gain : float or None  Multiplier of the form (inputs.ground) [m/s^2]; None: amplitude
         (a sine or Ricker pulse); amplitude / peak of the unit shape (MP); 1 (a record,
         whose values are in m/s^2)
     center : float  Centre t0 of a Ricker or MP pulse [s]
@@ -127,7 +127,7 @@ class GroundMotion:
     @property
     def ground_y(self) -> tuple:
         """The second component's ground tuple as the compiled functions read it
-        (physics.ground; a record pair's says SAMPLED, its values being values_y; gain 0
+        (inputs.ground; a record pair's says SAMPLED, its values being values_y; gain 0
         for a motion of one component)."""
         if self.second is not None:
             return self.second._ground
@@ -203,7 +203,7 @@ class GroundMotion:
     def next_pair_exceedance(self, t0: float, ratio: float, t_stop: float) -> float | None:
         """A pair: the first time t in [t0, t_stop) where the horizontal acceleration's
         magnitude exceeds ratio (g + a_v(t)) [m/s^2] (ratio = tan(alpha) for a block's
-        uplift), or None (physics.ground.pair_uplift: exact on each sample interval of a
+        uplift), or None (inputs.ground.pair_uplift: exact on each sample interval of a
         record pair; two sines in closed form; other formulas to the last bit)."""
         knots, values, vertical = self._samples
         last = min(self.pulse_end, self.t_end, t_stop)
@@ -214,7 +214,7 @@ class GroundMotion:
 
     @property
     def form(self) -> int:
-        """The form of a_g (physics.ground: SINE, RICKER, MP or SAMPLED)."""
+        """The form of a_g (inputs.ground: SINE, RICKER, MP or SAMPLED)."""
         return FORM_OF_KIND[self.kind]
 
     @property
@@ -283,8 +283,8 @@ class GroundMotion:
 
     def accel(self, t: float | np.ndarray) -> np.ndarray | float:
         """Ground acceleration a_g(t) [m/s^2] (0 after the pulse), vectorised: a Ricker or
-        MP pulse by physics/pulses.py (the integrators evaluate the same formula,
-        physics.ground.ground_at, to round-off)."""
+        MP pulse by inputs/pulses.py (the integrators evaluate the same formula,
+        inputs.ground.ground_at, to round-off)."""
         if self.amplitude == 0.0:
             return np.zeros_like(t) if isinstance(t, np.ndarray) else 0.0
         tt = np.asarray(t, dtype=float)
@@ -353,7 +353,7 @@ class GroundMotion:
     def next_exceedance(self, t0: float, level: float) -> float | None:
         """First time t >= t0 with |a_g(t)| > level [m/s^2], or None before the end of
         the pulse or run: the compiled search the integrators share
-        (physics.ground.next_uplift: exact for the sine, exact on the monotone pieces of
+        (inputs.ground.next_uplift: exact for the sine, exact on the monotone pieces of
         the other forms; with a vertical record the level is level (g + a_v(t)) / g). The
         time returned is where |a_g| = level and rising (t0 itself when already above)."""
         if self.amplitude <= level and self.vertical is None and self.second is None:
@@ -369,7 +369,7 @@ class GroundMotion:
 
     @cached_property
     def _ground(self) -> tuple:
-        """The motion's ground tuple, as the compiled functions read it (physics.ground)."""
+        """The motion's ground tuple, as the compiled functions read it (inputs.ground)."""
         return (int(self.form), float(self.shape_gain), float(self.omega), float(self.phase),
                 float(self.center), float(self.gamma), 0.0, 0.0, 0.0)  # fmt: skip
 

@@ -2,7 +2,7 @@
 
 Every pulse starts at t = 0, lasts its ``*_duration`` [s] and is 0 outside; SI units: the
 acceleration amplitude in [m/s^2], the frequency in [Hz] (the period is T_p = 1 / f_p).
-Positive acceleration is ground acceleration in +x (as the records, :mod:`rbm_cli.physics.records`).
+Positive acceleration is ground acceleration in +x (as the records, :mod:`rbm_cli.inputs.records`).
 
 - one-sine (Zhang and Makris's cycloidal type A): A sin(w t), 0 <= t <= T_p; peak A at T_p/4
 - cycloidal type B (one-cosine): A cos(w t), 0 <= t <= T_p; peak |A| at 0, T_p/2 and T_p

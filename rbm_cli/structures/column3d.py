@@ -14,7 +14,7 @@ for `absolute`, in each direction), along that vector:
 
     m_i = -f(|phi_i|) phi_i / |phi_i|        (the moment restoring the joint),
 
-and with it, per direction d = x, y (as the planar equations, rbm_cli.physics.equations),
+and with it, per direction d = x, y (as the planar equations, rbm_cli.structures.equations),
 
     M theta_d'' = D^T m_d + gam K_g theta_d - r a_d(t) - D^T (c phi_d')  (elastic joints),
 
@@ -31,7 +31,7 @@ direction c (the side the joint rocks onto), as a base flat to that side, and m 
 the rotation, solver.atol theta_u).
 
 The equations are compiled (numba) as the planar kernel's are, into the same slots of its
-right-hand side (rbm_cli.physics.rates.rhs: a state of 4n values is this model's):
+right-hand side (rbm_cli.structures.rates.rhs: a state of 4n values is this model's):
 
 - ``As`` (n, 3n): [M^-1 D^T | M^-1 K_g | the argument map];
 - ``cs`` (9n): per joint, the piece it is on: intercept, weight slope, elastic slope, its
@@ -42,7 +42,7 @@ right-hand side (rbm_cli.physics.rates.rhs: a state of 4n values is this model's
   horizontal component (flag, gain, omega, phase, centre, gamma: a record pair's straight
   piece, a_{k+1} - a_k, a_k, t_k, t_{k+1} - t_k, or an analytic component's formula; flag
   0 for one component), then 1.0 if K_g is not zero, then the second component's form
-  (physics.ground: LINE for a record pair's piece, or SINE, RICKER, MP).
+  (inputs.ground: LINE for a record pair's piece, or SINE, RICKER, MP).
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ from __future__ import annotations
 import math
 
 from rbm_cli.base.jit import jit
-from rbm_cli.physics.ground import LINE, gravity_factor, ground, shape_at
+from rbm_cli.inputs.ground import LINE, gravity_factor, ground, shape_at
 
 #: Entries of ``es`` after the n loads: the direction, the second component's piece or
 #: formula, whether gravity's term K_g is there (`geometric`), and the second component's

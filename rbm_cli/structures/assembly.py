@@ -1,5 +1,5 @@
 """The model of a config, assembled once and checked before any run: the column's
-equations (rbm_cli.physics.equations.Model, with the restitution rule resolved) and the
+equations (rbm_cli.structures.equations.Model, with the restitution rule resolved) and the
 one limit a ground motion sets on them (the time a vertical record changes the order of a
 law's pieces). Every integrator of the Rigid Beam Model takes the Model built here."""
 
@@ -11,10 +11,10 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config, G
-from rbm_cli.physics.column import Column, build_column
-from rbm_cli.physics.equations import Model, build_model
-from rbm_cli.physics.excitation import GroundMotion
-from rbm_cli.physics.restitution import column_restitution, resolve
+from rbm_cli.structures.column import Column, build_column
+from rbm_cli.structures.equations import Model, build_model
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.structures.restitution import column_restitution, resolve
 
 #: Why a run stops where g + a_v(t) changes the order of a law's pieces (shape_change).
 SHAPE_CHANGE = (

@@ -30,8 +30,8 @@ from functools import cached_property
 import numpy as np
 
 from rbm_cli.base.detmath import inverse, product
-from rbm_cli.physics.column import Column
-from rbm_cli.physics.law import Law, make_law
+from rbm_cli.structures.column import Column
+from rbm_cli.structures.law import Law, make_law
 
 #: Significant digits of the first elastic frequency where it sets the joints' damping. The
 #: eigenvalue solver (LAPACK) rounds its last bits as the processor's kernels do, so the
@@ -312,7 +312,7 @@ def build_model(
 
     Parameters
     ----------
-    column : Column  Derived properties (rbm_cli.physics.column.build_column)
+    column : Column  Derived properties (rbm_cli.structures.column.build_column)
     xi : float  Smoothing parameter of the law, 0 < xi <= 1
     restitution : float  e in (0, 1]
     formulation : str  'relative', 'absolute' or 'geometric' (docs/guide/assumptions.md)

@@ -2,12 +2,12 @@
 Kiureghian (2010), reproducible bit for bit from its seed on any machine.
 
 The model (RDK 2008, 2010; modulated, filtered white noise with a time-varying filter, then
-high-passed) is :mod:`rbm_cli.physics.rdk_model`; its names are re-exported here. The suite
+high-passed) is :mod:`rbm_cli.inputs.rdk_model`; its names are re-exported here. The suite
 draws each record's parameters from stated ranges (:data:`PARAMETER_RANGES`; these are our
 choice, a moderate shallow crustal earthquake on firm ground, not RDK's regression on
 magnitude and distance) and scales each record to a drawn peak ground acceleration.
 
-Bit for bit: the model's arithmetic is portable (see :mod:`rbm_cli.physics.rdk_model`), the
+Bit for bit: the model's arithmetic is portable (see :mod:`rbm_cli.inputs.rdk_model`), the
 normal draws come from :mod:`rbm_cli.base.portable_math`, and each record has its own
 generator spawned from the seed, so the suite is the same bytes on every machine.
 
@@ -29,7 +29,7 @@ import numpy as np
 
 from rbm_cli.base import portable_math as pm
 from rbm_cli.base.errors import RbmError
-from rbm_cli.physics.rdk_model import (
+from rbm_cli.inputs.rdk_model import (
     FLOOR_HZ,
     HIGHPASS_HZ,
     RDKParameters,
@@ -40,7 +40,7 @@ from rbm_cli.physics.rdk_model import (
     modulating_parameters,
     unit_process,
 )
-from rbm_cli.physics.records import G, Record, write_at2
+from rbm_cli.inputs.records import G, Record, write_at2
 
 #: Seed of the shipped suite (``configs/records/synthetic/``).
 SEED = 17
@@ -178,10 +178,10 @@ def write_suite(
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m rbm_cli.physics.synthetic FOLDER [N [SEED]]``: write the suite into FOLDER."""
+    """``python -m rbm_cli.inputs.synthetic FOLDER [N [SEED]]``: write the suite into FOLDER."""
     args = sys.argv[1:] if argv is None else argv
     if not 1 <= len(args) <= 3:
-        print("usage: python -m rbm_cli.physics.synthetic FOLDER [N [SEED]]", file=sys.stderr)
+        print("usage: python -m rbm_cli.inputs.synthetic FOLDER [N [SEED]]", file=sys.stderr)
         return 2
     n = int(args[1]) if len(args) > 1 else SUITE_SIZE
     seed = int(args[2]) if len(args) > 2 else SEED

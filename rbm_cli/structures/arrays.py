@@ -1,8 +1,8 @@
 """A column's equations as the compiled integrators read them: one record of arrays and
 numbers (:class:`ColumnArrays`), assembled once per column by :func:`column_arrays` and taken
 by the step integrator (rbm_cli.models.rbm.step) and the exact one (rbm_cli.models.rbm.exact)
-alike: the matrices, the laws' pieces (physics.law.law_arrays), the rows of the quantities a
-run watches (physics.equations.event_families) and the levels of the early stop and of a
+alike: the matrices, the laws' pieces (structures.law.law_arrays), the rows of the quantities a
+run watches (structures.equations.event_families) and the levels of the early stop and of a
 rigid block's rest (:func:`rest_levels`).
 
 numba reads the fields of a named tuple of arrays and scalars at no cost; n interfaces, SI
@@ -19,8 +19,8 @@ import numpy as np
 from rbm_cli.base.detmath import matmul, matvec
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
-from rbm_cli.physics.equations import Model, event_families
-from rbm_cli.physics.law import law_arrays
+from rbm_cli.structures.equations import Model, event_families
+from rbm_cli.structures.law import law_arrays
 
 #: A rigid block whose post-impact rate is below REST_RATE * p * theta_u is
 #: put to rest [assumption]: its next excursion would stay below

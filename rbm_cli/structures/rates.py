@@ -5,7 +5,7 @@ e a_g + A theta, with the joints' damping and a vertical record's factor."""
 from __future__ import annotations
 
 from rbm_cli.base.jit import jit
-from rbm_cli.physics.ground import gravity_factor, ground
+from rbm_cli.inputs.ground import gravity_factor, ground
 
 
 @jit(inline=True)

@@ -1,9 +1,9 @@
 """Ground motions of a config, SI inside: a_g [m/s^2], t [s], omega [rad/s].
 
 :func:`make_ground_motion` turns a config's excitation, an amplitude [g] and a frequency
-[Hz] (the grid's, at this edge only) into the :class:`~rbm_cli.physics.motion.GroundMotion`
-every model integrates: a harmonic, a half-sine or near-fault pulse (physics/pulses.py),
-or a record read from its file (physics/records.py) or given as arrays
+[Hz] (the grid's, at this edge only) into the :class:`~rbm_cli.inputs.motion.GroundMotion`
+every model integrates: a harmonic, a half-sine or near-fault pulse (inputs/pulses.py),
+or a record read from its file (inputs/records.py) or given as arrays
 (rbm_cli.config.motions.Motion), with its vertical record if any, both processed as
 ``excitation.processing`` says before they are scaled; a harmonic or a pulse with its
 analytic second horizontal component (``excitation.y``: :func:`second_component`).
@@ -21,15 +21,15 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import PULSES, ExcitationConfig, G, ProcessingConfig
-from rbm_cli.physics.ground import MP, RICKER, SINE, mp_knots, ricker_knots
-from rbm_cli.physics.motion import PULSE_KINDS, SAMPLES_PER_PERIOD, GroundMotion
-from rbm_cli.physics.pulses import (
+from rbm_cli.inputs.ground import MP, RICKER, SINE, mp_knots, ricker_knots
+from rbm_cli.inputs.motion import PULSE_KINDS, SAMPLES_PER_PERIOD, GroundMotion
+from rbm_cli.inputs.pulses import (
     mavroeidis_papageorgiou_duration,
     mp_peak,
     one_sine_duration,
     ricker_duration,
 )
-from rbm_cli.physics.records import Record, read_record
+from rbm_cli.inputs.records import Record, read_record
 
 __all__ = [
     "PULSE_KINDS",
@@ -76,7 +76,7 @@ def processed_record(
     path: str, units: str, sha256: str | None, processing: ProcessingConfig | None
 ) -> Record:
     """The record of a config's file (:func:`load_record`) processed as ``processing``
-    says (:meth:`~rbm_cli.physics.records.Record.processed`), once per process."""
+    says (:meth:`~rbm_cli.inputs.records.Record.processed`), once per process."""
     return load_record(path, units, sha256).processed(processing)
 
 
@@ -238,7 +238,7 @@ def merge_records(
 
 def pulse_motion(excitation: ExcitationConfig, amplitude: float, frequency_hz: float):
     """A near-fault pulse of peak acceleration amplitude [m/s^2] and frequency f_p [Hz]
-    (physics/pulses.py), then free motion up to excitation.duration [s] (the whole pulse
+    (inputs/pulses.py), then free motion up to excitation.duration [s] (the whole pulse
     is always simulated):
 
     - one-sine: A sin(w t) on [0, 1/f_p] (Zhang and Makris's cycloidal type A);

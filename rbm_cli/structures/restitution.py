@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from rbm_cli.physics.block import BlockGeometry
-from rbm_cli.physics.column import Column
+from rbm_cli.structures.block import BlockGeometry
+from rbm_cli.structures.column import Column
 
 
 def housner_coefficient(mass: float, lever: float, corner_inertia: float) -> float:

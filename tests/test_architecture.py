@@ -1,7 +1,7 @@
 """The structure of rbm_cli keeps its rule (docs/architecture.md): imports only go down the
-levels base -> config -> physics -> numerics -> models -> study -> report -> api -> cli, no
-two modules import each other round a circle, and the CLI stands on the API alone (it imports
-no other module of the package). Imports inside functions count: a lazy import up a level is
+levels base -> config -> inputs -> numerics -> structures -> models -> study -> report -> api ->
+cli, no two modules import each other round a circle, and the CLI stands on the API alone (it
+imports no other module of the package). Imports inside functions count: a lazy import up a level is
 still an import up a level. Modules are split where their meaning splits, not by a count of
 lines: no size is checked here."""
 
@@ -11,8 +11,8 @@ import ast
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "rbm_cli"
-LEVELS = {"base": 0, "config": 1, "physics": 2, "numerics": 3, "models": 4, "study": 5,
-          "report": 6, "api": 7, "cli": 8, "__main__": 9}  # fmt: skip
+LEVELS = {"base": 0, "config": 1, "inputs": 2, "numerics": 3, "structures": 4, "models": 5,
+          "study": 6, "report": 7, "api": 8, "cli": 9, "__main__": 10}  # fmt: skip
 
 
 def modules() -> dict[str, Path]:
@@ -99,9 +99,9 @@ def test_the_check_sees_an_upward_import(tmp_path):
     """The checker itself finds a lazy import up a level (so the tests above can fail)."""
     path = tmp_path / "x.py"
     path.write_text("def f():\n    from rbm_cli.report.plots import plot_shapes\n")
-    found = imports(path, "rbm_cli.physics.x", set(modules()))
+    found = imports(path, "rbm_cli.structures.x", set(modules()))
     assert "rbm_cli.report.plots" in found and level("rbm_cli.report.plots") > level(
-        "rbm_cli.physics.x"
+        "rbm_cli.structures.x"
     )
 
 
@@ -181,13 +181,13 @@ def test_no_new_private_import_across_modules():
 
 def test_the_check_sees_a_private_import(tmp_path, monkeypatch):
     """The checker itself finds `from rbm_cli.x import _y` in another module."""
-    path = tmp_path / "rbm_cli" / "physics" / "x.py"
+    path = tmp_path / "rbm_cli" / "structures" / "x.py"
     path.parent.mkdir(parents=True)
     path.write_text("from rbm_cli.base.files import _fsync\nfrom .law import _piece\n")
-    monkeypatch.setattr("tests.test_architecture.modules", lambda: {"rbm_cli.physics.x": path})
+    monkeypatch.setattr("tests.test_architecture.modules", lambda: {"rbm_cli.structures.x": path})
     assert private_imports() == {
-        ("rbm_cli.physics.x", "rbm_cli.base.files", "_fsync"),
-        ("rbm_cli.physics.x", "rbm_cli.structures.law", "_piece"),
+        ("rbm_cli.structures.x", "rbm_cli.base.files", "_fsync"),
+        ("rbm_cli.structures.x", "rbm_cli.structures.law", "_piece"),
     }
 
 

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from rbm_cli.config.load import load_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.structures.closed_forms import linear_rocking_parameters
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.bench_baseline import baseline_run
 from rbm_cli.study.simulate import model_from_config
 

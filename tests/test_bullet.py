@@ -21,6 +21,7 @@ from click.testing import CliRunner
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.run import (
@@ -38,7 +39,6 @@ from rbm_cli.models.bullet.scene import (
     read_frame,
 )
 from rbm_cli.structures.block import block_geometry
-from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.structures.restitution import block_restitution
 from rbm_cli.study.simulate import simulate
 

@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
+from rbm_cli.inputs.records import read_record
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.scene import (
     Frame,
@@ -40,7 +41,6 @@ from rbm_cli.models.bullet.space import (
     joint_state_3d,
     normals,
 )
-from rbm_cli.inputs.records import read_record
 from rbm_cli.study.cells import domain_fields
 from rbm_cli.study.result import THREE_D_FIELDS
 from rbm_cli.study.simulate import simulate

@@ -21,6 +21,7 @@ import pytest
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.bullet.convergence import (
     ensemble_agreement,
     outcome_marks,
@@ -32,7 +33,6 @@ from rbm_cli.models.bullet.impact import engine_restitution, measure_restitution
 from rbm_cli.models.bullet.normals import NormalCensus
 from rbm_cli.models.bullet.run import bullet_run
 from rbm_cli.models.bullet.settings import EngineSettings, settings_from_config
-from rbm_cli.inputs.excitation import GroundMotion
 from tests.paths import tool_script
 
 BLOCK = {"height": 4.0, "base_width": 1.0, "depth": 1.0}

@@ -35,10 +35,10 @@ import pytest
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import load_config, parse_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.registry import make_runner
 from rbm_cli.structures.closed_forms import free_rocking_period, linear_rocking_parameters
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 
 from .paths import CONFIGS
@@ -348,8 +348,8 @@ def test_compiled_and_uncompiled_give_the_same_bits(tmp_path):
     RBM monolith (explicit closed-form, harmonic and record), a housner-linear block and a
     housner-linear block under a vertical record (gam per piece); the event log too."""
     from rbm_cli.config.types import G
-    from rbm_cli.models.block.closed_form import linear_run
     from rbm_cli.inputs.records import write_csv
+    from rbm_cli.models.block.closed_form import linear_run
 
     t = np.linspace(0.0, 4.0, 401)  # a_g = A g sin(2 pi t), a_v = 0.4 A g sin(6 pi t + 0.3)
     h = write_csv(tmp_path / "h.csv", (t, G * np.sin(2 * np.pi * t)), units="g")

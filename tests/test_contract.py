@@ -21,10 +21,10 @@ import pytest
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config import parse_config
 from rbm_cli.config.types import MODELS
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.contract import Runner
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.registry import make_runner, model_names, runner_class
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 
 

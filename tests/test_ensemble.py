@@ -15,9 +15,9 @@ from rbm_cli.api import run_sweep
 from rbm_cli.cli.main import cli
 from rbm_cli.config.load import load_config
 from rbm_cli.config.types import GridConfig
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.structures.closed_forms import linear_rocking_parameters
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.domain import read_domain
 from rbm_cli.study.robustness import LARGEST, RULE, SMALLEST, member_config, members, tight_rtol
 from rbm_cli.study.simulate import model_from_config, simulate

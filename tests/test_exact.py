@@ -32,6 +32,7 @@ from scipy.integrate import solve_ivp
 from rbm_cli.base.errors import RbmError
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.config.load import load_config
+from rbm_cli.inputs.excitation import GroundMotion, make_ground_motion
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.rbm.exact.bounds import FULL, THIRD, empty_bounds, row_lower, track_upper
 from rbm_cli.models.rbm.exact.integrate import integrate_exact
@@ -46,7 +47,6 @@ from rbm_cli.structures.closed_forms import (
     linear_halfsine_threshold,
     linear_rocking_parameters,
 )
-from rbm_cli.inputs.excitation import GroundMotion, make_ground_motion
 from rbm_cli.study.simulate import model_from_config, simulate
 
 from .exact_forcing import Forcing, forcing_array

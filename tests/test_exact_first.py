@@ -18,9 +18,9 @@ import pytest
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import parse_config
+from rbm_cli.inputs.records import write_csv
 from rbm_cli.models.methods import resolve_method
 from rbm_cli.models.registry import make_runner
-from rbm_cli.inputs.records import write_csv
 from rbm_cli.study.simulate import simulate
 
 COLUMN = {"height": 3.0, "base_width": 0.6, "top_width": 0.45, "drums": 3}

@@ -26,8 +26,8 @@ import pytest
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.registry import make_runner
 from rbm_cli.inputs.records import Record, write_at2
+from rbm_cli.models.registry import make_runner
 from rbm_cli.study.simulate import simulate
 
 from .paths import CONFIGS
@@ -181,8 +181,8 @@ def test_the_record_arrays_are_the_record_segments():
     """The arrays of a record (record_arrays, vectorised) and its segments as Forcing
     objects, one per interval, are the same, a jump (a time written twice) and rest before
     the first sample included."""
-    from rbm_cli.models.rbm.forcing_arrays import record_arrays
     from rbm_cli.inputs.motion import GroundMotion
+    from rbm_cli.models.rbm.forcing_arrays import record_arrays
 
     from .exact_forcing import segment_arrays as _segments
 

@@ -138,8 +138,10 @@ def test_a_compile_in_another_process_is_waited_for_not_repeated(
         assert notes == [waiting]
         assert what == "waiting for the fake code to compile"
     else:
-        assert notes == [waiting,
-                         "compiling the fake code (first use only, about 7 s on an idle machine)"]
+        assert notes == [
+            waiting,
+            "compiling the fake code (first use only, about 7 s on an idle machine)",
+        ]
         assert what == "compiling the fake code"
     assert seconds > 0.0
     # the lock is free again: a compile now starts at once

@@ -20,8 +20,8 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import rbm  # noqa: E402
-from rbm_cli.structures.column import build_column  # noqa: E402
 from rbm_cli.report.run_figures import history_figure  # noqa: E402
+from rbm_cli.structures.column import build_column  # noqa: E402
 
 from .paths import CONFIGS  # noqa: E402
 

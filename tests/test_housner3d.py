@@ -27,13 +27,13 @@ from scipy.integrate import solve_ivp
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config import parse_config
 from rbm_cli.config.types import G
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.structures.cylinder import (
     cylinder_energy,
     cylinder_geometry,
     rolling_rates,
     tilt,
 )
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.simulate import simulate
 from rbm_cli.study.sweep import config_hash
 
@@ -204,8 +204,8 @@ def test_a_wobble_counts_its_turns_and_a_planar_motion_none(geo):
     reports a peak tilt of theta, no impact, and 3 turns of its lean; a planar rocking run
     (impacts and all) sweeps no angle but round-off's (a lean 2e-6 sin(alpha) from the
     vertical points within 1e-16 / 2e-6 rad of the motion's plane)."""
-    from rbm_cli.models.housner3d.runner import cylinder_run
     from rbm_cli.inputs.motion import GroundMotion
+    from rbm_cli.models.housner3d.runner import cylinder_run
 
     theta = 0.1
     m, rad, h = geo.mass, geo.radius, geo.centre_height

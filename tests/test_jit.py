@@ -19,8 +19,8 @@ import pytest
 
 from rbm_cli.base.jit import is_compiled, jit, plain
 from rbm_cli.config.load import load_config
-from rbm_cli.models.rbm.step import integrate
 from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.models.rbm.step import integrate
 from rbm_cli.study.simulate import model_from_config
 
 from .paths import CONFIGS

@@ -1,6 +1,6 @@
 """The law pieces of the compiled integrators (rbm_cli.models.rbm.pieces) against the Python
 bookkeeping of tests/piece_oracle.py (Pieces), the laws' potential
-(Law.potential), the shear ratios and the energy of the model (physics/equations); and the
+(Law.potential), the shear ratios and the energy of the model (structures/equations); and the
 compiled functions against their uncompiled versions, bit for bit."""
 
 from __future__ import annotations

@@ -15,9 +15,9 @@ import pytest  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, StiffnessConfig  # noqa: E402
+from rbm_cli.report.plot_domain import boundary, plot_domain  # noqa: E402
 from rbm_cli.structures.closed_forms import halfsine_threshold_curves  # noqa: E402
 from rbm_cli.structures.column import build_column  # noqa: E402
-from rbm_cli.report.plot_domain import boundary, plot_domain  # noqa: E402
 
 FREQS = (0.5, 1.0, 1.5, 2.0, 2.5)
 AMPS = tuple(np.round(np.arange(0.1, 1.01, 0.1), 10))

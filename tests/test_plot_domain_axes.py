@@ -28,14 +28,14 @@ from matplotlib.figure import Figure  # noqa: E402
 import rbm  # noqa: E402
 from rbm_cli.cli.main import cli  # noqa: E402
 from rbm_cli.config.types import G  # noqa: E402
+from rbm_cli.report.domain_figure import domain_figure  # noqa: E402
+from rbm_cli.report.domain_view import axis_groups, domain_view  # noqa: E402
 from rbm_cli.structures.closed_forms import (  # noqa: E402
     housner_halfsine_threshold,
     linear_halfsine_threshold,
     linear_rocking_parameters,
 )
 from rbm_cli.structures.column import build_column  # noqa: E402
-from rbm_cli.report.domain_figure import domain_figure  # noqa: E402
-from rbm_cli.report.domain_view import axis_groups, domain_view  # noqa: E402
 from rbm_cli.study.domain import domain_config, read_domain  # noqa: E402
 from rbm_cli.study.schema import SCALE_COLUMNS as SCALE_FIELDS  # noqa: E402
 

@@ -20,7 +20,6 @@ from rbm_cli.base.files import (
 )
 from rbm_cli.config.load import load_config
 from rbm_cli.models.history import History
-from rbm_cli.structures.column import build_column
 from rbm_cli.report.plots import (
     exaggeration_factor,
     infer_elevations,
@@ -30,6 +29,7 @@ from rbm_cli.report.plots import (
     top_relative_displacement,
 )
 from rbm_cli.report.run_folder import history_frame, run_folder_name, shape_instants, write_run
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.simulate import simulate
 
 THREE_DRUMS = """\

@@ -21,12 +21,12 @@ import pytest
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.block.closed_form import linear_run
-from rbm_cli.models.registry import make_runner
-from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.inputs.ground import next_uplift
 from rbm_cli.inputs.pulses import mavroeidis_papageorgiou, ricker_wavelet
+from rbm_cli.models.block.closed_form import linear_run
+from rbm_cli.models.registry import make_runner
+from rbm_cli.structures.assembly import model_from_config
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "drums": 1}
 UPLIFT_G = 0.96 / 5.0  # the rigid RBM's static multiplier B/H (housner's tan(alpha) is more)

@@ -25,8 +25,8 @@ import pytest
 
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config import parse_config
-from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.study.simulate import simulate
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "section": "circular",
@@ -268,9 +268,9 @@ def test_a_recorded_run_keeps_both_elevations():
     for a motion along x, round-off along 30 degrees (three elastic drums), not zero under
     a pair; history.csv has them, and shapes.png draws two elevations."""
     from rbm_cli.models.registry import make_runner
-    from rbm_cli.structures.column import build_column
     from rbm_cli.report.run_figures import shapes_figure
     from rbm_cli.report.run_folder import history_columns
+    from rbm_cli.structures.column import build_column
 
     for angle in (0.0, 30.0):
         cfg = config(drums=3, stiffness=ELASTIC, angle=angle, rtol=1e-8)

@@ -18,10 +18,10 @@ import pandas as pd
 import pytest
 
 from rbm_cli.config.load import load_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.structures.closed_forms import linear_rocking_parameters
 from rbm_cli.structures.column import build_column
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.domain import read_domain
 from rbm_cli.study.simulate import model_from_config, simulate
 

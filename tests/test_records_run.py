@@ -22,10 +22,10 @@ from rbm_cli.cli.main import cli
 from rbm_cli.config.excitation import resolve_record_path, with_record
 from rbm_cli.config.load import load_config, parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.registry import make_runner
 from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.inputs.ground import next_uplift
 from rbm_cli.inputs.records import Record, write_at2, write_csv
+from rbm_cli.models.registry import make_runner
 from rbm_cli.study.sweep import config_hash
 
 #: The paper's tapered monolithic column, rigid (its half-sine study, housner_halfsine)

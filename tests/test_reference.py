@@ -18,11 +18,11 @@ from scipy.integrate import quad, tplquad
 from scipy.optimize import brentq
 
 from rbm_cli.config.types import ColumnConfig, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.models.housner.runner import housner_run
 from rbm_cli.structures.arrays import REST_RATE
 from rbm_cli.structures.block import block_geometry
-from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.structures.restitution import block_restitution
 
 G = 9.81

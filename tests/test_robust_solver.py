@@ -136,4 +136,7 @@ def test_robust_cells_of_the_stored_band_keep_their_outcome_at_tight_tolerances(
         one = rbm.with_value(cfg, "excitation.file", row["excitation.file"])
         for solver in (TIGHT, {"method": "exact"}):
             assert _outcome(one, row["amplitude_g"], None, solver) == row["collapsed"], (
-                row["excitation.file"], row["amplitude_g"], solver)
+                row["excitation.file"],
+                row["amplitude_g"],
+                solver,
+            )

@@ -23,10 +23,10 @@ import pytest
 import rbm_cli.models.rbm.step as step
 import rbm_cli.models.rbm3d.runner as runner3d
 from rbm_cli.config import parse_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.registry import make_runner
 from rbm_cli.models.status import COLLAPSED, SURVIVED
 from rbm_cli.numerics.loop import RunEnd
-from rbm_cli.inputs.excitation import make_ground_motion
 
 COLUMN = {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "density": 2700}
 

@@ -24,9 +24,9 @@ from rbm_cli.api import run as run_cell
 from rbm_cli.base.files import write_csv_atomic
 from rbm_cli.config.load import load_config
 from rbm_cli.models.history import History
-from rbm_cli.structures.column import build_column
 from rbm_cli.report.figure_process import RUN_IMPORTS, FigureProcess
 from rbm_cli.report.run_folder import history_csv, history_frame, run_summary, write_run
+from rbm_cli.structures.column import build_column
 
 from .paths import CONFIGS
 from .processes import LONG, parent_modules

@@ -31,10 +31,10 @@ from scipy.integrate import quad
 
 from rbm_cli.api import load_config, run, sweep, with_values
 from rbm_cli.base.errors import ConfigError
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.registry import make_runner
 from rbm_cli.structures.arrays import survival_barrier
 from rbm_cli.structures.assembly import model_from_config
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.sweep import config_hash
 
 from .paths import CONFIGS, RESULTS
@@ -135,8 +135,13 @@ def test_the_default_keeps_every_stored_hash_and_outcome_changes_it():
 # ---------------------------------------------------------------------------- free motion
 
 
-def _free(stop: str, rotation: float, rate: float = 0.0, restitution: float = 0.9,
-          implementation: str = "compiled") -> dict:
+def _free(
+    stop: str,
+    rotation: float,
+    rate: float = 0.0,
+    restitution: float = 0.9,
+    implementation: str = "compiled",
+) -> dict:
     """Two drums rocking as one stack (theta_u 0.25 rad at the base) from `rotation` of
     theta_u and `rate` [rad/s], damped."""
     return {
@@ -276,7 +281,8 @@ def test_the_monolith_stop_keeps_every_figure_on_a_whole_domain(method, stride):
             full = runner.run(motion, cfg.solver, early_stop=False)
             assert short.status == full.status, (a, f)
             assert short.t_collapse == full.t_collapse or (
-                math.isnan(short.t_collapse) and math.isnan(full.t_collapse)), (a, f)
+                math.isnan(short.t_collapse) and math.isnan(full.t_collapse)
+            ), (a, f)
             assert np.max(short.max_ratio) == np.max(full.max_ratio), (a, f)
             assert short.max_top == full.max_top, (a, f)
             stopped += "stopped early" in short.message

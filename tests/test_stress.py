@@ -25,9 +25,9 @@ from hypothesis import strategies as st
 
 from rbm_cli.api import run_sweep
 from rbm_cli.config.load import parse_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.rbm.runner import RbmRunner
 from rbm_cli.models.rbm.step import integrate
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.report.info import describe
 from rbm_cli.study.result import STATUSES
 from rbm_cli.study.simulate import model_from_config, simulate

@@ -17,10 +17,10 @@ import pytest
 from rbm_cli.base.errors import ConfigError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.registry import make_runner
 from rbm_cli.inputs.excitation import make_ground_motion, merge_records
 from rbm_cli.inputs.ground import next_uplift
 from rbm_cli.inputs.records import write_csv
+from rbm_cli.models.registry import make_runner
 
 from .record_files import half_sine_csv
 

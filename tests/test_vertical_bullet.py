@@ -21,10 +21,10 @@ import pytest
 
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
-from rbm_cli.models.bullet.run import bullet_run, measure_restitution
-from rbm_cli.models.registry import make_runner
 from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.inputs.records import write_csv
+from rbm_cli.models.bullet.run import bullet_run, measure_restitution
+from rbm_cli.models.registry import make_runner
 from rbm_cli.study.simulate import simulate
 
 from .record_files import half_sine_csv

@@ -26,11 +26,11 @@ import pytest
 
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
+from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.inputs.records import write_csv
 from rbm_cli.models.rbm.step import integrate
 from rbm_cli.models.registry import make_runner
 from rbm_cli.structures.assembly import SHAPE_CHANGE, model_from_config
-from rbm_cli.inputs.excitation import make_ground_motion
-from rbm_cli.inputs.records import write_csv
 
 #: (drums, xi, k_n [Pa/m], formulation): a tri-linear law (the elastic end moves as gam:
 #: w = 0), a bilinear one (elastic against the descending branch: 0 < w < 1)

@@ -43,6 +43,7 @@ import pandas as pd  # noqa: E402
 from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import GridConfig  # noqa: E402
+from rbm_cli.inputs.excitation import make_ground_motion  # noqa: E402
 from rbm_cli.models.bullet.convergence import (  # noqa: E402
     ensemble_agreement,
     outcome_marks,
@@ -57,7 +58,6 @@ from rbm_cli.models.bullet.normals import NormalCensus  # noqa: E402
 from rbm_cli.models.bullet.run import bullet_run  # noqa: E402
 from rbm_cli.models.bullet.settings import EngineSettings  # noqa: E402
 from rbm_cli.structures.block import block_geometry  # noqa: E402
-from rbm_cli.inputs.excitation import make_ground_motion  # noqa: E402
 from rbm_cli.structures.restitution import block_restitution  # noqa: E402
 from rbm_cli.study.domain import boundary, read_domain  # noqa: E402
 from rbm_cli.study.simulate import simulate  # noqa: E402

@@ -21,9 +21,9 @@ from pathlib import Path
 from matplotlib.figure import Figure
 from model_error import CONSERVATIVE, UNCONSERVATIVE, ModelError, model_error  # beside this
 
+from rbm_cli.report.plot_domain import plot_domain
 from rbm_cli.structures.block import block_geometry
 from rbm_cli.structures.column import build_column
-from rbm_cli.report.plot_domain import plot_domain
 from rbm_cli.study.domain import domain_config, read_domain
 
 ROOT = Path(__file__).resolve().parent.parent

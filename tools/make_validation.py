@@ -40,7 +40,9 @@ from validation_measures import (  # noqa: E402  (the module beside this script)
 from rbm_cli.api import run_sweep  # noqa: E402
 from rbm_cli.config.load import load_config, parse_config  # noqa: E402
 from rbm_cli.config.types import ExcitationConfig, GridConfig, InitialConfig  # noqa: E402
+from rbm_cli.inputs.excitation import make_ground_motion  # noqa: E402
 from rbm_cli.models.block.closed_form import linear_run  # noqa: E402
+from rbm_cli.report.plot_domain import plot_domain  # noqa: E402
 from rbm_cli.structures.block import block_geometry  # noqa: E402
 from rbm_cli.structures.closed_forms import (  # noqa: E402
     free_rocking_period,
@@ -48,8 +50,6 @@ from rbm_cli.structures.closed_forms import (  # noqa: E402
     linear_rocking_parameters,
 )
 from rbm_cli.structures.column import build_column  # noqa: E402
-from rbm_cli.inputs.excitation import make_ground_motion  # noqa: E402
-from rbm_cli.report.plot_domain import plot_domain  # noqa: E402
 from rbm_cli.study.domain import boundary, compare, read_domain  # noqa: E402
 from rbm_cli.study.simulate import model_from_config, simulate  # noqa: E402
 

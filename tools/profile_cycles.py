@@ -183,8 +183,8 @@ def _child(method: str) -> None:
     from profile_records import CONFIG, points
 
     from rbm_cli.config.load import load_config
-    from rbm_cli.models.registry import make_runner
     from rbm_cli.inputs.excitation import make_ground_motion
+    from rbm_cli.models.registry import make_runner
 
     config = load_config(CONFIG)
     first = True

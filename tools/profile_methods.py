@@ -37,9 +37,9 @@ import numpy as np
 from profile_records import CONFIG, points  # the script beside this one
 
 from rbm_cli.config.load import load_config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.registry import make_runner
 from rbm_cli.structures.arrays import column_arrays
-from rbm_cli.inputs.excitation import make_ground_motion
 
 #: Sample interval of the recorded run that finds the first opening [s].
 OPEN_DT = 2e-4

@@ -26,8 +26,8 @@ import numpy as np
 
 from rbm_cli.config.load import load_config, parse_config
 from rbm_cli.config.points import expand
-from rbm_cli.models.registry import make_runner
 from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.models.registry import make_runner
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIG = ROOT / "configs" / "ci" / "suite_multidrum_ci.yaml"

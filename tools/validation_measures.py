@@ -18,8 +18,8 @@ import pandas as pd
 
 from rbm_cli.base.events import first_crossing
 from rbm_cli.config.types import Config
-from rbm_cli.models.block.closed_form import linear_run
 from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.models.block.closed_form import linear_run
 
 
 def _hermite(y0: float, y1: float, d0: float, d1: float):

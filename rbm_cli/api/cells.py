@@ -18,7 +18,6 @@ from rbm_cli.config.load import shown as shown_value
 from rbm_cli.config.types import Config
 from rbm_cli.models.compile_ahead import compile_once
 from rbm_cli.models.methods import compiled_codes
-from rbm_cli.structures.column import build_column
 from rbm_cli.report.plots import plot_history as _plot_history
 from rbm_cli.report.run_folder import (
     history_frame,
@@ -27,6 +26,7 @@ from rbm_cli.report.run_folder import (
     vertical_history,
     write_run,
 )
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.result import CSV_FIELDS, RESIDUAL_FIELDS, THREE_D_FIELDS, RunResult
 from rbm_cli.study.schema import C
 from rbm_cli.study.simulate import simulate

@@ -2,7 +2,7 @@
 
 Used by :func:`rbm_cli.inputs.records.read_record`, which documents the formats, and by the
 config's ``excitation.file`` check (:mod:`rbm_cli.config.excitation`), which refuses a malformed
-record when the config is loaded (so they live here, below physics). Each parser returns
+record when the config is loaded (so they live here, below the inputs). Each parser returns
 plain arrays in the file's units; every malformed file raises an
 :class:`~rbm_cli.base.errors.RbmError` whose one-line message names the file and the line.
 Memory is bounded: about 2 x 8 bytes a sample plus one block of lines; files of more than

@@ -17,8 +17,8 @@ from __future__ import annotations
 from typing import Protocol, runtime_checkable
 
 from rbm_cli.config.types import Config, SolverConfig
-from rbm_cli.models.outcome import Outcome
 from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.models.outcome import Outcome
 
 #: Sampling interval of a recorded history when the caller gives none [s].
 DEFAULT_OUTPUT_DT = 0.002

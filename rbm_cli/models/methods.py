@@ -37,10 +37,10 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import CLOSED_FORM_KINDS, STEP_DEFAULT, Config, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.exact.motion import exact_why_not
 from rbm_cli.structures.equations import Model
-from rbm_cli.inputs.excitation import GroundMotion
 
 
 class Integrator(Protocol):

@@ -16,11 +16,11 @@ from typing import TYPE_CHECKING
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import MODELS, Config
-from rbm_cli.structures.column import build_column
 from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
 from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, uplift_level
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.report.plot_polar import ANGLE_AXIS, draw_polar, has_angle_axis
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.cells import nominal_config
 from rbm_cli.study.domain import axis_columns
 from rbm_cli.study.samples import majority_frame

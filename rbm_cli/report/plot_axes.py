@@ -29,12 +29,6 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.config.types import Config
-from rbm_cli.structures.closed_forms import (
-    halfsine_threshold_curves,
-    housner_halfsine_threshold,
-    linear_halfsine_threshold,
-)
-from rbm_cli.structures.column import build_column
 from rbm_cli.report.domain_view import DomainView, Point, row_configs
 from rbm_cli.report.plot_domain import (
     CURVE_POINTS,
@@ -47,6 +41,12 @@ from rbm_cli.report.plot_domain import (
     legend_beside,
     plot_levels,
 )
+from rbm_cli.structures.closed_forms import (
+    halfsine_threshold_curves,
+    housner_halfsine_threshold,
+    linear_halfsine_threshold,
+)
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.domain import boundary
 from rbm_cli.study.schema import C
 

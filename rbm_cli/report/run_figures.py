@@ -19,7 +19,6 @@ from rbm_cli.base.errors import RbmError
 from rbm_cli.config.load import parse_config
 from rbm_cli.config.types import G
 from rbm_cli.models.history import History
-from rbm_cli.structures.column import build_column
 from rbm_cli.report.plots import (
     exaggeration_factor,
     ground_drifts,
@@ -29,6 +28,7 @@ from rbm_cli.report.plots import (
     plot_shapes,
     plot_top_relative,
 )
+from rbm_cli.structures.column import build_column
 from rbm_cli.study.schema import C
 
 #: Number of deformed shapes drawn in shapes.png.

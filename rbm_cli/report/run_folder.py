@@ -30,9 +30,9 @@ from rbm_cli.base.files import (
 )
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import G
-from rbm_cli.models.history import History
 from rbm_cli.inputs.excitation import make_ground_motion, pair_times
 from rbm_cli.inputs.ground import as_samples, vertical_factor
+from rbm_cli.models.history import History
 from rbm_cli.report.run_figures import (  # noqa: F401  (the run folder's figures, here before)
     N_SHAPES,
     RUN_PNGS,

@@ -11,9 +11,9 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config, G
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.structures.column import Column, build_column
 from rbm_cli.structures.equations import Model, build_model
-from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.structures.restitution import column_restitution, resolve
 
 #: Why a run stops where g + a_v(t) changes the order of a law's pieces (shape_change).

@@ -1,2 +1,3 @@
 """Studies of runs: simulate through the registry, sweep, ensembles, domains, fragility,
-the benchmark. No physics and no plotting. Imports models, physics, config and base."""
+the benchmark. No physics and no plotting. Imports models, structures, inputs, config and
+base."""

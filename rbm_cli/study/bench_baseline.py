@@ -17,12 +17,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from rbm_cli.base.errors import RbmError
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.inputs.ground import SINE
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.pieces import IMPACT, cross, locate, piece_bounds
 from rbm_cli.structures.arrays import rest_levels
 from rbm_cli.structures.equations import Model
-from rbm_cli.inputs.excitation import GroundMotion
-from rbm_cli.inputs.ground import SINE
 from rbm_cli.structures.law import law_arrays
 
 #: Tolerances of the baseline (a naive per-cell scipy solve: RK45, rtol 1e-6); atol in units of

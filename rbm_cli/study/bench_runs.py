@@ -16,13 +16,13 @@ import numpy as np
 import pandas as pd
 
 from rbm_cli.config.types import Config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.block.closed_form import linear_run, warm_up
 from rbm_cli.models.compile_ahead import compile_once
 from rbm_cli.models.methods import compiled_codes
 from rbm_cli.models.registry import make_runner
 from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.structures.closed_forms import linear_rocking_parameters
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.bench_baseline import baseline_run
 from rbm_cli.study.schema import C
 from rbm_cli.study.simulate import simulate

@@ -58,9 +58,9 @@ import numpy as np
 
 from rbm_cli.config.types import MODELS, Config, G
 from rbm_cli.inputs import intensity as im
-from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.inputs.excitation import load_record
 from rbm_cli.inputs.records import process
+from rbm_cli.structures.assembly import model_from_config
 
 #: How a measure goes with the factor c a cell multiplies its record by.
 SCALINGS = ("linear", "quadratic", "none")

@@ -14,11 +14,11 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import MODELS, Config
+from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT, Runner
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION
 from rbm_cli.models.registry import make_runner
 from rbm_cli.structures.assembly import check_derived, model_from_config
-from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.study.result import RunResult
 
 __all__ = ["check_derived", "make_runner", "model_from_config", "simulate"]

@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 from rbm_cli.config.types import Config, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.history import history_from_samples
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.structures.block import block_geometry, block_initial
-from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.structures.restitution import block_restitution, resolve
 
 

@@ -40,6 +40,7 @@ from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import CLOSED_FORM_KINDS, G, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models import status as cr
 from rbm_cli.models.block.run import (
     LOG_COLLAPSE,
@@ -57,7 +58,6 @@ from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings, sine_
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.structures.arrays import REST_RATE, rest_levels
 from rbm_cli.structures.equations import Model
-from rbm_cli.inputs.excitation import GroundMotion
 
 
 class Block(NamedTuple):

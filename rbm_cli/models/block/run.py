@@ -37,6 +37,7 @@ import numpy as np
 from rbm_cli.base.events import STOP_MARGIN
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
+from rbm_cli.inputs.ground import sine_exceedance
 from rbm_cli.models.block.piece import (
     A_EVALS,
     A_FRICTION,
@@ -81,7 +82,6 @@ from rbm_cli.models.status import (
     SURVIVED,
     guard_code,
 )
-from rbm_cli.inputs.ground import sine_exceedance
 
 T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG, T_SLIP = range(
     12

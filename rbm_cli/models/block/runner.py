@@ -18,10 +18,10 @@ References
 from __future__ import annotations
 
 from rbm_cli.config.types import SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.block.closed_form import linear_block, run_closed_form
 from rbm_cli.models.outcome import Outcome
-from rbm_cli.inputs.excitation import GroundMotion
 
 
 class HousnerLinearRunner(BlockRunner):

@@ -56,6 +56,7 @@ import numpy as np
 
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config, G, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.impact import impact_rate_ratios, measure_restitution
@@ -81,7 +82,6 @@ from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.history import History
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.plan import wrapped
-from rbm_cli.inputs.excitation import GroundMotion
 
 __all__ = [
     "BLOWUP",

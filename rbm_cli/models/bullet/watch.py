@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.bullet.scene import (
     Frame,
     Joints,
@@ -27,7 +28,6 @@ from rbm_cli.models.bullet.space import (
     normals,
 )
 from rbm_cli.models.outcome import WOBBLE_LEVEL, Outcome
-from rbm_cli.inputs.excitation import GroundMotion
 
 #: Interval of the collapse, sliding and contact checks [s].
 CHECK_DT = 1e-3

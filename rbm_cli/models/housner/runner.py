@@ -31,6 +31,8 @@ from scipy.integrate import DOP853, RK23, RK45
 from rbm_cli.base.events import EVENT_EPS, STOP_MARGIN, first_crossing, hermite_dip
 from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.config.types import G, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.inputs.ground import SINE
 from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.housner.state import BlockRun, Recorder
@@ -49,8 +51,6 @@ from rbm_cli.structures.block import (
     housner_energy,
     top_displacement,
 )
-from rbm_cli.inputs.excitation import GroundMotion
-from rbm_cli.inputs.ground import SINE
 from rbm_cli.structures.restitution import block_restitution, resolve
 
 _METHODS = {m.__name__: clip_at_knots(m) for m in (DOP853, RK45, RK23)}

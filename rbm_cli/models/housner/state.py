@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rbm_cli.models.outcome import Outcome
 from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.models.outcome import Outcome
 
 
 class Recorder:

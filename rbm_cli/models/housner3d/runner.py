@@ -44,6 +44,7 @@ from scipy.optimize import brentq
 from rbm_cli.base.events import EVENT_EPS, STOP_MARGIN, first_crossing
 from rbm_cli.base.knots import clip_at_knots
 from rbm_cli.config.types import G, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models import methods
 from rbm_cli.models.block.base import BlockRunner
 from rbm_cli.models.housner.state import BlockRun
@@ -64,7 +65,6 @@ from rbm_cli.structures.cylinder import (
     top_in_plan,
     uplift_level,
 )
-from rbm_cli.inputs.excitation import GroundMotion
 
 _METHODS = {m.__name__: clip_at_knots(m) for m in (DOP853, RK45, RK23)}
 

@@ -25,12 +25,12 @@ import dataclasses
 import time
 
 from rbm_cli.config.types import STEP_DEFAULT
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.models.rbm.exact.integrate import integrate_exact, prepare_exact
 from rbm_cli.models.rbm.step import integrate as integrate_steps
 from rbm_cli.models.rbm.step import prepare_kernel
 from rbm_cli.structures.equations import Model
-from rbm_cli.inputs.excitation import GroundMotion
 
 
 def prepare(model: Model):

@@ -12,11 +12,11 @@ import time
 
 import numpy as np
 
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.rbm.exact.modal import FORCING_SIZE, HARMONIC, LINEAR, ZERO
 from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.status import stop_level
 from rbm_cli.structures.equations import Model
-from rbm_cli.inputs.excitation import GroundMotion
 
 
 def record_arrays(motion: GroundMotion) -> tuple[np.ndarray, np.ndarray]:

@@ -14,13 +14,13 @@ import math
 import numpy as np
 
 from rbm_cli.config.types import Config, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.history import history_from_samples
 from rbm_cli.models.methods import resolve
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.structures.assembly import SHAPE_CHANGE, model_from_config, shape_change
 from rbm_cli.structures.equations import Model
-from rbm_cli.inputs.excitation import GroundMotion
 
 #: What a numerical failure of the integrator raises; the run ends `failed`, with the reason.
 NUMERICAL_FAILURES = (FloatingPointError, np.linalg.LinAlgError, ValueError, ZeroDivisionError)

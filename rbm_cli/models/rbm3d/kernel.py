@@ -19,6 +19,17 @@ from rbm_cli.base.brent import brent_step
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
+from rbm_cli.inputs.ground import (
+    LINE,
+    gravity_factor,
+    ground_at,
+    next_uplift,
+    pair_uplift,
+    record_piece,
+    rest_demand,
+    rest_shear,
+    vertical_factor,
+)
 from rbm_cli.models.outcome import WOBBLE_LEVEL
 from rbm_cli.models.rbm.pieces import (
     below_barrier,
@@ -40,17 +51,6 @@ from rbm_cli.numerics.records import new_record
 from rbm_cli.numerics.rk import TAB_EST, TAB_NS, dense_eval, steps_for
 from rbm_cli.structures.arrays import ColumnArrays, column_into
 from rbm_cli.structures.column3d import CS_PER_JOINT, ES_EXTRA, beam_rates, horizontal, pack_pieces
-from rbm_cli.inputs.ground import (
-    LINE,
-    gravity_factor,
-    ground_at,
-    next_uplift,
-    pair_uplift,
-    record_piece,
-    rest_demand,
-    rest_shear,
-    vertical_factor,
-)
 
 #: A rigid joint's direction is pinned within a distance of closure (c[i, 2], solver.atol
 #: theta_u: the runner's notes) and after an uplift or an impact, until LEAVE_FACTOR times
@@ -776,14 +776,14 @@ def rest(W, t, seg_end, gr_full, mc, n_out, next_out):
 
 @jit
 def restart(W, t, seg_end, seg_gain, h_carry, gr, mc, rtol, atol):
-    """A new stepper from (t, W.y): the current pieces packed (beam3d.pack_pieces), the watched
-    events (watch) and their distances at t, the first step's size (h_carry, the one proposed
-    before an event, or numerics.rk.initial_step's). Returns the step size [s], the
-    right-hand side's calls and the ground."""
+    """A new stepper from (t, W.y): the current pieces packed
+    (structures.column3d.pack_pieces), the watched events (watch) and their distances at
+    t, the first step's size (h_carry, the one proposed before an event, or the column's
+    initial_step). Returns the step size [s], the right-hand side's calls and the ground."""
     values_y = W.values_y
     k, phase, rising, c = W.k, W.phase, W.rising, W.c
     n = k.size
-    pinned = np.zeros(n, dtype=np.int64)  # beam3d.pack_pieces
+    pinned = np.zeros(n, dtype=np.int64)  # structures.column3d.pack_pieces
     for i in range(n):
         if phase[i] != FREE and W.rigid[i]:
             pinned[i] = 2 if rising[i] else 1

@@ -69,6 +69,8 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.inputs.ground import as_samples
 from rbm_cli.models.outcome import EnergyAccount, Outcome
 from rbm_cli.models.plan import as_line, from_ground, to_ground, turned_start, wrapped
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
@@ -85,8 +87,6 @@ from rbm_cli.models.status import (
 )
 from rbm_cli.structures.column import build_column
 from rbm_cli.structures.equations import build_model
-from rbm_cli.inputs.excitation import GroundMotion
-from rbm_cli.inputs.ground import as_samples
 
 
 def integrate3d(

@@ -18,6 +18,7 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig, StiffnessConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.outcome import Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.exact.motion import check_exact
 from rbm_cli.models.rbm.exact.piece import new_cache
@@ -34,7 +35,6 @@ from rbm_cli.models.status import (
 from rbm_cli.structures.arrays import ColumnArrays, column_arrays
 from rbm_cli.structures.column import build_column
 from rbm_cli.structures.equations import Model, build_model
-from rbm_cli.inputs.excitation import GroundMotion
 
 #: Points of the pool (3 for the run loop, the rest for the refinement of peaks) and
 #: entries of the refinement's stack.

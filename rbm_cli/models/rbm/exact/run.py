@@ -27,6 +27,7 @@ import numpy as np
 
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
+from rbm_cli.inputs.ground import sine_exceedance
 from rbm_cli.models.rbm.exact.modal import (
     LINEAR,
     ZERO,
@@ -66,7 +67,6 @@ from rbm_cli.models.status import (
     SURVIVED,
     guard_code,
 )
-from rbm_cli.inputs.ground import sine_exceedance
 
 T, H, NEXT_OUT, T_COLLAPSE, AT_REST, N_OUT, T_SLIP, SLIP_IF = range(8)
 UPLIFTS, IMPACTS, STEPS, RHS, EVENTS, COLLAPSE_IF, RHS_PEAKS, SEG = range(8)

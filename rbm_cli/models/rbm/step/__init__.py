@@ -44,6 +44,7 @@ from rbm_cli.base.compile_cache import cache_empty
 from rbm_cli.base.guard import arm, disarm, poll
 from rbm_cli.base.jit import plain
 from rbm_cli.config.types import ColumnConfig, InterfaceConfig, SolverConfig
+from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.outcome import EnergyAccount, Outcome, sample_buffer, sample_rows
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.models.rbm.step.inputs import (
@@ -64,7 +65,6 @@ from rbm_cli.models.status import (
 from rbm_cli.numerics.loop import RunEnd
 from rbm_cli.structures.column import build_column
 from rbm_cli.structures.equations import Model, build_model
-from rbm_cli.inputs.excitation import GroundMotion
 
 
 def integrate(

@@ -20,12 +20,12 @@ from typing import NamedTuple
 import numpy as np
 
 from rbm_cli.base.jit import jit
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.inputs.ground import as_samples
 from rbm_cli.models.methods import step_method
 from rbm_cli.numerics.rk import METHOD_CODES
 from rbm_cli.structures.arrays import ColumnArrays, column_arrays
 from rbm_cli.structures.equations import Model
-from rbm_cli.inputs.excitation import GroundMotion
-from rbm_cli.inputs.ground import as_samples
 
 #: excitation kind -> code in the kernel
 KIND_CODES = {

@@ -8,6 +8,15 @@ import numpy as np
 from rbm_cli.base.detmath import matvec
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
+from rbm_cli.inputs.ground import (
+    gravity_factor,
+    ground,
+    ground_at,
+    next_uplift,
+    record_piece,
+    rest_demand,
+    rest_shear,
+)
 from rbm_cli.models.rbm.pieces import (
     IMPACT,
     UPLIFT,
@@ -47,15 +56,6 @@ from rbm_cli.numerics.quadrature import GL_NODES, GL_WEIGHTS
 from rbm_cli.numerics.records import new_record
 from rbm_cli.numerics.rk import TAB_EST, dense_eval, emit, emit_rest, steps_for
 from rbm_cli.structures.arrays import ColumnArrays, column_into
-from rbm_cli.inputs.ground import (
-    gravity_factor,
-    ground,
-    ground_at,
-    next_uplift,
-    record_piece,
-    rest_demand,
-    rest_shear,
-)
 from rbm_cli.structures.rates import acc_of, rhs
 
 #: The planar column's Runge-Kutta steps on its right-hand side (structures.rates.rhs).

@@ -45,6 +45,9 @@ def jit(function: Callable | None = None, *, inline: bool = False):
     called in a hot loop; the arithmetic is the same).
 
     Use as ``@jit`` or ``@jit(inline=True)``.
+
+    A compiled caller's call is typed with its arguments' plain types, never their
+    literal ones (:func:`_typed_plainly`).
     """
 
     def decorate(f: Callable) -> Callable:
@@ -53,9 +56,31 @@ def jit(function: Callable | None = None, *, inline: bool = False):
         # lazy: numba loads only where needed (docs/architecture.md, Start-up)
         from numba import njit
 
-        return njit(cache=True, inline="always" if inline else "never")(f)
+        return _typed_plainly(njit(cache=True, inline="always" if inline else "never")(f))
 
     return decorate if function is None else decorate(function)
+
+
+def _typed_plainly(dispatcher):
+    """The dispatcher, compiled for the plain types of a compiled caller's arguments.
+
+    numba types a constant argument (``0``, ``-1``, ``True``, a tuple holding one) as a
+    literal first and compiles the callee for it, then, once the caller's types are
+    unified, compiles it again for the plain type: two compiles of the callee and of
+    everything it calls that is not cached yet. The run loop was compiled twice this way
+    (5 s of a first use of about 60 s). Here the call is typed with the plain types only;
+    the literal converts to its plain type as any argument does, and the code and its
+    arithmetic are the same."""
+    from numba.core import types  # lazy: as numba above
+
+    typed = dispatcher.get_call_template
+
+    def get_call_template(args, kws):
+        plain_args = tuple(types.unliteral(a) for a in args)
+        return typed(plain_args, {k: types.unliteral(v) for k, v in kws.items()})
+
+    dispatcher.get_call_template = get_call_template
+    return dispatcher
 
 
 def is_compiled(function: Callable) -> bool:

@@ -88,9 +88,14 @@ def _ground_other(t, form, amp, om, ph, c, gamma):
     return v if amp == 1.0 else amp * v
 
 
-@jit(inline=True)
+@jit
 def ground(t, gr):
-    """a_g(t) [m/s^2] of the ground tuple gr (0 on a free segment: gain 0)."""
+    """a_g(t) [m/s^2] of the ground tuple gr (0 on a free segment: gain 0).
+
+    Compiled on its own, not inlined into the right-hand sides (it takes numbers only, so
+    a call costs no reference count): inlined, each of its twelve callers compiled its
+    own copy of the sine (base.detmath.sin), 5 s of a first use of about 55 s, for no
+    measurable speed (the 8-drum band's CPU within 1 %, five paired runs)."""
     form, amp, om, ph, c, gamma = gr[0], gr[1], gr[2], gr[3], gr[4], gr[5]
     if amp == 0.0:
         return 0.0
@@ -99,7 +104,7 @@ def ground(t, gr):
     return _ground_other(t, form, amp, om, ph, c, gamma)
 
 
-@jit(inline=True)
+@jit
 def shape_at(t, form, amp, om, ph, c, gamma):
     """a(t) [m/s^2] of a form's formula (SINE, RICKER, MP, or a record's straight piece,
     LINE), its numbers given one by one (a pair's second component, structures.column3d)."""

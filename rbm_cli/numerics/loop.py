@@ -8,6 +8,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from rbm_cli.base.copies import copy_into
 from rbm_cli.base.guard import POLL_STEPS
 from rbm_cli.base.jit import jit
 from rbm_cli.numerics.binding import bind
@@ -202,7 +203,7 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
                 if t_new - seg_end >= 0:
                     running = False
                 t_old = t
-                y_new[:] = ynew
+                copy_into(y_new, ynew)
                 # the first watched event inside the step, on its dense output
                 t_e, hit, dense_ready, calls = find_event(W, mc, t_old, t_new, h, gr)  # noqa: F821
                 n_rhs += calls
@@ -217,8 +218,8 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
                 n_rhs += calls
                 n_imp += impacts
                 t = t_new
-                y[:] = y_new
-                f[:] = K[ns]
+                copy_into(y, y_new)
+                copy_into(f, K[ns])
                 if event:
                     break
                 if (can_stop or sure_stop) and may_stop(W, can_stop, sure_stop):  # noqa: F821

@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 import rbm_cli.base.rk_tableaux as _tb
+from rbm_cli.base.copies import copy_into
 from rbm_cli.base.detmath import pow_pos
 from rbm_cli.base.jit import jit
 from rbm_cli.numerics.binding import bind
@@ -153,7 +154,7 @@ def rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     """One Runge-Kutta step of size h; stages in K (row ns = f(t + h, y_new))."""
     B = TAB_B[mc]
     ns = TAB_NS[mc]
-    K[0, :] = f
+    copy_into(K[0], f)
     for s in range(1, ns):
         _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr)
     _combine(B, K, ns, y, h, ynew)

@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from rbm_cli.base.copies import copy_into
 from rbm_cli.base.detmath import matmul, matvec
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
@@ -197,8 +198,9 @@ def _derived(args, cmap, top, minv, diff, gravity, ground_load):
     md = matmul(minv, diff.T.copy())
     mg = matmul(minv, gravity)
     track = np.empty((n + 1, n))
-    track[:n, :] = cmap
-    track[n, :] = top
+    for i in range(n):
+        copy_into(track[i], cmap[i])
+    copy_into(track[n], top)
     es = -matvec(minv, ground_load, np.empty(n))
     return same, md, mg, track, es
 

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from rbm_cli.base.brent import brent_step
+from rbm_cli.base.copies import copy_into
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
@@ -339,7 +340,7 @@ def _emit(mc, t_stop, t_old, h, y_old, F, yq, samples, n_out, next_out, dt, n, d
         if h > 0.0:
             dense_eval(mc, next_out, t_old, h, y_old, F, yq)
         else:
-            yq[:] = y_old
+            copy_into(yq, y_old)
         row = samples[n_out]
         row[0] = next_out
         tx, ty = 0.0, 0.0
@@ -470,7 +471,7 @@ def system3d(col, n, d0, d1, values_y, gy):
             As[i, 2 * n + j] = col.argmap[i, j]
     cs = np.zeros(CS_PER_JOINT * n)
     es = np.zeros(n + ES_EXTRA)
-    es[:n] = col.es
+    copy_into(es, col.es)
     es[n], es[n + 1] = d0, d1
     es[n + 8] = 1.0 if np.any(col.mg != 0.0) else 0.0
     es[n + 9] = LINE if values_y.size > 0 else gy[0]
@@ -924,8 +925,8 @@ def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out,
                     impacts += 1
                     W.pending[i], W.phase[i] = False, FREE
     # the step's end is the next step's start
-    W.d_old[:] = W.d_new
-    W.r_old[:] = W.r_new
+    copy_into(W.d_old, W.d_new)
+    copy_into(W.r_old, W.r_new)
     return calls, n_out, next_out, impacts
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rbm_cli.base.copies import copy_into
 from rbm_cli.base.detmath import matvec
 from rbm_cli.base.jit import jit
 from rbm_cli.config.types import G
@@ -132,8 +133,8 @@ def start(theta0, rate0, W, account):
     the run's ledger; returns y and whether a rigid monolith starts at rest."""
     n = theta0.size
     y = np.empty(2 * n)
-    y[:n] = theta0
-    y[n:] = rate0
+    copy_into(y, theta0)
+    copy_into(y[n:], rate0)
     at_rest = W.uplift_level >= 0.0
     for i in range(2 * n):
         if y[i] != 0.0:
@@ -319,7 +320,7 @@ def find_event(W, mc, t_old, t_new, h, gr):
     dense output prepared and the crossing found on it. Returns (t_e, the row crossed or -1,
     the dense output ready, right-hand side calls)."""
     n = W.y.size // 2
-    W.acc_old[:] = W.acc
+    copy_into(W.acc_old, W.acc)
     W.ends[0], W.ends[1] = acc_of(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
     surfaces(W.gx, W.gc, W.same, W.y_new, W.acc, W.h0, W.d_new, W.dd_new, W.d2_new,
              t_new, gr, W.mv_e, W.mv_w)  # fmt: skip
@@ -409,13 +410,13 @@ def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out,
                      W.between)  # fmt: skip
         held_push(W.held, W.rx, W.ry, W.between)
     # the step's end is the next step's start
-    W.z_prev[:] = W.z_old
-    W.z_old[:] = W.z_new
-    W.dz_prev[:] = W.dz_old
-    W.dz_old[:] = W.dz_new
-    W.d_old[:] = W.d_new
-    W.dd_old[:] = W.dd_new
-    W.d2_old[:] = W.d2_new
+    copy_into(W.z_prev, W.z_old)
+    copy_into(W.z_old, W.z_new)
+    copy_into(W.dz_prev, W.dz_old)
+    copy_into(W.dz_old, W.dz_new)
+    copy_into(W.d_old, W.d_new)
+    copy_into(W.dd_old, W.dd_new)
+    copy_into(W.d2_old, W.d2_new)
     return calls, n_out, next_out, impacts
 
 

@@ -130,3 +130,36 @@ def test_rbm_jit_0_sweeps_as_the_compiled_code(tmp_path):
             meta = json.loads((out / name / "meta.json").read_text())
             assert meta["n_cells"] == 6
         assert outputs["0"] == outputs["1"], name
+
+
+_LITERALS = """
+from rbm_cli.base.jit import jit
+
+
+@jit
+def shifted(x, k):
+    return x + k
+
+
+@jit
+def caller(x, k):
+    return shifted(x, 0) + shifted(x, k) + shifted((x, -1)[0], 1)
+
+
+print(caller(1, 2), len(shifted.signatures), [str(s) for s in shifted.signatures])
+"""
+
+
+def test_a_constant_argument_compiles_its_callee_once(tmp_path):
+    """A compiled callee called with constants (0, a tuple holding -1) and with a variable
+    of the same type is compiled once, for the plain types: numba would compile it for the
+    literals first and again for the plain types (the run loop was compiled twice on every
+    first use)."""
+    (tmp_path / "literals.py").write_text(_LITERALS)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path]),
+           "NUMBA_CACHE_DIR": str(tmp_path / "cache")}  # fmt: skip
+    res = subprocess.run([sys.executable, "-c", "import literals"], capture_output=True,
+                         text=True, env=env, timeout=300)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    value, count, signatures = res.stdout.split(" ", 2)
+    assert value == "6" and count == "1", signatures

@@ -1,7 +1,7 @@
 """Copies between arrays in compiled code, as loops.
 
 ``a[:] = b`` between arrays makes numba compile its shape check and the message it raises
-on a mismatch (string formatting of the shapes): about 3 s of a first use of the step
+on a mismatch (string formatting of the shapes): about 7 s of a first use of the step
 integrator, for copies whose shapes are equal by construction. :func:`copy_into` is the
 loop; the values are the same.
 """

@@ -1,8 +1,8 @@
 """First use: the compiled code is compiled before the first run, one compile at a time.
 
-Compiling takes time, once per installation: the kernel about 90 s on two shared cores
+Compiling takes time, once per installation: the kernel about 45 s on two shared cores
 (less on a fast idle machine, more on a busy one), the integrator in two directions about
-100 s, the exact integrator about 80 s, the rigid block's closed form 6-10 s; numba then
+45 s, the exact integrator about 80 s, the rigid block's closed form 6-10 s; numba then
 keeps them in its on-disk cache. The first `rbm run` or `rbm sweep` that needs one of them
 compiles it in its own process before its first cell (:func:`compile_once`) and answers
 with it: the code every later run loads from the cache, so the same answer the first time
@@ -50,9 +50,9 @@ NAMES = {
     "rbm3d": "the integrator in two directions",
 }
 #: About how long a first compile takes [s]: measured on two shared cores at a load of 1-2
-#: (the first `rbm run` with an empty cache: kernel 94 s, in two directions 100 s, on
-#: 2026-11-29; exact integrator 76 s, closed form 6-10 s).
-ABOUT_S = {"kernel": 90, "closed-form": 10, "exact": 80, "rbm3d": 100}
+#: (the first `rbm run` with an empty cache: kernel 42 s, in two directions 45 s, on
+#: 2026-11-30 at a load of 0.7-0.9; exact integrator 76 s, closed form 6-10 s).
+ABOUT_S = {"kernel": 45, "closed-form": 10, "exact": 80, "rbm3d": 45}
 
 
 def _module(target: str):

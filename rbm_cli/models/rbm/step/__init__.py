@@ -167,7 +167,7 @@ def _outcome(
 
 def needs_compile() -> bool | None:
     """Whether the kernel has no usable on-disk cache: its first use then compiles it
-    (about 90 s on two shared cores, once per installation). See base.compile_cache.cache_empty."""
+    (about 45 s on two shared cores, once per installation). See base.compile_cache.cache_empty."""
     return cache_empty(run_kernel)
 
 

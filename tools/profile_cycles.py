@@ -103,7 +103,8 @@ ANCHORS = [
      "from rbm_cli.base.jit import jit\nfrom rbm_cli.base.cycles import cycles\n"),
     (STEPPER, "def find_event(W, mc, t_old, t_new, h, gr):\n",
      "def find_event(W, mc, t_old, t_new, h, gr, prof):\n"),
-    (STEPPER, "    W.acc_old[:] = W.acc\n", "    c0 = cycles()\n    W.acc_old[:] = W.acc\n"),
+    (STEPPER, "    copy_into(W.acc_old, W.acc)\n",
+     "    c0 = cycles()\n    copy_into(W.acc_old, W.acc)\n"),
     (STEPPER, "    if not within_reach(W.d_old, W.d_new, W.dd_old, W.dd_new, W.d2_old, W.d2_new, "
      "t_new - t_old,\n                        W.near):  # fmt: skip\n",
      f"    prof[1] += {TICK}\n    c0 = cycles()\n"
@@ -121,9 +122,9 @@ ANCHORS = [
      "    c0 = cycles()\n    affine(W.track, W.y_new, 0, W.no_offset, W.z_new)\n"),
     (STEPPER, "    shear_ratios(g_new, 0.0, gam_new,",
      f"    prof[6] += {TICK}\n    c0 = cycles()\n    shear_ratios(g_new, 0.0, gam_new,"),
-    (STEPPER, "    # the step's end is the next step's start\n    W.z_prev[:] = W.z_old\n",
+    (STEPPER, "    # the step's end is the next step's start\n    copy_into(W.z_prev, W.z_old)\n",
      f"    prof[7] += {TICK}\n"
-     "    # the step's end is the next step's start\n    W.z_prev[:] = W.z_old\n"),
+     "    # the step's end is the next step's start\n    copy_into(W.z_prev, W.z_old)\n"),
     (EXACT_RUN, "from rbm_cli.base.jit import jit\n",
      "from rbm_cli.base.jit import jit\nfrom rbm_cli.base.cycles import cycles\n"),
     (EXACT_RUN,

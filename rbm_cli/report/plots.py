@@ -11,7 +11,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from rbm_cli.models.history import History
-from rbm_cli.report.shape_geometry import base_slip, drum_outlines, round_factor
+from rbm_cli.report.shape_geometry import round_factor
+from rbm_cli.structures.outline import base_slip, drum_outlines
 
 #: Target of the shape exaggeration: largest drawn top displacement / height.
 SHAPE_TARGET_RATIO = 0.25
@@ -277,10 +278,10 @@ def plot_shapes(
     -----
     Drum i is drawn rigid, turned by s theta_i about the corner it rocks on,
     which sits on the corner of the drum below, so an open joint shows as a
-    wedge (:func:`rbm_cli.report.shape_geometry.drum_outlines`: exact for drums
+    wedge (:func:`rbm_cli.structures.outline.drum_outlines`: exact for drums
     rocking without sliding, and equal to the RBM's node displacements to first
     order). A base that moves on the ground (a contact engine's history) is
-    drawn displaced by s times its slip (:func:`~rbm_cli.report.shape_geometry.base_slip`);
+    drawn displaced by s times its slip (:func:`~rbm_cli.structures.outline.base_slip`);
     the slip of upper joints is not drawn. Heights are to scale; the x axis has
     no scale of its own (the instants stand side by side, each over its rest
     position, marked by a tick on the ground).

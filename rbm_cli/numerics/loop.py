@@ -55,9 +55,10 @@ RunEnd = namedtuple(
 #: (numerics.records: name, type): the state y and the accepted new state y_new, the
 #: Runge-Kutta work arrays (the stages K, the dense output's coefficients F, f = y'(t), the
 #: step's end ynew, a stage's argument tmp, a right-hand side's work, the error norm's scale,
-#: a state on the dense output yq), the right-hand side's arrays (structures.rates.rhs: As, cs,
-#: es as sys_A, sys_c, sys_e), and the run's figures, filled in place: RunEnd's max_ratio,
-#: friction, slip, swept and ledger, and top (1,): the top's peak.
+#: a state on the dense output yq), the right-hand side's arrays (a structure's rhs, e.g.
+#: structures.rates.rhs: As, cs, es as sys_A, sys_c, sys_e), and the run's figures, filled
+#: in place: RunEnd's max_ratio, friction, slip, swept and ledger, and top (1,): the top's
+#: peak.
 LOOP_FIELDS = [
     ("y", "float64[::1]"), ("y_new", "float64[::1]"), ("K", "float64[:, ::1]"),
     ("F", "float64[:, ::1]"), ("f", "float64[::1]"), ("ynew", "float64[::1]"),

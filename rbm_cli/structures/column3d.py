@@ -30,8 +30,9 @@ direction c (the side the joint rocks onto), as a base flat to that side, and m 
 (rbm_cli.models.rbm3d says when: that distance is the integrator's absolute tolerance of
 the rotation, solver.atol theta_u).
 
-The equations are compiled (numba) as the planar kernel's are, into the same slots of its
-right-hand side (rbm_cli.structures.rates.rhs: a state of 4n values is this model's):
+The equations are compiled (numba) as the planar kernel's are, in the same slots as its
+right-hand side's (rbm_cli.structures.rates.rhs), on a state of 4n values
+(:func:`beam_rates`, this column's right-hand side):
 
 - ``As`` (n, 3n): [M^-1 D^T | M^-1 K_g | the argument map];
 - ``cs`` (9n): per joint, the piece it is on: intercept, weight slope, elastic slope, its

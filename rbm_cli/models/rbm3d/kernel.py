@@ -1,8 +1,8 @@
 """The compiled run of `rbm-3d` (numba; the rules: rbm_cli.models.rbm3d.runner).
 
 One call runs a whole motion. The Runge-Kutta steps are the planar step kernel's
-(rbm_cli.numerics.rk: scipy's tableaux, error norm, step control and dense output,
-whose right-hand side takes a state of 4n values as this model's, structures.column3d); the
+(rbm_cli.numerics.rk: scipy's tableaux, error norm, step control and dense output, this
+column's copies on its own right-hand side, structures.column3d.beam_rates); the
 events are located on each step's dense output: the watched distances are evaluated at
 CHECK_INTERVALS + 1 points of the step, and in the first sub-interval where one ends below
 zero, or where its cubic Hermite dips below zero (confirmed on the dense output), each

@@ -13,10 +13,10 @@ from matplotlib.figure import Figure
 from rbm_cli.config.load import parse_config
 from rbm_cli.models.history import History
 from rbm_cli.report.bench_figures import work_precision_figure
+from rbm_cli.report.exaggeration import round_factor
 from rbm_cli.report.plots import plot_joint_rotations, plot_shapes
 from rbm_cli.report.run_figures import history_figure, run_column, run_title
 from rbm_cli.report.run_folder import run_summary
-from rbm_cli.report.shape_geometry import round_factor
 from rbm_cli.structures.column import build_column
 from rbm_cli.structures.outline import base_slip, drum_outlines
 from rbm_cli.study.bench import PEAK_TARGET, PROBLEMS

@@ -36,6 +36,7 @@ import time
 import numpy as np
 from profile_records import CONFIG, points  # the script beside this one
 
+from rbm_cli.base.jit import plain
 from rbm_cli.config.load import load_config
 from rbm_cli.inputs.excitation import make_ground_motion
 from rbm_cli.models.registry import make_runner
@@ -187,7 +188,11 @@ def after_events(seconds: float = 10.0, pga_g: float = 0.2) -> dict:
              IMPACT: "impact"}  # fmt: skip
     last = ["none"]
     seen: dict = collections.defaultdict(list)
-    attempt, switch = stepper.attempt_step, stepper.switch
+    # the run loop calls the step from its own names (numerics.loop.loop_for), the event's
+    # functions call switch from the stepper's; both run uncompiled here (base.jit.plain)
+    loop_names = getattr(stepper.run_plane, "py_func", stepper.run_plane).__globals__
+    attempt, switch = plain(loop_names["attempt_step"]), plain(stepper.switch)
+    compiled = loop_names["attempt_step"], stepper.switch
 
     def counted_attempt(mc, t, y, f, h_abs, *rest):
         res = attempt(mc, t, y, f, h_abs, *rest)
@@ -200,11 +205,11 @@ def after_events(seconds: float = 10.0, pga_g: float = 0.2) -> dict:
         last[0] = kinds.get(what, "impact")
         return what
 
-    stepper.attempt_step, stepper.switch = counted_attempt, counted_switch
+    loop_names["attempt_step"], stepper.switch = counted_attempt, counted_switch
     try:
         make_runner(cfg).run(motion, cfg.solver)
     finally:
-        stepper.attempt_step, stepper.switch = attempt, switch
+        loop_names["attempt_step"], stepper.switch = compiled
     out = {}
     for kind, steps in seen.items():
         rejected = [ratio for was_rejected, ratio in steps if was_rejected]

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from rbm_cli.models.history import History
-from rbm_cli.report.shape_geometry import round_factor
+from rbm_cli.report.exaggeration import round_factor
 from rbm_cli.structures.outline import base_slip, drum_outlines
 
 #: Target of the shape exaggeration: largest drawn top displacement / height.

@@ -56,30 +56,33 @@ RunEnd = namedtuple(
 #: Runge-Kutta work arrays (the stages K, the dense output's coefficients F, f = y'(t), the
 #: step's end ynew, a stage's argument tmp, a right-hand side's work, the error norm's scale,
 #: a state on the dense output yq), the right-hand side's arrays (a structure's rhs, e.g.
-#: structures.rates.rhs: As, cs, es as sys_A, sys_c, sys_e), and the run's figures, filled
-#: in place: RunEnd's max_ratio, friction, slip, swept and ledger, and top (1,): the top's
-#: peak.
+#: structures.rates.rhs: As, cs, es as sys_A, sys_c, sys_e), the step sizes remembered after
+#: each kind of event (h_after [s]: run_motion), and the run's figures, filled in place:
+#: RunEnd's max_ratio, friction, slip, swept and ledger, and top (1,): the top's peak.
 LOOP_FIELDS = [
     ("y", "float64[::1]"), ("y_new", "float64[::1]"), ("K", "float64[:, ::1]"),
     ("F", "float64[:, ::1]"), ("f", "float64[::1]"), ("ynew", "float64[::1]"),
     ("tmp", "float64[::1]"), ("work", "float64[::1]"), ("scale", "float64[::1]"),
     ("yq", "float64[::1]"), ("sys_A", "float64[:, ::1]"), ("sys_c", "float64[::1]"),
-    ("sys_e", "float64[::1]"), ("max_ratio", "float64[::1]"), ("friction", "float64[::1]"),
+    ("sys_e", "float64[::1]"), ("h_after", "float64[::1]"), ("max_ratio", "float64[::1]"),
+    ("friction", "float64[::1]"),
     ("slip", "float64[::1]"), ("swept", "float64[::1]"), ("ledger", "float64[::1]"),
     ("top", "float64[::1]"),
 ]  # fmt: skip
 
 
 @jit(inline=True)
-def loop_into(W, y, system):
+def loop_into(W, y, system, kinds):
     """Set the fields of a run's record W that the loop's own (LOOP_FIELDS but the figures):
     the state y, the Runge-Kutta work arrays for a state of its size, the right-hand side's
-    arrays system = (As, cs, es)."""
+    arrays system = (As, cs, es), and no step size remembered yet after any of the
+    structure's kinds of event (h_after: inf, the structure's at_event numbers them)."""
     m = y.size
     W.y, W.y_new, W.K, W.F = y, np.empty(m), np.empty((NS_MAX, m)), np.empty((8, m))
     W.f, W.ynew, W.tmp, W.work = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
     W.scale, W.yq = np.empty(m), np.empty(m)
     W.sys_A, W.sys_c, W.sys_e = system
+    W.h_after = np.full(kinds, np.inf)
 
 
 @jit(inline=True)
@@ -117,6 +120,13 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
     there, the structure's figures are taken over the step, and at the event the structure
     changes its pieces (an uplift, a kink, an impact, a collapse) and the stepper starts
     anew. A rigid monolith at rest waits, in closed form, for the ground to lift it.
+
+    The step after an event is the one proposed before it, no larger than the step the
+    controller proposed after the first step that followed the last event of the same
+    kind (the structure numbers the kinds: a joint's closure, say, whose stiff law piece
+    wants shorter steps than the open joint before it; W.h_after). Without that memory
+    the first attempt after a joint of the 8-drum column closes is rejected more often
+    than not.
 
     What is the structure's is called by name (the structure's functions, bound by
     loop_for): enter_segment, rest_to_end, rest, restart, ground_piece, find_event,
@@ -167,6 +177,7 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
         can_stop = early_stop != STOP_NEVER and free_seg and motion.pulse and monolith
         sure_stop = early_stop == STOP_OUTCOME and seg > last_forced and outcome_bound
         h_carry = -1.0  # the step size proposed before an event, carried over it
+        after = -1  # the kind of event just passed whose step size is to be remembered
         while t < seg_end:
             if at_rest:
                 if free_seg:  # no ground motion from here on: at rest to the end
@@ -197,6 +208,9 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
                     mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
                     scale, err_exp)  # fmt: skip
                 n_rhs += calls
+                if after >= 0:  # the first step after an event: remember what comes next
+                    W.h_after[after] = h_abs
+                    after = -1
                 code, n_steps = step_verdict(taken, n_steps, max_steps, deadline)
                 if code != GOING:
                     return run_end(W, code, t, np.nan, -1, (n_upl, n_imp, n_steps, n_rhs, n_ev),
@@ -243,6 +257,9 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
             if code == COLLAPSED:
                 return run_end(W, COLLAPSED, t, t, which, (n_upl, n_imp, n_steps, n_rhs, n_ev),
                                n_out, angle)  # fmt: skip
+            if which >= 0:  # an event of a kind whose step size is remembered
+                h_carry = min(h_carry, W.h_after[which])
+                after = which
     return run_end(W, SURVIVED, t, np.nan, -1, (n_upl, n_imp, n_steps, n_rhs, n_ev),
                    n_out, np.nan)  # fmt: skip
 

@@ -154,12 +154,18 @@ def test_the_6_drum_column_demand_agrees_between_methods_and_is_not_its_peak():
 
 @pytest.mark.slow
 def test_the_8_drum_column_demand_agrees_between_methods_and_is_not_its_peak():
+    """At 0.18 g, 2 Hz (its joints barely open) and at 0.25 g, 3 Hz (it rocks, its peak
+    rotation 0.2-0.5 of the limit by method, and survives) the held demand agrees between
+    methods; where it rocks, the base's peak (its impacts) holds for a few ms only, and the
+    held demand is about half of it. At 0.2 g, 2 Hz the column rocks or barely moves as
+    the amplitude changes by 1e-9: no cell to compare methods on."""
     cfg = rbm.load_config(CONFIGS / "harmonic_multidrum.yaml")
-    for amplitude_g in (0.18, 0.2):
-        held, runs = _agree(cfg, amplitude_g, 2.0)
-        assert all(h < 0.7 for h in held.values()), held
-    for r in runs.values():  # at 0.2 g the base's peak holds for a few ms: not the demand
-        assert r.friction_demand_peak[0] > 1.3, r.friction_demand_peak
+    held, _ = _agree(cfg, 0.18, 2.0)
+    assert all(h < 0.7 for h in held.values()), held
+    held, runs = _agree(cfg, 0.25, 3.0)
+    for name, r in runs.items():
+        assert r.friction_demand_peak[0] > 1.3, (name, r.friction_demand_peak)
+        assert held[name] < 0.6 * r.friction_demand_peak[0], (name, held)
 
 
 @pytest.mark.slow

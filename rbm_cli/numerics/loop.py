@@ -65,9 +65,8 @@ LOOP_FIELDS = [
     ("tmp", "float64[::1]"), ("work", "float64[::1]"), ("scale", "float64[::1]"),
     ("yq", "float64[::1]"), ("sys_A", "float64[:, ::1]"), ("sys_c", "float64[::1]"),
     ("sys_e", "float64[::1]"), ("h_after", "float64[::1]"), ("max_ratio", "float64[::1]"),
-    ("friction", "float64[::1]"),
-    ("slip", "float64[::1]"), ("swept", "float64[::1]"), ("ledger", "float64[::1]"),
-    ("top", "float64[::1]"),
+    ("friction", "float64[::1]"), ("slip", "float64[::1]"), ("swept", "float64[::1]"),
+    ("ledger", "float64[::1]"), ("top", "float64[::1]"),
 ]  # fmt: skip
 
 
@@ -121,12 +120,9 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
     changes its pieces (an uplift, a kink, an impact, a collapse) and the stepper starts
     anew. A rigid monolith at rest waits, in closed form, for the ground to lift it.
 
-    The step after an event is the one proposed before it, no larger than the step the
-    controller proposed after the first step that followed the last event of the same
-    kind (the structure numbers the kinds: a joint's closure, say, whose stiff law piece
-    wants shorter steps than the open joint before it; W.h_after). Without that memory
-    the first attempt after a joint of the 8-drum column closes is rejected more often
-    than not.
+    The step after an event is the one proposed before it, no larger than the one proposed
+    after the first step that followed the last event of its kind (W.h_after; the structure
+    numbers the kinds: a joint that closes wants shorter steps than it did open).
 
     What is the structure's is called by name (the structure's functions, bound by
     loop_for): enter_segment, rest_to_end, rest, restart, ground_piece, find_event,
@@ -208,9 +204,8 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
                     mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
                     scale, err_exp)  # fmt: skip
                 n_rhs += calls
-                if after >= 0:  # the first step after an event: remember what comes next
-                    W.h_after[after] = h_abs
-                    after = -1
+                if after >= 0:  # the first step after an event: what it proposes next
+                    W.h_after[after], after = h_abs, -1
                 code, n_steps = step_verdict(taken, n_steps, max_steps, deadline)
                 if code != GOING:
                     return run_end(W, code, t, np.nan, -1, (n_upl, n_imp, n_steps, n_rhs, n_ev),
@@ -257,9 +252,8 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
             if code == COLLAPSED:
                 return run_end(W, COLLAPSED, t, t, which, (n_upl, n_imp, n_steps, n_rhs, n_ev),
                                n_out, angle)  # fmt: skip
-            if which >= 0:  # an event of a kind whose step size is remembered
-                h_carry = min(h_carry, W.h_after[which])
-                after = which
+            if which >= 0:  # a kind of event whose next step is remembered
+                h_carry, after = min(h_carry, W.h_after[which]), which
     return run_end(W, SURVIVED, t, np.nan, -1, (n_upl, n_imp, n_steps, n_rhs, n_ev),
                    n_out, np.nan)  # fmt: skip
 

@@ -42,8 +42,6 @@ from .paths import CONFIGS, RESULTS
 
 CI_BAND = CONFIGS / "ci" / "suite_multidrum_ci.yaml"
 STOPPED = re.compile(r"stopped at ([0-9.e+-]+) s \(solver\.stop: outcome\)")
-#: the ensemble's columns of domain.csv (the stored domain is an ensemble; these sweeps are
-#: single runs), left out of the comparison
 RECORD_S = 30.0  # the synthetic records' length [s]
 
 

@@ -39,9 +39,16 @@ from profile_records import CONFIG, points  # the script beside this one
 from rbm_cli.base.jit import plain
 from rbm_cli.config.load import load_config
 from rbm_cli.inputs.excitation import make_ground_motion
+from rbm_cli.models.rbm.pieces import IMPACT, KINK, UPLIFT
+from rbm_cli.models.rbm.step import stepper
 from rbm_cli.models.registry import make_runner
+from rbm_cli.numerics.rk import TAB_NS
 from rbm_cli.structures.arrays import column_arrays
 
+#: The kinds of event a step follows, by what the column's switch returns (a rest counts
+#: as an impact).
+KINDS = {UPLIFT: "uplift", KINK: "kink (here: a joint back on its elastic branch)",
+         IMPACT: "impact"}  # fmt: skip
 #: Sample interval of the recorded run that finds the first opening [s].
 OPEN_DT = 2e-4
 REPEATS = 3
@@ -171,21 +178,17 @@ def report(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def after_events(seconds: float = 10.0, pga_g: float = 0.2) -> dict:
-    """Steps after each kind of event (and after none) whose first attempt was rejected:
-    {kind: (steps, of them rejected, median accepted / attempted size of those)}, from the
-    step kernel's source run uncompiled (the module's names wrapped while it runs)."""
-    from rbm_cli.models.rbm.pieces import IMPACT, KINK, UPLIFT
-    from rbm_cli.models.rbm.step import stepper
-    from rbm_cli.numerics.rk import TAB_NS
-
+def first_attempts(seconds: float = 10.0, pga_g: float = 0.2) -> tuple[str, dict, str]:
+    """The step kernel's source run uncompiled (the run loop's step and the column's switch
+    wrapped while it runs) over the first ``seconds`` of the CI band's first record at
+    ``pga_g``: (the record's name, {the kind of event before a step (KINDS' labels, or
+    "none"): [(its first attempt rejected, accepted / attempted size), ...]}, the run's
+    status)."""
     config = load_config(CONFIG)
     name, cfg = next(points(config))
     cfg = _with_method(cfg, "DOP853", "python")
     motion = make_ground_motion(cfg.excitation, pga_g)
     motion = _until(motion, seconds + 1e-9)
-    kinds = {UPLIFT: "uplift", KINK: "kink (here: a joint back on its elastic branch)",
-             IMPACT: "impact"}  # fmt: skip
     last = ["none"]
     seen: dict = collections.defaultdict(list)
     # the run loop calls the step from its own names (numerics.loop.loop_for), the event's
@@ -202,14 +205,22 @@ def after_events(seconds: float = 10.0, pga_g: float = 0.2) -> dict:
 
     def counted_switch(*args):
         what = switch(*args)
-        last[0] = kinds.get(what, "impact")
+        last[0] = KINDS.get(what, KINDS[IMPACT])
         return what
 
     loop_names["attempt_step"], stepper.switch = counted_attempt, counted_switch
     try:
-        make_runner(cfg).run(motion, cfg.solver)
+        out = make_runner(cfg).run(motion, cfg.solver)
     finally:
         loop_names["attempt_step"], stepper.switch = compiled
+    return name, seen, out.status
+
+
+def after_events(seconds: float = 10.0, pga_g: float = 0.2) -> dict:
+    """Steps after each kind of event (and after none) whose first attempt was rejected:
+    {kind: (steps, of them rejected, median accepted / attempted size of those)}
+    (first_attempts)."""
+    name, seen, _ = first_attempts(seconds, pga_g)
     out = {}
     for kind, steps in seen.items():
         rejected = [ratio for was_rejected, ratio in steps if was_rejected]

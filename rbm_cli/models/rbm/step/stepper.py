@@ -240,7 +240,7 @@ def run_kernel(model, motion, solver, task):
             last_forced = seg
     outcome_bound = model.survival == model.survival and not vert  # a barrier that applies
     stops = (task.early_stop, last_forced, outcome_bound, n == 1)
-    loop_into(W, y, system, 2 * n)
+    loop_into(W, y, system, 2 * n)  # the kinds of event at_event numbers: kinks, 2 a joint
     return run_plane(W, motion, solver, n, at_rest, stops, account)
 
 

@@ -73,11 +73,11 @@ def test_a_schema1_domain_migrates_to_the_hash_of_its_config(tmp_path):
     old = _meta(folder)["config_hash"]
     res = _migrate(folder)
     assert res.exit_code == 0, res.output
-    assert len(res.output.strip().splitlines()) == 1 and "schema 1 -> 3" in res.output
+    assert len(res.output.strip().splitlines()) == 1 and "schema 1 -> 4" in res.output
     meta = _meta(folder)
     # the hash of the shipped config, as a sweep of it computes it today
     assert meta["config_hash"] == config_hash(load_config(CONFIGS / f"{NAME}.yaml")) + "-ensemble16"
-    assert meta["schema"] == SCHEMA == 3 and meta["solver_method"] == "closed-form"
+    assert meta["schema"] == SCHEMA == 4 and meta["solver_method"] == "closed-form"
     assert meta["migrated"]["from_schema"] == 1 and meta["migrated"]["from_hash"] == old
     assert {name: (folder / name).read_bytes() for name in FILES} == before  # rows untouched
     text = (folder / "meta.json").read_bytes()
@@ -132,7 +132,7 @@ def _changed_setting(folder, meta):
 
 
 def _newer(folder, meta):
-    meta["schema"] = 4
+    meta["schema"] = SCHEMA + 1
 
 
 @pytest.mark.parametrize(
@@ -142,7 +142,7 @@ def _newer(folder, meta):
         (_changed_file, "its boundary.csv is not the file meta.json names"),
         (_changed_setting, "a setting differs: interface.restitution"),
         (_budget_row, "1 cell(s) ran out of a step or event budget"),
-        (_newer, "stored under schema 4: made by a newer rbm"),
+        (_newer, f"stored under schema {SCHEMA + 1}: made by a newer rbm"),
     ],
 )
 def test_migrate_refuses_a_domain_it_cannot_vouch_for(tmp_path, tamper, says):
@@ -224,54 +224,69 @@ def test_a_sweep_stores_the_schema_and_the_method(tmp_path):
     assert meta["config_hash"] == config_hash(cfg)
 
 
-# ------------------------------------------------------------------ schema 2 -> 3
+# ------------------------------------------------------------ schemas 2 and 3 -> 4
 
 #: A domain stored by rbm 0.2.0 under schema 2 (its meta.json's config is that rbm's
-#: resolved form) and migrated to schema 3 in results/: made schema-2 again here.
-SCHEMA2 = ROOT / "results" / NAME
+#: resolved form), migrated to schema 3 and then to 4 in results/: made schema-2 or
+#: schema-3 again here from the record of its migrations.
+EARLIER = ROOT / "results" / NAME
+#: The section each schema added to the resolved form (None where a config has none).
+ADDED = {3: "uncertain", 4: "frame"}
 
 
-def schema2_digest(meta: dict) -> str:
-    """Schema 2's hash of the config meta.json stores (the resolved form): without
-    solver.max_wall_time, the method that ran in place of the one written, under 2."""
+def earlier_digest(meta: dict, schema: int) -> str:
+    """Schema 2's or 3's hash of the config meta.json stores (rbm 0.2.0's resolved form,
+    schema 2's): without solver.max_wall_time, the sections added up to the schema as None
+    (the domain has none), the method that ran in place of the one written, under its
+    number."""
     form = copy.deepcopy(meta["config"])
     form["solver"].pop("max_wall_time", None)
     form["solver"]["method"] = meta["solver_method"]
-    form["schema"] = 2
+    for added, section in ADDED.items():
+        assert section not in form
+        if added <= schema:
+            form[section] = None
+    form["schema"] = schema
     return hashlib.sha256(json.dumps(form, sort_keys=True).encode()).hexdigest()[:16]
 
 
-def _schema2(tmp_path):
+def _earlier(tmp_path, schema):
     folder = tmp_path / "results" / NAME
-    shutil.copytree(SCHEMA2, folder)
+    shutil.copytree(EARLIER, folder)
     meta = _meta(folder)
-    meta["schema"], meta["config_hash"] = 2, meta.pop("migrated")["from_hash"]
+    record = meta.pop("migrated")
+    while record["from_schema"] != schema:
+        record = record["before"]
+    meta["schema"], meta["config_hash"] = schema, record["from_hash"]
     _write_meta(folder, meta)
     return folder
 
 
-def test_a_schema2_domain_holds_the_schema2_hash_of_its_config(tmp_path):
-    meta = _meta(_schema2(tmp_path))
-    assert meta["versions"]["rbm"] == "0.2.0" and "uncertain" not in meta["config"]
-    assert meta["config_hash"] == schema2_digest(meta) + "-ensemble16"
+@pytest.mark.parametrize("schema", [2, 3])
+def test_an_earlier_domain_holds_its_schemas_hash_of_its_config(tmp_path, schema):
+    meta = _meta(_earlier(tmp_path, schema))
+    assert meta["versions"]["rbm"] == "0.2.0"
+    assert meta["config_hash"] == earlier_digest(meta, schema) + "-ensemble16"
 
 
-def test_a_schema2_domain_migrates_to_schema3_with_its_rows_untouched(tmp_path):
-    folder = _schema2(tmp_path)
+@pytest.mark.parametrize("schema", [2, 3])
+def test_an_earlier_domain_migrates_to_schema4_with_its_rows_untouched(tmp_path, schema):
+    folder = _earlier(tmp_path, schema)
     before = {name: (folder / name).read_bytes() for name in FILES}
     old = _meta(folder)["config_hash"]
     res = _migrate(folder)
     assert res.exit_code == 0, res.output
-    assert len(res.output.strip().splitlines()) == 1 and "schema 2 -> 3" in res.output
+    assert len(res.output.strip().splitlines()) == 1 and f"schema {schema} -> 4" in res.output
     meta = _meta(folder)
     assert meta["config_hash"] == config_hash(load_config(CONFIGS / f"{NAME}.yaml")) + "-ensemble16"
-    assert meta["config_hash"] != old and meta["schema"] == SCHEMA == 3
-    assert meta["migrated"]["from_schema"] == 2 and meta["migrated"]["from_hash"] == old
+    assert meta["config_hash"] != old and meta["schema"] == SCHEMA == 4
+    assert meta["migrated"]["from_schema"] == schema and meta["migrated"]["from_hash"] == old
     assert {name: (folder / name).read_bytes() for name in FILES} == before
 
 
-def test_resume_takes_a_schema2_domain_as_finished(tmp_path):
-    folder = _schema2(tmp_path)
+@pytest.mark.parametrize("schema", [2, 3])
+def test_resume_takes_an_earlier_domain_as_finished(tmp_path, schema):
+    folder = _earlier(tmp_path, schema)
     meta = (folder / "meta.json").read_bytes()
     res = CliRunner().invoke(cli, ["sweep", str(CONFIGS / f"{NAME}.yaml"), "-o",
                                    str(folder.parent), "--ensemble", "16", "--resume"])  # fmt: skip
@@ -286,8 +301,8 @@ def test_resume_takes_a_schema2_domain_as_finished(tmp_path):
         (_changed_setting, "not the schema-2 hash of the config it holds"),
     ],
 )
-def test_a_schema2_domain_that_is_not_its_config_is_refused(tmp_path, tamper, says):
-    folder = _schema2(tmp_path)
+def test_an_earlier_domain_that_is_not_its_config_is_refused(tmp_path, tamper, says):
+    folder = _earlier(tmp_path, 2)
     meta = _meta(folder)
     tamper(folder, meta)
     _write_meta(folder, meta)

@@ -302,6 +302,6 @@ def migrate(folder: str | os.PathLike) -> str:
     --------
     >>> import rbm
     >>> rbm.migrate("results/suite_multidrum")  # doctest: +SKIP
-    'results/suite_multidrum: schema 2 -> 3, hash 8545b8977a6e898c-ensemble16 -> ...'
+    'results/suite_multidrum: schema 3 -> 4, hash ...-ensemble16 -> ...'
     """
     return _migrate(folder)

@@ -45,6 +45,7 @@ from rbm_cli.config.types import (
     CollapseConfig,
     ColumnConfig,
     Config,
+    FrameConfig,
     SolverConfig,
     TopMassConfig,
 )
@@ -75,7 +76,7 @@ __all__ = [
 
 TOP_KEYS = (
     "name", "model", "column", "interface", "excitation", "grid", "collapse", "solver",
-    "uncertain",
+    "uncertain", "frame",
 )  # fmt: skip
 COLUMN_KEYS = (
     "height",
@@ -90,6 +91,12 @@ COLUMN_KEYS = (
 )
 CAPITAL_KEYS = ("height", "width", "depth")
 TOP_MASS_KEYS = ("mass", "height_of_centre")
+FRAME_KEYS = ("columns", "beam_mass")
+#: Columns of a frame the tool accepts: a bay of two to a long colonnade.
+MAX_FRAME_COLUMNS = 1000
+#: Beam masses the tool accepts [kg] [assumption]: up to many times the heaviest stone
+#: entablature; far beyond, the beam's share swamps a column's own mass in floating point.
+BEAM_MASS_RANGE = (0.0, 1e12)
 #: Masses of a top mass the tool accepts [kg] [assumption]: a laboratory weight to the
 #: share of a heavy stone entablature many times a column's own mass.
 TOP_MASS_RANGE = (1e-3, 1e9)
@@ -378,6 +385,7 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
             )
         ),
         solver=_solver(top.get("solver")),
+        frame=_frame(top["frame"], model, column) if "frame" in top else None,
     )
     if top.get("uncertain") is not None:
         grid = config.grid
@@ -526,6 +534,37 @@ def _column(raw: Any) -> ColumnConfig:
         capital=_capital(c["capital"], section) if "capital" in c else None,
         top_mass=_top_mass(c["top_mass"]) if "top_mass" in c else None,
     )
+
+
+def _frame(raw: Any, model: str, column: ColumnConfig) -> FrameConfig:
+    """frame: {columns: N >= 2, beam_mass [kg] >= 0}, for a model that rocks frames
+    (ModelEntry.frame)."""
+    if raw is None:
+        raise _empty("frame", "columns (an integer >= 2), beam_mass [kg]")
+    f = mapping(raw, "frame", FRAME_KEYS, required=FRAME_KEYS)
+    if not MODELS[model].frame:
+        takes = ", ".join(name for name, entry in MODELS.items() if entry.frame)
+        three = " (a frame rocks in one plane)" if MODELS[model].three_d else ""
+        raise ConfigError(
+            f"frame is taken by models {takes} in this version, not by model {model}{three}:"
+            " delete frame or change the model"
+        )
+    columns = integer(f["columns"], "frame.columns", 2, MAX_FRAME_COLUMNS)
+    beam = number(f["beam_mass"], "frame.beam_mass", "kg", 0.0, lo_open=False)
+    beam = in_bounds(beam, "frame.beam_mass", "kg", BEAM_MASS_RANGE)
+    if column.top_mass is not None:
+        raise ConfigError(
+            "column.top_mass and frame both put an entablature on the column: the frame's"
+            " beam rests on every column top (frame.beam_mass); delete column.top_mass"
+        )
+    if not MODELS[model].multi_drum and column.top_width != column.base_width:
+        raise ConfigError(
+            f"model {model}'s frame is Makris and Vassiliou's equivalent block, exact for"
+            " columns whose centre of mass is at half their diagonal: give a prismatic column"
+            f" (column.top_width = base_width, got {fmt(column.top_width)} and"
+            f" {fmt(column.base_width)} m) or use model rbm"
+        )
+    return FrameConfig(columns=columns, beam_mass=beam)
 
 
 def _empty(path: str, keys: str) -> ConfigError:

@@ -74,8 +74,9 @@ class ModelEntry:
     in three dimensions when its motion is given a direction or a second component and in
     the plane otherwise (``any_direction``: Config.three_d), whether its joints are the
     Rigid Beam Model's (their laws, stiffness and damping, a capital or a top mass, the
-    friction demand), and whether its drums may slide for good (``residual``: its runs
-    give a residual slip, top offset and tilt, Outcome.residual_slip and the like)."""
+    friction demand), whether its drums may slide for good (``residual``: its runs
+    give a residual slip, top offset and tilt, Outcome.residual_slip and the like), and
+    whether it rocks a frame of columns under a beam (``frame``: Config.frame)."""
 
     runner: str
     multi_drum: bool
@@ -83,6 +84,7 @@ class ModelEntry:
     beam: bool = False
     any_direction: bool = False
     residual: bool = False
+    frame: bool = False
 
 
 #: The model registry, name -> runner (rbm_cli.models.registry resolves it). rbm: the
@@ -97,9 +99,11 @@ class ModelEntry:
 #: A new model is one module and one line here.
 MODELS = {
     "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True, beam=True),
-    "housner": ModelEntry("rbm_cli.models.housner.runner:HousnerRunner", multi_drum=False),
+    "housner": ModelEntry(
+        "rbm_cli.models.housner.runner:HousnerRunner", multi_drum=False, frame=True
+    ),
     "housner-linear": ModelEntry(
-        "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False
+        "rbm_cli.models.block.runner:HousnerLinearRunner", multi_drum=False, frame=True
     ),
     "bullet": ModelEntry(
         "rbm_cli.models.bullet.run:BulletRunner",
@@ -143,6 +147,25 @@ class TopMassConfig:
 
     mass: float
     height_of_centre: float = 0.0
+
+
+@dataclass(frozen=True)
+class FrameConfig:
+    """A frame (a colonnade's bay): ``columns`` identical columns, each the config's
+    ``column``, standing in a row in the plane of the motion under one rigid beam (an
+    architrave) that rests freely on their tops.
+
+    columns : int  N, the number of columns (>= 2)
+    beam_mass : float  The whole beam's mass [kg] (0: the columns stand free)
+    """
+
+    columns: int
+    beam_mass: float
+
+    def ratio(self, column_mass: float) -> float:
+        """gamma = m_beam / (N m), the beam's mass over the columns' [-], for a column of
+        mass ``column_mass`` [kg]."""
+        return self.beam_mass / (self.columns * column_mass)
 
 
 @dataclass(frozen=True)
@@ -528,6 +551,8 @@ class Config:
     solver: SolverConfig = field(default_factory=SolverConfig)
     #: Config keys drawn from distributions, a sample per cell (rbm_cli.config.uncertain).
     uncertain: UncertainConfig | None = None
+    #: Columns under a beam (a rocking frame): None for a column standing alone.
+    frame: FrameConfig | None = None
     written: dict | None = field(default=None, compare=False, repr=False)
     base_dir: str | None = field(default=None, compare=False, repr=False)
 

@@ -8,6 +8,8 @@ import math
 from rbm_cli.config.grid import VIRTUAL_PATHS
 from rbm_cli.config.types import MODELS, Config, G
 from rbm_cli.structures.assembly import model_from_config
+from rbm_cli.structures.block import block_geometry
+from rbm_cli.structures.frame import frame_figures
 from rbm_cli.structures.similarity import rocking_scales
 
 
@@ -32,7 +34,8 @@ def describe(config: Config) -> dict:
     (:func:`p_meaning`), as `rbm info` prints them.
     Elastic frequencies are those of the elastic branches of the laws in the chosen
     formulation. For `model: bullet` the figures are the RBM's, plus the engine's own uplift
-    level (true solids, min(tan alpha_i, friction) g).
+    level (true solids, min(tan alpha_i, friction) g). A frame (columns under a beam) adds
+    its figures (:func:`frame_info`; None for a column standing alone).
     """
     model = model_from_config(config)
     col = model.column
@@ -93,7 +96,29 @@ def describe(config: Config) -> dict:
         "damping_ratios": [model.damping * f / freqs[0] for f in freqs] if model.damping else [],
         "interfaces": interfaces,
         **engine,
+        **frame_info(config),
     }
+
+
+#: The figures of a frame in `rbm info`'s data (None each for a column standing alone).
+FRAME_KEYS = (
+    "frame_columns", "beam_mass_kg", "frame_gamma", "frame_p_rad_s", "frame_half_diagonal_m",
+    "frame_restitution", "frame_static_multiplier_g",
+)  # fmt: skip
+
+
+def frame_info(config: Config) -> dict:
+    """A frame's figures: its columns N, the beam's mass [kg], gamma = m_b / (N m) [-], and
+    the block it rocks as (rbm_cli.structures.frame.frame_figures, of the columns' true
+    rigid solids): p_hat [rad/s], R_hat [m], eta [-] and the acceleration that lifts it
+    [g]; None each without a frame."""
+    frame = config.frame
+    if frame is None:
+        return dict.fromkeys(FRAME_KEYS)
+    figures = frame_figures(block_geometry(config.column), frame)
+    values = (frame.columns, frame.beam_mass, figures.ratio, figures.frequency_parameter,
+              figures.half_diagonal, figures.restitution, figures.static_multiplier)  # fmt: skip
+    return dict(zip(FRAME_KEYS, values, strict=True))
 
 
 def p_meaning(config: Config, n: int, lever: float) -> dict[str, str]:
@@ -116,6 +141,10 @@ def p_meaning(config: Config, n: int, lever: float) -> dict[str, str]:
         )
     elif MODELS[config.model].beam:
         domain = "the RBM's monolith: the rocking p"
+    elif config.frame is not None:
+        domain = (f"the block the frame rocks as ({config.model}: its columns' true "
+                  "solids under the beam, tan alpha = b/z_c, p = p_hat), not the RBM's"
+                  " rocking p")  # fmt: skip
     else:
         domain = (f"the true solid's ({config.model}: a rigid block, tan alpha = b/z_c with "
                   "z_c its true centre of mass, p^2 = m g R / I_O about the base corner), "
@@ -191,6 +220,15 @@ def format_info(info: dict) -> str:
         rows.insert(2, ("top mass", f"{_fmt(info['top_mass_kg'])} kg, centre at "
                                     f"{_fmt(info['top_mass_centre_height_m'])} m above the"
                                     " ground (in the top drum's m_i and I_Gi)"))  # fmt: skip
+    if info.get("frame_columns") is not None:
+        rows.insert(2, ("frame", f"{info['frame_columns']} columns under a beam of"
+                                 f" {_fmt(info['beam_mass_kg'])} kg (gamma"
+                                 f" {_fmt(info['frame_gamma'])})"))  # fmt: skip
+        rows.append(("frame rocks as", (
+            f"one block (Makris and Vassiliou, rigid columns): p_hat"
+            f" {_fmt(info['frame_p_rad_s'])} rad/s, R_hat {_fmt(info['frame_half_diagonal_m'])}"
+            f" m, eta {_fmt(info['frame_restitution'])}, lifting at"
+            f" {_fmt(info['frame_static_multiplier_g'])} g")))  # fmt: skip
     if info.get("engine_uplift_g") is not None:
         rows.append(
             (

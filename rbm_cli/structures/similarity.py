@@ -17,7 +17,9 @@ column's own first scales however many drums it has:
   and the capital as one rigid stack: tan alpha = theta_u,1, p^2 = N_1 zbar_1 / (1^T M 1)
   (rbm_cli.structures.equations.Model.rocking_p);
 - ``housner``, ``housner-linear``, ``bullet`` (true geometry, rigid blocks): the block's
-  tan alpha = b / z_c and p^2 = m g R / I_O (rbm_cli.structures.block.block_geometry).
+  tan alpha = b / z_c and p^2 = m g R / I_O (rbm_cli.structures.block.block_geometry); for
+  a frame of such columns under a beam, the block it rocks as: its columns' alpha and
+  p_hat (rbm_cli.structures.frame), since the frame obeys the same law with p_hat.
 
 The static multiplier is the uniform horizontal acceleration [g] that starts the column
 rocking: min over the interfaces of theta_u,i for the RBM (the weakest stack), tan alpha
@@ -35,6 +37,7 @@ from rbm_cli.structures.block import block_geometry
 from rbm_cli.structures.closed_forms import linear_rocking_parameters
 from rbm_cli.structures.column import build_column
 from rbm_cli.structures.equations import build_model
+from rbm_cli.structures.frame import frame_block
 
 
 @dataclass(frozen=True)
@@ -69,6 +72,8 @@ def rocking_scales(config: Config) -> RockingScales:
         tan_alpha, p = linear_rocking_parameters(build_column(glued, rigid))
         return RockingScales(math.atan(tan_alpha), p, column.static_multiplier)
     block = block_geometry(glued)
+    if config.frame is not None:
+        block = frame_block(block, config.frame)
     tan_alpha = math.tan(block.slenderness)
     static = tan_alpha if config.column.n_drums == 1 else min(tan_alpha, column.static_multiplier)
     return RockingScales(block.slenderness, block.frequency_parameter, static)

@@ -28,12 +28,15 @@ version's): :func:`migrate` rewrites its meta.json with today's hash once it has
 
 Anything else is refused in one line, naming what differs: re-make the domain.
 
-Schema 2 took the hash of the same form as schema 3 before the config had an ``uncertain``
-section (rbm_cli.config.uncertain): schema 3's resolved form holds ``uncertain`` (None
-without one), which changed every config's hash and nothing else. A domain stored under
-schema 2 has no uncertain keys, so its rows stand: :func:`migrate` rewrites its meta.json
-with today's hash once its files are those meta.json names and its hash is the schema-2
-hash (:func:`schema2_hash`) of the config read back from it, as this version reads it.
+Schemas 2 and 3 took the hash of the same form as today's before the config had the
+sections a later schema added (ADDED_BY): schema 3 added ``uncertain``
+(rbm_cli.config.uncertain), schema 4 ``frame`` (columns under a beam,
+rbm_cli.config.types.FrameConfig); each is None in the resolved form of a config without
+it, so adding it changed every config's hash and nothing else. A domain stored under
+schema 2 or 3 has none of the sections added after it, so its rows stand: :func:`migrate`
+rewrites its meta.json with today's hash once its files are those meta.json names and its
+hash is the hash its schema took (:func:`earlier_hash`) of the config read back from it,
+as this version reads it.
 """
 
 from __future__ import annotations
@@ -57,7 +60,10 @@ from rbm_cli.study.schema import C
 from rbm_cli.study.store import JOURNAL
 
 #: The form of the config hash (written as meta.json's ``schema``).
-SCHEMA = 3
+SCHEMA = 4
+#: The section of the resolved config each schema added (schema -> section): a config of an
+#: earlier schema had none (None in today's form).
+ADDED_BY = {3: "uncertain", 4: "frame"}
 #: Settings left out of the hash: they fail a run, never change a finished one.
 NOT_SETTINGS = (("solver", "max_wall_time"),)
 #: Settings schema 1 left out of its hash where they had these (default) values: they came
@@ -82,6 +88,7 @@ SCHEMA1_LEFT_OUT = {
     ("excitation", "initial", "rotations_across"): [],
     ("excitation", "initial", "velocities_across"): [],
     ("uncertain",): None,
+    ("frame",): None,
 }
 #: Schema 1's step and event budgets of one run (fixed then; ``auto`` now, never less).
 SCHEMA1_BUDGETS = {"max_steps": 2_000_000, "max_events": 200_000}
@@ -136,15 +143,17 @@ def config_hash(config: Config, points: list | None = None) -> str:
     return _digest(hash_form(config, points))
 
 
-def schema2_hash(config: Config, points: list | None = None) -> str | None:
-    """The hash schema 2 took of a config (the module's docstring): today's form without
-    ``uncertain``, under the number 2; None for a config with uncertain keys, which
-    schema 2 could not hold."""
-    if config.uncertain is not None:
+def earlier_hash(config: Config, schema: int, points: list | None = None) -> str | None:
+    """The hash schema 2 or 3 took of a config (the module's docstring): today's form
+    without the sections added after ``schema``, under its number; None for a config that
+    has one of them, which that schema could not hold."""
+    later = [section for added, section in ADDED_BY.items() if added > schema]
+    if any(getattr(config, section) is not None for section in later):
         return None
     form = hash_form(config, points)
-    form.pop("uncertain", None)
-    form["schema"] = 2
+    for section in later:
+        form.pop(section, None)
+    form["schema"] = schema
     return _digest(form)
 
 
@@ -157,15 +166,16 @@ def _files_problem(folder: Path, meta: dict) -> str | None:
     return None
 
 
-def schema2_problem(folder: Path, meta: dict, config: Config) -> str | None:
-    """Why the domain in ``folder``, stored under schema 2 with this ``meta``, is not the
-    domain ``config`` gives today, or None."""
+def earlier_problem(folder: Path, meta: dict, config: Config) -> str | None:
+    """Why the domain in ``folder``, stored under schema 2 or 3 with this ``meta``, is not
+    the domain ``config`` gives today, or None."""
     problem = _files_problem(folder, meta)
     if problem:
         return problem
+    schema = meta["schema"]
     stored = str(meta.get("config_hash", ""))[:16]
-    if schema2_hash(config) != stored:
-        return "its config hash is not the schema-2 hash of the config it holds"
+    if earlier_hash(config, schema) != stored:
+        return f"its config hash is not the schema-{schema} hash of the config it holds"
     return None
 
 
@@ -283,13 +293,13 @@ def read_meta(folder: Path) -> dict:
 def same_domain(folder: Path, meta: dict, config: Config, digest: str) -> bool:
     """Whether the finished domain in ``folder`` (its ``meta``) is the one ``config`` gives
     under ``digest`` (its hash, with the ensemble's suffix): the same hash under this
-    schema, or a schema-1 or schema-2 domain that :func:`migrate` would take."""
+    schema, or a domain of an earlier schema that :func:`migrate` would take."""
     schema = meta.get("schema", 1)
     if schema == SCHEMA:
         return meta.get("config_hash") == digest
-    if schema == 2:
+    if schema in (2, 3):
         stored = str(meta.get("config_hash", ""))
-        return _suffix(stored) == _suffix(digest) and stored[:16] == schema2_hash(config)
+        return _suffix(stored) == _suffix(digest) and stored[:16] == earlier_hash(config, schema)
     if schema != 1 or _suffix(str(meta.get("config_hash", ""))) != _suffix(digest):
         return False
     try:
@@ -303,7 +313,7 @@ def _suffix(digest: str) -> str:
 
 
 def migrate(folder: str | Path) -> str:
-    """Rewrite the meta.json of a domain stored under schema 1 or 2 with today's hash and
+    """Rewrite the meta.json of a domain stored under schema 1, 2 or 3 with today's hash and
     schema, once the module's checks hold; its other files are not touched. Returns a
     one-line note; RbmError (one line) when it cannot or need not be done."""
     folder = Path(folder)
@@ -311,14 +321,14 @@ def migrate(folder: str | Path) -> str:
     schema = meta.get("schema", 1)
     if schema == SCHEMA:
         return f"{folder}: already stored under schema {SCHEMA}, nothing to do"
-    if schema not in (1, 2):
+    if schema not in (1, 2, 3):
         raise RbmError(f"{folder} was stored under schema {schema!r}: made by a newer rbm")
     if (folder / JOURNAL).exists() or not (folder / "domain.csv").is_file():
         raise RbmError(f"{folder} holds no finished domain: finish it with the rbm that started it")
     config = domain_config(folder / "domain.csv")
     if config is None:
         raise RbmError(f"{folder}: its meta.json holds no config this rbm can read")
-    check = schema1_problem if schema == 1 else schema2_problem
+    check = schema1_problem if schema == 1 else earlier_problem
     problem = check(folder, meta, config)
     if problem:
         raise RbmError(f"cannot migrate {folder}: {problem}; re-make it")

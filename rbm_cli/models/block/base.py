@@ -1,5 +1,6 @@
 """What the two single-block reference models share as runners: the true block of the
-config's monolithic column (rbm_cli.structures.block), its restitution, its initial state and
+config's monolithic column (rbm_cli.structures.block), or the block a frame of such columns
+under a beam rocks as (rbm_cli.structures.frame), its restitution, its initial state and
 its history. Each model says only how it integrates one run (`_integrate`)."""
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from rbm_cli.models.contract import DEFAULT_OUTPUT_DT
 from rbm_cli.models.history import history_from_samples
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.structures.block import block_geometry, block_initial
+from rbm_cli.structures.frame import frame_block, frame_restitution
 from rbm_cli.structures.restitution import block_restitution, resolve
 
 
@@ -20,8 +22,9 @@ class BlockRunner:
 
     Attributes
     ----------
-    geometry : BlockGeometry  The true block of the column
-    restitution : float  e [-] (Housner's, of the true block, for 'housner')
+    geometry : BlockGeometry  The true block of the column, or of a frame of such columns
+        under a beam the equivalent block (rbm_cli.structures.frame.frame_block)
+    restitution : float  e [-] (Housner's, of the true block or the frame, for 'housner')
     initial : (float, float)  theta0 [rad], rate0 [rad/s]
     """
 
@@ -29,9 +32,13 @@ class BlockRunner:
 
     def __init__(self, config: Config) -> None:
         self.config = config
-        self.geometry = block_geometry(config.column)
+        column, frame = block_geometry(config.column), config.frame
+        self.geometry = column if frame is None else frame_block(column, frame)
         self.restitution = resolve(
-            config.interface.restitution, lambda: block_restitution(self.geometry)
+            config.interface.restitution,
+            lambda: (
+                block_restitution(column) if frame is None else frame_restitution(column, frame)
+            ),
         )
         self.initial = block_initial(config)
         self.node_map = np.array([[0.0], [config.column.height]])

@@ -430,6 +430,12 @@ def _check_dimensions(config: Config) -> None:
             f"excitation.initial.{key} is a state across the motion's plane, and model"
             f" {model} {why}: use a model in three dimensions ({spatial}) or delete it"
         )
+    if config.three_d and config.frame is not None:
+        raise ConfigError(
+            f"frame rocks in one plane, and model {model} moves in three dimensions here (its"
+            " motion given a direction or a second component): delete excitation.angle,"
+            " excitation.y and excitation.file_y, or delete frame"
+        )
     if config.three_d:
         if section != "circular":
             when = (

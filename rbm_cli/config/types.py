@@ -110,6 +110,7 @@ MODELS = {
         multi_drum=True,
         any_direction=True,
         residual=True,
+        frame=True,
     ),
     "housner-3d": ModelEntry(
         "rbm_cli.models.housner3d.runner:Housner3dRunner", multi_drum=False, three_d=True

@@ -36,8 +36,12 @@ FRICTION_MAX = 100.0
 BOTH_FORMS = "{rotational: K_M} [N m/rad] or {normal: k_n} [Pa/m]"
 
 
-def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
-    """Validate the ``interface`` mapping of a column of n drums for a model."""
+def interface_section(
+    raw: Any, n: int, model: str = "rbm", beam_joint: bool = False
+) -> InterfaceConfig:
+    """Validate the ``interface`` mapping of a column of n drums for a model; beam_joint:
+    the column carries a frame's beam on a joint of its own above the top drum (a list of
+    K_M then has n + 1 values, the beam joint's last)."""
     i = mapping(raw, "interface", INTERFACE_KEYS)
     if "friction" in i and not (model == "bullet" or MODELS[model].beam):
         beams = " and ".join(name for name, entry in MODELS.items() if entry.beam)
@@ -69,7 +73,9 @@ def interface_section(raw: Any, n: int, model: str = "rbm") -> InterfaceConfig:
             f"interface.restitution must be a number in (0, 1] or housner, got"
             f" {describe(restitution)}"
         )
-    stiffness = stiffness_value(i.get("stiffness", "rigid"), n, given="stiffness" in i)
+    stiffness = stiffness_value(
+        i.get("stiffness", "rigid"), n, given="stiffness" in i, beam_joint=beam_joint
+    )
     if damping > 0.0 and stiffness.kind == "rigid":
         raise ConfigError(
             "interface.damping damps the joints' elastic branch, which a rigid interface does"
@@ -100,8 +106,11 @@ def damping_value(i: Mapping, model: str) -> float:
     return number(i["damping"], "interface.damping", "", 0.0, 1.0, lo_open=False, hi_open=True)
 
 
-def stiffness_value(value: Any, n: int, *, given: bool = True) -> StiffnessConfig:
-    """``rigid``, ``{rotational: K_M or [K_M,i]}`` or ``{normal: k_n}``."""
+def stiffness_value(
+    value: Any, n: int, *, given: bool = True, beam_joint: bool = False
+) -> StiffnessConfig:
+    """``rigid``, ``{rotational: K_M or [K_M,i]}`` or ``{normal: k_n}`` (beam_joint: a
+    frame's beam joint above the n drums' takes the list's last value)."""
     path = "interface.stiffness"
     if isinstance(value, str) and value == "rigid":
         if n > 1:
@@ -121,7 +130,7 @@ def stiffness_value(value: Any, n: int, *, given: bool = True) -> StiffnessConfi
         if len(m) != 1:
             raise ConfigError(f"{path} needs exactly one of rotational and normal: {BOTH_FORMS}")
         if "rotational" in m:
-            return _rotational(m["rotational"], n)
+            return _rotational(m["rotational"], n, beam_joint)
         sub = f"{path}.normal"
         k_n = number(m["normal"], sub, "Pa/m", 0.0, inf_hint="use rigid for an infinite stiffness")
         return StiffnessConfig("normal", (in_bounds(k_n, sub, "Pa/m", NORMAL_RANGE, SOUND_WHY),))
@@ -131,11 +140,14 @@ def stiffness_value(value: Any, n: int, *, given: bool = True) -> StiffnessConfi
     )
 
 
-def _rotational(value: Any, n: int) -> StiffnessConfig:
+def _rotational(value: Any, n: int, beam_joint: bool = False) -> StiffnessConfig:
     path = "interface.stiffness.rotational"
     if isinstance(value, list | tuple):
         per = f"one K_M per interface ({n} for {n} drum{'s' if n > 1 else ''})"
-        values = number_list(value, path, "N m/rad", 0.0, length=n, length_text=per)
+        if beam_joint:
+            per = f"one K_M per interface ({n + 1}: {n} of the drums, then the beam's joint)"
+        length = n + 1 if beam_joint else n
+        values = number_list(value, path, "N m/rad", 0.0, length=length, length_text=per)
         for i, k in enumerate(values):
             in_bounds(k, f"{path}[{i}]", "N m/rad", ROTATIONAL_RANGE, SOUND_WHY)
         return StiffnessConfig("moment", values)

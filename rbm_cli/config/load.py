@@ -366,7 +366,8 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
             "interface.stiffness: rigid needs a monolithic column, and column.capital is a drum"
             f" of its own ({n} drums): give {{rotational: K_M}} or {{normal: k_n}}"
         )
-    interface = interface_section(top.get("interface"), n, model)
+    beam_joint = "frame" in top and MODELS[model].beam and MODELS[model].frame
+    interface = interface_section(top.get("interface"), n, model, beam_joint)
     excitation = excitation_section(top.get("excitation"), n, base_dir)
     config = Config(
         name=name,
@@ -393,7 +394,29 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         config = dataclasses.replace(config, uncertain=with_design(uncertain))
     _check_dimensions(config)
     _check_stop(config)
+    _check_frame(config)
     return config
+
+
+def _check_frame(config: Config) -> None:
+    """The Rigid Beam Model's frame (rbm_cli.structures.frame) in its relative formulation
+    only (the beam's joint reads the top drum's rotation against the level beam), and
+    without solver.stop: outcome for columns of drums (their joints collapse with the
+    beam's: no energy certificate)."""
+    if config.frame is None or not MODELS[config.model].beam:
+        return
+    formulation = config.interface.formulation
+    if formulation != "relative":
+        raise ConfigError(
+            f"frame: model {config.model}'s frame takes interface.formulation relative (the"
+            f" beam's joint reads the top drum's rotation against the level beam), got"
+            f" {formulation}"
+        )
+    if config.solver.stop == "outcome" and config.column.n_drums > 1:
+        raise ConfigError(
+            "solver.stop: outcome has no energy certificate for a frame of columns of drums"
+            " (a joint collapses together with the beam's joint): delete solver.stop"
+        )
 
 
 def _check_stop(config: Config) -> None:

@@ -98,7 +98,9 @@ class ModelEntry:
 #: rbm-3d: the Rigid Beam Model in two horizontal directions (circular drums).
 #: A new model is one module and one line here.
 MODELS = {
-    "rbm": ModelEntry("rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True, beam=True),
+    "rbm": ModelEntry(
+        "rbm_cli.models.rbm.runner:RbmRunner", multi_drum=True, beam=True, frame=True
+    ),
     "housner": ModelEntry(
         "rbm_cli.models.housner.runner:HousnerRunner", multi_drum=False, frame=True
     ),

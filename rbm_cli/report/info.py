@@ -3,13 +3,14 @@ note naming the grid point a run of the config is."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from rbm_cli.config.grid import VIRTUAL_PATHS
-from rbm_cli.config.types import MODELS, Config, G
+from rbm_cli.config.types import MODELS, Config, G, InterfaceConfig, StiffnessConfig
 from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.structures.block import block_geometry
-from rbm_cli.structures.frame import frame_figures
+from rbm_cli.structures.frame import frame_figures, rbm_frame_restitution
 from rbm_cli.structures.similarity import rocking_scales
 
 
@@ -44,14 +45,15 @@ def describe(config: Config) -> dict:
     freqs = model.elastic_frequencies_hz()
     uplift = model.uplift_level / G if model.uplift_level is not None else None
     interfaces = []
-    for i in range(n):
+    for i in range(model.joints):  # a frame's beam joint last: no drum above it
+        drum = i < n
         interfaces.append(
             {
                 "interface": i + 1,
                 "width_m": float(col.widths[i]),
-                "drum_height_m": float(col.heights[i]),
-                "drum_mass_kg": float(col.masses[i]),
-                "drum_inertia_kgm2": float(col.inertias[i]),
+                "drum_height_m": float(col.heights[i]) if drum else None,
+                "drum_mass_kg": float(col.masses[i]) if drum else None,
+                "drum_inertia_kgm2": float(col.inertias[i]) if drum else None,
                 "normal_force_N": float(col.normal_forces[i]),
                 "moment_capacity_Nm": float(col.moment_capacity[i]),
                 "rotation_capacity_rad": float(col.rotation_capacity[i]),
@@ -103,22 +105,41 @@ def describe(config: Config) -> dict:
 #: The figures of a frame in `rbm info`'s data (None each for a column standing alone).
 FRAME_KEYS = (
     "frame_columns", "beam_mass_kg", "frame_gamma", "frame_p_rad_s", "frame_half_diagonal_m",
-    "frame_restitution", "frame_static_multiplier_g",
+    "frame_restitution", "frame_static_multiplier_g", "frame_block_is",
 )  # fmt: skip
 
 
 def frame_info(config: Config) -> dict:
-    """A frame's figures: its columns N, the beam's mass [kg], gamma = m_b / (N m) [-], and
-    the block it rocks as (rbm_cli.structures.frame.frame_figures, of the columns' true
-    rigid solids): p_hat [rad/s], R_hat [m], eta [-] and the acceleration that lifts it
-    [g]; None each without a frame."""
+    """A frame's figures: its columns N, the beam's mass [kg], gamma = m_b / (N m) [-] (m a
+    column's mass, drums and capital), and the block its columns glued into rigid
+    monoliths rock as under the beam: p_hat [rad/s], R_hat [m] (the size of a block of
+    the column's shape that rocks with p_hat alone), eta [-] (Housner's rule for the frame)
+    and the acceleration that lifts it [g]. The true solids' exact frame of Makris and
+    Vassiliou (rbm_cli.structures.frame.frame_figures) for the reference blocks and the
+    engine, the RBM's own (its equivalent block, structures.frame) for the RBM's models.
+    None each without a frame."""
     frame = config.frame
     if frame is None:
         return dict.fromkeys(FRAME_KEYS)
-    figures = frame_figures(block_geometry(config.column), frame)
-    values = (frame.columns, frame.beam_mass, figures.ratio, figures.frequency_parameter,
-              figures.half_diagonal, figures.restitution, figures.static_multiplier)  # fmt: skip
-    return dict(zip(FRAME_KEYS, values, strict=True))
+    glued = dataclasses.replace(config.column, drum_heights=(config.column.height,))
+    if MODELS[config.model].beam:
+        rigid = InterfaceConfig(stiffness=StiffnessConfig("rigid", ()))
+        alone = model_from_config(dataclasses.replace(config, column=glued, interface=rigid,
+                                                      frame=None))  # fmt: skip
+        under = model_from_config(dataclasses.replace(config, column=glued, interface=rigid))
+        p, p_hat = alone.rocking_p, under.rocking_p
+        col = alone.column
+        r = math.hypot(float(col.widths[0]) / 2.0, float(col.lever_arms[0]))
+        gamma = frame.ratio(col.total_mass)
+        values = (gamma, p_hat, r * (p / p_hat) ** 2, rbm_frame_restitution(col, frame),
+                  under.column.static_multiplier,
+                  "the RBM's equivalent block (its rigid monolithic frame)")  # fmt: skip
+    else:
+        figures = frame_figures(block_geometry(glued), frame)
+        values = (figures.ratio, figures.frequency_parameter, figures.half_diagonal,
+                  figures.restitution, figures.static_multiplier,
+                  "Makris and Vassiliou's equivalent block (true rigid solids)")  # fmt: skip
+    return dict(zip(FRAME_KEYS, (frame.columns, frame.beam_mass, *values), strict=True))
 
 
 def p_meaning(config: Config, n: int, lever: float) -> dict[str, str]:
@@ -225,7 +246,7 @@ def format_info(info: dict) -> str:
                                  f" {_fmt(info['beam_mass_kg'])} kg (gamma"
                                  f" {_fmt(info['frame_gamma'])})"))  # fmt: skip
         rows.append(("frame rocks as", (
-            f"one block (Makris and Vassiliou, rigid columns): p_hat"
+            f"{info.get('frame_block_is')}: p_hat"
             f" {_fmt(info['frame_p_rad_s'])} rad/s, R_hat {_fmt(info['frame_half_diagonal_m'])}"
             f" m, eta {_fmt(info['frame_restitution'])}, lifting at"
             f" {_fmt(info['frame_static_multiplier_g'])} g")))  # fmt: skip

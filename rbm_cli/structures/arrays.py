@@ -20,7 +20,7 @@ from rbm_cli.base.copies import copy_into
 from rbm_cli.base.detmath import matmul, matvec
 from rbm_cli.base.events import EVENT_EPS
 from rbm_cli.base.jit import jit
-from rbm_cli.structures.equations import Model, event_families
+from rbm_cli.structures.equations import Model, body_masses, event_families
 from rbm_cli.structures.law import law_arrays
 
 #: A rigid block whose post-impact rate is below REST_RATE * p * theta_u is
@@ -178,8 +178,9 @@ def survival_barrier(model: Model) -> float:
     The barrier is the least of these. Free motion (no forcing, impacts with e <= 1, joint
     damping >= 0) never gains energy, so a column below it survives whatever follows. Other
     formulations: NaN (`geometric` adds gravity's potential, negative and coupling the
-    joints; `absolute` is not energy-conserving)."""
-    if model.formulation != "relative":
+    joints; `absolute` is not energy-conserving), and a frame of columns of drums (a joint
+    collapses with the beam's joint, past its own law's zero: rbm_cli.structures.frame)."""
+    if model.formulation != "relative" or model.joints != model.n:
         return math.nan
     limit = model.collapse_ratio * model.column.rotation_capacity
     return float(min(min(law.potential(x), law.potential(-x))
@@ -190,17 +191,17 @@ def survival_barrier(model: Model) -> float:
 def _derived(args, cmap, top, minv, diff, gravity, ground_load):
     """The step integrator's products of the model's arrays: (same, md, mg, track, es),
     from the event families args, cmap, top."""
-    n = args.shape[0]
+    m, n = args.shape  # the joints and the drums
     same = True
-    for i in range(n):
+    for i in range(m):
         for j in range(n):
             same = same and args[i, j] == cmap[i, j]
     md = matmul(minv, diff.T.copy())
     mg = matmul(minv, gravity)
-    track = np.empty((n + 1, n))
-    for i in range(n):
+    track = np.empty((m + 1, n))
+    for i in range(m):
         copy_into(track[i], cmap[i])
-    copy_into(track[n], top)
+    copy_into(track[m], top)
     es = -matvec(minv, ground_load, np.empty(n))
     return same, md, mg, track, es
 
@@ -223,10 +224,10 @@ def column_arrays(model: Model) -> ColumnArrays:
         gravity=model.gravity.copy(), ground_load=model.ground_load.copy(),
         diff_t=np.ascontiguousarray(model.diff.T), edges=edges, nedges=nedges,
         intercepts=inter, slopes=slopes, rigid=rigid, silent=model.silent_impacts.copy(),
-        tu=col.rotation_capacity.astype(float), c_ratio=float(model.collapse_ratio),
+        tu=model.argument_scale.astype(float), c_ratio=float(model.collapse_ratio),
         e_rest=float(model.restitution), literal_impact=model.formulation == "absolute",
         impulse_dir=impulse_dir.copy(), impulse_w=np.asarray(impulse_w, dtype=float),
-        centre_map=model.centre_map.copy(), masses=col.masses.astype(float),
+        centre_map=model.centre_map.copy(), masses=body_masses(col).astype(float),
         normal_forces=col.normal_forces.astype(float), rigid_mono=uplift is not None,
         uplift_level=-1.0 if uplift is None else float(uplift), rest_rate=float(rest_rate),
         barrier=float(barrier), survival=survival_barrier(model),

@@ -14,6 +14,7 @@ from rbm_cli.config.types import Config, G
 from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.structures.column import Column, build_column
 from rbm_cli.structures.equations import Model, build_model
+from rbm_cli.structures.frame import frame_column, rbm_frame_restitution
 from rbm_cli.structures.restitution import column_restitution, resolve
 
 #: Why a run stops where g + a_v(t) changes the order of a law's pieces (shape_change).
@@ -53,7 +54,14 @@ def model_from_config(config: Config, column: Column | None = None) -> Model:
     with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
         if column is None:
             column = build_column(config.column, config.interface)
-        e = resolve(config.interface.restitution, lambda: column_restitution(column))
+            if config.frame is not None:  # columns under a beam (structures.frame)
+                alone, frame = column, config.frame
+                column = frame_column(alone, frame, config.interface)
+                e = resolve(
+                    config.interface.restitution, lambda: rbm_frame_restitution(alone, frame)
+                )
+        if config.frame is None or column.beam_mass == 0.0:
+            e = resolve(config.interface.restitution, lambda: column_restitution(column))
         try:
             model = build_model(
                 column,
@@ -77,13 +85,14 @@ def check_derived(model: Model) -> None:
     run starts: a density of 1e307 once made masses overflow and a collapsing column
     report 'survived'. Raises RbmError naming the first bad quantity."""
     col = model.column
+    n = col.n  # a frame's beam joint: its weight at the joint (lever 0, theta_u inf)
     positive = {
         "drum masses": col.masses,
         "drum inertias": col.inertias,
         "normal forces N_i": col.normal_forces,
         "moment capacities M_u,i": col.moment_capacity,
-        "rotation capacities theta_u,i": col.rotation_capacity,
-        "lever arms": col.lever_arms,
+        "rotation capacities theta_u,i": col.rotation_capacity[:n],
+        "lever arms": col.lever_arms[:n],
     }
     finite = {
         "mass matrix": model.mass,

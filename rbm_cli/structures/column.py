@@ -36,6 +36,13 @@ class Column:
     rotation_capacity : (n,) theta_u,i = (B_i / 2) / zbar_i [rad]
     stiffness : (n,) K_M,i [N m/rad]; inf for a rigid law
     section : str  'rectangular' or 'circular'
+    beam_mass : float  A frame's beam share m_b / N [kg] carried on the top node (a point
+        body moving with the top, rbm_cli.structures.frame), 0 for a column standing
+        alone; with one, the interface arrays (normal_forces to stiffness) are the joints'
+        (:attr:`joints` of them: the drums' and the beam's), the drum arrays the drums'
+    beam_law : (float, float) or None  (M_u [N m], K_M [N m/rad]) of a monolithic frame's
+        beam joint, whose argument is minus the base's: its law joins the base's
+        (rbm_cli.structures.frame.frame_column)
     """
 
     heights: np.ndarray
@@ -52,6 +59,8 @@ class Column:
     stiffness: np.ndarray
     section: str = "rectangular"
     centres: np.ndarray | None = None
+    beam_mass: float = 0.0
+    beam_law: tuple[float, float] | None = None
 
     def __post_init__(self):
         if self.centres is None:  # drums of uniform section: the centre at mid-height
@@ -60,6 +69,12 @@ class Column:
     @property
     def n(self) -> int:
         return len(self.heights)
+
+    @property
+    def joints(self) -> int:
+        """Joints with a law: the drums' (n), and a frame's beam joint unless folded into
+        the base's (:attr:`beam_law`)."""
+        return len(self.normal_forces)
 
     @property
     def height(self) -> float:
@@ -76,7 +91,12 @@ class Column:
     @property
     def static_multiplier(self) -> float:
         """Uniform horizontal acceleration [g] that overturns the weakest rigid stack:
-        min_i M_u,i / (N_i zbar_i) = min_i theta_u,i."""
+        min_i M_u,i / (N_i zbar_i) = min_i theta_u,i. Under a frame's beam the stack above
+        joint i lifts the beam's joint too: min_i (M_u,i + M_u,beam) / (N_i zbar_i)
+        (rbm_cli.structures.frame.frame_limits)."""
+        if self.joints > self.n:
+            mu, beam = self.moment_capacity[: self.n], self.moment_capacity[self.n]
+            return float(np.min(self.rotation_capacity[: self.n] * (1.0 + beam / mu)))
         return float(np.min(self.rotation_capacity))
 
 
@@ -158,7 +178,7 @@ def _moment_stiffness(
         k_m = np.full(n, np.inf)
     elif stiff.kind == "moment":
         vals = np.asarray(stiff.values, dtype=float)
-        k_m = np.full(n, vals[0]) if len(vals) == 1 else vals.copy()
+        k_m = np.full(n, vals[0]) if len(vals) == 1 else vals[:n].copy()  # a frame's: +1
     else:  # joint normal stiffness k_n [Pa/m]
         k_n = float(stiff.values[0])
         b_i = widths[:-1]

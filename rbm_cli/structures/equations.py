@@ -31,7 +31,7 @@ import numpy as np
 
 from rbm_cli.base.detmath import inverse, product
 from rbm_cli.structures.column import Column
-from rbm_cli.structures.law import Law, make_law
+from rbm_cli.structures.law import Law, law_sum, make_law
 
 #: Significant digits of the first elastic frequency where it sets the joints' damping. The
 #: eigenvalue solver (LAPACK) rounds its last bits as the processor's kernels do, so the
@@ -43,20 +43,22 @@ DAMPING_DIGITS = 10
 
 @dataclass(frozen=True)
 class Model:
-    """Assembled equations of one column (SI units).
+    """Assembled equations of one column (SI units): n drums, m joints with a law (n, or
+    n + 1 with a frame's beam joint, rbm_cli.structures.frame), the drums' bodies and a
+    frame's beam share (centre_map's last row, on the top node).
 
     mass : (n, n) Mass matrix M [kg m^2]
     mass_inv : (n, n) M^-1
     ground_load : (n,) r = L^T m [kg m]
-    centre_map : (n, n) L, theta -> drum-centre displacements [m]
+    centre_map : (bodies, n) L, theta -> the bodies' centre displacements [m]
     node_map : (n+1, n) theta -> node displacements relative to the ground [m]
-    arg_map : (n, n) theta -> law arguments x (D, or I for `absolute`)
-    diff : (n, n) D
+    arg_map : (m, n) theta -> law arguments x (D, or I for `absolute`)
+    diff : (m, n) D
     gravity : (n, n) K_g [N m/rad] (zero unless `geometric`)
-    laws : tuple of Law, one per interface
-    collapse_map : (n, n) theta -> collapse quantities (law arguments, or
+    laws : tuple of Law, one per joint
+    collapse_map : (m, n) theta -> collapse quantities (law arguments, or
         overturning moments of the stacks above each joint for `geometric`)
-    collapse_limit : (n,) their limits (theta_u [rad] or M_u [N m])
+    collapse_limit : (m,) their limits (theta_u [rad] or M_u [N m])
     collapse_ratio : float  c, collapse when |quantity| >= c * limit
     restitution : float  e, angular-velocity ratio at an impact
     formulation : str
@@ -86,6 +88,11 @@ class Model:
     @property
     def n(self) -> int:
         return self.mass.shape[0]
+
+    @property
+    def joints(self) -> int:
+        """Joints with a law (n, or n + 1 with a frame's beam joint)."""
+        return len(self.laws)
 
     @property
     def rigid(self) -> bool:
@@ -129,9 +136,25 @@ class Model:
         return float(self.laws[0].intercepts[0] / abs(self.ground_load[0]))
 
     @cached_property
+    def argument_scale(self) -> np.ndarray:
+        """(m,) the rotation each joint's argument is watched over [rad]: its theta_u, and
+        for a frame's beam joint (theta_u infinite: no descending branch) the top drum's."""
+        tu = self.column.rotation_capacity
+        if self.joints == self.n:
+            return tu
+        return np.where(np.isfinite(tu), tu, tu[self.n - 1])
+
+    @cached_property
     def arg_inverse(self) -> np.ndarray:
-        """(n, n) inverse of the argument map: law arguments -> drum rotations."""
-        return inverse(self.arg_map)
+        """(n, m) the moves of the drum rotations that change one joint's argument by 1: the
+        inverse of the argument map for n joints; a frame's beam joint (argument -theta_n)
+        moves the top drum alone (and so changes the top drum's joint by -1)."""
+        n = self.n
+        if self.joints == n:
+            return inverse(self.arg_map)
+        beam = np.zeros((n, 1))
+        beam[n - 1, 0] = -1.0
+        return np.hstack([inverse(self.arg_map[:n]), beam])
 
     @cached_property
     def silent_impacts(self) -> np.ndarray:
@@ -171,7 +194,7 @@ class Model:
         leaves rigid-body rocking undamped (impacts dissipate it, as for an undamped
         column). Zero without damping or for a rigid law. omega_1 is that of the first
         frequency rounded to DAMPING_DIGITS significant digits [Hz]."""
-        out = np.zeros(self.n)
+        out = np.zeros(self.joints)
         if self.damping == 0.0 or self.rigid:
             return out
         f_1 = float(f"{self.elastic_frequencies_hz()[0]:.{DAMPING_DIGITS}g}")
@@ -184,7 +207,7 @@ class Model:
         """(D, w) of an impact at joint i: the impulsive moment acts along P^T e_i, so
         the rates change along column i of D = M^-1 P^T; w_i = e_i^T P M^-1 P^T e_i."""
         directions = product(self.mass_inv, self.arg_map.T)
-        w = np.array([product(self.arg_map[i], directions[:, i]) for i in range(self.n)])
+        w = np.array([product(self.arg_map[i], directions[:, i]) for i in range(self.joints)])
         return directions, w
 
     def impact_rates(self, rate: np.ndarray, i: int) -> np.ndarray:
@@ -222,7 +245,7 @@ class Model:
         `geometric` extra slope M_u / theta_u; the elastic part is K_M on the elastic branch
         (piece 0 of a law with a finite stiffness), 0 elsewhere."""
         width = max(len(law.slopes) for law in self.laws)
-        weight, elastic = np.zeros((self.n, width)), np.zeros((self.n, width))
+        weight, elastic = np.zeros((self.joints, width)), np.zeros((self.joints, width))
         for i, law in enumerate(self.laws):
             m = len(law.slopes)
             weight[i, :m] = law.slopes
@@ -249,7 +272,7 @@ class Model:
         elastic against the descending branch."""
         weight, elastic = self.slope_parts
         width = max(1, max(len(law.edges) for law in self.laws))
-        shares = np.ones((self.n, width))
+        shares = np.ones((self.joints, width))
         for i, law in enumerate(self.laws):
             for q in range(len(law.edges)):
                 dbs = weight[i, q + 1] - weight[i, q]
@@ -295,8 +318,8 @@ class Model:
         """
         col = self.column
         abs_acc = accel @ self.centre_map.T + np.asarray(ground_accel)[:, None]
-        forces = abs_acc * col.masses
-        shear = np.cumsum(forces[:, ::-1], axis=1)[:, ::-1]
+        forces = abs_acc * body_masses(col)
+        shear = np.cumsum(forces[:, ::-1], axis=1)[:, ::-1][:, : self.joints]
         return np.abs(shear) / col.normal_forces
 
 
@@ -319,13 +342,18 @@ def build_model(
     collapse_ratio : float  c in (0, 1]
     damping : float  zeta in [0, 1): damping of the first elastic mode (Model.joint_damping)
     """
-    n = column.n
+    n, m = column.n, column.joints
     h = column.heights
     lower = np.tril(np.ones((n, n)), -1) * h[None, :]
     centre = lower + np.diag(column.centres)
-    mass = product(centre.T, column.masses[:, None] * centre) + np.diag(column.inertias)
     node = np.vstack([np.zeros(n), np.tril(np.ones((n, n))) * h[None, :]])
-    diff = np.eye(n) - np.eye(n, k=-1)
+    if column.beam_mass > 0.0:  # a frame's beam share: a body moving with the top node
+        centre = np.vstack([centre, node[n]])
+    bodies = body_masses(column)
+    mass = product(centre.T, bodies[:, None] * centre) + np.diag(column.inertias)
+    diff = np.eye(m, n) - np.eye(m, n, k=-1)  # a beam joint's row: -theta_n
+    if m != n and formulation != "relative":
+        raise ValueError("a frame's beam joint takes the relative formulation only")
     arg_map = np.eye(n) if formulation == "absolute" else diff.copy()
 
     mu, tu = column.moment_capacity, column.rotation_capacity
@@ -346,18 +374,20 @@ def build_model(
         collapse_map, collapse_limit = over, mu.copy()
     else:
         gravity = np.zeros((n, n))
-        extra = np.zeros(n)
+        extra = np.zeros(m)
         collapse_map, collapse_limit = arg_map.copy(), tu.copy()
 
     laws = tuple(
         make_law(mu[i], tu[i], column.stiffness[i], xi, extra_slope=float(extra[i]))
-        for i in range(n)
+        for i in range(m)
     )
+    if column.beam_mass > 0.0:
+        laws, collapse_map, collapse_limit = frame_joints(column, laws, xi, collapse_map)
     return Model(
         column=column,
         mass=mass,
         mass_inv=inverse(mass),
-        ground_load=product(centre.T, column.masses),
+        ground_load=product(centre.T, bodies),
         centre_map=centre,
         node_map=node,
         arg_map=arg_map,
@@ -374,19 +404,58 @@ def build_model(
     )
 
 
+def body_masses(column: Column) -> np.ndarray:
+    """The masses [kg] of the bodies that move: the drums, then a frame's beam share
+    (Column.beam_mass) on the top node."""
+    if column.beam_mass > 0.0:
+        return np.append(column.masses, column.beam_mass)
+    return column.masses
+
+
+def frame_joints(column: Column, laws: tuple, xi: float, collapse_map: np.ndarray):
+    """The laws and the collapse map and limits of a frame's joints (Column.beam_mass > 0).
+
+    The beam joint's law (the cap M_u,b = (B_top / 2) W_b / N, no descending branch)
+    resists the stack above every joint i: with the beam held level, joint i opening by x
+    turns the drums above it and opens the beam joint too, so the stack above i overturns
+    where f_i(x) + xi M_u,b = 0, at x = theta_u,i (1 + xi M_u,b / M_u,i), not at
+    theta_u,i (where f_i alone vanishes). That is joint i's collapse limit; the beam joint
+    itself never overturns (its row of the collapse map is 0). A monolith's beam joint
+    reads minus the base's argument (Column.beam_law): its law is added to the base's,
+    whose limit is then the sum's zero. For a rigid monolith the frame's base law is
+    (M_u,1 + M_u,b) (1 - |x| / limit), limit = (B / 2) / (H / 2) for a prismatic column:
+    the uplift and the collapse of the free column, whatever the beam."""
+    n = column.n
+    if column.beam_law is not None:  # the base's own law and the beam joint's, summed
+        mu_b, k_b = column.beam_law
+        k_0 = float(column.stiffness[0])
+        base = make_law(float(column.moment_capacity[0]) - mu_b,
+                        float(column.widths[0]) / 2.0 / float(column.lever_arms[0]),
+                        k_0 if math.isinf(k_0) else k_0 - k_b, xi)  # fmt: skip
+        law = law_sum(base, make_law(mu_b, math.inf, k_b, xi))
+        limit = -float(law.intercepts[-1]) / float(law.slopes[-1])
+        return (law,), collapse_map, np.array([limit])
+    cap = float(laws[n].intercepts[-1])
+    limits = np.array([-(float(law.intercepts[-1]) + cap) / float(law.slopes[-1])
+                       for law in laws[:n]] + [1.0])  # fmt: skip
+    collapse_map = collapse_map.copy()
+    collapse_map[n] = 0.0  # the beam joint: never (its limit, 1, any finite number)
+    return laws, collapse_map, limits
+
+
 def event_families(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The quantities linear in theta [rad] that a run watches, one row each: where they
     cross a bound is an event, their peaks are its maxima.
 
     Returns
     -------
-    arguments : (n, n)  Each interface's law argument over its rotation capacity theta_u
-        (arg_map / theta_u) [-/rad].
+    arguments : (m, n)  Each interface's law argument over its rotation capacity theta_u
+        (arg_map / theta_u; Model.argument_scale) [-/rad].
     collapse : (n, n)  Each interface's collapse ratio (collapse_map / collapse_limit),
         collapse at Model.collapse_ratio [-/rad].
     top : (n,)  The top's horizontal displacement (the drums' heights) [m/rad].
     """
     column = model.column
-    arguments = model.arg_map / column.rotation_capacity[:, None]
+    arguments = model.arg_map / model.argument_scale[:, None]
     collapse = model.collapse_map / model.collapse_limit[:, None]
     return arguments, collapse, column.heights.astype(float)

@@ -41,9 +41,12 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from rbm_cli.config.types import FrameConfig
+import numpy as np
+
+from rbm_cli.config.types import FrameConfig, G, InterfaceConfig
 from rbm_cli.structures.block import BlockGeometry
-from rbm_cli.structures.restitution import block_restitution
+from rbm_cli.structures.column import Column
+from rbm_cli.structures.restitution import block_restitution, column_restitution
 
 
 @dataclasses.dataclass(frozen=True)
@@ -106,3 +109,73 @@ def frame_figures(column: BlockGeometry, frame: FrameConfig) -> FrameFigures:
         restitution=frame_restitution(column, frame),
         static_multiplier=math.tan(column.slenderness),
     )
+
+
+# ---- the Rigid Beam Model's frame
+
+
+def beam_stiffness(interface: InterfaceConfig, column: Column) -> float:
+    """K_M of the beam's joint [N m/rad]: rigid, the last value given (one for every joint,
+    or the beam's after the drums'), or k_n over the column's top section."""
+    stiff = interface.stiffness
+    if stiff.kind == "rigid":
+        return math.inf
+    if stiff.kind == "moment":
+        return float(stiff.values[-1])
+    k_n, width, depth = float(stiff.values[0]), float(column.widths[-1]), float(column.depths[-1])
+    if column.section == "circular":
+        return k_n * math.pi * width**4 / 64.0
+    return k_n * depth * width**3 / 12.0
+
+
+def frame_column(column: Column, frame: FrameConfig, interface: InterfaceConfig) -> Column:
+    """A column of the RBM's frame: the drums of ``column`` under a share m_b / N of the
+    beam, a point body on the top node (the RBM's small rotations move it horizontally with
+    the top; it does not rotate). Every joint below carries its weight W_b / N at the top's
+    height (normal forces, lever arms, M_u and theta_u of the drums' joints), and the beam
+    rests on the top on a joint of its own: width the top's, M_u = (B_top / 2) W_b / N, no
+    descending branch (the beam's weight acts at the joint: theta_u infinite), its argument
+    -theta_n (the beam does not rotate). A monolith's beam joint reads minus the base's
+    argument, so its law joins the base's (Column.beam_law; one joint: M_u, K_M the sums,
+    theta_u the rigid frame's, (M_u,1 + M_u,b) / (N_1 zbar_1)); beam_mass 0 is the column
+    itself."""
+    share = frame.beam_mass / frame.columns
+    if share == 0.0:
+        return column
+    n, w = column.n, share * G
+    normal = column.normal_forces + w
+    lever = (
+        column.normal_forces * column.lever_arms + w * (column.height - column.bottoms)
+    ) / normal
+    half = column.widths[:n] / 2.0
+    beam = (float(column.widths[-1]) / 2.0 * w, beam_stiffness(interface, column))
+    if n == 1:
+        mu = half * normal + beam[0]
+        return dataclasses.replace(column, beam_mass=share, lever_arms=lever,
+                                   normal_forces=normal, beam_law=beam, moment_capacity=mu,
+                                   rotation_capacity=mu / (normal * lever),
+                                   stiffness=column.stiffness + beam[1])  # fmt: skip
+    return dataclasses.replace(
+        column,
+        beam_mass=share,
+        normal_forces=np.append(normal, w),
+        lever_arms=np.append(lever, 0.0),
+        moment_capacity=np.append(half * normal, beam[0]),
+        rotation_capacity=np.append(half / lever, math.inf),
+        stiffness=np.append(column.stiffness, beam[1]),
+    )
+
+
+def rbm_frame_restitution(column: Column, frame: FrameConfig) -> float:
+    """eta of a monolithic RBM column under a frame's beam (``restitution: housner``):
+    the module's eta with the RBM's column (its centre at mid-height, I_O = I_G +
+    m (h^2 + b^2), h = H / 2, b = B_1 / 2, R^2 = h^2 + b^2), as
+    (e + 4 gamma (m R^2 / I_O) cos 2 alpha) / (1 + 4 gamma m R^2 / I_O), e the column's
+    own (rbm_cli.structures.restitution.column_restitution)."""
+    m = column.total_mass
+    half_b, half_h = float(column.widths[0]) / 2.0, float(column.centres[0])
+    r2 = half_h**2 + half_b**2
+    share = m * r2 / (float(column.inertias[0]) + m * r2)
+    gamma = frame.ratio(m)
+    cos2 = (half_h**2 - half_b**2) / r2
+    return (column_restitution(column) + 4.0 * gamma * share * cos2) / (1.0 + 4.0 * gamma * share)

@@ -123,6 +123,24 @@ def make_law(
     )
 
 
+def law_sum(a: Law, b: Law) -> Law:
+    """The law f_a(x) + f_b(x) of two joints that read one argument (a monolithic frame's
+    base and beam joint, rbm_cli.structures.frame): pieces on the union of their edges,
+    each the sum of the two pieces there; rigid if either jumps at 0."""
+    edges = np.unique(np.concatenate([a.edges, b.edges]))
+    starts = np.concatenate([[0.0], edges])
+    ka = np.searchsorted(a.edges, starts, side="right")
+    kb = np.searchsorted(b.edges, starts, side="right")
+    rigid = a.rigid or b.rigid
+    return Law(
+        edges=edges,
+        intercepts=a.intercepts[ka] + b.intercepts[kb],
+        slopes=a.slopes[ka] + b.slopes[kb],
+        rigid=rigid,
+        elastic_limit=0.0 if rigid else float(edges[0] if edges.size else np.inf),
+    )
+
+
 def law_arrays(laws) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The pieces of n laws as padded arrays (the form compiled code reads).
 

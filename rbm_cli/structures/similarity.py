@@ -15,7 +15,8 @@ column's own first scales however many drums it has:
 - ``rbm``: the RBM's rigid monolith (rbm_cli.structures.closed_forms.linear_rocking_parameters:
   tan alpha = theta_u,1, p^2 = m g (H / 2) / (I_G + m H^2 / 4)); with a capital, the shaft
   and the capital as one rigid stack: tan alpha = theta_u,1, p^2 = N_1 zbar_1 / (1^T M 1)
-  (rbm_cli.structures.equations.Model.rocking_p);
+  (rbm_cli.structures.equations.Model.rocking_p); under a frame's beam, the RBM's rigid
+  monolithic frame (rbm_cli.structures.frame): its lifting level and Model.rocking_p;
 - ``housner``, ``housner-linear``, ``bullet`` (true geometry, rigid blocks): the block's
   tan alpha = b / z_c and p^2 = m g R / I_O (rbm_cli.structures.block.block_geometry); for
   a frame of such columns under a beam, the block it rocks as: its columns' alpha and
@@ -33,11 +34,12 @@ import math
 from dataclasses import dataclass
 
 from rbm_cli.config.types import MODELS, Config, InterfaceConfig, StiffnessConfig
+from rbm_cli.structures.assembly import model_from_config
 from rbm_cli.structures.block import block_geometry
 from rbm_cli.structures.closed_forms import linear_rocking_parameters
 from rbm_cli.structures.column import build_column
 from rbm_cli.structures.equations import build_model
-from rbm_cli.structures.frame import frame_block
+from rbm_cli.structures.frame import frame_block, frame_column
 
 
 @dataclass(frozen=True)
@@ -63,6 +65,11 @@ def rocking_scales(config: Config) -> RockingScales:
     rigid = InterfaceConfig(stiffness=StiffnessConfig("rigid", ()))
     column = build_column(config.column, rigid)
     glued = dataclasses.replace(config.column, drum_heights=(config.column.height,))
+    if MODELS[config.model].beam and config.frame is not None:
+        # the RBM's rigid monolithic frame (structures.frame): its lifting level and p
+        frame = model_from_config(dataclasses.replace(config, column=glued, interface=rigid))
+        static = frame_column(column, config.frame, rigid).static_multiplier
+        return RockingScales(math.atan(frame.column.static_multiplier), frame.rocking_p, static)
     if MODELS[config.model].beam and config.column.capital is not None:
         # shaft and capital glued into one rigid stack: its base's theta_u and its p
         p = build_model(build_column(glued, rigid)).rocking_p

@@ -57,11 +57,13 @@ import numpy as np
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config, G, SolverConfig
 from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.models.bullet.colonnade import FrameWatch, frame_layout
 from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.impact import impact_rate_ratios, measure_restitution
 from rbm_cli.models.bullet.scene import (
     Frame,
+    build_frame,
     build_scene,
     keep_in_plane,
     read_frame,
@@ -96,6 +98,7 @@ __all__ = [
     "EngineSettings",
     "PhysicsClient",
     "bullet_run",
+    "has_beam",
     "engine_uplift_g",
     "ground_friction_demand",
     "impact_rate_ratios",
@@ -243,7 +246,14 @@ def bullet_run(
         it survived; 0 where the ground's acceleration stays below the uplift and
         sliding levels, the stack moving with it). A vertical record reaching -g ends
         the run there, 'failed' (unless it collapsed before).
+        A frame whose beam has mass (Config.frame, :func:`has_beam`): its columns and beam
+        (:mod:`rbm_cli.models.bullet.colonnade`), the per-joint arrays n + 1 long (the
+        beam's joint last, collapse_interface n + 1 where the beam fell); a frame whose
+        beam has no mass is its free column, whose run this is to the bit.
     """
+    if has_beam(config):
+        return _frame_run(config, motion, record, output_dt, early_stop, settings, client,
+                          observe)  # fmt: skip
     solids = drum_solids(config.column)
     n = len(solids)
     settings = settings or settings_from_config(config)
@@ -299,6 +309,85 @@ def bullet_run(
         out.message += "; " + _slip_text(watch.max_slip)
     history = _history(samples, motion, space) if record else None
     return out, history
+
+
+def has_beam(config: Config) -> bool:
+    """The config is a frame whose beam has mass (a frame with a beam of no mass is its
+    free column: its run is the column's, to the bit)."""
+    return config.frame is not None and config.frame.beam_mass > 0.0
+
+
+def _frame_run(config, motion, record, output_dt, early_stop, settings, client, observe):
+    """bullet_run of a frame of columns under a beam of mass (its parameters): every run
+    in the engine (a frame's ground motion below its columns' uplift and sliding levels is
+    not skipped: how the columns share the beam's load, so their friction demand and the
+    level that uplifts the beam, are the engine's to find)."""
+    solids = drum_solids(config.column)
+    n = len(solids)
+    layout = frame_layout(config.column, config.frame, solids)
+    settings = settings or settings_from_config(config)
+    tilt, rate = _initial(config)
+    t_lift = motion.lift_off  # a vertical record dropping faster than gravity
+    if t_lift is not None:
+        motion = motion.until(t_lift)
+    out = Outcome()
+    out.max_ratio = np.zeros(n + 1)
+    out.friction = np.full(n + 1, np.nan)
+    dt = settings.time_step
+    sample = max(1, int(round(output_dt / dt))) if record else 0
+    if client is None:
+        client = PhysicsClient.for_process()
+    cylinders = config.column.section == "circular"
+    bodies = build_frame(client, solids, layout.axes, layout.beam, settings, tilt, rate,
+                         cylinders=cylinders)  # fmt: skip
+    samples, watch = _drive_frame(client, bodies, solids, layout, config.collapse.ratio, dt, motion,
+                                  out, sample, early_stop, observe)  # fmt: skip
+    out.lifted_off(t_lift)
+    watch.residual(out)
+    out.message += "; " + _slip_text(watch.max_slip) + f", beam {1e3 * watch.max_beam_slip:.3g} mm"
+    history = _history(samples, motion) if record else None
+    return out, history
+
+
+def _drive_frame(client, bodies, solids, layout, limit, dt, motion, out, sample, early_stop,
+                 observe) -> tuple[list, FrameWatch]:  # fmt: skip
+    """_drive for a frame in the plane: step the engine from t = 0 to the motion's end or
+    a stop, checking the frame every CHECK_DT (and at every sample); fills `out`. Returns
+    (samples, watch), the samples the first column's."""
+    p, cid = client.module, client.id
+    n_steps = int(round(motion.t_end / dt))
+    check = max(1, int(round(CHECK_DT / dt)))
+    set_gravity, step = p.setGravity, p.stepSimulation
+    mid = (np.arange(n_steps) + 0.5) * dt
+    accel_array = np.asarray(motion.accel(mid), dtype=float)
+    accel = accel_array.tolist()
+    upward = upward_accel(motion, mid)
+    down = (-(G + upward)).tolist() if upward is not None else [-G] * n_steps
+    frame = read_frame(p, cid, bodies)
+    alpha = stack_slenderness(solids)
+    watch = FrameWatch(solids, layout, alpha, limit, dt, accel_array, frame, upward)
+    first = watch.column_view(watch.joints(frame))
+    samples = [_sample(0.0, *first)] if sample else []
+    k = 0
+    while k < n_steps:
+        set_gravity(-accel[k], 0.0, down[k], physicsClientId=cid)
+        step(physicsClientId=cid)
+        k += 1
+        if observe is not None:
+            observe(p, cid, bodies)
+        checked = keep_in_plane(p, cid, bodies, pose=k % check == 0)
+        if checked is None and not (sample and k % sample == 0) and k != n_steps:
+            continue
+        frame = checked if checked is not None else read_frame(p, cid, bodies)
+        joints = watch.see(frame)
+        if sample and k % sample == 0:
+            samples.append(_sample(k * dt, *watch.column_view(joints)))
+        if watch.check(out, k, frame, joints, motion, early_stop):
+            break
+    else:
+        out.n_steps = out.n_rhs = k
+        out.stop("survived", "no joint passed over its edge, the beam on every top", motion.t_end)
+    return samples, watch
 
 
 def _initial(config: Config) -> tuple[float, float]:
@@ -376,7 +465,8 @@ class BulletRunner:
 
     def __init__(self, config: Config) -> None:
         self.config = config
-        self.n_interfaces = config.column.n_drums
+        # a frame's beam joint after the columns' (bullet_run)
+        self.n_interfaces = config.column.n_drums + int(has_beam(config))
         self._client: PhysicsClient | None = None  # the runner's own, opened on first run
 
     def close(self) -> None:

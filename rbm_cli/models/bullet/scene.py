@@ -60,6 +60,58 @@ def build_scene(
     return bodies
 
 
+def build_frame(
+    client: PhysicsClient,
+    solids,
+    axes: np.ndarray,
+    beam,
+    settings: EngineSettings,
+    tilt: float = 0.0,
+    rate: float = 0.0,
+    cylinders: bool = False,
+) -> list[int]:
+    """Reset the client's world and build ground, a frame's columns and its beam
+    (:mod:`rbm_cli.models.bullet.colonnade`); returns the body ids: column by column, each
+    bottom first, then the beam.
+
+    axes : (N,) x of each column's axis [m]; every column is the stack ``solids``.
+    beam : DrumSolid  The beam (a box) resting on the columns' tops, centred on x = 0.
+    tilt [rad], rate [rad/s]: every column turned rigidly about its own base corner on the
+    side of the tilt, as :func:`build_scene` turns its stack; the beam, resting on the
+    tops' corners on the other side, translated with them and moving as they move
+    (Makris and Vassiliou's frame rocking in unison).
+    cylinders: circular drums collided as the engine's cylinders (the beam is a box).
+    """
+    p, cid = client.module, client.id
+    _reset_world(p, cid, settings)
+    c, s = math.cos(tilt), math.sin(tilt)
+    rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    quat = p.getQuaternionFromEuler([0.0, tilt, 0.0])
+    side = math.copysign(1.0, tilt or 1.0)
+    spin = np.array([0.0, rate, 0.0])
+    bodies = []
+    for x in axes:
+        pivot = np.array([x + side * solids[0].half_bottom, 0.0, 0.0])
+        for d in solids:
+            centre = pivot + rot @ (np.array([x, 0.0, d.bottom + d.centre]) - pivot)
+            body = _add_drum(p, cid, d, settings, centre, quat, cylinders)
+            if rate:
+                p.resetBaseVelocity(body, linearVelocity=np.cross(spin, centre - pivot).tolist(),
+                                    angularVelocity=spin.tolist(), physicsClientId=cid)  # fmt: skip
+            bodies.append(body)
+    # the corner the beam rests on moves alike in every column
+    pivot = np.array([axes[0] + side * solids[0].half_bottom, 0.0, 0.0])
+    corner = np.array([axes[0] - side * solids[-1].half_top, 0.0, beam.bottom])
+    arm = rot @ (corner - pivot)
+    centre = np.array([0.0, 0.0, beam.bottom + beam.centre]) + (pivot + arm - corner)
+    body = _add_drum(p, cid, beam, settings, centre, (0.0, 0.0, 0.0, 1.0))
+    if rate:
+        p.resetBaseVelocity(body, linearVelocity=np.cross(spin, arm).tolist(),
+                            angularVelocity=[0.0, 0.0, 0.0], physicsClientId=cid)  # fmt: skip
+    bodies.append(body)
+    return bodies
+
+
 def _reset_world(p, cid, settings: EngineSettings) -> None:
     """Empty the world, set the engine's parameters and lay the ground plane."""
     p.resetSimulation(physicsClientId=cid)

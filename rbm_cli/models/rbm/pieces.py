@@ -137,12 +137,11 @@ def settle(awaiting, argmap, y, side):
     """Count the silent impacts up to the state y (rotations y[:n] [rad]): the interfaces
     awaiting one whose argument (argmap @ y[:n]) has changed sign, each a silent_impact.
     Returns how many."""
-    n = side.size
     hits = 0
-    for i in range(n):
+    for i in range(side.size):
         if awaiting[i]:
             x_i = 0.0
-            for j in range(n):
+            for j in range(argmap.shape[1]):
                 x_i += argmap[i, j] * y[j]
             if side[i] * x_i < 0.0:
                 silent_impact(i, side, awaiting)
@@ -182,8 +181,8 @@ def energy(theta, rate, mass, argmap, gravity, edges, nedges, intercepts, slopes
     e = 0.5 * dot(rate, matvec(mass, rate, np.empty(n))) - 0.5 * dot(
         theta, matvec(gravity, theta, np.empty(n))
     )
-    x = matvec(argmap, theta, np.empty(n))
-    for i in range(n):
+    x = matvec(argmap, theta, np.empty(argmap.shape[0]))
+    for i in range(x.size):
         e += law_potential(i, x[i], edges, nedges, intercepts, slopes)
     return e
 
@@ -202,17 +201,20 @@ def below_barrier(theta, rate, mass, argmap, gravity, edges, nedges, intercepts,
 
 @jit(inline=True)
 def shear_ratios(ag, ag_y, gam, centre_map, acc, acc_y, masses, normal_forces, rx, ry, peak):
-    """The friction demand of each interface at one instant: rx, ry (n) get the shear
-    T_i / (N_i gam) [-] (its x and y components; ry 0 in the plane), peak (n) is raised to
-    its magnitude |T_i| / (N_i gam). T_i [N] is the shear of the drums above interface i,
-    from their absolute horizontal accelerations: the ground's (ag, ag_y) [m/s^2] +
+    """The friction demand of each interface at one instant: rx, ry (joints) get the shear
+    T_i / (N_i gam) [-] (its x and y components; ry 0 in the plane), peak (joints) is raised
+    to its magnitude |T_i| / (N_i gam). T_i [N] is the shear of the bodies above interface
+    i (the drums above it, and a frame's beam share on the top node, the last body), from
+    their absolute horizontal accelerations: the ground's (ag, ag_y) [m/s^2] +
     centre_map @ (acc, acc_y) (acc the drums' theta'' [rad/s^2]; acc_y empty in the
-    plane), masses [kg]; N_i the normal force [N] at rest, gam = (g + a_v) / g [-] (1
-    without vertical motion)."""
+    plane), masses [kg] (a body each); N_i the normal force [N] at rest (normal_forces
+    holds one per joint: body i lies on joint i, and a monolithic frame's beam share lies
+    on its base), gam = (g + a_v) / g [-] (1 without vertical motion)."""
     n = acc.size
+    joints = normal_forces.size
     three = acc_y.size > 0
     sx, sy = 0.0, 0.0
-    for i in range(n - 1, -1, -1):
+    for i in range(masses.size - 1, -1, -1):
         bx, by = ag, ag_y
         for j in range(n):
             bx += centre_map[i, j] * acc[j]
@@ -220,6 +222,8 @@ def shear_ratios(ag, ag_y, gam, centre_map, acc, acc_y, masses, normal_forces, r
                 by += centre_map[i, j] * acc_y[j]
         sx += bx * masses[i]
         sy += by * masses[i]
+        if i >= joints:
+            continue
         w = normal_forces[i] * gam
         rx[i], ry[i] = sx / w, sy / w
         d = math.sqrt(sx * sx + sy * sy) / w if three else abs(sx) / w

@@ -38,7 +38,7 @@ class RbmRunner:
     def __init__(self, config: Config, model: Model | None = None) -> None:
         self.config = config
         self.model = model if model is not None else model_from_config(config)
-        self.n_interfaces = self.model.n
+        self.n_interfaces = self.model.joints
         init = config.excitation.initial
         n = self.model.n
         self.theta0 = np.zeros(n) if not init.rotations else np.asarray(init.rotations, float)
@@ -70,7 +70,7 @@ class RbmRunner:
         integrator = self._integrators.get(key)
         if integrator is None:
             integrator = self._integrators[key] = self.integrator_of(method)
-        n = self.model.n
+        n = self.model.joints
         t_lift = motion.lift_off  # a vertical record dropping faster than gravity
         t_shape = shape_change(self.model, motion)  # or changing the order of a law's pieces
         if t_shape is not None and t_lift is not None:  # the earlier one ends the run

@@ -102,11 +102,11 @@ def integrate(
     if prepared is None:
         prepared = prepare_kernel(model)
     n = model.n
-    solver = solver.for_run(motion.t_end, n)
+    solver = solver.for_run(motion.t_end, model.joints)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)
-    held = held_array(n, float(friction_duration), float(friction_limit))
+    held = held_array(model.joints, float(friction_duration), float(friction_limit))
     # a RunTask, as a plain tuple (step.inputs)
     task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
             stop_level(early_stop, solver),

@@ -205,27 +205,29 @@ def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1
     """events.first_crossing on the step's dense output, over the rows in `mask`:
     (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
 
-    The 4n rows are [gx; -gx; -gc; gc] theta + h0 (_event_rows), so their interpolants
-    (polynomials in the step's fraction) are those of n rows (2n unless `same`), signed:
+    The 4m rows (m joints, n drums) are [gx; -gx; -gc; gc] theta + h0 (_event_rows), so
+    their interpolants (polynomials in the step's fraction) are those of m rows (2m unless
+    `same`), signed:
     each is projected once and evaluated once a check point (poly_part), each masked row
     adds its sign and its own constant term (CP, BP: its distance; CR, BR: its rate; the
     same numbers as row_poly's). Rows r < mv_e.size with mv_e[r] != 0 add their moving
     part (step.vertical) on the step's ground piece gr."""
     nseg = CHECK_INTERVALS
     h = t1 - t0
-    nrow = 4 * n
+    m = gx.shape[0]  # the joints; n the drums
+    nrow = 4 * m
     nq = TAB_NP[mc]
     for r in range(nrow):
         if not mask[r]:
             D[r, :], R[r, :] = np.inf, 0.0  # inert: never below zero, never turning
-    for b in range(n if same else 2 * n):
-        i = b % n
-        rows = gx if b < n else gc
+    for b in range(m if same else 2 * m):
+        i = b % m
+        rows = gx if b < m else gc
         # the rows built on rows[i], with their signs: the first is where its interpolant is
         # projected; the collapse pair too when same (-1: none)
-        p = i if b < n else 3 * n + i
-        signed = ((p, 1.0), (n + i if b < n else 2 * n + i, -1.0),
-                  (3 * n + i if same else -1, 1.0), (2 * n + i if same else -1, -1.0))  # fmt: skip
+        p = i if b < m else 3 * m + i
+        signed = ((p, 1.0), (m + i if b < m else 2 * m + i, -1.0),
+                  (3 * m + i if same else -1, 1.0), (2 * m + i if same else -1, -1.0))  # fmt: skip
         used = False
         for r, _ in signed:
             used = used or (r >= 0 and mask[r])
@@ -305,7 +307,7 @@ def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, c
     with 3n columns) gets -sum_i c_i (M^-1 D^T)[:, i] argmap[i, :] in As[:, 2n:], over the
     interfaces on their elastic piece (k_i = 0; Model.joint_damping c), read on the rates:
     theta'' += As[:, 2n:] theta'."""
-    n = side.size
+    n = As.shape[0]  # the drums; side.size the joints
     damped = As.shape[1] > 2 * n
     for p in range(n):
         cs[p] = 0.0
@@ -314,7 +316,7 @@ def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, c
             As[p, n + q] = 0.0
             if damped:
                 As[p, 2 * n + q] = 0.0
-    for i in range(n):
+    for i in range(side.size):
         a = side[i] * intercepts[i, k[i]]
         b = parts[0, i, k[i]] if vert else slopes[i, k[i]]
         be = parts[1, i, k[i]] if vert else 0.0
@@ -335,18 +337,18 @@ def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, c
 
 @jit
 def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
-    """The event rows event_rows v[off:off + n] (+ h0) of the kernel, from their two
-    distinct blocks: event_rows = [gx; -gx; -gc; gc] (gx = argmap / theta_u, gc the
-    normalised collapse map; `same` when gc == gx, as for `relative`)."""
-    n = gx.shape[0]
+    """The event rows event_rows v[off:off + n] (+ h0) of the kernel (m joints, n drums),
+    from their two distinct blocks: event_rows = [gx; -gx; -gc; gc] (gx = argmap / theta_u,
+    gc the normalised collapse map; `same` when gc == gx, as for `relative`)."""
+    n = gx.shape[0]  # the joints (the rows' blocks); the drums: gx.shape[1]
     for i in range(n):
         a = 0.0
-        for j in range(n):
+        for j in range(gx.shape[1]):
             a += gx[i, j] * v[off + j]
         c = a
         if not same:
             c = 0.0
-            for j in range(n):
+            for j in range(gx.shape[1]):
                 c += gc[i, j] * v[off + j]
         if with_h0:
             out[i], out[n + i] = a + h0[i], h0[n + i] - a
@@ -360,7 +362,7 @@ def surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
     """The event distances d, rates dd and second derivatives d2 at the state y (time t [s])
     with accelerations acc; with a vertical record (mv_e not empty) the moving kinks'
     parts added (step.vertical)."""
-    n = gx.shape[0]
+    n = gx.shape[1]  # the drums: the rates' offset in y
     _event_rows(gx, gc, same, y, 0, h0, True, d)
     _event_rows(gx, gc, same, y, n, h0, False, dd)
     _event_rows(gx, gc, same, acc, 0, h0, False, d2)

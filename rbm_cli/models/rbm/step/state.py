@@ -45,7 +45,7 @@ def switch(model, i, going_up, bound, y, side, k, pending, awaiting, rigid_mono)
     int  UPLIFT, KINK, IMPACT (rbm_cli.models.rbm.pieces) or REST (an impact after which the
         monolith rests).
     """
-    n = side.size
+    n = y.size // 2
     argmap, arg_inv = model.argmap, model.arg_inv
     x_i = 0.0
     for j in range(n):

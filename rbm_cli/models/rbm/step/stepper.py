@@ -69,7 +69,7 @@ def account_step(mc, t_old, t_new, h, y_old, F, gr, ground_load, argmap, damp, k
     ledger[3] [J]: over [t_old, t_new] on the step's dense output (F, from y_old; its
     interpolant over h), the powers -a_g r . theta' (r the ground load) and
     sum_i c_i x_i'^2 (the joints on their elastic piece, k_i = 0) by Gauss-Legendre."""
-    n = damp.size
+    n = ground_load.size  # the drums; damp.size the joints
     dt = t_new - t_old
     for q in range(GL_NODES.size):
         tq = t_old + GL_NODES[q] * dt
@@ -79,7 +79,7 @@ def account_step(mc, t_old, t_new, h, y_old, F, gr, ground_load, argmap, damp, k
         for j in range(n):
             p_in -= ag * ground_load[j] * yq[n + j]
         p_d = 0.0
-        for i in range(n):
+        for i in range(damp.size):
             if damp[i] != 0.0 and k[i] == 0:
                 xd = 0.0
                 for j in range(n):
@@ -139,8 +139,9 @@ def start(theta0, rate0, W, account):
     for i in range(2 * n):
         if y[i] != 0.0:
             at_rest = False
-    x0 = matvec(W.argmap, y[:n], np.empty(n))
-    r0 = matvec(W.argmap, y[n:], np.empty(n))
+    m = W.argmap.shape[0]  # the joints
+    x0 = matvec(W.argmap, y[:n], np.empty(m))
+    r0 = matvec(W.argmap, y[n:], np.empty(m))
     locate(x0, r0, W.side, W.k, W.pending, W.rigid, W.edges, W.nedges)
     if account:
         ledger = W.ledger
@@ -152,22 +153,24 @@ def start(theta0, rate0, W, account):
 
 @jit(inline=True)
 def plane_record(model, motion, task, n, vert):
-    """The run's record (step.work.PLANE) of a column of n joints: model its ColumnArrays,
-    motion the Excitation, task the RunTask; vert: under a vertical record."""
+    """The run's record (step.work.PLANE) of a column of n drums (and m joints: n, or n + 1
+    with a frame's beam joint): model its ColumnArrays, motion the Excitation, task the
+    RunTask; vert: under a vertical record."""
     W = new_record(PLANE)
     column_into(W, model)
     motion_into(W, motion)
+    m = model.argmap.shape[0]
     # max_ratio, friction, slip, swept (none), the energy account (run_kernel's Returns), the
     # top's peak
-    W.max_ratio, W.friction, W.slip = np.zeros(n), np.zeros(n), np.array([np.nan, 0.0])
+    W.max_ratio, W.friction, W.slip = np.zeros(m), np.zeros(m), np.array([np.nan, 0.0])
     W.swept, W.ledger, W.top = np.zeros(0), np.zeros(5), np.zeros(1)
-    nrow, nt, nv = 4 * n, n + 1, 2 * n if vert else 0
-    W.side, W.k = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
-    W.pending, W.awaiting = np.zeros(n, dtype=np.bool_), np.zeros(n, dtype=np.bool_)
+    nrow, nt, nv = 4 * m, m + 1, 2 * m if vert else 0
+    W.side, W.k = np.ones(m, dtype=np.int64), np.zeros(m, dtype=np.int64)
+    W.pending, W.awaiting = np.zeros(m, dtype=np.bool_), np.zeros(m, dtype=np.bool_)
     W.lo, W.hi, W.h0, W.mv_e, W.mv_w = (
-        np.empty(n),
-        np.empty(n),
-        np.empty(4 * n),
+        np.empty(m),
+        np.empty(m),
+        np.empty(4 * m),
         np.zeros(nv),
         np.ones(nv),
     )
@@ -186,7 +189,7 @@ def plane_record(model, motion, task, n, vert):
         np.empty(nrow),
     )
     W.acc, W.acc_old, W.acc_k = np.empty(n), np.empty(n), np.empty(n)
-    W.rx, W.ry, W.between, W.ends = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(2)
+    W.rx, W.ry, W.between, W.ends = np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(2)
     W.samples, W.held, W.record = task.samples, task.held, task.record
     W.output_dt, W.mu, W.vert = task.output_dt, task.friction_limit, vert
     W.any_silent = model.silent.any()
@@ -240,7 +243,8 @@ def run_kernel(model, motion, solver, task):
             last_forced = seg
     outcome_bound = model.survival == model.survival and not vert  # a barrier that applies
     stops = (task.early_stop, last_forced, outcome_bound, n == 1)
-    loop_into(W, y, system, 2 * n)  # the kinds of event at_event numbers: kinks, 2 a joint
+    # the kinds of event at_event numbers: kinks, 2 a joint
+    loop_into(W, y, system, 2 * model.argmap.shape[0])
     return run_plane(W, motion, solver, n, at_rest, stops, account)
 
 
@@ -370,7 +374,8 @@ def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out,
     affine(W.track, W.y_new, 0, W.no_offset, W.z_new)
     affine(W.track, W.y_new, n, W.no_offset, W.dz_new)
     # peaks inside the step: at the root of the rate, on the dense output
-    for r in range(n + 1):
+    m = W.side.size  # the joints: the tracked rows are their collapse ratios, then the top
+    for r in range(m + 1):
         v = max(abs(W.z_old[r]), abs(W.z_new[r]))
         # a turn inside the step that may beat the running maximum: the step's cubic
         # Hermite exceeds its end values by at most 4/27 h (|rate0| + |rate1|); the margin
@@ -388,11 +393,11 @@ def step_figures(W, mc, t_old, t_new, h, gr, event, dense_ready, account, n_out,
             v = max(v, abs(poly_val(mc, t_pk, t_old, h, W.coef, base)))
         if v > W.peaks[r]:
             W.peaks[r] = v
-    for i in range(n):
+    for i in range(m):
         if W.peaks[i] > W.max_ratio[i]:
             W.max_ratio[i] = W.peaks[i]
-    if W.peaks[n] > W.top[0]:
-        W.top[0] = W.peaks[n]
+    if W.peaks[m] > W.top[0]:
+        W.top[0] = W.peaks[m]
     shear_ratios(g_new, 0.0, gam_new, W.centre_map, W.acc, W.no_offset, W.masses,
                  W.normal_forces, W.rx, W.ry, W.friction)  # fmt: skip
     if W.slip[1] == 0.0:
@@ -439,13 +444,14 @@ def at_event(W, row, t, gr, account):
     or the kind of event whose step size the run loop remembers (2 i + 0 or 1: joint i's
     kink down or up; -1: an uplift, an impact), nan)."""
     n = W.y.size // 2
-    i = row % n
-    if row // n >= 2:
+    m = W.side.size  # the joints: the rows are 4 of theirs
+    i = row % m
+    if row // m >= 2:
         if W.c_ratio > W.max_ratio[i]:
             W.max_ratio[i] = W.c_ratio
         return COLLAPSED, 0, 0, False, i + 1, np.nan
-    going_up = row // n == 1
-    bound = bound_now(i, going_up, n, W.lo, W.hi, W.tu, t, gr, W.mv_e, W.mv_w) if W.vert else (
+    going_up = row // m == 1
+    bound = bound_now(i, going_up, m, W.lo, W.hi, W.tu, t, gr, W.mv_e, W.mv_w) if W.vert else (
         W.hi[i] if going_up else W.lo[i])  # fmt: skip
     what = switch(W, i, going_up, bound, W.y, W.side, W.k, W.pending, W.awaiting, W.rigid_mono)
     if account:

@@ -1,0 +1,445 @@
+"""A frame of columns under a beam in the contact engine (`model: bullet` with ``frame``).
+
+A frame (a colonnade's bay, Config.frame) is N identical columns, each the config's stack of
+drums (:func:`rbm_cli.models.bullet.geometry.drum_solids`), standing in a row along x, the
+plane of the motion, under one rigid beam (an architrave): a box resting freely on their
+tops, in contact with them with the joints' friction (interface.friction). The beam may
+slide and turn, lift off a top and land on it again, and the columns need not move in
+unison; every body is held in the plane (rbm_cli.models.bullet.scene.keep_in_plane). The
+scene is built by rbm_cli.models.bullet.scene.build_frame. SI units.
+
+Layout (:func:`frame_layout`) [assumptions]:
+
+- the columns' axes stand SPACING = 2.5 base widths apart (a colonnade's
+  intercolumniation, axis to axis, is about 1.5 to 3 base widths), the frame centred on
+  x = 0;
+- the beam spans from the first column's outer top edge to the last one's:
+  L = (N - 1) spacing + the top's width; its depth is the top's (column.depth, or the top's
+  width for a square or a circular section); its height makes its mass beam_mass at the
+  column's density, h = beam_mass / (density L depth): finite, as the config bounds
+  beam_mass, and positive, as a beam of no mass is the free column (its run is the
+  column's, rbm_cli.models.bullet.run.bullet_run).
+
+Readings at every check (:class:`FrameWatch`):
+
+- each column's joints as a free column's (rbm_cli.models.bullet.scene.joint_state, read in
+  the column's own axes): per joint the largest ratio and slip over the columns, and the
+  rotation of largest magnitude, whose openings and closures are counted as a column's
+  (a frame rocking in unison counts as one column);
+- joint n + 1, the beam's: on each top, the share of the top's width the beam's bottom face
+  no longer covers, in the top's own axes, ``1 - overlap / top width`` (0 seated over the
+  whole top, 1 once it has left the top in plan), the largest over the tops; its slip on
+  each top as a drum's on its support (the offset of the beam's point that stood over the
+  top's centre, less the b (1 - cos phi) that turning on the top's corner gives without
+  sliding, b the top's half-width, phi the beam's rotation relative to the top).
+
+Collapse, whichever comes first (the run stops there):
+
+- a column collapses by the column's rule (a joint's ratio reaches collapse.ratio, or a
+  drum drops by DROP_FRACTION of its height): collapse_interface is that joint (1: the
+  base) and the message names the column;
+- the beam falls (collapse_interface n + 1): its ratio reaches collapse.ratio (with the
+  default 1, it has left a top in plan: no longer over it, it cannot land on it again and
+  rests on the others or falls), or its centre of mass drops by DROP_FRACTION of the top
+  drum's height (only off the tops can it drop that far: a top under it rises as its
+  column rocks, the corner it rests on turning up). A beam lifted off a top it still
+  stands over may land on it again: that is not its fall.
+
+Friction demand (FRICTION_DT windows, as a column's): the engine's momentum balance gives
+the mean force on a set of bodies that touches the rest through one joint only. A column's
+joint i carries its drums above and an unknown share of the beam (how the columns share the
+beam is statically indeterminate), so the reading at joint i is that of the frame's level
+i: the drums above joint i of every column and the beam together, over the contact normals
+any column's faces at that joint admit. It is each column's demand while they move alike
+(at rest, rocking in unison) and at most the largest column's otherwise (each column's
+force inside its Coulomb cone, their sum lies in the cones' union: the notes of
+rbm_cli.models.bullet.scene.joint_friction). The beam's joint: the beam's own mean force,
+over the normals of its bottom face and of every top face.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rbm_cli.config.types import ColumnConfig, FrameConfig, G
+from rbm_cli.inputs.excitation import GroundMotion
+from rbm_cli.models.bullet.geometry import DrumSolid
+from rbm_cli.models.bullet.scene import (
+    Frame,
+    Joints,
+    StackGeometry,
+    joint_normal_range,
+    joint_state,
+)
+from rbm_cli.models.bullet.watch import (
+    BLOWUP,
+    DROP_FRACTION,
+    FRICTION_DT,
+    OPEN_FRACTION,
+    REST_ANGULAR_RATE,
+    REST_SPEED,
+    REST_TIME,
+)
+from rbm_cli.models.outcome import Outcome
+
+#: The columns' axes stand this many base widths apart [assumption: a colonnade's
+#: intercolumniation, axis to axis, is about 1.5 to 3 base widths].
+SPACING = 2.5
+OVERHANG = 0.0
+
+
+@dataclass(frozen=True)
+class FrameLayout:
+    """Where a frame's bodies stand (the module's notes).
+
+    axes : (N,) x of each column's axis [m], the frame centred on x = 0
+    spacing : float  Axis to axis [m]
+    beam : DrumSolid  The beam, a box whose bottom face is at the columns' height
+        (half_bottom = half_top: half its length)
+    depth : float  The beam's depth [m]
+    """
+
+    axes: np.ndarray
+    spacing: float
+    beam: DrumSolid
+    depth: float
+
+    @property
+    def length(self) -> float:
+        """The beam's length L [m]."""
+        return 2.0 * self.beam.half_bottom
+
+
+def frame_layout(column: ColumnConfig, frame: FrameConfig, solids) -> FrameLayout:
+    """The layout of a frame of columns (each the drums ``solids`` of ``column``) under a
+    beam of frame.beam_mass [kg] > 0: the module's rules."""
+    count = frame.columns
+    spacing = SPACING * column.base_width
+    axes = (np.arange(count) - 0.5 * (count - 1)) * spacing
+    width = 2.0 * solids[-1].half_top
+    length = (count - 1) * spacing + width + 2.0 * OVERHANG * width
+    depth = width if column.section == "circular" or column.depth is None else column.depth
+    mass = frame.beam_mass
+    height = mass / (column.density * length * depth)
+    half = (0.5 * length, 0.5 * depth, 0.5 * height)
+    corners = np.array(
+        [(sx * half[0], sy * half[1], sz * half[2]) for sz in (-1.0, 1.0)
+         for sx in (-1.0, 1.0) for sy in (-1.0, 1.0)]
+    )  # fmt: skip
+    inertia = (
+        mass * (depth**2 + height**2) / 12.0,
+        mass * (length**2 + height**2) / 12.0,
+        mass * (length**2 + depth**2) / 12.0,
+    )
+    beam = DrumSolid(
+        bottom=solids[-1].bottom + solids[-1].height,
+        height=height,
+        half_bottom=half[0],
+        half_top=half[0],
+        mass=mass,
+        centre=half[2],
+        inertia=inertia,
+        vertices=corners,
+        box=True,
+        half_extents=half,
+    )
+    return FrameLayout(axes=axes, spacing=spacing, beam=beam, depth=depth)
+
+
+@dataclass(frozen=True)
+class FrameJoints:
+    """The frame's joints at one instant (the module's readings).
+
+    frames : tuple of Frame  Each column's drums, in its own axes (its axis at x = 0)
+    columns : tuple of Joints  Each column's joints (scene.joint_state of its frame)
+    ratio : (n + 1,) Per joint the largest ratio over the columns; the beam's last
+    relative : (n,) Per joint the columns' relative rotation of largest magnitude [rad]
+    slip : (n,) Per joint the largest |slip| over the columns [m]
+    beam_ratio : (N,) The share of each top's width the beam has left [-]
+    beam_slip : (N,) The beam's slip on each top [m]
+    """
+
+    frames: tuple[Frame, ...]
+    columns: tuple[Joints, ...]
+    ratio: np.ndarray
+    relative: np.ndarray
+    slip: np.ndarray
+    beam_ratio: np.ndarray
+    beam_slip: np.ndarray
+
+
+def _friction_demand(force, lo, hi, mass) -> np.ndarray:
+    """tan of the distance from each force's angle to its joint's range [lo, hi] of contact
+    normals (nan: not loaded), as scene.joint_friction reads it: force (k, 3) [N], lo and
+    hi (k,) [rad], mass (k,) the mass the joint carries [kg]."""
+    psi = np.arctan2(force[:, 0], force[:, 2])
+    gap = np.maximum(0.0, np.maximum(lo - psi, psi - hi))
+    normal = np.hypot(force[:, 0], force[:, 2]) * np.cos(gap)
+    out = np.full(len(force), np.nan)
+    loaded = (gap < 0.5 * math.pi) & (normal > 1e-6 * G * mass)
+    out[loaded] = np.tan(gap[loaded])
+    return out
+
+
+def frame_friction(
+    before: Frame,
+    after: Frame,
+    masses: np.ndarray,
+    n: int,
+    duration: float,
+    mean_accel: float,
+    tilt_range: tuple[np.ndarray, np.ndarray],
+    mean_up: float = 0.0,
+) -> np.ndarray:
+    """Friction demand of a frame's n + 1 joints over an interval (the module's notes) [-].
+
+    Parameters
+    ----------
+    before, after : Frame  Every body (columns' drums, column by column, then the beam) at
+        the interval's ends
+    masses : (N n + 1,) The bodies' masses [kg]
+    n : int  Drums per column
+    duration : float  The interval [s]
+    mean_accel, mean_up : float  Mean a_g and a_v over it, as the engine applied them [m/s^2]
+    tilt_range : (lo, hi)  Range of every body's tilt over the interval [rad]
+    """
+    count = (len(masses) - 1) // n
+    momentum = masses[:, None] * (after.velocities - before.velocities)
+    beam = momentum[-1]
+    levels = momentum[:-1].reshape(count, n, 3).sum(axis=0)
+    level_mass = masses[:-1].reshape(count, n).sum(axis=0)
+    above = np.vstack([np.cumsum(levels[::-1], axis=0)[::-1] + beam, beam[None]])
+    carried = np.append(np.cumsum(level_mass[::-1])[::-1] + masses[-1], masses[-1])
+    inertial = np.array([mean_accel, 0.0, G + mean_up])
+    force = above / duration + carried[:, None] * inertial
+    lo, hi = tilt_range
+    lo_c, hi_c = lo[:-1].reshape(count, n), hi[:-1].reshape(count, n)
+    ranges = [joint_normal_range(lo_c[c], hi_c[c]) for c in range(count)]
+    level_lo = np.min([r[0] for r in ranges], axis=0)
+    level_hi = np.max([r[1] for r in ranges], axis=0)
+    beam_lo = min(float(lo[-1]), float(np.min(lo_c[:, -1])))
+    beam_hi = max(float(hi[-1]), float(np.max(hi_c[:, -1])))
+    return _friction_demand(
+        force, np.append(level_lo, beam_lo), np.append(level_hi, beam_hi), carried
+    )
+
+
+class FrameWatch:
+    """The readings a frame's run carries from check to check, and the tests made at each
+    (:class:`rbm_cli.models.bullet.watch.RunWatch`'s, for a frame in the plane: the
+    module's notes).
+
+    Parameters
+    ----------
+    solids : tuple of DrumSolid  A column's drums, bottom first
+    layout : FrameLayout
+    alpha : (n,) array  Overturning angle of a column above each joint [rad]
+    limit : float  collapse.ratio [-]
+    dt : float  Engine time step [s]
+    accel : (n_steps,) array  a_g at every mid-step, as the engine applies it [m/s^2]
+    frame : Frame  Every body at t = 0 (columns' drums, column by column, then the beam)
+    upward : (n_steps,) array or None  a_v at every mid-step [m/s^2] (None: 0)
+
+    Attributes
+    ----------
+    max_slip : (n,) The largest |slip| of each column joint so far, over the columns [m]
+    max_beam_slip : float  The beam's largest |slip| on a top so far [m]
+    """
+
+    def __init__(self, solids, layout: FrameLayout, alpha, limit: float, dt: float, accel,
+                 frame: Frame, upward=None) -> None:  # fmt: skip
+        n, count = len(solids), len(layout.axes)
+        self.n, self.count = n, count
+        self.stack = StackGeometry.of(solids)
+        self.layout = layout
+        self.half_top = solids[-1].half_top
+        self.alpha, self.limit, self.dt = alpha, limit, dt
+        self.shifts = [np.array([x, 0.0, 0.0]) for x in layout.axes]
+        beam = layout.beam
+        self.masses = np.append(np.tile(self.stack.masses, count), beam.mass)
+        column_z = [d.bottom + d.centre for d in solids] * count
+        self.rest_z = np.array(column_z + [beam.bottom + beam.centre])
+        drops = [DROP_FRACTION * d.height for d in solids] * count
+        self.drop = np.array(drops + [DROP_FRACTION * solids[-1].height])
+        self.open_tol = OPEN_FRACTION * alpha
+        self.max_slip = np.zeros(n)
+        self.max_beam_slip = 0.0
+        self.was_open = np.zeros(n, bool)
+        self.last_sign = np.zeros(n)
+        self.prev_ratio, self.prev_t, self.quiet_since = 0.0, 0.0, None
+        self.accel_sum = np.concatenate([[0.0], np.cumsum(np.asarray(accel, dtype=float))])
+        self.up_sum = None if upward is None else np.concatenate([[0.0], np.cumsum(upward)])
+        self.friction_steps = max(1, int(round(FRICTION_DT / dt)))
+        self.k_prev = 0
+        self.frame_prev = self.frame_last = frame
+        self.tilt_lo = self.tilt_hi = frame.tilts
+        self.top_start = np.array([j.top[0] for j in self.joints(frame).columns])
+
+    def joints(self, frame: Frame) -> FrameJoints:
+        """The frame's joints at a frame of the engine (no reading kept)."""
+        n, frames, cols = self.n, [], []
+        for c, shift in enumerate(self.shifts):
+            s = slice(c * n, (c + 1) * n)
+            sub = Frame(frame.centres[s] - shift, frame.rotations[s], frame.rates[s],
+                        frame.speeds[s], frame.velocities[s], frame.angular[s])  # fmt: skip
+            frames.append(sub)
+            cols.append(joint_state(sub, self.stack, self.alpha))
+        beam_ratio, beam_slip = self._seat(frame, cols)
+        rel = np.array([j.relative for j in cols])
+        pick = np.argmax(np.abs(rel), axis=0)
+        return FrameJoints(
+            frames=tuple(frames),
+            columns=tuple(cols),
+            ratio=np.append(np.max([j.ratio for j in cols], axis=0), np.max(beam_ratio)),
+            relative=rel[pick, np.arange(n)],
+            slip=np.max(np.abs([j.slip for j in cols]), axis=0),
+            beam_ratio=beam_ratio,
+            beam_slip=beam_slip,
+        )
+
+    def _seat(self, frame: Frame, cols) -> tuple[np.ndarray, np.ndarray]:
+        """The beam on each top: the share of the top's width it has left, and its slip
+        (the module's notes), each (N,)."""
+        beam, axes, half = self.layout.beam, self.layout.axes, self.half_top
+        centre, rot, tilts = frame.centres[-1], frame.rotations[-1], frame.tilts
+        ends = np.array([-beam.half_bottom, beam.half_bottom])
+        ratio, slip = np.empty(self.count), np.empty(self.count)
+        for c, joints in enumerate(cols):
+            top = (c + 1) * self.n - 1
+            top_rot = frame.rotations[top]
+            point = centre + rot @ np.array([axes[c], 0.0, -beam.centre]) - self.shifts[c]
+            q = top_rot.T @ (point - joints.top)
+            along = top_rot.T @ rot[:, 0]
+            x = q[0] + (ends - axes[c]) * along[0]
+            overlap = min(float(np.max(x)), half) - max(float(np.min(x)), -half)
+            ratio[c] = 1.0 - max(overlap, 0.0) / (2.0 * half)
+            phi = tilts[-1] - tilts[top]
+            slip[c] = q[0] - math.copysign(half * (1.0 - math.cos(phi)), phi)
+        return ratio, slip
+
+    def see(self, frame: Frame) -> FrameJoints:
+        """The joints of a checked frame; widens the friction window's range of tilts."""
+        joints = self.joints(frame)
+        self.frame_last = frame
+        tilts = frame.tilts
+        self.tilt_lo = np.minimum(self.tilt_lo, tilts)
+        self.tilt_hi = np.maximum(self.tilt_hi, tilts)
+        return joints
+
+    def column_view(self, joints: FrameJoints) -> tuple[Frame, Joints]:
+        """The first column's drums and joints (a frame's history is its first column's)."""
+        return joints.frames[0], joints.columns[0]
+
+    def residual(self, out: Outcome) -> None:
+        """The run's residual state into ``out``, as RunWatch.residual reads a column's:
+        the largest |slip| of a joint, the beam's on a top included [m], the largest
+        offset of a column's top from its start [m] and the largest |relative rotation| /
+        alpha_i of a column's joint [-]; left NaN unless the run survived."""
+        if out.status != "survived":
+            return
+        joints = self.joints(self.frame_last)
+        out.residual_slip = float(max(np.max(joints.slip), np.max(np.abs(joints.beam_slip))))
+        tops = np.array([j.top[0] for j in joints.columns])
+        out.residual_top = float(np.max(np.abs(tops - self.top_start)))
+        tilt = np.max([np.abs(j.relative) / self.alpha for j in joints.columns])
+        out.residual_tilt = float(tilt)
+
+    def check(self, out: Outcome, k: int, frame: Frame, joints: FrameJoints,
+              motion: GroundMotion, early_stop: bool) -> bool:  # fmt: skip
+        """Update `out` with the check after engine step k; True when the run stops here
+        (diverged, collapsed, or at rest after the pulse with `early_stop`)."""
+        t = k * self.dt
+        if not (np.all(np.isfinite(frame.centres)) and np.max(frame.speeds) < BLOWUP):
+            out.n_steps = out.n_rhs = k
+            out.stop("failed", "the engine diverged (non-finite or runaway body)", t)
+            return True
+        if k - self.k_prev >= self.friction_steps:
+            self._friction(out, k, frame)
+        is_open = self._track(out, joints)
+        if self._collapsed(out, k, t, frame, joints):
+            return True
+        if early_stop and motion.kind != "harmonic" and t >= motion.pulse_end:
+            return self._at_rest(out, k, t, frame, is_open)
+        return False
+
+    def _friction(self, out: Outcome, k: int, frame: Frame) -> None:
+        """Close the friction window at step k: the joints' mean-force demand over it."""
+        k_prev = self.k_prev
+        steps = k - k_prev
+        mean_accel = (self.accel_sum[k] - self.accel_sum[k_prev]) / steps
+        up_sum = self.up_sum
+        mean_up = 0.0 if up_sum is None else (up_sum[k] - up_sum[k_prev]) / steps
+        demand = frame_friction(self.frame_prev, frame, self.masses, self.n, steps * self.dt,
+                                mean_accel, (self.tilt_lo, self.tilt_hi), mean_up)  # fmt: skip
+        out.friction = np.fmax(out.friction, demand)
+        self.tilt_lo = self.tilt_hi = frame.tilts
+        self.frame_prev, self.k_prev = frame, k
+
+    def _track(self, out: Outcome, joints: FrameJoints) -> np.ndarray:
+        """Maxima of ratio, top displacement and slip; joint openings and closures (of the
+        rotation of largest magnitude over the columns). Returns which joints are open."""
+        out.max_ratio = np.maximum(out.max_ratio, joints.ratio)
+        top = max(abs(j.top[0] - j.bottoms[0, 0]) for j in joints.columns)
+        out.max_top = max(out.max_top, float(top))
+        self.max_slip = np.maximum(self.max_slip, joints.slip)
+        self.max_beam_slip = max(self.max_beam_slip, float(np.max(np.abs(joints.beam_slip))))
+        is_open = np.abs(joints.relative) > self.open_tol
+        sign = np.sign(joints.relative) * is_open
+        out.n_uplifts += int(np.sum(is_open & ~self.was_open))
+        out.n_impacts += int(np.sum(self.was_open & (~is_open | (sign * self.last_sign < 0))))
+        self.was_open, self.last_sign = is_open, np.where(is_open, sign, self.last_sign)
+        return is_open
+
+    def _collapsed(self, out: Outcome, k: int, t: float, frame: Frame,
+                   joints: FrameJoints) -> bool:  # fmt: skip
+        """Collapse (the module's rule): a column's joint or the beam's reached the limit
+        (time interpolated between checks), or a body dropped."""
+        limit, n = self.limit, self.n
+        ratio = joints.ratio
+        worst = int(np.argmax(ratio))
+        dropped = np.nonzero(self.rest_z - frame.centres[:, 2] > self.drop)[0]
+        if ratio[worst] < limit and not dropped.size:
+            self.prev_ratio, self.prev_t = float(ratio[worst]), t
+            return False
+        out.n_steps = out.n_rhs = k
+        if ratio[worst] >= limit:
+            prev_ratio, prev_t = self.prev_ratio, self.prev_t
+            frac = (limit - prev_ratio) / max(ratio[worst] - prev_ratio, 1e-300)
+            out.t_collapse = prev_t + min(max(frac, 0.0), 1.0) * (t - prev_t)
+            out.collapse_interface = worst + 1
+            if worst == n:
+                column = int(np.argmax(joints.beam_ratio)) + 1
+                why = f"the beam left the top of column {column}"
+            else:
+                column = int(np.argmax([j.ratio[worst] for j in joints.columns])) + 1
+                why = f"the drums above joint {worst + 1} of column {column} passed over its edge"
+        else:
+            out.t_collapse = t
+            body = int(dropped[0])
+            if body == len(self.rest_z) - 1:
+                out.collapse_interface = n + 1
+                why = "the beam dropped by half the top drum's height"
+            else:
+                column, drum = divmod(body, n)
+                out.collapse_interface = drum + 1
+                why = f"drum {drum + 1} of column {column + 1} dropped by half its height"
+        out.stop("collapsed", why, out.t_collapse)
+        return True
+
+    def _at_rest(self, out: Outcome, k: int, t: float, frame: Frame, is_open) -> bool:
+        """After the pulse: at rest (every body's rate below REST_ANGULAR_RATE and speed
+        below REST_SPEED, every joint closed) for REST_TIME."""
+        moving = np.max(np.abs(frame.rates)) >= REST_ANGULAR_RATE or (
+            np.max(frame.speeds) >= REST_SPEED
+        )
+        still = not moving and not np.any(is_open)
+        quiet = self.quiet_since
+        self.quiet_since = (quiet if quiet is not None else t) if still else None
+        if self.quiet_since is not None and t - self.quiet_since >= REST_TIME:
+            out.n_steps = out.n_rhs = k
+            out.stop("survived", "at rest after the pulse", t)
+            return True
+        return False

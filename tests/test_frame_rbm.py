@@ -1,0 +1,226 @@
+"""The Rigid Beam Model's frame (rbm_cli.structures.frame): N columns under a beam that rests
+on their tops, rocking in unison.
+
+Checked against what holds independently of the frame's code:
+- a rigid monolithic frame is the RBM's own equivalent block: with the beam's share a body
+  on the top node (the RBM's small rotations move it horizontally, at H), the frame's
+  equation is (I_G + m h^2 + 4 (m_b / N) h^2) theta'' = -(m + 2 m_b / N) g b sgn(theta)
+  + (m + 2 m_b / N) g h theta - (m + 2 m_b / N) h a_g (h = H / 2, b = B / 2), the
+  linear block of tan alpha = b / h (the free column's: its uplift and collapse whatever
+  gamma) and p^2 = 6 g H (1 + 2 gamma) / (4 H^2 + B^2 + 12 gamma H^2) for a rectangle.
+  The free RBM column's p^2 = 6 g H / (4 H^2 + B^2) falls as 1 / size at a fixed shape,
+  so the frame rocks as the free column scaled by k = p^2 / p_frame^2 (Makris and
+  Vassiliou's exact frame has k = (1 + 3 gamma) / (1 + 2 gamma) instead: the RBM puts the
+  beam at the top node, not at the column's far corner): checked cell by cell, in the
+  closed form and in the step integrator;
+- ``restitution: housner`` on a rectangular monolith is Makris and Vassiliou's eta, since
+  the RBM's corner inertia of a rectangle is the true block's (4/3 m R^2);
+- a beam of no mass is the free column, to the bit, rigid or of drums;
+- a frame of drums: the energy balance closes (the ground's work less the impacts' loss
+  is the energy kept, each term computed on its own, the beam's motion and its joint's
+  law in every term); a beam moving with the ground carries a friction demand of a_g / g
+  on its joint; very stiff joints rock as the rigid monolithic frame;
+- what the frame cannot take is refused in one line.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from click.testing import CliRunner
+
+from rbm_cli.api import info as rbm_info
+from rbm_cli.api import load_config, run
+from rbm_cli.cli.main import cli
+
+G = 9.81
+H, B, RHO = 4.0, 0.8, 2700.0
+M = RHO * B * B * H  # a square column's mass [kg]
+#: Harmonic cells (amplitude [g], frequency [Hz]) around a slender column's boundary.
+CELLS = [(0.25, 0.5), (0.3, 0.8), (0.4, 1.0), (0.6, 1.5), (0.8, 2.5), (1.2, 3.0), (0.5, 0.6),
+         (0.9, 1.2)]  # fmt: skip
+
+
+def _monolith(gamma=None, size=1.0, restitution=0.9, method="auto", **extra):
+    cfg = {
+        "name": "frame",
+        "model": "rbm",
+        "column": {"height": H * size, "base_width": B * size},
+        "interface": {"restitution": restitution},
+        "excitation": {"type": "harmonic", "duration": 6.0},
+        # the step integrator at rtol 1e-12: two runs on other time scales agree to 1e-8
+        "solver": {"method": method} if method == "auto" else {"method": method, "rtol": 1e-12},
+        **extra,
+    }
+    if gamma is not None:
+        cfg["frame"] = {"columns": 2, "beam_mass": 2 * M * gamma}
+    return load_config(cfg)
+
+
+def _scale(gamma: float) -> float:
+    """k = p^2 / p_frame^2 of a rectangular RBM monolith under a beam of ratio gamma."""
+    return (4 * H * H + B * B + 12 * gamma * H * H) / ((1 + 2 * gamma) * (4 * H * H + B * B))
+
+
+def _same_rocking(a, b):
+    assert a.status == b.status
+    if a.status == "collapsed":
+        assert a.t_collapse_s == pytest.approx(b.t_collapse_s, rel=1e-8)
+    ra, rb = a.result, b.result
+    assert ra["max_rotation_ratio"] == pytest.approx(rb["max_rotation_ratio"], rel=1e-8)
+    assert ra["n_impacts"] == rb["n_impacts"] and ra["n_uplifts"] == rb["n_uplifts"]
+
+
+@pytest.mark.parametrize("gamma", [0.5, 1.0, 2.0])
+@pytest.mark.parametrize("method", ["auto", "DOP853"])
+def test_a_rigid_monolithic_frame_is_the_rbm_equivalent_block(gamma, method):
+    frame = _monolith(gamma, method=method)
+    block = _monolith(size=_scale(gamma), method=method)
+    outcomes = set()
+    for amplitude, frequency in CELLS:
+        a, b = run(frame, amplitude, frequency), run(block, amplitude, frequency)
+        _same_rocking(a, b)
+        outcomes.add(a.status)
+        assert a.result["method"] == ("closed-form" if method == "auto" else "DOP853")
+    assert outcomes == {"collapsed", "survived"}
+
+
+def test_the_frame_lifts_at_the_free_columns_level_whatever_gamma():
+    alpha = B / H  # the RBM's tan alpha: (B / 2) / (H / 2)
+    for gamma in (0.0, 0.5, 2.0):
+        cfg = _monolith(gamma)
+        assert rbm_info(cfg)["static_multiplier_g"] == pytest.approx(alpha, rel=1e-12)
+        below = run(cfg, 0.99 * alpha, 0.5)
+        above = run(cfg, 1.01 * alpha, 0.5)
+        assert below.result["n_uplifts"] == 0 and below.result["max_rotation_ratio"] == 0.0
+        assert above.result["n_uplifts"] > 0
+
+
+@pytest.mark.parametrize("gamma", [0.5, 2.0])
+def test_restitution_housner_is_the_frames_eta(gamma):
+    sin2 = (B / 2) ** 2 / ((B / 2) ** 2 + (H / 2) ** 2)
+    cos2a = 1.0 - 2.0 * sin2
+    eta = (1.0 - 1.5 * sin2 + 3.0 * gamma * cos2a) / (1.0 + 3.0 * gamma)
+    frame = _monolith(gamma, restitution="housner")
+    block = _monolith(size=_scale(gamma), restitution=eta)
+    for amplitude, frequency in CELLS:
+        _same_rocking(run(frame, amplitude, frequency), run(block, amplitude, frequency))
+
+
+def _bits(cell) -> dict:
+    out = dict(cell.result)
+    out.pop("wall_time_s")
+    return {k: repr(v) for k, v in out.items()}
+
+
+@pytest.mark.parametrize(
+    "column, interface",
+    [
+        ({"height": H, "base_width": B}, {"restitution": 0.9}),
+        ({"height": H, "base_width": B, "top_width": 0.6, "drums": 3},
+         {"restitution": 0.9, "stiffness": {"normal": 5e9}, "damping": 0.02}),
+    ],
+)  # fmt: skip
+def test_a_beam_of_no_mass_is_the_free_column_to_the_bit(column, interface):
+    base = {"name": "f", "column": column, "interface": interface,
+            "excitation": {"type": "harmonic", "duration": 4.0}}  # fmt: skip
+    free = load_config(base)
+    frame = load_config({**base, "frame": {"columns": 3, "beam_mass": 0.0}})
+    for amplitude, frequency in [(0.3, 1.0), (0.6, 2.0)]:
+        assert _bits(run(frame, amplitude, frequency)) == _bits(run(free, amplitude, frequency))
+
+
+DRUMS = {"height": H, "base_width": B, "drums": 4}
+
+
+def _drums(gamma, stiffness=None, **extra):
+    return load_config(
+        {
+            "name": "colonnade",
+            "model": "rbm",
+            "column": DRUMS,
+            "interface": {"restitution": 0.9, "stiffness": stiffness or {"normal": 5e9}},
+            "excitation": {"type": "harmonic", "duration": 4.0},
+            "frame": {"columns": 2, "beam_mass": 2 * M * gamma},
+            **extra,
+        }
+    )
+
+
+def test_a_frame_of_drums_closes_its_energy_balance():
+    cell = run(_drums(1.0), 0.35, 1.5, record=True)
+    r = cell.result
+    assert r["n_uplifts"] > 5 and r["n_impacts"] > 5  # every joint's law at work
+    assert len(r["friction_demand"]) == 5  # four drum joints and the beam's
+    e = r["energy"]
+    kept = e["final_J"] - e["initial_J"]
+    balance = kept - (e["ground_work_J"] - e["damping_J"] - e["impacts_J"])
+    assert e["impacts_J"] > 0 and e["ground_work_J"] > 0
+    assert abs(balance) <= 1e-8 * e["ground_work_J"], e
+
+
+def test_a_beam_moving_with_the_ground_carries_its_acceleration_on_its_joint():
+    # 0.05 g at 0.25 Hz: far below uplift (B / H = 0.2 g), the joints' elastic modes far
+    # above (the first at 68 Hz: the quasi-static amplification (0.25 / 68)^2 ~ 1e-5) and
+    # damped (their ringing from the motion's start gone): the column and the beam move
+    # with the ground, each joint's shear is its load's mass times a_g, its demand a_g / g
+    cfg = _drums(1.0, {"normal": 5e11})
+    cfg = load_config({**cfg.written, "interface": {**cfg.written["interface"], "damping": 0.2}})
+    assert rbm_info(cfg)["elastic_frequencies_hz"][0] > 60.0
+    demand = run(cfg, 0.05, 0.25).result["friction_demand"]
+    assert demand[-1] == pytest.approx(0.05, rel=1e-3)
+    assert max(demand) == pytest.approx(0.05, rel=1e-3)
+
+
+def test_very_stiff_joints_rock_as_the_rigid_monolithic_frame():
+    stiff = _drums(1.0, {"normal": 5e12})
+    rigid = _monolith(1.0, method="DOP853")
+    agree = 0
+    cells = [(0.3, 0.5), (0.6, 1.0), (0.25, 0.8), (1.0, 2.0), (0.5, 0.6)]
+    for amplitude, frequency in cells:
+        a, b = run(stiff, amplitude, frequency), run(rigid, amplitude, frequency)
+        agree += a.status == b.status
+        if a.status == b.status == "collapsed":
+            assert a.t_collapse_s == pytest.approx(b.t_collapse_s, rel=2e-2)
+    assert agree == len(cells)
+
+
+@pytest.mark.parametrize(
+    "extra, says",
+    [
+        ({"interface": {"stiffness": {"normal": 5e9}, "formulation": "geometric"}},
+         "frame: model rbm's frame takes interface.formulation relative"),
+        ({"interface": {"stiffness": {"normal": 5e9}}, "solver": {"stop": "outcome"}},
+         "solver.stop: outcome has no energy certificate for a frame"),
+        ({"interface": {"stiffness": {"rotational": [1e9, 1e9, 1e9, 1e9]}}},
+         "interface.stiffness.rotational"),
+        ({"interface": {"stiffness": {"normal": 5e9}}, "solver": {"method": "exact"}},
+         "not a frame's beam joint"),
+        ({"column": {**DRUMS, "top_mass": {"mass": 100.0}},
+          "interface": {"stiffness": {"normal": 5e9}}}, "column.top_mass and frame"),
+    ],
+)  # fmt: skip
+def test_what_an_rbm_frame_cannot_take_is_refused_in_one_line(tmp_path, extra, says):
+    import yaml
+
+    cfg = {"name": "c", "model": "rbm", "column": DRUMS,
+           "frame": {"columns": 2, "beam_mass": 1000.0}, **extra}  # fmt: skip
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    res = CliRunner().invoke(cli, ["run", str(path), "-a", "0.3", "-f", "1.0"])
+    lines = res.output.strip().splitlines()
+    assert res.exit_code == 2 and len(lines) == 1 and says in lines[0], res.output
+    assert "Traceback" not in res.output
+
+
+def test_a_list_of_stiffnesses_takes_the_beam_joints_last():
+    cfg = _drums(1.0, {"rotational": [2e9, 2e9, 2e9, 2e9, 1e9]})
+    assert rbm_info(cfg)["interfaces"]["stiffness_Nm_per_rad"].tolist()[-1] == 1e9
+
+
+def test_info_gives_the_frames_rbm_figures():
+    figures = rbm_info(_monolith(1.0))
+    # the RBM's equivalent block: p^2 = 6 g H (1 + 2 gamma) / (4 H^2 + B^2 + 12 gamma H^2)
+    p2 = 6 * G * H * 3.0 / (4 * H * H + B * B + 12 * H * H)
+    assert figures["rocking_p_rad_s"] == pytest.approx(math.sqrt(p2), rel=1e-12)

@@ -44,7 +44,7 @@ def column_note(config: Config, model: bool = True) -> str:
     """The column a domain was swept with, in one line under its title: H, B (base and
     top width where they differ), drums, the joint stiffness (k_n, K_M or rigid), the
     restitution e, the joints' damping zeta where there is some, and interface.friction where
-    model rbm's demand is checked against it.
+    model rbm's demand is checked against it; a frame's columns and beam before them.
     A grid over one of these says so ("over the grid") instead of one value, and an
     uncertain key ("uncertain", and the cells are said to be the majority of the samples:
     rbm_cli.study.samples), unless its distribution draws one value, which is shown.
@@ -91,6 +91,11 @@ def column_note(config: Config, model: bool = True) -> str:
         parts.insert(5, f"damping zeta = {value('interface.damping', f'{itf.damping:.3g}')}")
     if MODELS[config.model].beam and itf.friction_limit is not None:
         parts.append(f"interface.friction = {itf.friction_limit:.3g}")
+    frame = config.frame
+    if frame is not None:
+        beam = value("frame.beam_mass", f"{frame.beam_mass:.4g} kg")
+        beam = f"(its mass {beam})" if beam == "over the grid" else f"of {beam}"
+        return f"frame: {frame.columns} columns under a beam {beam}; each " + ", ".join(parts)
     return "column: " + ", ".join(parts)
 
 

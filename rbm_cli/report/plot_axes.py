@@ -47,6 +47,7 @@ from rbm_cli.structures.closed_forms import (
     linear_halfsine_threshold,
 )
 from rbm_cli.structures.column import build_column
+from rbm_cli.structures.frame import frame_column
 from rbm_cli.study.domain import boundary
 from rbm_cli.study.schema import C
 
@@ -68,13 +69,16 @@ LINEAR_LABEL = "exact, linear model (rigid monolith)"
 
 def uplift_level(config: Config) -> tuple[float, str]:
     """(level [g], label) at which the config's column starts to rock: the RBM's static
-    multiplier, or for `bullet` the engine's own level from its true solids."""
+    multiplier (a frame's columns under its beam: rbm_cli.structures.frame.frame_column),
+    or for `bullet` the engine's own level from its true solids."""
     if config.model == "bullet":
         # lazy: loads pybullet only where needed (docs/architecture.md, Start-up)
         from rbm_cli.models.bullet.run import engine_uplift_g
 
         return engine_uplift_g(config), "engine uplift level"
     column = build_column(config.column, config.interface)
+    if config.frame is not None:
+        column = frame_column(column, config.frame, config.interface)
     return column.static_multiplier, "static multiplier"
 
 

@@ -226,18 +226,30 @@ def _shape_label(t: float, t_collapse: float | None, slip: float) -> str:
     return label
 
 
-def _draw_instant(ax, outlines, x0: float, z0: float, pitch: float, height: float, label):
-    """One instant of plot_shapes: its drums, the ground with a tick at the rest position,
-    and the label under it."""
+def _draw_instant(ax, outlines, x0: float, z0: float, pitch: float, height: float, label,
+                  frame=None):  # fmt: skip
+    """One instant of plot_shapes: its drums (a frame's columns side by side, its beam on
+    their tops), the ground with a tick at the rest position, and the label under it."""
     # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.patches import Polygon
 
     colors = ("#c9b79c", "#b39d7d")
-    for i, corners in enumerate(outlines):
-        ax.add_patch(
-            Polygon(corners + [x0, z0], closed=True, facecolor=colors[i % 2],
-                    edgecolor="0.2", linewidth=0.8, gid="drum")
-        )  # fmt: skip
+    columns, spacing, beam = (1, 0.0, 0.0) if frame is None else frame
+    first = x0 - (columns - 1) * spacing / 2.0
+    for c in range(columns):
+        for i, corners in enumerate(outlines):
+            ax.add_patch(
+                Polygon(corners + [first + c * spacing, z0], closed=True,
+                        facecolor=colors[i % 2], edgecolor="0.2", linewidth=0.8, gid="drum")
+            )  # fmt: skip
+    if frame is not None:  # the beam rests level on the tops' highest corners
+        top = outlines[-1][2:]
+        z_b = z0 + float(np.max(top[:, 1]))
+        left = first + float(np.min(top[:, 0]))
+        right = first + (columns - 1) * spacing + float(np.max(top[:, 0]))
+        box = np.array([[left, z_b], [right, z_b], [right, z_b + beam], [left, z_b + beam]])
+        ax.add_patch(Polygon(box, closed=True, facecolor="#a89070", edgecolor="0.2",
+                             linewidth=0.8, gid="beam"))  # fmt: skip
     ax.plot([x0 - pitch / 2.2, x0 + pitch / 2.2], [z0, z0], color="0.3", linewidth=1.2)
     ax.plot([x0, x0], [z0, z0 - 0.02 * height], color="0.3", linewidth=1.0)
     ax.text(x0, z0 - 0.04 * height, label, ha="center", va="top", fontsize="small")
@@ -252,6 +264,7 @@ def plot_shapes(
     elevations: Sequence[float] | None = None,
     scale: float | None = None,
     t_collapse: float | None = None,
+    frame: tuple[int, float, float] | None = None,
 ):
     """Deformed column at chosen instants side by side (paper fig. 3), rotations exaggerated.
 
@@ -268,6 +281,9 @@ def plot_shapes(
         :func:`exaggeration_factor` (a round number)
     t_collapse : float, optional  Collapse time [s]; the instant at or after
         it is labelled "collapse"
+    frame : (columns, spacing [m], beam height [m]), optional  A frame: its columns drawn
+        side by side, their axes spacing apart, rocking in unison, and the beam (gid
+        'beam') resting level on their tops (rbm_cli.structures.frame.beam_box)
 
     Returns
     -------
@@ -300,13 +316,15 @@ def plot_shapes(
 
     shapes = [drum_outlines(s * theta[k], widths, np.diff(z), s * slip[k]) for k in idx]
     reach = max([float(np.max(np.abs(np.vstack(o)[:, 0]))) for o in shapes] or [0.0])
-    pitch = 2.0 * max(reach, 0.5 * float(np.max(widths))) + 0.15 * height
+    row = 0.0 if frame is None else (frame[0] - 1) * frame[1]  # a frame's row of axes
+    pitch = 2.0 * max(reach, 0.5 * float(np.max(widths))) + row + 0.15 * height
     for j, (k, outlines) in enumerate(zip(idx, shapes, strict=True)):
         label = _shape_label(float(t[k]), t_collapse, float(slip[k]))
-        _draw_instant(ax, outlines, j * pitch, z[0], pitch, height, label)
+        _draw_instant(ax, outlines, j * pitch, z[0], pitch, height, label, frame)
 
     ax.set_xlim(-pitch / 2, (max(len(idx), 1) - 0.5) * pitch)
-    top = max([z[-1]] + [float(np.max(np.vstack(o)[:, 1])) for o in shapes])
+    beam = 0.0 if frame is None else frame[2]
+    top = max([z[-1]] + [float(np.max(np.vstack(o)[:, 1])) for o in shapes]) + beam
     ax.set_ylim(z[0] - 0.22 * height, top + 0.05 * height)
     ax.set_aspect("equal")
     ax.set_xticks([])

@@ -29,6 +29,7 @@ from rbm_cli.report.plots import (
     plot_top_relative,
 )
 from rbm_cli.structures.column import build_column
+from rbm_cli.structures.frame import beam_box
 from rbm_cli.study.schema import C
 
 #: Number of deformed shapes drawn in shapes.png.
@@ -212,11 +213,17 @@ def plot_top_plan(history: History, ax, t_collapse: float | None = None) -> None
 
 
 def shapes_figure(
-    history: History, widths, elevations, t_collapse: float | None, title: str | None = None
+    history: History,
+    widths,
+    elevations,
+    t_collapse: float | None,
+    title: str | None = None,
+    frame: tuple[int, float, float] | None = None,
 ):
-    """shapes.png's figure: the deformed column at chosen instants; for a model in three
-    dimensions in two elevations, the motion's vertical plane above and the plane across
-    it below (the same instants and exaggeration)."""
+    """shapes.png's figure: the deformed column at chosen instants (a frame's columns and
+    beam: plot_shapes's ``frame``); for a model in three dimensions in two elevations, the
+    motion's vertical plane above and the plane across it below (the same instants and
+    exaggeration)."""
     # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
     from matplotlib.figure import Figure
 
@@ -235,7 +242,7 @@ def shapes_figure(
     axes = fig.subplots(len(views), 1, squeeze=False)[:, 0]
     for ax, (view, label) in zip(axes, views, strict=True):
         plot_shapes(view, widths, instants, ax=ax, elevations=z, scale=scale,
-                    t_collapse=t_collapse)  # fmt: skip
+                    t_collapse=t_collapse, frame=frame)  # fmt: skip
         if len(views) > 1:
             ax.set_title(ax.get_title().replace("Deformed shapes", f"Deformed shapes {label}"),
                          fontsize="medium")  # fmt: skip
@@ -265,9 +272,21 @@ def history_png(history: History, t_collapse: float | None, summary: dict,
     return png_bytes(figure)
 
 
+def drawn_frame(summary: dict) -> tuple[int, float, float] | None:
+    """A run's frame as plot_shapes draws it, (columns, spacing [m], beam height [m]) from
+    its summary's config (rbm_cli.structures.frame.beam_box), or None without one."""
+    config = summary.get("config") or {}
+    frame = config.get("frame")
+    if not frame or not frame.get("beam_mass"):
+        return None
+    spacing, _, height, _ = beam_box(config["column"], frame)
+    return int(frame["columns"]), spacing, height
+
+
 def shapes_png(history: History, t_collapse: float | None, summary: dict, widths, elevations):
     """shapes.png of one run (see :func:`run_pngs` for the arguments), as bytes."""
-    figure = shapes_figure(history, widths, elevations, t_collapse, run_title(summary))
+    figure = shapes_figure(history, widths, elevations, t_collapse, run_title(summary),
+                           frame=drawn_frame(summary))  # fmt: skip
     return png_bytes(figure)
 
 

@@ -179,3 +179,29 @@ def rbm_frame_restitution(column: Column, frame: FrameConfig) -> float:
     gamma = frame.ratio(m)
     cos2 = (half_h**2 - half_b**2) / r2
     return (column_restitution(column) + 4.0 * gamma * share * cos2) / (1.0 + 4.0 * gamma * share)
+
+
+# ---- the frame as drawn (and as the contact engine builds it)
+
+#: The columns' axes stand this many base widths apart [assumption: an intercolumniation
+#: of 1.5 base widths between the shafts, the Greek and Roman orders' range being about
+#: 1.5 to 3]; the planar frame's equations do not depend on it.
+AXIS_SPACING = 2.5
+
+
+def beam_box(column: dict, frame: dict) -> tuple[float, float, float, float]:
+    """(spacing of the axes, beam length, beam height, beam depth) [m] of a frame: the
+    columns' axes AXIS_SPACING base widths apart; the beam spans the row from the first
+    column's outer top edge to the last one's, as deep as the top (or the capital), of
+    the columns' density, as high as its mass then makes it. ``column`` and ``frame``:
+    the config's sections as plain data (Config.resolved()'s)."""
+    capital = column.get("capital")
+    if capital:
+        top, depth = float(capital["width"]), capital.get("depth")
+    else:
+        top, depth = float(column["top_width"]), column.get("depth")
+    depth = top if depth is None or column.get("section") == "circular" else float(depth)
+    spacing = AXIS_SPACING * float(column["base_width"])
+    length = (int(frame["columns"]) - 1) * spacing + top
+    height = float(frame["beam_mass"]) / (float(column["density"]) * length * depth)
+    return spacing, length, height, depth

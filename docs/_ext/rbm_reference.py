@@ -231,6 +231,7 @@ def config_keys() -> list[str]:
         CAPITAL_KEYS,
         COLLAPSE_KEYS,
         COLUMN_KEYS,
+        FRAME_KEYS,
         SOLVER_KEYS,
         TOP_KEYS,
         TOP_MASS_KEYS,
@@ -245,6 +246,7 @@ def config_keys() -> list[str]:
         "solver": SOLVER_KEYS,
         "grid": (*EXCITATION_AXES, LINKED, *(p for p in VIRTUAL_PATHS), "<key path>"),
         "uncertain": (*(k for k in UNCERTAIN_KEYS if k != "keys"), "keys.<key path>"),
+        "frame": FRAME_KEYS,
     }
     sub = {
         "interface.stiffness": STIFFNESS_KEYS,
@@ -319,12 +321,14 @@ def _ranges() -> dict[str, str]:
     from rbm_cli.config.grid import AMPLITUDE_RANGE_G, FREQUENCY_RANGE_HZ, MAX_CELLS, MAX_POINTS
     from rbm_cli.config.interface import FRICTION_MAX, NORMAL_RANGE, ROTATIONAL_RANGE
     from rbm_cli.config.load import (
+        BEAM_MASS_RANGE,
         CAPITAL_RANGE,
         DENSITY_RANGE,
         HEIGHT_RANGE,
         LENGTH_RANGE,
         MAX_BUDGET,
         MAX_DRUMS,
+        MAX_FRAME_COLUMNS,
         MAX_TOP_TAPER,
         TIME_STEP_RANGE,
         TOP_MASS_RANGE,
@@ -352,6 +356,8 @@ def _ranges() -> dict[str, str]:
         "rectangular only",
         "column.top_mass.mass": f"[{fmt(TOP_MASS_RANGE[0])}, {fmt(TOP_MASS_RANGE[1])}]",
         "column.top_mass.height_of_centre": f"[0, {fmt(LENGTH_RANGE[1])}]",
+        "frame.columns": f"an integer 2-{MAX_FRAME_COLUMNS}",
+        "frame.beam_mass": f"[{fmt(BEAM_MASS_RANGE[0])}, {fmt(BEAM_MASS_RANGE[1])}]",
         "interface.stiffness.rotational": f"[{fmt(ROTATIONAL_RANGE[0])}, "
         f"{fmt(ROTATIONAL_RANGE[1])}], one value or one per interface",
         "interface.stiffness.normal": f"[{fmt(NORMAL_RANGE[0])}, {fmt(NORMAL_RANGE[1])}]",
@@ -719,6 +725,25 @@ KEY_DOCS: dict[str, tuple[str, str, str]] = {
         "``interface.restitution``, ``column.drums``, ``excitation.file`` "
         "...); values as amplitudes, a range may add ``spacing: log``. "
         "``name`` and ``model`` cannot vary.",
+    ),
+    "frame.columns": (
+        "",
+        "models ``rbm``, ``housner``, ``housner-linear``, ``bullet`` (2 only)",
+        "Required. A colonnade's bay: this many identical columns N (each the ``column``"
+        " section) standing in a row in the plane of the motion under one rigid beam (an"
+        " architrave) resting freely on their tops. In the plane only (no"
+        " ``excitation.angle`` or second component). ``rbm``: every joint carries the"
+        " beam's share, the beam rests on its own joint at the top (the formulation"
+        " ``relative`` only); ``housner`` and ``housner-linear``: Makris and Vassiliou's"
+        " equivalent block (prismatic columns); ``bullet``: the columns and a free beam in"
+        " the engine. Without ``frame``: a column standing alone.",
+    ),
+    "frame.beam_mass": (
+        "kg",
+        "",
+        "Required. The whole beam's mass m_b; gamma = m_b / (N m), m a column's mass (rbm"
+        " info gives gamma and the frame's figures). 0: the columns standing alone, the"
+        " free column's run to the bit.",
     ),
     "uncertain.samples": (
         "",

@@ -120,8 +120,13 @@ def tasks(
 
 
 def max_drums(points: list[GridPoint]) -> int:
-    """The most drums of any point's column (the journal's collapse_interface range)."""
-    return max(p.config.column.n_drums for p in points)
+    """The most joints of any point's column (the journal's collapse_interface range): its
+    drums, and a frame's beam joint where the beam has a mass (rbm_cli.structures.frame)."""
+    return max(p.config.column.n_drums + _beam_joint(p.config) for p in points)
+
+
+def _beam_joint(config) -> int:
+    return int(config.frame is not None and config.frame.beam_mass > 0.0)
 
 
 #: add_point's period not given: computed from the config.

@@ -41,6 +41,11 @@ on a corner this is Housner's |theta| = alpha, the rule of `housner`. It also
 stops when a drum's centre of mass drops by half the drum's height (a drum
 slid off its support).
 
+A frame (Config.frame: N columns under one beam) is N stacks of the drums in a row along x
+under a free rigid box resting on their tops (:mod:`rbm_cli.models.bullet.colonnade`: its
+layout, its readings and its collapse, a column's or the beam's fall from the tops, joint
+n + 1); a beam of no mass is the free column, whose run this is to the bit.
+
 References
 ----------
 .. [1] E. Coumans and Y. Bai (2016-2021). PyBullet, a Python module for physics
@@ -248,8 +253,9 @@ def bullet_run(
         the run there, 'failed' (unless it collapsed before).
         A frame whose beam has mass (Config.frame, :func:`has_beam`): its columns and beam
         (:mod:`rbm_cli.models.bullet.colonnade`), the per-joint arrays n + 1 long (the
-        beam's joint last, collapse_interface n + 1 where the beam fell); a frame whose
-        beam has no mass is its free column, whose run this is to the bit.
+        beam's joint last, collapse_interface n + 1 where the beam fell; its history the
+        first column's); a frame whose beam has no mass is its free column, whose run this
+        is to the bit.
     """
     if has_beam(config):
         return _frame_run(config, motion, record, output_dt, early_stop, settings, client,

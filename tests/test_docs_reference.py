@@ -58,13 +58,13 @@ def test_every_config_key_is_in_the_config_reference(ref):
     from rbm_cli.config.excitation import EXCITATION_KEYS, INITIAL_KEYS
     from rbm_cli.config.grid import EXCITATION_AXES, LINKED, VIRTUAL_PATHS
     from rbm_cli.config.interface import INTERFACE_KEYS, STIFFNESS_KEYS
-    from rbm_cli.config.load import COLLAPSE_KEYS, COLUMN_KEYS, SOLVER_KEYS, TOP_KEYS
+    from rbm_cli.config.load import COLLAPSE_KEYS, COLUMN_KEYS, FRAME_KEYS, SOLVER_KEYS, TOP_KEYS
 
     text = ref.config_rst()
     expected = {"name", "model"}
     for section, keys in (("column", COLUMN_KEYS), ("interface", INTERFACE_KEYS),
                           ("excitation", EXCITATION_KEYS), ("collapse", COLLAPSE_KEYS),
-                          ("solver", SOLVER_KEYS)):  # fmt: skip
+                          ("solver", SOLVER_KEYS), ("frame", FRAME_KEYS)):  # fmt: skip
         expected |= {f"{section}.{k}" for k in keys}
     expected |= {f"interface.stiffness.{k}" for k in STIFFNESS_KEYS}
     expected |= {f"excitation.initial.{k}" for k in INITIAL_KEYS}

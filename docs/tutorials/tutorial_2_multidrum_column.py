@@ -99,3 +99,29 @@ fig, ax = plt.subplots(figsize=(7, 5))
 rbm.plot_domain(ensemble, ax=ax, config=cfg)
 fig.tight_layout()
 plt.show()
+
+# %%
+# A colonnade: the column under an architrave
+# -------------------------------------------
+# Columns rarely stand alone: a peristyle's carry an architrave resting freely on their
+# tops. ``frame: {columns: N, beam_mass: m_b}`` makes the column one of N identical ones
+# under a rigid beam of mass m_b [kg], rocking in unison (a rocking frame). gamma =
+# m_b / (N m), m a column's mass, measures the beam; ``rbm.info`` gives it and the block a
+# frame of the same columns glued into monoliths rocks as (its p_hat and the acceleration
+# that lifts it).
+mass = figures["total_mass_kg"]
+frames = {gamma: rbm.with_value(cfg, "frame", {"columns": 2, "beam_mass": 2 * gamma * mass})
+          for gamma in (0.5, 1.0, 2.0)}  # fmt: skip
+for gamma, frame in frames.items():
+    f = rbm.info(frame)
+    print(f"gamma {f['frame_gamma']:.2f}: p_hat {f['frame_p_rad_s']:.3f} rad/s "
+          f"(alone {figures['domain_p_rad_s']:.3f}), lifts at {f['static_multiplier_g']:.3f} g, "
+          f"beam joint K_M {f['interfaces']['stiffness_Nm_per_rad'].iloc[-1]:.3g} N m/rad")  # fmt: skip
+
+# %%
+# The beam rests on a joint of its own at the top (the last row of ``interfaces``); its
+# weight loads every joint below. A heavier beam lowers p_hat: the frame rocks as a larger
+# block. The same cells, the column alone and under each beam:
+for name, one in {"alone": cfg, **{f"gamma {g}": c for g, c in frames.items()}}.items():
+    out = rbm.sweep(one, jobs=2)
+    print(f"{name:>9}: {int(out['collapsed'].sum())} of {len(out)} cells collapse")

@@ -151,7 +151,7 @@ _BEFORE: tuple[Column, ...] = (
         "collapse_interface",
         "int",
         "",
-        "interface that reached its limit (1 at the ground)",
+        "interface that reached its limit (1 at the ground; a frame's beam joint: n + 1)",
         "empty without a collapse",
     ),  # fmt: skip
     _result(

@@ -57,7 +57,7 @@ from rbm_cli.models.rbm.exact.modal import LINEAR
 from rbm_cli.models.rbm.forcing_arrays import record_arrays, run_settings, sine_arrays
 from rbm_cli.models.rbm.pieces import FRICTION_DURATION, held_array, held_result
 from rbm_cli.structures.arrays import REST_RATE, rest_levels
-from rbm_cli.structures.equations import Model
+from rbm_cli.structures.equations import Model, body_masses
 
 
 class Block(NamedTuple):
@@ -81,7 +81,9 @@ def rbm_block(model: Model) -> Block:
     Its friction demand T / N [-]: the ground joint carries the shear T = m (a_g + c
     theta'') of the drum's centre, c = centre_map[0, 0] [m] (its horizontal acceleration
     over theta'', H/2 for the RBM's small rotations), against the normal force at rest
-    N = m g (normal_forces[0]). On a piece theta'' = p^2 (theta - s alpha) + e a_g, so
+    N = m g (normal_forces[0]); under a frame's beam, of the drum and the beam's share
+    (m their masses' sum, c their centre: sum m_b c_b / m). On a piece
+    theta'' = p^2 (theta - s alpha) + e a_g, so
     T / N = (1 + c e) a_g / g + (c p^2 / g)(theta - s alpha) = fa a_g + fb (theta - s
     alpha) with fa = (m / N)(1 + c e) [s^2/m] and fb = (m / N) c p^2 [1/rad] (block.piece's
     demand, linear in a_g and theta: exact on every piece). At rest theta'' = 0 and
@@ -102,6 +104,10 @@ def rbm_block(model: Model) -> Block:
     c_ratio = float(model.collapse_ratio)
     uplift, rest_rate, barrier = rest_levels(model)
     centre, mass = float(model.centre_map[0, 0]), float(col.masses[0])
+    if model.centre_map.shape[0] > 1:  # a frame's beam share on the top node too
+        bodies = body_masses(col)
+        mass = float(bodies.sum())
+        centre = float(bodies @ model.centre_map[:, 0]) / mass
     ratio = mass / float(col.normal_forces[0])
     params = _params(
         math.sqrt(p2), alpha, e, c_ratio * scale, model.restitution,

@@ -33,6 +33,9 @@ from click.testing import CliRunner
 from rbm_cli.api import info as rbm_info
 from rbm_cli.api import load_config, run
 from rbm_cli.cli.main import cli
+from rbm_cli.study.domain import read_domain
+
+from .paths import RESULTS
 
 G = 9.81
 H, B, RHO = 4.0, 0.8, 2700.0
@@ -201,6 +204,22 @@ def test_very_stiff_joints_rock_as_the_rigid_monolithic_frame():
         if a.status == b.status == "collapsed":
             assert a.t_collapse_s == pytest.approx(b.t_collapse_s, rel=2e-2)
     assert agree == len(cells)
+
+
+def test_the_stored_colonnade_band_without_a_beam_is_the_stored_column():
+    """The CI band of the stored colonnade holds the column alone (beam_mass 0) beside the
+    beams: on every cell both stored ensembles call robust, its outcome is the stored
+    8-drum study's (results/harmonic_multidrum, the same column and cells, swept from its
+    own config)."""
+    band = read_domain(RESULTS / "colonnade_harmonic_ci" / "domain.csv")
+    alone = band[band["frame.beam_mass"] == 0.0]
+    column = read_domain(RESULTS / "harmonic_multidrum" / "domain.csv")
+    cells = ["amplitude_g", "frequency_hz"]
+    both = alone.merge(column, on=cells, suffixes=("_band", "_column"))
+    assert len(both) == len(alone) == 36
+    robust = both[(both["robust_band"] == 1) & (both["robust_column"] == 1)]
+    assert len(robust) >= len(alone) // 2  # the band is the chaotic one: 20 of its 36
+    assert (robust["status_band"] == robust["status_column"]).all()
 
 
 @pytest.mark.parametrize(

@@ -61,6 +61,8 @@ STUDIES = {
     # record suites: the monolith whole, the 8-drum column by its CI band
     "suite_monolithic": CONFIGS / "suite_monolithic.yaml",
     "suite_multidrum_ci": CONFIGS / "ci" / "suite_multidrum_ci.yaml",
+    # the colonnade (two 8-drum columns under an architrave) by its CI band
+    "colonnade_harmonic_ci": CONFIGS / "ci" / "colonnade_harmonic_ci.yaml",
 }
 
 

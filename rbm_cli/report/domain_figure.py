@@ -14,6 +14,8 @@ import numbers
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import MODELS, Config
 from rbm_cli.report.domain_view import DomainView, domain_view, with_scales
@@ -21,6 +23,8 @@ from rbm_cli.report.plot_axes import draw_overlay, draw_panels, draw_plane, upli
 from rbm_cli.report.plot_domain import fraction_colorbar, plot_domain
 from rbm_cli.report.plot_polar import ANGLE_AXIS, draw_polar, has_angle_axis
 from rbm_cli.structures.column import build_column
+from rbm_cli.structures.frame import beam_box
+from rbm_cli.structures.outline import drum_outlines
 from rbm_cli.study.cells import nominal_config
 from rbm_cli.study.domain import axis_columns
 from rbm_cli.study.samples import majority_frame
@@ -307,7 +311,37 @@ def domain_figure(
     fig.tight_layout()
     if isinstance(drawn, list) and C.collapse_fraction in df.columns:
         _colorbar_below(fig, drawn)
+    frame_sketch(fig, config)
     return fig
+
+
+def frame_sketch(fig, config: Config | None) -> None:
+    """A frame's columns and beam at rest, drawn small in the figure's lower right corner
+    (the rule of rbm_cli.structures.frame.beam_box, as `rbm run`'s shapes.png draws them);
+    nothing for a column standing alone."""
+    if config is None or config.frame is None or config.frame.beam_mass == 0.0:
+        return
+    # lazy: matplotlib loads only where needed (docs/architecture.md, Start-up)
+    from matplotlib.patches import Polygon
+
+    column = build_column(config.column, config.interface)
+    resolved = config.resolved()
+    spacing, length, height, _ = beam_box(resolved["column"], resolved["frame"])
+    drums = drum_outlines(np.zeros(column.n), column.widths, column.heights)
+    ax = fig.add_axes((0.87, 0.02, 0.12, 0.26))
+    first = -(config.frame.columns - 1) * spacing / 2.0
+    for c in range(config.frame.columns):
+        for corners in drums:
+            ax.add_patch(Polygon(corners + [first + c * spacing, 0.0], closed=True,
+                                 facecolor="#c9b79c", edgecolor="0.2", linewidth=0.5))  # fmt: skip
+    top, half = column.height, length / 2.0
+    box = [[-half, top], [half, top], [half, top + height], [-half, top + height]]
+    ax.add_patch(Polygon(box, closed=True, facecolor="#a89070", edgecolor="0.2", linewidth=0.5))
+    ax.set_xlim(-half * 1.1, half * 1.1)
+    ax.set_ylim(0.0, top + height)
+    ax.set_aspect("equal")
+    ax.axis("off")
+    ax.set_title(f"{config.frame.columns} columns under a beam", fontsize="x-small")
 
 
 def _colorbar_below(fig, axes: list) -> None:
@@ -361,4 +395,5 @@ def _plain_figure(df, config, compare, labels) -> Figure:
     ax.set_title(f"{config.name}: safe-unsafe domain ({config.excitation.type})\n"
                  f"{column_note(config)}")  # fmt: skip
     fig.tight_layout()
+    frame_sketch(fig, config)
     return fig

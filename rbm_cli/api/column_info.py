@@ -56,8 +56,15 @@ def info(
         normal_force_N [N], moment_capacity_Nm [N m], rotation_capacity_rad [rad],
         stiffness_Nm_per_rad [N m/rad], normal_stiffness_Pa_per_m [Pa/m] (inf when
         rigid), elastic_limit_rad [rad]; a bullet model adds engine_uplift_g [g] and
-        friction [-]. For a list of configs a DataFrame, one row per config (indexed by
-        name) of the figures but ``interfaces``
+        friction [-]. A frame (columns under a beam) adds frame_columns, beam_mass_kg [kg],
+        frame_gamma [-] (m_b / (N m)), frame_p_rad_s [rad/s] (p_hat), frame_half_diagonal_m
+        [m] (R_hat), frame_restitution [-] (eta), frame_static_multiplier_g [g] and
+        frame_block_is (which equivalent block: Makris and Vassiliou's for the rigid blocks
+        and the engine, the RBM's own for its models), None each without a frame; a frame
+        of drums' ``interfaces`` ends with the beam's joint (no drum above it; a monolith's
+        is in its base's law). For a list of
+        configs a DataFrame, one row per config (indexed by name) of the figures but
+        ``interfaces``
 
     Raises
     ------

@@ -55,8 +55,8 @@ rocks on its own, out of unison with the others, which Makris and Vassiliou's fr
 assumes (measured there: peak ratio 0.29 with three columns and 0.39 with four against
 0.22 for the equivalent block, which two columns match to 0.001). The run of two columns
 is determinate (its two tops' shares follow from the beam's balance) and follows the
-equivalent block; with more, read the engine's frame as one of the motions rigid bodies
-admit, not as the unison one.
+equivalent block; the config refuses more (rbm_cli.config.load), the layout here holds
+for any N.
 
 Friction demand (FRICTION_DT windows, as a column's): the engine's momentum balance gives
 the mean force on a set of bodies that touches the rest through one joint only. A column's

@@ -90,13 +90,18 @@ def frame_block(column: BlockGeometry, frame: FrameConfig) -> BlockGeometry:
 
 
 def frame_restitution(column: BlockGeometry, frame: FrameConfig) -> float:
-    """eta, Housner's coefficient of restitution of the frame [-] (the module's docstring),
-    as (e + 4 gamma (m R^2 / I_O) cos 2 alpha) / (1 + 4 gamma m R^2 / I_O) with e the
-    column's own."""
-    gamma, _, inertia = _factors(column, frame)
+    """eta, Housner's coefficient of restitution of the frame [-] (the module's docstring,
+    :func:`eta`) with e the column's own."""
     share = column.mass * column.half_diagonal**2 / column.corner_inertia
-    e = block_restitution(column)
-    return (e + 4.0 * gamma * share * math.cos(2.0 * column.slenderness)) / inertia
+    cos2a = math.cos(2.0 * column.slenderness)
+    return eta(block_restitution(column), frame.ratio(column.mass), share, cos2a)
+
+
+def eta(e: float, gamma: float, share: float, cos2a: float) -> float:
+    """(e + 4 gamma share cos 2 alpha) / (1 + 4 gamma share): the frame's restitution [-]
+    from its column's e, the beam's ratio gamma, share = m R^2 / I_O and cos 2 alpha;
+    exactly e at gamma = 0."""
+    return (e + 4.0 * gamma * share * cos2a) / (1.0 + 4.0 * gamma * share)
 
 
 def frame_figures(column: BlockGeometry, frame: FrameConfig) -> FrameFigures:
@@ -176,9 +181,7 @@ def rbm_frame_restitution(column: Column, frame: FrameConfig) -> float:
     half_b, half_h = float(column.widths[0]) / 2.0, float(column.centres[0])
     r2 = half_h**2 + half_b**2
     share = m * r2 / (float(column.inertias[0]) + m * r2)
-    gamma = frame.ratio(m)
-    cos2 = (half_h**2 - half_b**2) / r2
-    return (column_restitution(column) + 4.0 * gamma * share * cos2) / (1.0 + 4.0 * gamma * share)
+    return eta(column_restitution(column), frame.ratio(m), share, (half_h**2 - half_b**2) / r2)
 
 
 # ---- the frame as drawn (and as the contact engine builds it)

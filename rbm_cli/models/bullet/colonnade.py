@@ -79,7 +79,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from rbm_cli.config.types import ColumnConfig, FrameConfig, G
-from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models.bullet.geometry import DrumSolid
 from rbm_cli.models.bullet.scene import (
     Frame,
@@ -88,15 +87,7 @@ from rbm_cli.models.bullet.scene import (
     joint_normal_range,
     joint_state,
 )
-from rbm_cli.models.bullet.watch import (
-    BLOWUP,
-    DROP_FRACTION,
-    FRICTION_DT,
-    OPEN_FRACTION,
-    REST_ANGULAR_RATE,
-    REST_SPEED,
-    REST_TIME,
-)
+from rbm_cli.models.bullet.watch import DROP_FRACTION, OPEN_FRACTION, RunWatch
 from rbm_cli.models.outcome import Outcome
 from rbm_cli.structures.frame import beam_box
 
@@ -234,10 +225,11 @@ def frame_friction(
     )
 
 
-class FrameWatch:
-    """The readings a frame's run carries from check to check, and the tests made at each
-    (:class:`rbm_cli.models.bullet.watch.RunWatch`'s, for a frame in the plane: the
-    module's notes).
+class FrameWatch(RunWatch):
+    """The readings a frame's run carries from check to check, and the tests made at each:
+    :class:`rbm_cli.models.bullet.watch.RunWatch`'s checks (divergence, the friction
+    windows, collapse, rest after the pulse) on a frame in the plane, with the frame's own
+    joints, demand, tracking and collapse rule (the module's notes).
 
     Parameters
     ----------
@@ -256,6 +248,8 @@ class FrameWatch:
     max_beam_slip : float  The beam's largest |slip| on a top so far [m]
     """
 
+    BODY = "body"
+
     def __init__(self, solids, layout: FrameLayout, alpha, limit: float, dt: float, accel,
                  frame: Frame, upward=None) -> None:  # fmt: skip
         n, count = len(solids), len(layout.axes)
@@ -263,7 +257,7 @@ class FrameWatch:
         self.stack = StackGeometry.of(solids)
         self.layout = layout
         self.half_top = solids[-1].half_top
-        self.alpha, self.limit, self.dt = alpha, limit, dt
+        self.alpha, self.limit = alpha, limit
         self.shifts = [np.array([x, 0.0, 0.0]) for x in layout.axes]
         beam = layout.beam
         self.masses = np.append(np.tile(self.stack.masses, count), beam.mass)
@@ -276,12 +270,7 @@ class FrameWatch:
         self.max_beam_slip = 0.0
         self.was_open = np.zeros(n, bool)
         self.last_sign = np.zeros(n)
-        self.prev_ratio, self.prev_t, self.quiet_since = 0.0, 0.0, None
-        self.accel_sum = np.concatenate([[0.0], np.cumsum(np.asarray(accel, dtype=float))])
-        self.up_sum = None if upward is None else np.concatenate([[0.0], np.cumsum(upward)])
-        self.friction_steps = max(1, int(round(FRICTION_DT / dt)))
-        self.k_prev = 0
-        self.frame_prev = self.frame_last = frame
+        self._start_checks(dt, accel, frame, upward, False)
         self.tilt_lo = self.tilt_hi = frame.tilts
         self.top_start = np.array([j.top[0] for j in self.joints(frame).columns])
 
@@ -327,16 +316,7 @@ class FrameWatch:
             slip[c] = q[0] - math.copysign(half * (1.0 - math.cos(phi)), phi)
         return ratio, slip
 
-    def see(self, frame: Frame) -> FrameJoints:
-        """The joints of a checked frame; widens the friction window's range of tilts."""
-        joints = self.joints(frame)
-        self.frame_last = frame
-        tilts = frame.tilts
-        self.tilt_lo = np.minimum(self.tilt_lo, tilts)
-        self.tilt_hi = np.maximum(self.tilt_hi, tilts)
-        return joints
-
-    def column_view(self, joints: FrameJoints) -> tuple[Frame, Joints]:
+    def seen(self, frame: Frame, joints: FrameJoints) -> tuple[Frame, Joints]:
         """The first column's drums and joints (a frame's history is its first column's)."""
         return joints.frames[0], joints.columns[0]
 
@@ -354,38 +334,14 @@ class FrameWatch:
         tilt = np.max([np.abs(j.relative) / self.alpha for j in joints.columns])
         out.residual_tilt = float(tilt)
 
-    def check(self, out: Outcome, k: int, frame: Frame, joints: FrameJoints,
-              motion: GroundMotion, early_stop: bool) -> bool:  # fmt: skip
-        """Update `out` with the check after engine step k; True when the run stops here
-        (diverged, collapsed, or at rest after the pulse with `early_stop`)."""
-        t = k * self.dt
-        if not (np.all(np.isfinite(frame.centres)) and np.max(frame.speeds) < BLOWUP):
-            out.n_steps = out.n_rhs = k
-            out.stop("failed", "the engine diverged (non-finite or runaway body)", t)
-            return True
-        if k - self.k_prev >= self.friction_steps:
-            self._friction(out, k, frame)
-        is_open = self._track(out, joints)
-        if self._collapsed(out, k, t, frame, joints):
-            return True
-        if early_stop and motion.kind != "harmonic" and t >= motion.pulse_end:
-            return self._at_rest(out, k, t, frame, is_open)
-        return False
-
-    def _friction(self, out: Outcome, k: int, frame: Frame) -> None:
-        """Close the friction window at step k: the joints' mean-force demand over it."""
-        k_prev = self.k_prev
-        steps = k - k_prev
-        mean_accel = (self.accel_sum[k] - self.accel_sum[k_prev]) / steps
-        up_sum = self.up_sum
-        mean_up = 0.0 if up_sum is None else (up_sum[k] - up_sum[k_prev]) / steps
-        demand = frame_friction(self.frame_prev, frame, self.masses, self.n, steps * self.dt,
-                                mean_accel, (self.tilt_lo, self.tilt_hi), mean_up)  # fmt: skip
-        out.friction = np.fmax(out.friction, demand)
+    def _demand(self, frame: Frame, span: float, mean_accel, mean_up: float) -> np.ndarray:
+        """The frame's n + 1 joints' mean-force demand over the window (frame_friction)."""
+        demand = frame_friction(self.frame_prev, frame, self.masses, self.n, span, mean_accel,
+                                (self.tilt_lo, self.tilt_hi), mean_up)  # fmt: skip
         self.tilt_lo = self.tilt_hi = frame.tilts
-        self.frame_prev, self.k_prev = frame, k
+        return demand
 
-    def _track(self, out: Outcome, joints: FrameJoints) -> np.ndarray:
+    def _track(self, out: Outcome, joints: FrameJoints, frame: Frame, t: float) -> np.ndarray:
         """Maxima of ratio, top displacement and slip; joint openings and closures (of the
         rotation of largest magnitude over the columns). Returns which joints are open."""
         out.max_ratio = np.maximum(out.max_ratio, joints.ratio)
@@ -435,18 +391,3 @@ class FrameWatch:
                 why = f"drum {drum + 1} of column {column + 1} dropped by half its height"
         out.stop("collapsed", why, out.t_collapse)
         return True
-
-    def _at_rest(self, out: Outcome, k: int, t: float, frame: Frame, is_open) -> bool:
-        """After the pulse: at rest (every body's rate below REST_ANGULAR_RATE and speed
-        below REST_SPEED, every joint closed) for REST_TIME."""
-        moving = np.max(np.abs(frame.rates)) >= REST_ANGULAR_RATE or (
-            np.max(frame.speeds) >= REST_SPEED
-        )
-        still = not moving and not np.any(is_open)
-        quiet = self.quiet_since
-        self.quiet_since = (quiet if quiet is not None else t) if still else None
-        if self.quiet_since is not None and t - self.quiet_since >= REST_TIME:
-            out.n_steps = out.n_rhs = k
-            out.stop("survived", "at rest after the pulse", t)
-            return True
-        return False

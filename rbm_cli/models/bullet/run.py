@@ -157,11 +157,14 @@ def ground_friction_demand(motion: GroundMotion) -> float:
     return float(np.max(horizontal / weight))
 
 
-def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, observe, space):
-    """Step the engine from t = 0 to the motion's end or a stop, checking the stack
-    every CHECK_DT (and at every sample); fills `out`. Returns (samples, watch)."""
+def _drive(client, bodies, dt, motion, out, sample, early_stop, observe, space, watch_of,
+           survived="no joint passed over its edge"):  # fmt: skip
+    """Step the engine from t = 0 to the motion's end or a stop, checking the bodies
+    every CHECK_DT (and at every sample); fills `out`. ``watch_of(accel, frame, upward)``
+    makes the run's watch (RunWatch or the frame's) from a_g (and a_v) at every mid-step
+    and the bodies at t = 0; ``survived`` is the message of a run that went to its end.
+    Returns (samples, watch)."""
     p, cid = client.module, client.id
-    alpha = stack_slenderness(solids)
     n_steps = int(round(motion.t_end / dt))
     check = max(1, int(round(CHECK_DT / dt)))
     set_gravity, step = p.setGravity, p.stepSimulation
@@ -177,9 +180,9 @@ def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, o
     upward = upward_accel(motion, mid)
     down = (-(G + upward)).tolist() if upward is not None else [-G] * n_steps
     frame = read_frame(p, cid, bodies)
-    watch = RunWatch(solids, alpha, limit, dt, accel_array, frame, upward, space)
+    watch = watch_of(accel_array, frame, upward)
     look = motion.direction if space else None
-    samples = [_sample(0.0, frame, watch.joints(frame), look)] if sample else []
+    samples = [_sample(0.0, *watch.seen(frame, watch.joints(frame)), look)] if sample else []
     k = 0
     while k < n_steps:
         set_gravity(-accel[k], side[k], down[k], physicsClientId=cid)
@@ -196,12 +199,12 @@ def _drive(client, bodies, solids, limit, dt, motion, out, sample, early_stop, o
         frame = checked if checked is not None else read_frame(p, cid, bodies)
         joints = watch.see(frame)
         if sample and k % sample == 0:
-            samples.append(_sample(k * dt, frame, joints, look))
+            samples.append(_sample(k * dt, *watch.seen(frame, joints), look))
         if watch.check(out, k, frame, joints, motion, early_stop):
             break
     else:
         out.n_steps = out.n_rhs = k
-        out.stop("survived", "no joint passed over its edge", motion.t_end)
+        out.stop("survived", survived, motion.t_end)
     return samples, watch
 
 
@@ -293,19 +296,13 @@ def bullet_run(
     # circular drums as the engine's cylinders, in three dimensions and held in the plane
     cylinders = space or config.column.section == "circular"
     bodies = build_scene(client, solids, settings, tilt, rate, cylinders=cylinders)
-    samples, watch = _drive(
-        client,
-        bodies,
-        solids,
-        config.collapse.ratio,
-        dt,
-        motion,
-        out,
-        sample,
-        early_stop,
-        observe,
-        space,
-    )
+    alpha, limit = stack_slenderness(solids), config.collapse.ratio
+
+    def watch_of(accel, frame, upward):
+        return RunWatch(solids, alpha, limit, dt, accel, frame, upward, space)
+
+    samples, watch = _drive(client, bodies, dt, motion, out, sample, early_stop, observe, space,
+                            watch_of)  # fmt: skip
     out.lifted_off(t_lift)
     watch.residual(out)
     if space:
@@ -346,54 +343,19 @@ def _frame_run(config, motion, record, output_dt, early_stop, settings, client, 
     cylinders = config.column.section == "circular"
     bodies = build_frame(client, solids, layout.axes, layout.beam, settings, tilt, rate,
                          cylinders=cylinders)  # fmt: skip
-    samples, watch = _drive_frame(client, bodies, solids, layout, config.collapse.ratio, dt, motion,
-                                  out, sample, early_stop, observe)  # fmt: skip
+    alpha, limit = stack_slenderness(solids), config.collapse.ratio
+
+    def watch_of(accel, frame, upward):
+        return FrameWatch(solids, layout, alpha, limit, dt, accel, frame, upward)
+
+    went = "no joint passed over its edge, the beam on every top"
+    samples, watch = _drive(client, bodies, dt, motion, out, sample, early_stop, observe, False,
+                            watch_of, went)  # fmt: skip
     out.lifted_off(t_lift)
     watch.residual(out)
     out.message += "; " + _slip_text(watch.max_slip) + f", beam {1e3 * watch.max_beam_slip:.3g} mm"
     history = _history(samples, motion) if record else None
     return out, history
-
-
-def _drive_frame(client, bodies, solids, layout, limit, dt, motion, out, sample, early_stop,
-                 observe) -> tuple[list, FrameWatch]:  # fmt: skip
-    """_drive for a frame in the plane: step the engine from t = 0 to the motion's end or
-    a stop, checking the frame every CHECK_DT (and at every sample); fills `out`. Returns
-    (samples, watch), the samples the first column's."""
-    p, cid = client.module, client.id
-    n_steps = int(round(motion.t_end / dt))
-    check = max(1, int(round(CHECK_DT / dt)))
-    set_gravity, step = p.setGravity, p.stepSimulation
-    mid = (np.arange(n_steps) + 0.5) * dt
-    accel_array = np.asarray(motion.accel(mid), dtype=float)
-    accel = accel_array.tolist()
-    upward = upward_accel(motion, mid)
-    down = (-(G + upward)).tolist() if upward is not None else [-G] * n_steps
-    frame = read_frame(p, cid, bodies)
-    alpha = stack_slenderness(solids)
-    watch = FrameWatch(solids, layout, alpha, limit, dt, accel_array, frame, upward)
-    first = watch.column_view(watch.joints(frame))
-    samples = [_sample(0.0, *first)] if sample else []
-    k = 0
-    while k < n_steps:
-        set_gravity(-accel[k], 0.0, down[k], physicsClientId=cid)
-        step(physicsClientId=cid)
-        k += 1
-        if observe is not None:
-            observe(p, cid, bodies)
-        checked = keep_in_plane(p, cid, bodies, pose=k % check == 0)
-        if checked is None and not (sample and k % sample == 0) and k != n_steps:
-            continue
-        frame = checked if checked is not None else read_frame(p, cid, bodies)
-        joints = watch.see(frame)
-        if sample and k % sample == 0:
-            samples.append(_sample(k * dt, *watch.column_view(joints)))
-        if watch.check(out, k, frame, joints, motion, early_stop):
-            break
-    else:
-        out.n_steps = out.n_rhs = k
-        out.stop("survived", "no joint passed over its edge, the beam on every top", motion.t_end)
-    return samples, watch
 
 
 def _initial(config: Config) -> tuple[float, float]:

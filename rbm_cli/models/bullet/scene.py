@@ -40,24 +40,7 @@ def build_scene(
     """
     p, cid = client.module, client.id
     _reset_world(p, cid, settings)
-    pivot = np.array([math.copysign(solids[0].half_bottom, tilt or 1.0), 0.0, 0.0])
-    c, s = math.cos(tilt), math.sin(tilt)
-    rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-    quat = p.getQuaternionFromEuler([0.0, tilt, 0.0])
-    bodies = []
-    for d in solids:
-        centre = pivot + rot @ (np.array([0.0, 0.0, d.bottom + d.centre]) - pivot)
-        body = _add_drum(p, cid, d, settings, centre, quat, cylinders)
-        if rate:
-            arm = centre - pivot
-            p.resetBaseVelocity(
-                body,
-                linearVelocity=np.cross([0.0, rate, 0.0], arm).tolist(),
-                angularVelocity=[0.0, rate, 0.0],
-                physicsClientId=cid,
-            )
-        bodies.append(body)
-    return bodies
+    return _add_columns(p, cid, solids, (0.0,), settings, tilt, rate, cylinders)
 
 
 def build_frame(
@@ -84,6 +67,29 @@ def build_frame(
     """
     p, cid = client.module, client.id
     _reset_world(p, cid, settings)
+    bodies = _add_columns(p, cid, solids, axes, settings, tilt, rate, cylinders)
+    c, s = math.cos(tilt), math.sin(tilt)
+    rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    side = math.copysign(1.0, tilt or 1.0)
+    spin = np.array([0.0, rate, 0.0])
+    # the corner the beam rests on moves alike in every column
+    pivot = np.array([axes[0] + side * solids[0].half_bottom, 0.0, 0.0])
+    corner = np.array([axes[0] - side * solids[-1].half_top, 0.0, beam.bottom])
+    arm = rot @ (corner - pivot)
+    centre = np.array([0.0, 0.0, beam.bottom + beam.centre]) + (pivot + arm - corner)
+    body = _add_drum(p, cid, beam, settings, centre, (0.0, 0.0, 0.0, 1.0))
+    if rate:
+        p.resetBaseVelocity(body, linearVelocity=np.cross(spin, arm).tolist(),
+                            angularVelocity=[0.0, 0.0, 0.0], physicsClientId=cid)  # fmt: skip
+    bodies.append(body)
+    return bodies
+
+
+def _add_columns(p, cid, solids, axes, settings, tilt, rate, cylinders) -> list[int]:
+    """The stack ``solids`` standing on each of the axes (x [m]), every stack turned
+    rigidly by ``tilt`` [rad] about its own base corner on the side of the tilt and
+    turning at ``rate`` [rad/s]; returns the drums' body ids, stack by stack, bottom
+    first."""
     c, s = math.cos(tilt), math.sin(tilt)
     rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
     quat = p.getQuaternionFromEuler([0.0, tilt, 0.0])
@@ -99,16 +105,6 @@ def build_frame(
                 p.resetBaseVelocity(body, linearVelocity=np.cross(spin, centre - pivot).tolist(),
                                     angularVelocity=spin.tolist(), physicsClientId=cid)  # fmt: skip
             bodies.append(body)
-    # the corner the beam rests on moves alike in every column
-    pivot = np.array([axes[0] + side * solids[0].half_bottom, 0.0, 0.0])
-    corner = np.array([axes[0] - side * solids[-1].half_top, 0.0, beam.bottom])
-    arm = rot @ (corner - pivot)
-    centre = np.array([0.0, 0.0, beam.bottom + beam.centre]) + (pivot + arm - corner)
-    body = _add_drum(p, cid, beam, settings, centre, (0.0, 0.0, 0.0, 1.0))
-    if rate:
-        p.resetBaseVelocity(body, linearVelocity=np.cross(spin, arm).tolist(),
-                            angularVelocity=[0.0, 0.0, 0.0], physicsClientId=cid)  # fmt: skip
-    bodies.append(body)
     return bodies
 
 

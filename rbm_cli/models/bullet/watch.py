@@ -85,6 +85,9 @@ class RunWatch:
         peak's tilt wobbles.
     """
 
+    #: What a moving body is called where the engine diverged.
+    BODY = "drum"
+
     def __init__(
         self,
         solids,
@@ -100,23 +103,13 @@ class RunWatch:
         self.stack = StackGeometry.of(solids)
         self.alpha = alpha
         self.limit = limit
-        self.dt = dt
         self.rest_z = np.array([d.bottom + d.centre for d in solids])
         self.drop = np.array([DROP_FRACTION * d.height for d in solids])
         self.open_tol = OPEN_FRACTION * alpha
         self.max_slip = np.zeros(n)
         self.was_open = np.zeros(n, bool)
         self.last_sign = np.zeros(n)
-        self.prev_ratio, self.prev_t, self.quiet_since = 0.0, 0.0, None
-        accel = np.asarray(accel, dtype=float)
-        zero = np.zeros((1,) + accel.shape[1:])
-        self.accel_sum = np.concatenate([zero, np.cumsum(accel, axis=0)])  # means over windows
-        self.up_sum = None if upward is None else np.concatenate([[0.0], np.cumsum(upward)])
-        self.friction_steps = max(1, int(round(FRICTION_DT / dt)))
-        self.k_prev = 0
-        self.frame_prev = frame
-        self.frame_last = frame  # the last frame checked (see): the run's state at its end
-        self.space = space
+        self._start_checks(dt, accel, frame, upward, space)
         self.top_start = self.joints(frame).top.copy()
         if space:
             self.faces = [normals(frame)]
@@ -131,6 +124,19 @@ class RunWatch:
             self.t_track = 0.0
         else:
             self.tilt_lo = self.tilt_hi = frame.tilts
+
+    def _start_checks(self, dt: float, accel, frame: Frame, upward, space: bool) -> None:
+        """The state the checks carry (check, _friction, _collapsed, _at_rest), at t = 0."""
+        self.dt, self.space = dt, space
+        self.prev_ratio, self.prev_t, self.quiet_since = 0.0, 0.0, None
+        accel = np.asarray(accel, dtype=float)
+        zero = np.zeros((1,) + accel.shape[1:])
+        self.accel_sum = np.concatenate([zero, np.cumsum(accel, axis=0)])  # means over windows
+        self.up_sum = None if upward is None else np.concatenate([[0.0], np.cumsum(upward)])
+        self.friction_steps = max(1, int(round(FRICTION_DT / dt)))
+        self.k_prev = 0
+        self.frame_prev = frame
+        self.frame_last = frame  # the last frame checked (see): the run's state at its end
 
     def joints(self, frame: Frame) -> Joints | Joints3d:
         """The joints of a frame (no reading kept)."""
@@ -149,6 +155,10 @@ class RunWatch:
         self.tilt_lo = np.minimum(self.tilt_lo, tilts)
         self.tilt_hi = np.maximum(self.tilt_hi, tilts)
         return joints
+
+    def seen(self, frame: Frame, joints):
+        """The (frame, joints) a run's history samples: the stack's."""
+        return frame, joints
 
     def residual(self, out: Outcome) -> None:
         """The run's residual state, read from the last frame checked (where the run
@@ -187,7 +197,7 @@ class RunWatch:
         t = k * self.dt
         if not (np.all(np.isfinite(frame.centres)) and np.max(frame.speeds) < BLOWUP):
             out.n_steps = out.n_rhs = k
-            out.stop("failed", "the engine diverged (non-finite or runaway drum)", t)
+            out.stop("failed", f"the engine diverged (non-finite or runaway {self.BODY})", t)
             return True
         if k - self.k_prev >= self.friction_steps:
             self._friction(out, k, frame)
@@ -204,19 +214,25 @@ class RunWatch:
         mean_accel = (self.accel_sum[k] - self.accel_sum[k_prev]) / (k - k_prev)
         up_sum = self.up_sum
         mean_up = 0.0 if up_sum is None else (up_sum[k] - up_sum[k_prev]) / (k - k_prev)
+        demand = self._demand(frame, (k - k_prev) * self.dt, mean_accel, mean_up)
+        out.friction = np.fmax(out.friction, demand)
+        self.frame_prev, self.k_prev = frame, k
+
+    def _demand(self, frame: Frame, span: float, mean_accel, mean_up: float) -> np.ndarray:
+        """The joints' mean-force demand over the window closing at ``frame`` (span [s],
+        the ground's mean accelerations over it [m/s^2])."""
         if self.space:
             # the window's normals, this frame's last (see() read them)
-            span, window = (k - k_prev) * self.dt, self.faces
+            window = self.faces
             demand = joint_friction_3d(self.frame_prev, frame, self.stack, span, mean_accel,
                                        window, mean_up)  # fmt: skip
             self.faces = window[-1:]
-        else:
-            span, tilts = (k - k_prev) * self.dt, (self.tilt_lo, self.tilt_hi)
-            demand = joint_friction(self.frame_prev, frame, self.stack, span, mean_accel, tilts,
-                                    mean_up)  # fmt: skip
-            self.tilt_lo = self.tilt_hi = frame.tilts
-        out.friction = np.fmax(out.friction, demand)
-        self.frame_prev, self.k_prev = frame, k
+            return demand
+        tilts = (self.tilt_lo, self.tilt_hi)
+        demand = joint_friction(self.frame_prev, frame, self.stack, span, mean_accel, tilts,
+                                mean_up)  # fmt: skip
+        self.tilt_lo = self.tilt_hi = frame.tilts
+        return demand
 
     def _track(self, out: Outcome, joints, frame: Frame, t: float) -> np.ndarray:
         """Maxima of ratio, top displacement and slip; joint openings and closures.

@@ -399,19 +399,10 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
 
 
 def _check_frame(config: Config) -> None:
-    """The Rigid Beam Model's frame (rbm_cli.structures.frame) in its relative formulation
-    only (the beam's joint reads the top drum's rotation against the level beam), and
-    without solver.stop: outcome for columns of drums (their joints collapse with the
-    beam's: no energy certificate)."""
+    """The Rigid Beam Model's frame (rbm_cli.structures.frame) without solver.stop: outcome
+    for columns of drums (their joints collapse with the beam's: no energy certificate)."""
     if config.frame is None or not MODELS[config.model].beam:
         return
-    formulation = config.interface.formulation
-    if formulation != "relative":
-        raise ConfigError(
-            f"frame: model {config.model}'s frame takes interface.formulation relative (the"
-            f" beam's joint reads the top drum's rotation against the level beam), got"
-            f" {formulation}"
-        )
     if config.solver.stop == "outcome" and config.column.n_drums > 1:
         raise ConfigError(
             "solver.stop: outcome has no energy certificate for a frame of columns of drums"

@@ -30,6 +30,7 @@ from functools import cached_property
 import numpy as np
 
 from rbm_cli.base.detmath import inverse, product
+from rbm_cli.config.types import G
 from rbm_cli.structures.column import Column
 from rbm_cli.structures.law import Law, law_sum, make_law
 
@@ -352,25 +353,30 @@ def build_model(
     bodies = body_masses(column)
     mass = product(centre.T, bodies[:, None] * centre) + np.diag(column.inertias)
     diff = np.eye(m, n) - np.eye(m, n, k=-1)  # a beam joint's row: -theta_n
-    if m != n and formulation != "relative":
-        raise ValueError("a frame's beam joint takes the relative formulation only")
-    arg_map = np.eye(n) if formulation == "absolute" else diff.copy()
+    # `absolute`: a drum's joint reads the drum's rotation; a frame's beam joint, between
+    # the top drum and the level beam, reads -theta_n in every formulation
+    arg_map = np.vstack([np.eye(n), diff[n:]]) if formulation == "absolute" else diff.copy()
 
     mu, tu = column.moment_capacity, column.rotation_capacity
     if formulation == "geometric":
-        n_above = np.concatenate([column.normal_forces[1:], [0.0]])
+        # the load on each drum's top: the drums above it and a frame's beam share
+        n_above = np.append(column.normal_forces[1:n], column.beam_mass * G)
+        normal = column.normal_forces[:n]
         # P_i c_i + N_{i+1} h_i: written as (N_i + N_{i+1}) h_i / 2 + P_i (c_i - h_i / 2),
         # whose last term is 0 for a drum with its centre at mid-height
         gravity = np.diag(
-            (column.normal_forces + n_above) * h / 2.0 + column.weights * (column.centres - h / 2.0)
+            (normal + n_above) * h / 2.0 + column.weights * (column.centres - h / 2.0)
         )
         extra = mu / tu
         # overturning moment of the drums above joint i about the joint:
-        # sum_{j>=i} P_j (x_j - u_i), x_j the centre, u_i the joint's node
-        over = np.zeros((n, n))
+        # sum_{j>=i} P_j (x_j - u_i), x_j the centre, u_i the joint's node (and a frame's
+        # beam share's weight at the top node; its joint's row 0)
+        over = np.zeros((m, n))
         for i in range(n):
             for j in range(i, n):
                 over[i] += column.weights[j] * (centre[j] - node[i])
+            if column.beam_mass > 0.0:
+                over[i] += column.beam_mass * G * (node[n] - node[i])
         collapse_map, collapse_limit = over, mu.copy()
     else:
         gravity = np.zeros((n, n))
@@ -382,7 +388,9 @@ def build_model(
         for i in range(m)
     )
     if column.beam_mass > 0.0:
-        laws, collapse_map, collapse_limit = frame_joints(column, laws, xi, collapse_map)
+        laws, collapse_map, collapse_limit = frame_joints(
+            column, laws, xi, collapse_map, formulation == "geometric"
+        )
     return Model(
         column=column,
         mass=mass,
@@ -412,7 +420,9 @@ def body_masses(column: Column) -> np.ndarray:
     return column.masses
 
 
-def frame_joints(column: Column, laws: tuple, xi: float, collapse_map: np.ndarray):
+def frame_joints(
+    column: Column, laws: tuple, xi: float, collapse_map: np.ndarray, geometric: bool = False
+):
     """The laws and the collapse map and limits of a frame's joints (Column.beam_mass > 0).
 
     The beam joint's law (the cap M_u,b = (B_top / 2) W_b / N, no descending branch)
@@ -420,27 +430,35 @@ def frame_joints(column: Column, laws: tuple, xi: float, collapse_map: np.ndarra
     turns the drums above it and opens the beam joint too, so the stack above i overturns
     where f_i(x) + xi M_u,b = 0, at x = theta_u,i (1 + xi M_u,b / M_u,i), not at
     theta_u,i (where f_i alone vanishes). That is joint i's collapse limit; the beam joint
-    itself never overturns (its row of the collapse map is 0). A monolith's beam joint
-    reads minus the base's argument (Column.beam_law): its law is added to the base's,
-    whose limit is then the sum's zero. For a rigid monolith the frame's base law is
-    (M_u,1 + M_u,b) (1 - |x| / limit), limit = (B / 2) / (H / 2) for a prismatic column:
-    the uplift and the collapse of the free column, whatever the beam."""
+    itself never overturns (its row of the collapse map is 0). In the `geometric`
+    formulation the collapse quantity is the overturning moment of the stack above i (the
+    beam's share included), and its limit M_u,i + xi M_u,b: the same tilt of a rigid stack.
+    A monolith's beam joint reads minus the base's argument (Column.beam_law): its law is
+    added to the base's, whose limit is then the sum's zero (`geometric`: the sum's
+    intercept). For a rigid monolith the frame's base law is (M_u,1 + M_u,b) (1 - |x| /
+    limit), limit = (B / 2) / (H / 2) for a prismatic column: the uplift and the collapse
+    of the free column, whatever the beam."""
     n = column.n
     if column.beam_law is not None:  # the base's own law and the beam joint's, summed
         mu_b, k_b = column.beam_law
         k_0 = float(column.stiffness[0])
-        base = make_law(float(column.moment_capacity[0]) - mu_b,
-                        float(column.widths[0]) / 2.0 / float(column.lever_arms[0]),
-                        k_0 if math.isinf(k_0) else k_0 - k_b, xi)  # fmt: skip
+        mu_0 = float(column.moment_capacity[0]) - mu_b
+        tu_0 = float(column.widths[0]) / 2.0 / float(column.lever_arms[0])
+        base = make_law(mu_0, tu_0, k_0 if math.isinf(k_0) else k_0 - k_b, xi,
+                        extra_slope=mu_0 / tu_0 if geometric else 0.0)  # fmt: skip
         law = law_sum(base, make_law(mu_b, math.inf, k_b, xi))
+        if geometric:
+            return (law,), collapse_map, np.array([float(law.intercepts[-1])])
         limit = -float(law.intercepts[-1]) / float(law.slopes[-1])
         return (law,), collapse_map, np.array([limit])
     cap = float(laws[n].intercepts[-1])
-    limits = np.array([-(float(law.intercepts[-1]) + cap) / float(law.slopes[-1])
-                       for law in laws[:n]] + [1.0])  # fmt: skip
+    if geometric:
+        limits = [float(law.intercepts[-1]) + cap for law in laws[:n]]
+    else:
+        limits = [-(float(law.intercepts[-1]) + cap) / float(law.slopes[-1]) for law in laws[:n]]
     collapse_map = collapse_map.copy()
     collapse_map[n] = 0.0  # the beam joint: never (its limit, 1, any finite number)
-    return laws, collapse_map, limits
+    return laws, collapse_map, np.array(limits + [1.0])
 
 
 def event_families(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

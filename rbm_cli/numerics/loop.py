@@ -56,32 +56,29 @@ RunEnd = namedtuple(
 #: Runge-Kutta work arrays (the stages K, the dense output's coefficients F, f = y'(t), the
 #: step's end ynew, a stage's argument tmp, a right-hand side's work, the error norm's scale,
 #: a state on the dense output yq), the right-hand side's arrays (a structure's rhs, e.g.
-#: structures.rates.rhs: As, cs, es as sys_A, sys_c, sys_e), the step sizes remembered after
-#: each kind of event (h_after [s]: run_motion), and the run's figures, filled in place:
+#: structures.rates.rhs: As, cs, es as sys_A, sys_c, sys_e), and the run's figures, filled in place:
 #: RunEnd's max_ratio, friction, slip, swept and ledger, and top (1,): the top's peak.
 LOOP_FIELDS = [
     ("y", "float64[::1]"), ("y_new", "float64[::1]"), ("K", "float64[:, ::1]"),
     ("F", "float64[:, ::1]"), ("f", "float64[::1]"), ("ynew", "float64[::1]"),
     ("tmp", "float64[::1]"), ("work", "float64[::1]"), ("scale", "float64[::1]"),
     ("yq", "float64[::1]"), ("sys_A", "float64[:, ::1]"), ("sys_c", "float64[::1]"),
-    ("sys_e", "float64[::1]"), ("h_after", "float64[::1]"), ("max_ratio", "float64[::1]"),
+    ("sys_e", "float64[::1]"), ("max_ratio", "float64[::1]"),
     ("friction", "float64[::1]"), ("slip", "float64[::1]"), ("swept", "float64[::1]"),
     ("ledger", "float64[::1]"), ("top", "float64[::1]"),
 ]  # fmt: skip
 
 
 @jit(inline=True)
-def loop_into(W, y, system, kinds):
+def loop_into(W, y, system):
     """Set the fields of a run's record W that the loop's own (LOOP_FIELDS but the figures):
-    the state y, the Runge-Kutta work arrays for a state of its size, the right-hand side's
-    arrays system = (As, cs, es), and no step size remembered yet after any of the
-    structure's kinds of event (h_after: inf, the structure's at_event numbers them)."""
+    the state y, the Runge-Kutta work arrays for a state of its size and the right-hand
+    side's arrays system = (As, cs, es)."""
     m = y.size
     W.y, W.y_new, W.K, W.F = y, np.empty(m), np.empty((NS_MAX, m)), np.empty((8, m))
     W.f, W.ynew, W.tmp, W.work = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
     W.scale, W.yq = np.empty(m), np.empty(m)
     W.sys_A, W.sys_c, W.sys_e = system
-    W.h_after = np.full(kinds, np.inf)
 
 
 @jit(inline=True)
@@ -120,9 +117,10 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
     changes its pieces (an uplift, a kink, an impact, a collapse) and the stepper starts
     anew. A rigid monolith at rest waits, in closed form, for the ground to lift it.
 
-    The step after an event is the one proposed before it, no larger than the one proposed
-    after the first step that followed the last event of its kind (W.h_after; the structure
-    numbers the kinds: a joint that closes wants shorter steps than it did open).
+    The step after an event is the one the error control proposed before it. (Bounding it
+    by the step proposed after the last event of the same kind, say a joint's closure,
+    rejects fewer first attempts but takes more steps: it cost the 8-drum record band
+    about 5 % more CPU, docs/performance.md.)
 
     What is the structure's is called by name (the structure's functions, bound by
     loop_for): enter_segment, rest_to_end, rest, restart, ground_piece, find_event,
@@ -173,7 +171,6 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
         can_stop = early_stop != STOP_NEVER and free_seg and motion.pulse and monolith
         sure_stop = early_stop == STOP_OUTCOME and seg > last_forced and outcome_bound
         h_carry = -1.0  # the step size proposed before an event, carried over it
-        after = -1  # the kind of event just passed whose step size is to be remembered
         while t < seg_end:
             if at_rest:
                 if free_seg:  # no ground motion from here on: at rest to the end
@@ -204,8 +201,6 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
                     mc, t, y, f, h_abs, bound, K, ynew, tmp, n, As, cs, es, gr, atol, rtol,
                     scale, err_exp)  # fmt: skip
                 n_rhs += calls
-                if after >= 0:  # the first step after an event: what it proposes next
-                    W.h_after[after], after = h_abs, -1
                 code, n_steps = step_verdict(taken, n_steps, max_steps, deadline)
                 if code != GOING:
                     return run_end(W, code, t, np.nan, -1, (n_upl, n_imp, n_steps, n_rhs, n_ev),
@@ -252,8 +247,6 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
             if code == COLLAPSED:
                 return run_end(W, COLLAPSED, t, t, which, (n_upl, n_imp, n_steps, n_rhs, n_ev),
                                n_out, angle)  # fmt: skip
-            if which >= 0:  # a kind of event whose next step is remembered
-                h_carry, after = min(h_carry, W.h_after[which]), which
     return run_end(W, SURVIVED, t, np.nan, -1, (n_upl, n_imp, n_steps, n_rhs, n_ev),
                    n_out, np.nan)  # fmt: skip
 

@@ -696,7 +696,7 @@ def run3d(col, motion, solver, task, pair):
         W.ledger[1] = W.ledger[0]
     W.top[0] = _magnitude(col.families[2 * n], y, n)[0]
     stops = (task[5], -1, False, n == 1)
-    loop_into(W, y, system3d(W, n, W.d0, W.d1, W.values_y, W.gy), 0)
+    loop_into(W, y, system3d(W, n, W.d0, W.d1, W.values_y, W.gy))
     return run_3d(W, motion, solver, n, at_rest, stops, account)
 
 
@@ -945,8 +945,7 @@ def may_stop(W, can_stop, sure_stop):
 def at_event(W, row, t, gr, account):
     """The state change at the watched event row at (t, W.y): a collapse, else event3d.
     Returns (GOING or COLLAPSED, uplifts, impacts, at rest, the collapsed joint from 0 (-1
-    going on: no kind of event whose step size the run loop remembers), the azimuth of its
-    lean [rad])."""
+    going on), the azimuth of its lean [rad])."""
     n = W.k.size
     kind, i = W.kinds[row], W.joints[row]
     if kind == COLLAPSE:

@@ -243,8 +243,7 @@ def run_kernel(model, motion, solver, task):
             last_forced = seg
     outcome_bound = model.survival == model.survival and not vert  # a barrier that applies
     stops = (task.early_stop, last_forced, outcome_bound, n == 1)
-    # the kinds of event at_event numbers: kinks, 2 a joint
-    loop_into(W, y, system, 2 * model.argmap.shape[0])
+    loop_into(W, y, system)
     return run_plane(W, motion, solver, n, at_rest, stops, account)
 
 
@@ -441,8 +440,7 @@ def at_event(W, row, t, gr, account):
     """The state change at the crossing of a watched row at (t, W.y): a collapse (its row's
     family 2: the column's collapse rows), else a joint's kink, uplift or impact (switch).
     Returns (GOING or COLLAPSED, uplifts, impacts, at rest, the collapsed interface from 1
-    or the kind of event whose step size the run loop remembers (2 i + 0 or 1: joint i's
-    kink down or up; -1: an uplift, an impact), nan)."""
+    (-1: none), nan)."""
     n = W.y.size // 2
     m = W.side.size  # the joints: the rows are 4 of theirs
     i = row % m
@@ -464,7 +462,7 @@ def at_event(W, row, t, gr, account):
         return GOING, 1, 0, False, -1, np.nan
     if what >= IMPACT:
         return GOING, 0, 1, what == REST, -1, np.nan
-    return GOING, 0, 0, False, 2 * i + (1 if going_up else 0), np.nan
+    return GOING, 0, 0, False, -1, np.nan
 
 
 #: The planar column's run loop (numerics.loop.run_motion with the functions above).

@@ -270,17 +270,21 @@ def test_a_monolithic_frame_rocks_alike_in_every_formulation(formulation):
         _same_rocking(a, run(other, amplitude, frequency))
 
 
-@pytest.mark.parametrize("formulation", ["absolute", "geometric"])
-def test_a_frame_of_drums_runs_in_every_formulation_through_the_cli(tmp_path, formulation):
+def _rbm_run(tmp_path, cfg, *more):
+    """`rbm run` of the config cfg (written as tmp_path/c.yaml) at 0.3 g, 1 Hz."""
     import yaml
 
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    return CliRunner().invoke(cli, ["run", str(path), "-a", "0.3", "-f", "1.0", *more])
+
+
+@pytest.mark.parametrize("formulation", ["absolute", "geometric"])
+def test_a_frame_of_drums_runs_in_every_formulation_through_the_cli(tmp_path, formulation):
     cfg = {"name": "c", "model": "rbm", "column": DRUMS,
            "interface": {"stiffness": {"normal": 5e9}, "formulation": formulation},
            "frame": {"columns": 2, "beam_mass": 2 * M}}  # fmt: skip
-    path = tmp_path / "c.yaml"
-    path.write_text(yaml.safe_dump(cfg))
-    res = CliRunner().invoke(cli, ["run", str(path), "-a", "0.3", "-f", "1.0", "-o",
-                                   str(tmp_path / "out")])  # fmt: skip
+    res = _rbm_run(tmp_path, cfg, "-o", str(tmp_path / "out"))
     assert res.exit_code == 0, res.output
     assert (tmp_path / "out" / "c" / "run_A0.3_f1" / "summary.json").is_file()
 
@@ -315,13 +319,9 @@ def test_the_stored_colonnade_band_without_a_beam_is_the_stored_column():
     ],
 )  # fmt: skip
 def test_what_an_rbm_frame_cannot_take_is_refused_in_one_line(tmp_path, extra, says):
-    import yaml
-
     cfg = {"name": "c", "model": "rbm", "column": DRUMS,
            "frame": {"columns": 2, "beam_mass": 1000.0}, **extra}  # fmt: skip
-    path = tmp_path / "c.yaml"
-    path.write_text(yaml.safe_dump(cfg))
-    res = CliRunner().invoke(cli, ["run", str(path), "-a", "0.3", "-f", "1.0"])
+    res = _rbm_run(tmp_path, cfg)
     lines = res.output.strip().splitlines()
     assert res.exit_code == 2 and len(lines) == 1 and says in lines[0], res.output
     assert "Traceback" not in res.output

@@ -56,8 +56,9 @@ RunEnd = namedtuple(
 #: Runge-Kutta work arrays (the stages K, the dense output's coefficients F, f = y'(t), the
 #: step's end ynew, a stage's argument tmp, a right-hand side's work, the error norm's scale,
 #: a state on the dense output yq), the right-hand side's arrays (a structure's rhs, e.g.
-#: structures.rates.rhs: As, cs, es as sys_A, sys_c, sys_e), and the run's figures, filled in place:
-#: RunEnd's max_ratio, friction, slip, swept and ledger, and top (1,): the top's peak.
+#: structures.rates.rhs: As, cs, es as sys_A, sys_c, sys_e), and the run's figures, filled
+#: in place: RunEnd's max_ratio, friction, slip, swept and ledger, and top (1,): the top's
+#: peak.
 LOOP_FIELDS = [
     ("y", "float64[::1]"), ("y_new", "float64[::1]"), ("K", "float64[:, ::1]"),
     ("F", "float64[:, ::1]"), ("f", "float64[::1]"), ("ynew", "float64[::1]"),
@@ -120,7 +121,7 @@ def run_motion(W, motion, solver, n, at_rest, stops, account):
     The step after an event is the one the error control proposed before it. (Bounding it
     by the step proposed after the last event of the same kind, say a joint's closure,
     rejects fewer first attempts but takes more steps: it cost the 8-drum record band
-    about 5 % more CPU, docs/performance.md.)
+    about 6 % more CPU, docs/performance.md.)
 
     What is the structure's is called by name (the structure's functions, bound by
     loop_for): enter_segment, rest_to_end, rest, restart, ground_piece, find_event,

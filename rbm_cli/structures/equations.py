@@ -447,18 +447,20 @@ def frame_joints(
         base = make_law(mu_0, tu_0, k_0 if math.isinf(k_0) else k_0 - k_b, xi,
                         extra_slope=mu_0 / tu_0 if geometric else 0.0)  # fmt: skip
         law = law_sum(base, make_law(mu_b, math.inf, k_b, xi))
-        if geometric:
-            return (law,), collapse_map, np.array([float(law.intercepts[-1])])
-        limit = -float(law.intercepts[-1]) / float(law.slopes[-1])
-        return (law,), collapse_map, np.array([limit])
+        return (law,), collapse_map, np.array([_collapse_limit(law, 0.0, geometric)])
     cap = float(laws[n].intercepts[-1])
-    if geometric:
-        limits = [float(law.intercepts[-1]) + cap for law in laws[:n]]
-    else:
-        limits = [-(float(law.intercepts[-1]) + cap) / float(law.slopes[-1]) for law in laws[:n]]
+    limits = [_collapse_limit(law, cap, geometric) for law in laws[:n]]
     collapse_map = collapse_map.copy()
     collapse_map[n] = 0.0  # the beam joint: never (its limit, 1, any finite number)
     return laws, collapse_map, np.array(limits + [1.0])
+
+
+def _collapse_limit(law: Law, cap: float, geometric: bool) -> float:
+    """Where the stack on a law's joint overturns with the beam joint's cap beside it: the
+    moment capacity, the law's last intercept plus the cap [N m] (`geometric`), or the
+    argument at which the law's last piece plus the cap vanishes [rad]."""
+    capacity = float(law.intercepts[-1]) + cap
+    return capacity if geometric else -capacity / float(law.slopes[-1])
 
 
 def event_families(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

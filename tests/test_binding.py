@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rbm_cli.base.jit import plain
+from rbm_cli.base.jit import ENABLED, jit, plain
 from rbm_cli.models.rbm.step import stepper
 from rbm_cli.models.rbm3d import kernel
 from rbm_cli.numerics import rk
@@ -53,5 +53,25 @@ def test_a_copy_runs_the_template_on_the_given_function():
 
 def test_templates_come_from_one_module():
     with pytest.raises(TypeError, match="one module"):
-        bind({"a": (rk.initial_step, False), "b": (test_templates_come_from_one_module, False)},
+        bind({"a": (rk.initial_step, {}), "b": (test_templates_come_from_one_module, {})},
              {}, "mixed")  # fmt: skip
+
+
+@pytest.mark.skipif(not ENABLED, reason="compiled only: RBM_JIT=0 runs Python")
+def test_the_steps_of_a_run_borrow_their_arrays():
+    """The steps a run takes every step are compiled without reference counts (base.jit's
+    borrow), the first step's size with them (it allocates); a borrowed function that
+    allocates is refused when it compiles, and one cannot be both borrowed and inlined."""
+    for steps in (stepper, kernel):
+        assert steps.attempt_step.targetoptions.get("_nrt") is False
+        assert steps.dense_prepare.targetoptions.get("_nrt") is False
+        assert steps.initial_step.targetoptions.get("_nrt", True) is not False
+
+    @jit(borrow=True)
+    def allocates(n):
+        return np.empty(n).size
+
+    with pytest.raises(Exception, match="nopython mode"):  # numba refuses it as it types it
+        allocates(3)
+    with pytest.raises(TypeError, match="borrowed"):
+        jit(inline=True, borrow=True)

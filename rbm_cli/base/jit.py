@@ -39,16 +39,25 @@ if ENABLED:
     key_numba_cache()  # before the first decorator: the cache is keyed on every source
 
 
-def jit(function: Callable | None = None, *, inline: bool = False):
+def jit(function: Callable | None = None, *, inline: bool = False, borrow: bool = False):
     """Compile ``function`` with numba (``njit(cache=True)``), or leave it as it is when
     ``RBM_JIT=0``. ``inline=True`` inlines it into its compiled callers (a small helper
-    called in a hot loop; the arithmetic is the same).
+    called in a hot loop; the arithmetic is the same). ``borrow=True`` compiles it without
+    reference counts (numba's ``_nrt=False``): for a function called every step that only
+    reads and writes the arrays and records it is given, allocates none and returns none
+    (numba refuses to compile one that does). Compiled with them, a function counts a
+    reference to each array it takes, an atomic add at its start and a subtract at its end,
+    that numba's pruning of counts removes only in straight code (a function with loops and
+    branches, or a helper inlined into one, keeps them); a borrowed function counts none, and
+    whatever it inlines is borrowed too. The arithmetic is the same.
 
-    Use as ``@jit`` or ``@jit(inline=True)``.
+    Use as ``@jit``, ``@jit(inline=True)`` or ``@jit(borrow=True)``.
 
     A compiled caller's call is typed with its arguments' plain types, never their
     literal ones (:func:`_typed_plainly`).
     """
+    if inline and borrow:
+        raise TypeError("a borrowed function is called, not inlined")
 
     def decorate(f: Callable) -> Callable:
         if not ENABLED:
@@ -56,6 +65,8 @@ def jit(function: Callable | None = None, *, inline: bool = False):
         # lazy: numba loads only where needed (docs/architecture.md, Start-up)
         from numba import njit
 
+        if borrow:
+            return _typed_plainly(njit(cache=True, _nrt=False)(f))
         return _typed_plainly(njit(cache=True, inline="always" if inline else "never")(f))
 
     return decorate if function is None else decorate(function)

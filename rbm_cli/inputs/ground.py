@@ -121,7 +121,7 @@ def gravity_factor(t, gr):
     return 1.0 + (gr[7] + gr[8] * ((t - gr[4]) / gr[5])) / G
 
 
-@jit
+@jit(borrow=True)
 def _first_after(knots, x):
     """Index of the first knot > x (np.searchsorted(knots, x, side='right'))."""
     lo, hi = 0, knots.size
@@ -134,7 +134,7 @@ def _first_after(knots, x):
     return lo
 
 
-@jit
+@jit(borrow=True)
 def record_piece(t, knots, values, vertical, gain, seg_end):
     """The straight piece of a record a step from t [s] runs on, as a ground tuple, and
     the time that step ends at: the first sample past t + the smallest step (10 ulp of
@@ -156,7 +156,7 @@ def record_piece(t, knots, values, vertical, gain, seg_end):
     return gr, bound
 
 
-@jit
+@jit(borrow=True)
 def _sampled_at(t, knots, values):
     """a_g(t) of samples (knots [s], values): linear between them, 0 outside them;
     a_k + (a_{k+1} - a_k) ((t - t_k) / (t_{k+1} - t_k))."""

@@ -18,15 +18,16 @@ from rbm_cli.base.jit import jit
 
 
 def bind(
-    templates: dict[str, tuple[Callable, bool]],
+    templates: dict[str, tuple[Callable, dict]],
     given: dict[str, Callable],
     suffix: str,
 ) -> dict[str, Callable]:
-    """Copies of the template functions (name -> (uncompiled function, inlined or not)),
+    """Copies of the template functions (name -> (uncompiled function, how base.jit.jit
+    compiles it: ``{}``, ``{"inline": True}`` or ``{"borrow": True}``)),
     written in one module, whose globals are that module's with the names of ``given``
     bound to its functions and the templates' names to each other's copies. Each copy is
     named ``<name>_<suffix>`` (numba's on-disk cache keeps one entry per name) and compiled
-    with base.jit.jit (inlined into its compiled callers where the template says so)."""
+    with base.jit.jit as the template says."""
     modules = {f.__module__ for f, _ in templates.values()}
     if len(modules) != 1:
         raise TypeError(f"templates come from one module, not {sorted(modules)}")
@@ -34,11 +35,11 @@ def bind(
     namespace = dict(first.__globals__)
     namespace.update(given)
     copies = {}
-    for name, (template, inline) in templates.items():
+    for name, (template, how) in templates.items():
         code = template.__code__
         copy = types.FunctionType(code, namespace, f"{name}_{suffix}", template.__defaults__)
         copy.__qualname__ = f"{name}_{suffix}"
         copy.__doc__, copy.__module__ = template.__doc__, template.__module__
-        copies[name] = jit(copy, inline=inline)
+        copies[name] = jit(copy, **how)
     namespace.update(copies)  # before any compile: the copies call each other
     return copies

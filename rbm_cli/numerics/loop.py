@@ -268,4 +268,4 @@ def loop_for(name: str, functions: dict):
     if missing:
         raise TypeError(f"structure {name!r} lacks {sorted(missing)}")
     given = {key: functions[key] for key in STRUCTURE_FUNCTIONS}
-    return bind({"run_motion": (run_motion, False)}, given, name)["run_motion"]
+    return bind({"run_motion": (run_motion, {})}, given, name)["run_motion"]

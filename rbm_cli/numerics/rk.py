@@ -143,8 +143,8 @@ def _combine(w, K, count, y, h, out):
 
 def _stage(mc, s, t, y, h, K, tmp, n, As, cs, es, gr):
     """Stage s from the stages before it: K[s] = f(t + c_s h, y + h sum_j a_sj K_j).
-    Inlined (as detmath.sin is): a call costs a reference count of every array it takes
-    (the ground's knots and values included), 12 times a step."""
+    Inlined into the borrowed steps that call it (RHS_STEPS), as is the right-hand side:
+    neither counts a reference to the arrays it takes (base.jit), 12 times a step."""
     A = TAB_A[mc]
     _combine(A[s], K, s, y, h, tmp)
     rhs(t + TAB_C[mc][s] * h, tmp, n, As, cs, es, gr, K[s])  # noqa: F821
@@ -161,7 +161,7 @@ def rk_attempt(mc, t, y, f, h, K, ynew, tmp, n, As, cs, es, gr):
     rhs(t + h, ynew, n, As, cs, es, gr, K[ns])  # noqa: F821
 
 
-@jit
+@jit(borrow=True)
 def error_norm(mc, K, h, y, ynew, atol, rtol, scale):
     ns = TAB_NS[mc]
     E = TAB_E[mc]
@@ -271,7 +271,7 @@ def dense_prepare(mc, t_old, h, y_old, y_new, K, F, tmp, n, As, cs, es, gr):
     return 0
 
 
-@jit
+@jit(borrow=True)
 def dense_eval(mc, t, t_old, h, y_old, F, out):
     x = (t - t_old) / h
     m = y_old.size
@@ -303,7 +303,7 @@ def emit_rest(t_stop, samples, n_out, next_out, dt):
     return n_out, next_out
 
 
-@jit
+@jit(borrow=True)
 def emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
     while next_out <= t_stop + 1e-12 and n_out < samples.shape[0]:
         samples[n_out, 0] = next_out
@@ -313,14 +313,16 @@ def emit(mc, t_stop, t_old, h, y_old, F, samples, n_out, next_out, dt):
     return n_out, next_out
 
 
-#: The steps that call the right-hand side, with whether each is inlined into its callers
-#: (:func:`steps_for` copies them per structure).
+#: The steps that call the right-hand side, with how each is compiled (base.jit.jit;
+#: :func:`steps_for` copies them per structure): borrowed, the steps a run takes every step
+#: (no reference counts, base.jit), with the stage inlined into them; the first step's size
+#: (once a stepper) allocates and counts.
 RHS_STEPS = {
-    "initial_step": (initial_step, False),
-    "_stage": (_stage, True),
-    "rk_attempt": (rk_attempt, False),
-    "attempt_step": (attempt_step, True),
-    "dense_prepare": (dense_prepare, False),
+    "initial_step": (initial_step, {}),
+    "_stage": (_stage, {"inline": True}),
+    "rk_attempt": (rk_attempt, {"borrow": True}),
+    "attempt_step": (attempt_step, {"borrow": True}),
+    "dense_prepare": (dense_prepare, {"borrow": True}),
 }
 
 

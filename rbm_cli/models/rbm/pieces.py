@@ -294,7 +294,7 @@ def held_time(held):
     return held[held.shape[0] - 1, HELD_T_NEXT]
 
 
-@jit
+@jit(borrow=True)
 def held_push(held, rx, ry, peak):
     """Take the sample due (at :func:`held_time`): rx, ry (n) the shear ratios of each
     interface there (:func:`shear_ratios`). Each interface's held level is raised to the

@@ -171,7 +171,7 @@ def rows_at(y, gam, n, col, k, c, kinds, joints, m, dist, rate):
         dist[r], rate[r] = distance(kinds[r], joints[r], y, n, col, k, c, gam)
 
 
-@jit
+@jit(borrow=True)
 def within_reach(d0, r0, d1, r1, dt, kinds, m, near):
     """The watched distances that may cross zero inside a step of dt [s], from their values
     and rates at both ends, into near (m,) bool; returns whether any may: it ends below
@@ -213,7 +213,7 @@ def _root(a, b, r, mc, t_old, h, y_old, F, yq, n, col, k, c, gr, kinds, joints):
     return xcur
 
 
-@jit
+@jit(borrow=True)
 def _hermite_min(p0, p1, m0, m1):
     """s in (0, 1) of the lowest interior minimum of the cubic Hermite of values p0, p1 and
     slopes m0, m1 (per unit s), with its value; (-1, 0) if none."""
@@ -284,13 +284,13 @@ def first_event(mc, t_old, t_new, h, y_old, F, yq, n, col, k, c, gr, kinds, join
     return -1.0, -1
 
 
-@jit
+@jit(borrow=True)
 def _rate_at(t, row, mc, t_old, h, y_old, F, yq, n):
     dense_eval(mc, t, t_old, h, y_old, F, yq)
     return _magnitude(row, yq, n)[1]
 
 
-@jit
+@jit(borrow=True)
 def _peak_in(row, a, b, mc, t_old, h, y_old, F, yq, n):
     """The magnitude of row where its rate turns from rising to falling in [a, b]."""
     xpre, xcur = a, b
@@ -357,7 +357,7 @@ def _emit(mc, t_stop, t_old, h, y_old, F, yq, samples, n_out, next_out, dt, n, d
     return n_out, next_out
 
 
-@jit
+@jit(borrow=True)
 def _pieces(t, knots, values, values_y, vertical, gain, seg_end, es):
     """A record's straight piece from t (inputs.ground.record_piece) and the time its step
     ends at; a pair's second record's piece written into es (structures.column3d)."""

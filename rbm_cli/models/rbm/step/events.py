@@ -17,7 +17,7 @@ from rbm_cli.models.rbm.step.vertical import add_moving, moving_rate, moving_val
 from rbm_cli.numerics.rk import TAB_NP
 
 
-@jit
+@jit(borrow=True)
 def affine(event_rows, y, off, h0, out):
     """out = event_rows @ y[off:off + cols] (+ h0 if given): no allocation."""
     for r in range(event_rows.shape[0]):
@@ -27,7 +27,7 @@ def affine(event_rows, y, off, h0, out):
         out[r] = d
 
 
-@jit
+@jit(borrow=True)
 def row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
     """One row of the step's interpolant, projected: the distance event_rows[row] theta +
     h0[row] (or, rate, the rate event_rows[row] theta') as a polynomial in the step's
@@ -80,7 +80,7 @@ def poly_part(mc, x, coef):
     return v
 
 
-@jit
+@jit(borrow=True)
 def poly_val(mc, t, t_old, h, coef, base):
     """A projected row (row_poly) at time t: dense_eval for one row."""
     return poly_part(mc, (t - t_old) / h, coef) + base
@@ -100,7 +100,7 @@ def _row_val(mc, t, t_old, h, coef, base, mv):
     return v
 
 
-@jit
+@jit(borrow=True)
 def brentq(mc, xa, xb, t_old, h, coef, base, mv):
     """scipy's brentq (zeros.c) along a projected row of the step's interpolant (plus its
     moving part, _row_val)."""
@@ -122,29 +122,23 @@ def brentq(mc, xa, xb, t_old, h, coef, base, mv):
     return xcur
 
 
-@jit
+@jit(inline=True)
 def _quad_roots(qa, qb, qc):
-    """Real roots of qa s^2 + qb s + qc (as np.roots: leading zeros dropped)."""
-    r = np.full(2, np.nan)
+    """Real roots of qa s^2 + qb s + qc (as np.roots: leading zeros dropped), a pair with
+    nan for a root that is not."""
     if qa == 0.0:
-        if qb != 0.0:
-            r[0] = -qc / qb
-        return r
+        return (-qc / qb if qb != 0.0 else np.nan), np.nan
     disc = qb * qb - 4.0 * qa * qc
     if disc < 0.0:
-        return r
+        return np.nan, np.nan
     sq = math.sqrt(disc)
     q = -0.5 * (qb + sq if qb >= 0.0 else qb - sq)
     if q != 0.0:
-        r[0] = q / qa
-        r[1] = qc / q
-    else:
-        r[0] = 0.0
-        r[1] = 0.0
-    return r
+        return q / qa, qc / q
+    return 0.0, 0.0
 
 
-@jit
+@jit(borrow=True)
 def _lowest_dip(d0, d1, r0, r1, dt):
     """events._lowest_dip: (time from the start, row) of the lowest interior minimum
     below zero of the cubic Hermite interpolants, or (-1, -1)."""
@@ -160,7 +154,8 @@ def _lowest_dip(d0, d1, r0, r1, dt):
         if abs(a) + abs(b) == 0.0:
             continue
         roots = _quad_roots(3 * a, 2 * b, m0)
-        for s in roots:
+        for k in range(2):
+            s = roots[k]
             if 0.0 < s < 1.0:
                 val = ((a * s + b) * s + m0) * s + p0
                 if val < best:
@@ -180,7 +175,7 @@ def _mv(r, gr, mv_e, mv_w):
 CHECK_INTERVALS = 8
 
 
-@jit
+@jit(borrow=True)
 def within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
     """Whether an event distance may reach zero inside a step, judged from its values d,
     rates r and second derivatives a at both ends, with a wide margin; mask[r] marks the
@@ -199,7 +194,7 @@ def within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
     return anyrow
 
 
-@jit
+@jit(borrow=True)
 def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1, rcol0, rcol1,
                     mask, CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
@@ -357,7 +352,7 @@ def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
             out[i], out[n + i], out[2 * n + i], out[3 * n + i] = a, -a, -c, c
 
 
-@jit
+@jit(borrow=True)
 def surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
     """The event distances d, rates dd and second derivatives d2 at the state y (time t [s])
     with accelerations acc; with a vertical record (mv_e not empty) the moving kinks'

@@ -63,7 +63,7 @@ from rbm_cli.structures.rates import acc_of, rhs
 initial_step, attempt_step, dense_prepare = steps_for("plane", rhs)
 
 
-@jit
+@jit(borrow=True)
 def account_step(mc, t_old, t_new, h, y_old, F, gr, ground_load, argmap, damp, k, yq, ledger):
     """Add one step's work of the ground and the energy its damping took to ledger[2] and
     ledger[3] [J]: over [t_old, t_new] on the step's dense output (F, from y_old; its

@@ -62,7 +62,7 @@ def piece_bounds(i, side, k, pending, rigid, edges, nedges):
     return -end, -start
 
 
-@jit(borrow=True)
+@jit
 def bound_rows(side, k, pending, rigid, edges, nedges, tu, c_ratio, lo, hi, off):
     """The bounds lo, hi [rad] (n,) of the current pieces and the offsets off[:4n] [-] of the
     event rows, in their order: argument over theta_u above lo (x / tu + off[i]), below hi
@@ -92,7 +92,7 @@ def locate(x, rate, side, k, pending, rigid, edges, nedges):
         pending[i] = k[i] > 0 and not rigid[i]
 
 
-@jit(borrow=True)
+@jit
 def cross(i, going_up, side, k, pending, awaiting, rigid, silent):
     """Move interface i to its next piece as its argument crosses the current piece's upper
     (going_up) or lower bound.

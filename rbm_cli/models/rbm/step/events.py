@@ -291,7 +291,7 @@ def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1
 
 
 # ---------------------------------------------------------------- the equations, the rows
-@jit(borrow=True)
+@jit
 def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, cs):
     """(A, c) of theta'' = A theta + c + e a_g for the active pieces, in place into
     As[:, :n] and cs: A = M^-1 K_g - sum_i b_i (M^-1 D^T)[:, i] argmap[i, :],

@@ -280,51 +280,34 @@ def restart(W, t, seg_end, seg_gain, h_carry, gr, mc, rtol, atol):
     """A new stepper from (t, W.y): the system of the current pieces (step.events.system), the
     watched rows' bounds (and their moving parts), the rows and their distances at t, the
     first step's size (h_carry, the one proposed before an event, or numerics.rk's
-    initial_step). Returns the step size [s], the right-hand side's calls and the ground.
-    (The record's fields read in one statement for each borrowed part: base.jit.)"""
-    gr, t_bound = new_pieces(t, seg_end, seg_gain, gr, W.vert, W.clipped, W.side, W.k,
-                             W.pending, W.rigid, W.edges, W.nedges, W.edge_w, W.tu, W.c_ratio,
-                             W.intercepts, W.slopes, W.slope_parts, W.md, W.mg, W.argmap,
-                             W.damp, W.knots, W.values, W.vertical, W.lo, W.hi, W.h0, W.mv_e,
-                             W.mv_w, W.sys_A, W.sys_c, W.sys_e, W.y, W.f)  # fmt: skip
+    initial_step). Returns the step size [s], the right-hand side's calls and the ground."""
+    vert = W.vert
+    n = W.y.size // 2
+    system(W.side, W.k, W.intercepts, W.slopes, W.slope_parts, vert, W.md,
+           W.mg, W.argmap, W.damp, W.sys_A, W.sys_c)  # fmt: skip
+    bound_rows(W.side, W.k, W.pending, W.rigid, W.edges, W.nedges, W.tu,
+               W.c_ratio, W.lo, W.hi, W.h0)  # fmt: skip
+    if vert:
+        moving_rows(W.side, W.k, W.pending, W.rigid, W.edges, W.nedges,
+                    W.edge_w, W.tu, W.h0, W.mv_e, W.mv_w)  # fmt: skip
+    t_bound = seg_end
+    if W.clipped:
+        gr, t_bound = record_piece(t, W.knots, W.values, W.vertical, seg_gain,
+                                   seg_end)  # fmt: skip
+    rhs(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.f)
     if h_carry > 0.0:
         h_abs, calls = min(h_carry, seg_end - t), 1
     else:
-        h_abs = initial_step(t, W.y, W.f, t_bound, TAB_EST[mc], rtol, atol, W.y.size // 2,
-                             W.sys_A, W.sys_c, W.sys_e, gr, W.work)  # fmt: skip
+        h_abs = initial_step(
+            t, W.y, W.f, t_bound, TAB_EST[mc], rtol, atol, n, W.sys_A, W.sys_c, W.sys_e, gr, W.work
+        )
         calls = 2
-    rows_at_start(t, gr, W.y, W.track, W.no_offset, W.z_old, W.dz_old, W.sys_A, W.sys_c,
-                  W.sys_e, W.acc, W.gx, W.gc, W.same, W.h0, W.d_old, W.dd_old, W.d2_old,
-                  W.mv_e, W.mv_w)  # fmt: skip
+    affine(W.track, W.y, 0, W.no_offset, W.z_old)
+    affine(W.track, W.y, n, W.no_offset, W.dz_old)
+    acc_of(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
+    surfaces(W.gx, W.gc, W.same, W.y, W.acc, W.h0, W.d_old, W.dd_old, W.d2_old, t, gr,
+             W.mv_e, W.mv_w)  # fmt: skip
     return h_abs, calls, gr
-
-
-@jit(borrow=True)
-def new_pieces(t, seg_end, seg_gain, gr, vert, clipped, side, k, pending, rigid, edges, nedges,
-               edge_w, tu, c_ratio, intercepts, slopes, slope_parts, md, mg, argmap, damp,
-               knots, values, vertical, lo, hi, h0, mv_e, mv_w, As, cs, es, y, f):  # fmt: skip
-    """restart's system, watched rows' bounds and record piece at t, and f = y'(t). Returns
-    the ground and the time the first step ends at [s]."""
-    system(side, k, intercepts, slopes, slope_parts, vert, md, mg, argmap, damp, As, cs)
-    bound_rows(side, k, pending, rigid, edges, nedges, tu, c_ratio, lo, hi, h0)
-    if vert:
-        moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv_w)
-    t_bound = seg_end
-    if clipped:
-        gr, t_bound = record_piece(t, knots, values, vertical, seg_gain, seg_end)
-    rhs(t, y, y.size // 2, As, cs, es, gr, f)
-    return gr, t_bound
-
-
-@jit(borrow=True)
-def rows_at_start(t, gr, y, track, no_offset, z_old, dz_old, As, cs, es, acc, gx, gc, same, h0,
-                  d_old, dd_old, d2_old, mv_e, mv_w):  # fmt: skip
-    """restart's tracked rows, theta'' and watched rows' distances at (t, y)."""
-    n = y.size // 2
-    affine(track, y, 0, no_offset, z_old)
-    affine(track, y, n, no_offset, dz_old)
-    acc_of(t, y, n, As, cs, es, gr, acc)
-    surfaces(gx, gc, same, y, acc, h0, d_old, dd_old, d2_old, t, gr, mv_e, mv_w)
 
 
 @jit
@@ -338,29 +321,21 @@ def find_event(W, mc, t_old, t_new, h, gr):
     """The first watched row's crossing in the step [t_old, t_new] (step.events): theta''
     and the rows at the step's end, then, where a crossing may lie within reach, the step's
     dense output prepared and the crossing found on it. Returns (t_e, the row crossed or -1,
-    the dense output ready, right-hand side calls). (The record's fields read in one
-    statement, for the borrowed search: base.jit.)"""
-    return crossing_in_step(mc, t_old, t_new, h, gr, W.y, W.y_new, W.acc, W.acc_old, W.ends,
-                            W.sys_A, W.sys_c, W.sys_e, W.K, W.F, W.tmp, W.gx, W.gc, W.same,
-                            W.h0, W.mv_e, W.mv_w, W.near, W.d_old, W.dd_old, W.d2_old,
-                            W.d_new, W.dd_new, W.d2_new, W.Dq, W.Rq, W.dc0, W.dc1, W.rc0,
-                            W.rc1, W.CP, W.BP, W.CR, W.BR)  # fmt: skip
-
-
-@jit(borrow=True)
-def crossing_in_step(mc, t_old, t_new, h, gr, y, y_new, acc, acc_old, ends, As, cs, es, K, F,
-                     tmp, gx, gc, same, h0, mv_e, mv_w, near, d_old, dd_old, d2_old, d_new,
-                     dd_new, d2_new, Dq, Rq, dc0, dc1, rc0, rc1, CP, BP, CR, BR):  # fmt: skip
-    """find_event on the record's arrays."""
-    n = y.size // 2
-    copy_into(acc_old, acc)
-    ends[0], ends[1] = acc_of(t_new, y_new, n, As, cs, es, gr, acc)
-    surfaces(gx, gc, same, y_new, acc, h0, d_new, dd_new, d2_new, t_new, gr, mv_e, mv_w)
-    if not within_reach(d_old, d_new, dd_old, dd_new, d2_old, d2_new, t_new - t_old, near):
+    the dense output ready, right-hand side calls)."""
+    n = W.y.size // 2
+    copy_into(W.acc_old, W.acc)
+    W.ends[0], W.ends[1] = acc_of(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
+    surfaces(W.gx, W.gc, W.same, W.y_new, W.acc, W.h0, W.d_new, W.dd_new, W.d2_new,
+             t_new, gr, W.mv_e, W.mv_w)  # fmt: skip
+    if not within_reach(W.d_old, W.d_new, W.dd_old, W.dd_new, W.d2_old, W.d2_new, t_new - t_old,
+                        W.near):  # fmt: skip
         return t_new, -1, False, 0
-    calls = dense_prepare(mc, t_old, h, y, y_new, K, F, tmp, n, As, cs, es, gr)
-    t_e, row = first_crossing(mc, t_old, t_new, y, F, gx, gc, same, h0, n, Dq, Rq, dc0, dc1,
-                              rc0, rc1, near, CP, BP, CR, BR, gr, mv_e, mv_w)  # fmt: skip
+    calls = dense_prepare(
+        mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
+    )
+    t_e, row = first_crossing(mc, t_old, t_new, W.y, W.F, W.gx, W.gc, W.same, W.h0, n,
+                              W.Dq, W.Rq, W.dc0, W.dc1, W.rc0, W.rc1, W.near, W.CP, W.BP, W.CR,
+                              W.BR, gr, W.mv_e, W.mv_w)  # fmt: skip
     return t_e, row, True, calls
 
 

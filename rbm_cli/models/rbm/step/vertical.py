@@ -90,7 +90,7 @@ def _end(i, k, ne, rigid, pending):
     return k - 1, 1.0, q_end, 1.0
 
 
-@jit(borrow=True)
+@jit
 def moving_rows(side, k, pending, rigid, edges, nedges, edge_w, tu, h0, mv_e, mv_w):
     """mv_e, mv_w of the law-bound rows of the active pieces (module docstring); h0 of a
     moving row keeps EVENT_EPS only."""

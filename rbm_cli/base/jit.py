@@ -44,8 +44,8 @@ def jit(function: Callable | None = None, *, inline: bool = False, borrow: bool 
     ``RBM_JIT=0``. ``inline=True`` inlines it into its compiled callers (a small helper
     called in a hot loop; the arithmetic is the same). ``borrow=True`` compiles it without
     reference counts (numba's ``_nrt=False``): for a function called every step that only
-    reads and writes the arrays and records it is given, allocates none and returns none
-    (numba refuses to compile one that does). Compiled with them, a function counts a
+    reads and writes the arrays and numbers it is given and returns numbers (numba refuses
+    to compile one that allocates an array or reads a record's field). Compiled with them, a function counts a
     reference to each array it takes, an atomic add at its start and a subtract at its end,
     that numba's pruning of counts removes only in straight code (a function with loops and
     branches, or a helper inlined into one, keeps them); a borrowed function counts none, and

@@ -45,11 +45,12 @@ def jit(function: Callable | None = None, *, inline: bool = False, borrow: bool 
     called in a hot loop; the arithmetic is the same). ``borrow=True`` compiles it without
     reference counts (numba's ``_nrt=False``): for a function called every step that only
     reads and writes the arrays and numbers it is given and returns numbers (numba refuses
-    to compile one that allocates an array or reads a record's field). Compiled with them, a function counts a
-    reference to each array it takes, an atomic add at its start and a subtract at its end,
-    that numba's pruning of counts removes only in straight code (a function with loops and
-    branches, or a helper inlined into one, keeps them); a borrowed function counts none, and
-    whatever it inlines is borrowed too. The arithmetic is the same.
+    to compile one that allocates an array or reads a record's field). Compiled with them,
+    a function counts a reference to each array it takes, an atomic add at its start and a
+    subtract at its end, that numba's pruning of counts removes only in straight code (a
+    function with loops and branches, or a helper inlined into one, keeps them); a borrowed
+    function counts none, and whatever it inlines is borrowed too. The arithmetic is the
+    same.
 
     Use as ``@jit``, ``@jit(inline=True)`` or ``@jit(borrow=True)``.
 

@@ -570,12 +570,6 @@ def _frame(raw: Any, model: str, column: ColumnConfig) -> FrameConfig:
             " delete frame or change the model"
         )
     columns = integer(f["columns"], "frame.columns", 2, MAX_FRAME_COLUMNS)
-    if columns > 2 and not MODELS[model].beam and MODELS[model].multi_drum:
-        raise ConfigError(
-            f"frame.columns: model {model}'s frame takes 2 columns, got {columns} (three or"
-            " more rigid tops under one rigid beam leave the load's share to the engine,"
-            " which lets the columns drift out of step): use 2, or model rbm"
-        )
     beam = number(f["beam_mass"], "frame.beam_mass", "kg", 0.0, lo_open=False)
     beam = in_bounds(beam, "frame.beam_mass", "kg", BEAM_MASS_RANGE)
     if column.top_mass is not None:

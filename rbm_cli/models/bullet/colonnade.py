@@ -47,16 +47,38 @@ Collapse, whichever comes first (the run stops there):
   column rocks, the corner it rests on turning up). A beam lifted off a top it still
   stands over may land on it again: that is not its fall.
 
-Three or more columns: the beam's weight shared by three or more rigid tops is statically
-indeterminate, and the engine's contact solver shares it unevenly (measured, a beam of
-gamma 1 on three 2 x 0.4 m columns at the start of a 0.5 g, 2 Hz half-sine: 43, 38 and
-19 % of its weight, the last share falling to 0 as they rock): a column left unloaded
-rocks on its own, out of unison with the others, which Makris and Vassiliou's frame
-assumes (measured there: peak ratio 0.29 with three columns and 0.39 with four against
-0.22 for the equivalent block, which two columns match to 0.001). The run of two columns
-is determinate (its two tops' shares follow from the beam's balance) and follows the
-equivalent block; the config refuses more (rbm_cli.config.load), the layout here holds
-for any N.
+The beam's seats (:func:`seat_contact`). The share of a rigid beam's weight that each of
+three or more tops carries is statically indeterminate: a real frame's follows from the
+compliance of its supports. On rigid contacts the engine's solver settles it by the order
+it visits the contacts in, its error reduction (erp) and round-off: measured (a beam of
+gamma 1 on 2 x 0.4 m columns, at rest, 2026-11-30), 50/0/50 % of the weight on three tops
+and 30/0/57/13 % on four, with 100 or 1,000 solver iterations, split impulse on or off;
+50/0/50 % with erp 0.02, 23/58/20 % with erp 0.8. A column left unloaded rocks on its own,
+out of the unison Makris and Vassiliou's frame assumes (under a 0.5 g, 2 Hz half-sine peak
+ratio 0.29 with three columns, 0.39 with four, against 0.22 for the equivalent block). So
+the beam's contacts with the tops are compliant where the frame has three or more columns
+(the engine's soft contact: each contact point a spring and a dashpot, solved implicitly
+with the rest) [assumptions]:
+
+- a top's seat has the joints' normal stiffness over the top's face, k_n A
+  (interface.stiffness: {normal: k_n}, else SEAT_NORMAL_STIFFNESS), shared by the
+  SEAT_POINTS points the engine keeps on a seated face (springs in parallel);
+- its damping is SEAT_DAMPING (critical) of the beam's share bouncing on it,
+  2 sqrt(k_n A m_b / N): the seat does not ring, its impacts are near plastic, as the
+  engine's rigid contacts are (restitution 0).
+
+Equal columns then share a symmetric beam equally (W / N each within 2.5 % over the first
+0.1 s at rest, tests/test_frame_bullet.py), and three columns follow two (the similarity
+law of Makris and Vassiliou's frame, whose motion depends on gamma, not N). The seats cost
+the rigid frame's precision: a seat of k_n 5e9 Pa/m lets the frame rock further than the
+rigid block on a half-sine (peak ratio up to 0.03 above it where two rigid columns match it
+to 0.001; the difference shrinks as k_n grows, 0.002 at 1e11), and stiffer seats do not
+help three columns: the engine's rigid contacts below (the bases on the ground) settle by
+micrometres, and from 2e10 Pa/m up this unloads the middle columns again. At rest the
+shares drift as those contacts creep (W / N within 5 % at 0.2 s, the middle column of
+three at 0.71 W / N after 1 s). Two columns keep rigid seats (their shares follow from the
+beam's balance, and their runs stay those of the stored study) unless the config gives
+k_n. A seat holds no more than a contact: the beam may lift off, slide and land again.
 
 Friction demand (FRICTION_DT windows, as a column's): the engine's momentum balance gives
 the mean force on a set of bodies that touches the rest through one joint only. A column's
@@ -78,7 +100,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rbm_cli.config.types import ColumnConfig, FrameConfig, G
+from rbm_cli.config.types import ColumnConfig, FrameConfig, G, InterfaceConfig
 from rbm_cli.models.bullet.geometry import DrumSolid
 from rbm_cli.models.bullet.scene import (
     Frame,
@@ -145,6 +167,37 @@ def frame_layout(column: ColumnConfig, frame: FrameConfig, solids) -> FrameLayou
         half_extents=half,
     )
     return FrameLayout(axes=axes, spacing=spacing, beam=beam, depth=depth)
+
+
+#: The joints' normal stiffness k_n [Pa/m] of the seats of three or more columns where the
+#: config gives none (interface.stiffness rigid or rotational) [assumption: the stone
+#: joints' value of the engine's comparisons with the Rigid Beam Model, docs/engine.md].
+SEAT_NORMAL_STIFFNESS = 5e9
+#: Contact points the engine keeps between the beam and a seated top (measured: 4, the
+#: face's corners).
+SEAT_POINTS = 4
+#: Ratio of critical damping of the beam bouncing on its seats [assumption].
+SEAT_DAMPING = 1.0
+
+
+def seat_contact(column: ColumnConfig, frame: FrameConfig, interface: InterfaceConfig,
+                 solids) -> tuple[float, float] | None:  # fmt: skip
+    """(stiffness [N/m], damping [N s/m]) of each contact point of the beam on a top (the
+    module's notes): compliant seats where the config gives the joints' k_n
+    (interface.stiffness: {normal: k_n}) or the frame has three or more columns (k_n
+    SEAT_NORMAL_STIFFNESS where none is given); None, rigid seats, otherwise."""
+    stiff = interface.stiffness
+    if frame.beam_mass <= 0.0 or (frame.columns < 3 and stiff.kind != "normal"):
+        return None
+    k_n = float(stiff.values[0]) if stiff.kind == "normal" else SEAT_NORMAL_STIFFNESS
+    width = 2.0 * solids[-1].half_top
+    if column.section == "circular":
+        area = 0.25 * math.pi * width**2
+    else:
+        area = width * (width if column.depth is None else column.depth)
+    seat = k_n * area  # one top's [N/m]
+    damping = 2.0 * SEAT_DAMPING * math.sqrt(seat * frame.beam_mass / frame.columns)
+    return seat / SEAT_POINTS, damping / SEAT_POINTS
 
 
 @dataclass(frozen=True)

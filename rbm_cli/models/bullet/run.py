@@ -62,7 +62,7 @@ import numpy as np
 from rbm_cli.base.errors import RbmError
 from rbm_cli.config.types import Config, G, SolverConfig
 from rbm_cli.inputs.excitation import GroundMotion
-from rbm_cli.models.bullet.colonnade import FrameWatch, frame_layout
+from rbm_cli.models.bullet.colonnade import FrameWatch, frame_layout, seat_contact
 from rbm_cli.models.bullet.engine import PhysicsClient
 from rbm_cli.models.bullet.geometry import drum_solids, stack_slenderness
 from rbm_cli.models.bullet.impact import impact_rate_ratios, measure_restitution
@@ -341,8 +341,9 @@ def _frame_run(config, motion, record, output_dt, early_stop, settings, client, 
     if client is None:
         client = PhysicsClient.for_process()
     cylinders = config.column.section == "circular"
+    seat = seat_contact(config.column, config.frame, config.interface, solids)
     bodies = build_frame(client, solids, layout.axes, layout.beam, settings, tilt, rate,
-                         cylinders=cylinders)  # fmt: skip
+                         cylinders=cylinders, seat=seat)  # fmt: skip
     alpha, limit = stack_slenderness(solids), config.collapse.ratio
 
     def watch_of(accel, frame, upward):

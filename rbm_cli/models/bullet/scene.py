@@ -52,6 +52,7 @@ def build_frame(
     tilt: float = 0.0,
     rate: float = 0.0,
     cylinders: bool = False,
+    seat: tuple[float, float] | None = None,
 ) -> list[int]:
     """Reset the client's world and build ground, a frame's columns and its beam
     (:mod:`rbm_cli.models.bullet.colonnade`); returns the body ids: column by column, each
@@ -64,6 +65,8 @@ def build_frame(
     tops' corners on the other side, translated with them and moving as they move
     (Makris and Vassiliou's frame rocking in unison).
     cylinders: circular drums collided as the engine's cylinders (the beam is a box).
+    seat : (stiffness [N/m], damping [N s/m]) of each of the beam's contact points, or None:
+        rigid contacts, as the drums' (rbm_cli.models.bullet.colonnade.seat_contact).
     """
     p, cid = client.module, client.id
     _reset_world(p, cid, settings)
@@ -78,6 +81,9 @@ def build_frame(
     arm = rot @ (corner - pivot)
     centre = np.array([0.0, 0.0, beam.bottom + beam.centre]) + (pivot + arm - corner)
     body = _add_drum(p, cid, beam, settings, centre, (0.0, 0.0, 0.0, 1.0))
+    if seat is not None:  # the engine's soft contact: an implicit spring and dashpot
+        p.changeDynamics(body, -1, contactStiffness=seat[0], contactDamping=seat[1],
+                         physicsClientId=cid)  # fmt: skip
     if rate:
         p.resetBaseVelocity(body, linearVelocity=np.cross(spin, arm).tolist(),
                             angularVelocity=[0.0, 0.0, 0.0], physicsClientId=cid)  # fmt: skip

@@ -6,8 +6,10 @@ Expected values come from outside the engine: the layout's arithmetic written he
 column's density), the geometry of a beam moved off a top, the bullet run of the free
 column (a beam of no mass is the column, to the bit), the statics of a rigid frame (it
 cannot lift below tan(alpha) g whatever its beam, Makris and Vassiliou 2013), their
-equivalent block run by `housner`, and Coulomb's friction (a frame that slides on the
-ground drags its beam along at mu g, which asks exactly mu of the beam's contact).
+equivalent block run by `housner`, its similarity law (the frame's motion depends on gamma,
+not on the number of columns), the symmetry of equal columns under a centred beam, and
+Coulomb's friction (a frame that slides on the ground drags its beam along at mu g, which
+asks exactly mu of the beam's contact).
 Engine runs of 1-3 s of motion each (about 1 s of wall time).
 """
 

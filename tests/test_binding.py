@@ -75,3 +75,17 @@ def test_the_steps_of_a_run_borrow_their_arrays():
         allocates(3)
     with pytest.raises(TypeError, match="borrowed"):
         jit(inline=True, borrow=True)
+
+
+@pytest.mark.skipif(not ENABLED, reason="compiled only: RBM_JIT=0 runs Python")
+def test_the_exact_integrators_intervals_borrow_their_arrays():
+    """The exact integrator's work on every interval (the certified search, the modes' and
+    families' bounds, a point of the closed form, the peaks' bound) is compiled without
+    reference counts; a new piece, which allocates its rows, is not."""
+    from rbm_cli.models.rbm.exact import bounds, modal, peaks, piece, search
+
+    borrowed = (search.next_point, bounds.mode_bounds, bounds.family_bounds, modal.advance,
+                piece.eval_point, piece.eval_family, peaks.may_exceed)  # fmt: skip
+    for function in borrowed:
+        assert function.targetoptions.get("_nrt") is False, function
+    assert piece.make_piece.targetoptions.get("_nrt", True) is not False

@@ -132,9 +132,9 @@ ANCHORS = [
      "        c0 = cycles()\n"
      "        row, s.st[H], ev, fresh = next_point(pc, pts, s.st[H], seg_end, wk.mb, wk.fb)\n"
      "        s.cnt[8] += cycles() - c0\n        c0 = cycles()\n"),
-    (EXACT_RUN, "        s.cnt[RHS_PEAKS] += ev\n        if se[4] != 0.0:\n",
-     "        s.cnt[RHS_PEAKS] += ev\n        s.cnt[9] += cycles() - c0\n        c0 = cycles()\n"
-     "        if se[4] != 0.0:\n"),
+    (EXACT_RUN, "            s.cnt[RHS_PEAKS] += ev\n        if se[4] != 0.0:\n",
+     "            s.cnt[RHS_PEAKS] += ev\n        s.cnt[9] += cycles() - c0\n"
+     "        c0 = cycles()\n        if se[4] != 0.0:\n"),
     (EXACT_RUN, "        if can_stop and _passed_peak(mdl, pc, pts):",
      "        s.cnt[10] += cycles() - c0\n        if can_stop and _passed_peak(mdl, pc, pts):"),
     (EXACT_RUN, "        pc = make_piece(mdl, cache, s.side, s.k, s.pending, s.awaiting, fc)\n",
@@ -146,10 +146,10 @@ ANCHORS = [
     (EXACT_RUN, "            code = _handle(mdl, pc, row, s, se)\n",
      "            c0 = cycles()\n            code = _handle(mdl, pc, row, s, se)\n"
      "            s.cnt[12] += cycles() - c0\n"),
-    (EXACT_RUN, "              np.zeros(8, dtype=np.int64), held, np.zeros(n), np.zeros(n))"
-     "  # fmt: skip\n",
-     "              np.zeros(14, dtype=np.int64), held, np.zeros(n), np.zeros(n))"
-     "  # fmt: skip\n    c_all = cycles()\n"),
+    (EXACT_RUN, "              np.zeros(8, dtype=np.int64), held, np.zeros(n), np.zeros(n),"
+     " np.zeros(n),\n              np.zeros(n))  # fmt: skip\n",
+     "              np.zeros(14, dtype=np.int64), held, np.zeros(n), np.zeros(n), np.zeros(n),\n"
+     "              np.zeros(n))  # fmt: skip\n    c_all = cycles()\n"),
     (EXACT_RUN, "        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n",
      "        c0 = cycles()\n"
      "        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n"

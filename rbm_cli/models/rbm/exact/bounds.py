@@ -51,7 +51,7 @@ CURV, FULL, THIRD, FAST, ENV, OSC_A, OSC_B, RATE_A, RATE_B = range(9)
 MB_ROWS = 9
 
 
-@jit
+@jit(borrow=True)
 def _particular(lam, f, g, fc, ag_a, ag_b, sin_a, cos_a, sin_b, cos_b):
     """(p, p') of an eligible mode at both ends of an interval (module docstring),
     from the forcing's sines at both ends (harmonic) or its values ag_a, ag_b (linear)."""
@@ -93,7 +93,7 @@ def _mode(lam, q, v, big, dbig, h):
     return alam * qmax + big, alam * vmax + dbig
 
 
-@jit
+@jit(borrow=True)
 def mode_bounds(lam, f, g, elig, w, fc, t, q, v, h, qb, vb, mb):
     """Fill mb (MB_ROWS, n) with the modes' bounds on [t, t + h] (module docstring)
     from (q, v) at t and (qb, vb) at t + h. Returns whether some mode is fast."""
@@ -141,7 +141,7 @@ def mode_bounds(lam, f, g, elig, w, fc, t, q, v, h, qb, vb, mb):
     return any_fast
 
 
-@jit
+@jit(borrow=True)
 def family_bounds(gf, absgf, mb, any_fast, fb):
     """Family-level bounds into fb (8, families): |Gf| @ CURV (FULL when no mode is fast),
     FULL, THIRD, ENV, and the fast oscillations Gf @ OSC_A, OSC_B, RATE_A, RATE_B (a row's
@@ -183,7 +183,7 @@ def upper_abs2(va, vb, ra, rb, curv, h):
     return min(interp, min(left, right))
 
 
-@jit
+@jit(borrow=True)
 def row_lower(sgn, off, k, fa, fb_, da, db, fb, any_fast, h):
     """Lower bound on [a, b] of the event row sgn * F[k] + off, from the family values fa,
     fb_ and rates da, db at both ends and the family bounds fb (NaN counts as no bound)."""
@@ -198,7 +198,7 @@ def row_lower(sgn, off, k, fa, fb_, da, db, fb, any_fast, h):
     return full
 
 
-@jit
+@jit(borrow=True)
 def track_upper(k, fa, fb_, da, db, fb, any_fast, h):
     """Upper bound of |F[k]| on [a, b] (a tracked quantity)."""
     full = upper_abs2(fa, fb_, da, db, fb[1, k], h)

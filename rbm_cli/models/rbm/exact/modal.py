@@ -57,7 +57,7 @@ ZERO, HARMONIC, LINEAR = 0, 1, 2
 FORCING_SIZE = 7
 
 
-@jit
+@jit(borrow=True)
 def f_accel(fc, t):
     """a_g(t) [m/s^2]."""
     kind = int(fc[0])
@@ -106,7 +106,7 @@ def f_exceedance(fc, t0, level, t_stop):
     return -1.0
 
 
-@jit
+@jit(borrow=True)
 def f_peak(fc, t, h):
     """Bound of |a_g| on [t, t + h] [m/s^2]."""
     kind = int(fc[0])
@@ -117,7 +117,7 @@ def f_peak(fc, t, h):
     return 0.0
 
 
-@jit
+@jit(borrow=True)
 def f_phase(fc, t):
     """Phase [rad] of a harmonic forcing seen from t: a_g(t + tau) = A sin(om tau + phase)."""
     return np.fmod(fc[2] * t + fc[3], 2.0 * math.pi)  # exact, as math.fmod
@@ -191,7 +191,7 @@ def harmonic_near(lam, tau, om, phase, c, s):
     return y, dy
 
 
-@jit
+@jit(borrow=True)
 def advance(lam, q, v, f, g, fc, t, tau, qn, vn):
     """Modal coordinates and rates (q, v) at t + tau [s] from (q, v) at t, exactly, into
     (qn, vn) (equation (1) of the module docstring, the forcing fc read from absolute time

@@ -60,25 +60,32 @@ def _compact(notes, maxima):
     notes.count[0] = j
 
 
-@jit
-def note_interval(pc, pts, maxima, mb, fb, fresh, notes, side, k, seg, wk):
-    """Raise the maxima to the values at points 0 and 1 and note the interval between
-    them if a peak inside may exceed them. Returns the evaluations spent (refinement when
-    the notes are full)."""
+@jit(borrow=True)
+def may_exceed(pc, pts, maxima, mb, fb, fresh, up):
+    """Raise the maxima to the values at points 0 and 1; up gets the upper bounds of the
+    tracked quantities between them. Returns whether one may exceed its maximum there."""
     n, of, nf = pc.n, 1 + 2 * pc.n, pc.nf
     for i in range(n + 1):
         maxima[i] = max(maxima[i], abs(pts[0, of + n + i]), abs(pts[1, of + n + i]))
     fast = bounds_of(pc, pts, 0, 1, mb, fb) if not fresh else _any_fast(mb, n)
     h = pts[1, 0] - pts[0, 0]
-    up = np.empty(n + 1)
     above = False
     for i in range(n + 1):
         kk = n + i
         up[i] = track_upper(kk, pts[0, of + kk], pts[1, of + kk], pts[0, of + nf + kk],
                             pts[1, of + nf + kk], fb, fast, h)  # fmt: skip
         above = above or not up[i] <= maxima[i]
-    if not above:
-        return 0
+    return above
+
+
+@jit
+def note_interval(pc, pts, maxima, mb, fb, notes, side, k, seg, wk):
+    """Note the interval between points 0 and 1, where a peak may exceed the maxima
+    (:func:`may_exceed` said so and left the upper bounds in wk.up). Returns the
+    evaluations spent (refinement when the notes are full)."""
+    n = pc.n
+    h = pts[1, 0] - pts[0, 0]
+    up = wk.up
     if notes.count[0] == notes.t.size:
         _compact(notes, maxima)
     if notes.count[0] == notes.t.size:  # still full: refine this one now
@@ -92,7 +99,7 @@ def note_interval(pc, pts, maxima, mb, fb, fresh, notes, side, k, seg, wk):
     return 0
 
 
-@jit
+@jit(borrow=True)
 def _any_fast(mb, n):
     for j in range(n):
         if mb[3, j] != 0.0:

@@ -162,7 +162,7 @@ def point_size(n: int) -> int:
     return 1 + 2 * n + 3 * (2 * n + 1)
 
 
-@jit
+@jit(borrow=True)
 def _derived(pc, pts, i):
     """Family values and rates of point i from its (t, q, v), and the second derivatives
     of the tracked families (the peaks' rows, n and above)."""
@@ -183,7 +183,7 @@ def _derived(pc, pts, i):
         pts[i, of + 2 * nf + r] = ff
 
 
-@jit
+@jit(borrow=True)
 def eval_family(pc, pts, src, tau, k, second):
     """(F_k, F_k', and F_k'' if second else 0) tau [s] after point src, through the
     scratch point's (q, v) only (SCRATCH_SLOT)."""
@@ -214,7 +214,7 @@ def set_point(pc, pts, i, t, q, v):
     _derived(pc, pts, i)
 
 
-@jit
+@jit(borrow=True)
 def eval_point(pc, pts, src, tau, dst):
     """Point dst, tau [s] after point src."""
     n = pc.n
@@ -225,7 +225,7 @@ def eval_point(pc, pts, src, tau, dst):
     _derived(pc, pts, dst)
 
 
-@jit
+@jit(borrow=True)
 def row_at(pc, pts, i, r):
     """(value, rate) of event row r at point i."""
     of = 1 + 2 * pc.n

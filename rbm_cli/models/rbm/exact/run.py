@@ -36,7 +36,13 @@ from rbm_cli.models.rbm.exact.modal import (
     f_peak_on,
     linear_exceedance,
 )
-from rbm_cli.models.rbm.exact.peaks import NOTES, new_notes, note_interval, settle_peaks
+from rbm_cli.models.rbm.exact.peaks import (
+    NOTES,
+    may_exceed,
+    new_notes,
+    note_interval,
+    settle_peaks,
+)
 from rbm_cli.models.rbm.exact.piece import eval_point, make_piece, row_at, set_point
 from rbm_cli.models.rbm.exact.search import SCRATCH, next_point
 from rbm_cli.models.rbm.pieces import (
@@ -76,11 +82,13 @@ FIRST_STEP = 1e-3
 
 #: Work arrays of a run: the point pool, mode and family bounds, the peak refinement's
 #: reference counts, free list and stack, and the noted intervals (exact.peaks).
-Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes")
+Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes up")
 #: The moving state: rotations, rates, law pieces (side, k, pending, awaiting), maxima of
 #: the tracked quantities, friction demand (its peak; the held demand, pieces.held_array,
 #: and the shear ratios of a sample).
-State = namedtuple("State", "theta rate side k pending awaiting maxima fric st cnt held rx ry")
+State = namedtuple(
+    "State", "theta rate side k pending awaiting maxima fric st cnt held rx ry modal_acc acc"
+)
 
 
 @jit
@@ -113,11 +121,12 @@ def _accel_and_friction(mdl, pc, pts, i, s):
     """The shear ratios (s.rx) of the state at point i (at its time pts[i, 0]); the peak
     s.fric raised to them."""
     n = pc.n
-    from_modes = np.empty(n)
+    from_modes = s.modal_acc
     ag = f_accel(pc.fc, pts[i, 0])
     for j in range(n):
         from_modes[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
-    shear_ratios(ag, 0.0, 1.0, mdl.centre_map, pc.phi @ from_modes, s.ry[:0], mdl.masses,
+    np.dot(pc.phi, from_modes, s.acc)
+    shear_ratios(ag, 0.0, 1.0, mdl.centre_map, s.acc, s.ry[:0], mdl.masses,
                  mdl.normal_forces, s.rx, s.ry, s.fric)  # fmt: skip
 
 
@@ -162,12 +171,12 @@ def _survives(mdl, pc, pts):
                          mdl.nedges, mdl.intercepts, mdl.slopes, mdl.survival)  # fmt: skip
 
 
-@jit
-def _budget(s, se):
-    """A failure code when a budget is exceeded, else GOING."""
-    if s.cnt[STEPS] > se[0]:
+@jit(borrow=True)
+def _budget(cnt, se):
+    """A failure code when a budget is exceeded, else GOING (cnt: the State's counts)."""
+    if cnt[STEPS] > se[0]:
         return FAILED_STEPS
-    if s.cnt[STEPS] % POLL_PIECES == 0:
+    if cnt[STEPS] % POLL_PIECES == 0:
         return guard_code(se[2])
     return GOING
 
@@ -187,22 +196,24 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, sure_stop, samples):
     row = -1
     while pts[0, 0] < seg_end and row < 0:
         s.cnt[STEPS] += 1
-        code = _budget(s, se)
+        code = _budget(s.cnt, se)
         if code != GOING:
             s.st[T] = pts[0, 0]
             return -code
         row, s.st[H], ev, fresh = next_point(pc, pts, s.st[H], seg_end, wk.mb, wk.fb)
         s.cnt[RHS] += ev
-        ev = note_interval(pc, pts, s.maxima, wk.mb, wk.fb, fresh, wk.notes, s.side, s.k,
-                           s.cnt[SEG], wk)  # fmt: skip
-        s.cnt[RHS] += ev
-        s.cnt[RHS_PEAKS] += ev
+        if may_exceed(pc, pts, s.maxima, wk.mb, wk.fb, fresh, wk.up):
+            ev = note_interval(pc, pts, s.maxima, wk.mb, wk.fb, wk.notes, s.side, s.k,
+                               s.cnt[SEG], wk)  # fmt: skip
+            s.cnt[RHS] += ev
+            s.cnt[RHS_PEAKS] += ev
         if se[4] != 0.0:
             _emit(pc, pts, s, samples, pts[1, 0], se[5])
         _accel_and_friction(mdl, pc, pts, 1, s)
         if s.st[SLIP_IF] == 0.0:
             first_over(s.fric, se[6], pts[1, 0], s.st[T_SLIP : SLIP_IF + 1])
-        _held_samples(mdl, pc, pts, s)
+        if held_time(s.held) <= pts[1, 0]:
+            _held_samples(mdl, pc, pts, s)
         if can_stop and _passed_peak(mdl, pc, pts):
             s.st[T] = pts[1, 0]
             return -STOPPED_EARLY
@@ -346,12 +357,14 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
         st[AT_REST] = 1.0
     s = State(theta, rate, side, k, pending, awaiting, np.zeros(n + 1), np.zeros(n), st,
-              np.zeros(8, dtype=np.int64), held, np.zeros(n), np.zeros(n))  # fmt: skip
+              np.zeros(8, dtype=np.int64), held, np.zeros(n), np.zeros(n), np.zeros(n),
+              np.zeros(n))  # fmt: skip
     nf = 2 * n + 1
     wk = Work(np.zeros((pool, 1 + 2 * n + 3 * nf)), np.zeros((9, n)), np.zeros((8, nf)),
               np.zeros(pool, dtype=np.int64), np.zeros(pool - 3, dtype=np.int64),
               np.zeros((stack, 2), dtype=np.int64),
-              np.zeros((stack, n + 1), dtype=np.bool_), new_notes(n, NOTES))  # fmt: skip
+              np.zeros((stack, n + 1), dtype=np.bool_), new_notes(n, NOTES),
+              np.zeros(n + 1))  # fmt: skip
     code = GOING
     for i in range(seg_t.shape[0]):
         if s.st[T] >= seg_t[i, 1]:

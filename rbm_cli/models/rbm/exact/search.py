@@ -58,7 +58,7 @@ RESERVED = 3
 SCRATCH = 2
 
 
-@jit
+@jit(borrow=True)
 def bounds_of(pc, pts, ia, ib, mb, fb):
     """Mode and family bounds of the interval between points ia and ib; any fast mode."""
     n = pc.n
@@ -70,7 +70,7 @@ def bounds_of(pc, pts, ia, ib, mb, fb):
     return fast
 
 
-@jit
+@jit(borrow=True)
 def _value(pc, pts, ia, x, r, kind):
     """(value, derivative) at x [s] after point ia: of event row r (kind 0) or of the rate
     of family r (kind 1)."""
@@ -103,7 +103,7 @@ def hermite_root(f0, d0, fh, dh, h):
     return s * h
 
 
-@jit
+@jit(borrow=True)
 def _newton(pc, pts, ia, h, f0, fh, r, kind, x0):
     """Root in [0, h] [s] after point ia of event row r (kind 0) or of the rate of family
     r (kind 1), f0 fh < 0 the values at the ends, from x0 (NaN: the secant's root)
@@ -136,7 +136,7 @@ def _newton(pc, pts, ia, h, f0, fh, r, kind, x0):
     return x, evals
 
 
-@jit
+@jit(borrow=True)
 def _check(pc, pts, ia, ib, fb, fast, h):
     """(any row uncertified, any crossed row, an uncertified row not crossed)."""
     of, nf = 1 + 2 * pc.n, pc.nf
@@ -154,7 +154,7 @@ def _check(pc, pts, ia, ib, fb, fast, h):
     return bad, crossed, other
 
 
-@jit
+@jit(borrow=True)
 def _first_root(pc, pts, ia, ib, fb, h, small):
     """(row, tau [s], evaluations) of the earliest crossing among the rows ending below
     zero at ib; row -1 when some such row is not monotone (and the interval not small)."""
@@ -190,7 +190,7 @@ def _first_root(pc, pts, ia, ib, fb, h, small):
     return best_r, best, evals
 
 
-@jit
+@jit(borrow=True)
 def next_point(pc, pts, h, t_stop, mb, fb):
     """From point 0: point 1 becomes the end of a certified interval of length <= h [s]
     (or t_stop), or the first event (module docstring). Returns (event row or -1,

@@ -394,20 +394,7 @@ def _config(data: Any, base_dir: str | os.PathLike[str] | None) -> Config:
         config = dataclasses.replace(config, uncertain=with_design(uncertain))
     _check_dimensions(config)
     _check_stop(config)
-    _check_frame(config)
     return config
-
-
-def _check_frame(config: Config) -> None:
-    """The Rigid Beam Model's frame (rbm_cli.structures.frame) without solver.stop: outcome
-    for columns of drums (their joints collapse with the beam's: no energy certificate)."""
-    if config.frame is None or not MODELS[config.model].beam:
-        return
-    if config.solver.stop == "outcome" and config.column.n_drums > 1:
-        raise ConfigError(
-            "solver.stop: outcome has no energy certificate for a frame of columns of drums"
-            " (a joint collapses together with the beam's joint): delete solver.stop"
-        )
 
 
 def _check_stop(config: Config) -> None:

@@ -171,20 +171,32 @@ def survival_barrier(model: Model) -> float:
     gives no such bound.
 
     For the `relative` formulation the energy is the kinetic energy plus the laws'
-    potentials F_i(x_i) = integral_0^x_i f_i, each a function of its own joint's argument.
-    A joint collapses where |x_i| reaches c theta_u,i (c <= 1), and on [0, theta_u] a law's
-    moment is >= 0, so F_i grows with |x_i| there and every F_j >= 0 before any joint
-    collapses: reaching the collapse of joint i takes an energy of at least F_i(c theta_u,i).
-    The barrier is the least of these. Free motion (no forcing, impacts with e <= 1, joint
-    damping >= 0) never gains energy, so a column below it survives whatever follows. Other
-    formulations: NaN (`geometric` adds gravity's potential, negative and coupling the
-    joints; `absolute` is not energy-conserving), and a frame of columns of drums (a joint
-    collapses with the beam's joint, past its own law's zero: rbm_cli.structures.frame)."""
-    if model.formulation != "relative" or model.joints != model.n:
+    potentials F_j(x_j) = integral_0^x_j f_j, each a function of its own joint's argument.
+    A joint collapses where |x_i| reaches c L_i (c <= 1, L_i its collapse limit: theta_u,i
+    for a column's joint; for a frame's, past theta_u,i, where the law plus the beam
+    joint's cap vanish). Each law's moment is >= 0 up to theta_u and < 0 beyond, so F_j
+    grows with |x_j| up to theta_u and falls after: before any joint collapses, F_j(x_j) is
+    at least min(0, F_j(c L_j)), and a joint that never collapses (a frame's beam joint,
+    its cap without a descending branch) has F_j >= 0 wherever it is. Reaching the collapse
+    of joint i therefore takes an energy of at least F_i(c L_i) plus the other joints'
+    min(0, F_j(c L_j)). If every F_j(c L_j) is positive the least of these is
+    min_i F_i(c L_i), the barrier; if one is not (a frame's heavy beam can take a joint's
+    below 0), the least is not positive and there is no barrier (NaN), nor is there one if
+    a joint that never collapses has a law that turns negative. Free motion (no forcing,
+    impacts with e <= 1, joint damping >= 0) never gains energy, so a column below the
+    barrier survives whatever follows. Other formulations: NaN (`geometric` adds gravity's
+    potential, negative and coupling the joints; `absolute` is not energy-conserving)."""
+    if model.formulation != "relative":
         return math.nan
-    limit = model.collapse_ratio * model.column.rotation_capacity
-    return float(min(min(law.potential(x), law.potential(-x))
-                     for law, x in zip(model.laws, limit, strict=True)))  # fmt: skip
+    watched = np.any(model.collapse_map != 0.0, axis=1)
+    limit = model.collapse_ratio * np.asarray(model.collapse_limit, dtype=float)
+    barrier = math.inf
+    for law, x, w in zip(model.laws, limit, watched, strict=True):
+        if w:
+            barrier = min(barrier, float(min(law.potential(x), law.potential(-x))))
+        elif law.slopes[-1] < 0.0 or law.intercepts[-1] < 0.0:  # never collapses: F >= 0?
+            return math.nan
+    return barrier if 0.0 < barrier < math.inf else math.nan
 
 
 @jit

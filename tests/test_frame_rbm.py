@@ -312,8 +312,6 @@ def test_the_stored_colonnade_band_without_a_beam_is_the_stored_column():
          "solver.stop: outcome has no energy certificate for a frame"),
         ({"interface": {"stiffness": {"rotational": [1e9, 1e9, 1e9, 1e9]}}},
          "interface.stiffness.rotational"),
-        ({"interface": {"stiffness": {"normal": 5e9}}, "solver": {"method": "exact"}},
-         "not a frame's beam joint"),
         ({"column": {**DRUMS, "top_mass": {"mass": 100.0}},
           "interface": {"stiffness": {"normal": 5e9}}}, "column.top_mass and frame"),
     ],

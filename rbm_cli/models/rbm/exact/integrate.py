@@ -122,7 +122,7 @@ def integrate_exact(
     solver = solver.for_run(motion.t_end, m)
     mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit, until_open)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
-    held = held_array(m, float(friction_duration), float(friction_limit))
+    held = held_array(model.friction_joints, float(friction_duration), float(friction_limit))
     armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
     try:
         run = run_exact if solver.implementation == "compiled" else plain(run_exact)

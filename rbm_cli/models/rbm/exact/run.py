@@ -261,15 +261,19 @@ def _handle(mdl, pc, row, s, se):
 @jit
 def _rest_friction(s, fc, t0, t1, mu):
     """The friction demand of a monolith at rest on [t0, t1] [s]: |a_g| / g (T = m a_g,
-    N = m g); where it first exceeds mu, the time |a_g| reaches mu g."""
+    N = m g), at every joint it is reported for (a monolithic frame's beam joint too); where
+    it first exceeds mu, the time |a_g| reaches mu g."""
     d = f_peak_on(fc, t0, t1) / G
-    if d > s.fric[0]:
-        s.fric[0] = d
+    for i in range(s.fric.size):
+        if d > s.fric[i]:
+            s.fric[i] = d
     if s.st[SLIP_IF] == 0.0 and d > mu:
         s.st[T_SLIP] = f_exceedance(fc, t0, mu * G, t1)
         s.st[SLIP_IF] = 1.0
     while held_time(s.held) <= t1:
-        s.rx[0] = f_accel(fc, held_time(s.held)) / G
+        r = f_accel(fc, held_time(s.held)) / G
+        for i in range(s.rx.size):
+            s.rx[i] = r
         held_push(s.held, s.rx, s.ry, s.fric)
 
 
@@ -335,9 +339,11 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     """One run (exact.integrate.integrate_exact) of a column of n drums (theta0, rate0)
     and m joints (mdl.argmap's rows: n, or n + 1 with a frame's beam joint); held: the held
     friction demand (pieces.held_array), changed in place. Returns (code, st, cnt, maxima:
-    the m joints' collapse ratios and the top's displacement, friction: its peak)."""
+    the m joints' collapse ratios and the top's displacement, friction: its peak at the
+    joints it is reported for, mdl.normal_forces')."""
     n = theta0.size
     m = mdl.argmap.shape[0]
+    mf = mdl.normal_forces.size
     side = np.ones(m, dtype=np.int64)
     k = np.zeros(m, dtype=np.int64)
     pending = np.zeros(m, dtype=np.bool_)
@@ -348,8 +354,8 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     st = np.array([0.0, FIRST_STEP, 0.0, math.nan, 0.0, 0.0, math.nan, 0.0])
     if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
         st[AT_REST] = 1.0
-    s = State(theta, rate, side, k, pending, awaiting, np.zeros(m + 1), np.zeros(m), st,
-              np.zeros(8, dtype=np.int64), held, np.zeros(m), np.zeros(m))  # fmt: skip
+    s = State(theta, rate, side, k, pending, awaiting, np.zeros(m + 1), np.zeros(mf), st,
+              np.zeros(8, dtype=np.int64), held, np.zeros(mf), np.zeros(mf))  # fmt: skip
     nf = 2 * m + 1
     wk = Work(np.zeros((pool, 1 + 2 * n + 3 * nf)), np.zeros((9, n)), np.zeros((8, nf)),
               np.zeros(pool, dtype=np.int64), np.zeros(pool - 3, dtype=np.int64),

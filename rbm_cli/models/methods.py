@@ -109,15 +109,6 @@ def _closed_form_why_not(config: Config, model: Model | None) -> str | None:
 
 
 def _exact_why_not(config: Config, model: Model | None, method: str = "exact") -> str | None:
-    frame = config.frame
-    drums = config.column.n_drums > 1
-    beam_joint = (model.joints != model.n if model is not None else
-                  frame is not None and frame.beam_mass > 0.0 and drums)  # fmt: skip
-    if beam_joint:
-        return (
-            f"solver.method {method} takes a column's joints only, not a frame's beam joint"
-            " over a column of drums: use DOP853 (or auto)"
-        )
     excitation = config.excitation
     return exact_why_not(
         config.interface.formulation,

@@ -59,7 +59,9 @@ class ColumnArrays(NamedTuple):
     impulse_w: np.ndarray  #: their weights (n,)
     centre_map: np.ndarray  #: state -> drum centre accelerations (n, n)
     masses: np.ndarray  #: drum masses [kg] (n,)
-    normal_forces: np.ndarray  #: normal force at each interface [N] (n,)
+    #: normal force at rest of each joint whose friction demand is reported [N]
+    #: (Model.friction_normals: the joints', and a monolithic frame's beam joint's)
+    normal_forces: np.ndarray
     rigid_mono: bool  #: a rigid monolith (it rests until the ground lifts it)
     uplift_level: float  #: ground acceleration that uplifts a rigid monolith [m/s^2] (-1: none)
     rest_rate: float  #: rate below which a rigid monolith comes to rest after an impact [rad/s]
@@ -240,7 +242,7 @@ def column_arrays(model: Model) -> ColumnArrays:
         e_rest=float(model.restitution), literal_impact=model.formulation == "absolute",
         impulse_dir=impulse_dir.copy(), impulse_w=np.asarray(impulse_w, dtype=float),
         centre_map=model.centre_map.copy(), masses=body_masses(col).astype(float),
-        normal_forces=col.normal_forces.astype(float), rigid_mono=uplift is not None,
+        normal_forces=model.friction_normals.astype(float), rigid_mono=uplift is not None,
         uplift_level=-1.0 if uplift is None else float(uplift), rest_rate=float(rest_rate),
         barrier=float(barrier), survival=survival_barrier(model),
         families=np.vstack([args, cmap, top[None, :]]),

@@ -99,6 +99,23 @@ class Model:
     def rigid(self) -> bool:
         return any(law.rigid for law in self.laws)
 
+    @cached_property
+    def friction_normals(self) -> np.ndarray:
+        """The normal forces at rest [N] of the joints whose friction demand a run reports
+        (|T_i / N_i|): every joint with a law, and a monolithic frame's beam joint, whose law
+        is folded into the base's (Column.beam_law) but whose shear, the beam share's
+        inertia force, is its own: N = W_b / N (the beam share's weight), last."""
+        col = self.column
+        if col.beam_law is not None:
+            return np.append(col.normal_forces, col.beam_mass * G)
+        return col.normal_forces
+
+    @property
+    def friction_joints(self) -> int:
+        """Joints whose friction demand a run reports (:attr:`friction_normals`): the joints,
+        and a monolithic frame's beam joint."""
+        return len(self.friction_normals)
+
     def arguments(self, theta: np.ndarray) -> np.ndarray:
         """Law arguments x (..., n) of rotations theta (..., n) [rad]."""
         return theta @ self.arg_map.T
@@ -313,15 +330,16 @@ class Model:
         return aw, ae, -product(minv, c), -product(minv, self.ground_load)
 
     def shear_ratios(self, accel: np.ndarray, ground_accel: np.ndarray) -> np.ndarray:
-        """|T_i / N_i| (k, n) from drum angular accelerations (k, n) and a_g (k,).
+        """|T_i / N_i| (k, friction_joints) from drum angular accelerations (k, n) and a_g
+        (k,), N_i the :attr:`friction_normals`.
 
-        T_i = -sum_{j>=i} m_j (absolute horizontal acceleration of drum j's centre).
+        T_i = -sum_{j>=i} m_j (absolute horizontal acceleration of body j's centre: the
+        drums', then a frame's beam share on the top node).
         """
-        col = self.column
         abs_acc = accel @ self.centre_map.T + np.asarray(ground_accel)[:, None]
-        forces = abs_acc * body_masses(col)
-        shear = np.cumsum(forces[:, ::-1], axis=1)[:, ::-1][:, : self.joints]
-        return np.abs(shear) / col.normal_forces
+        forces = abs_acc * body_masses(self.column)
+        shear = np.cumsum(forces[:, ::-1], axis=1)[:, ::-1][:, : self.friction_joints]
+        return np.abs(shear) / self.friction_normals
 
 
 def build_model(

@@ -42,12 +42,15 @@ from rbm_cli.base.jit import plain
 from rbm_cli.config.types import CLOSED_FORM_KINDS, G, SolverConfig
 from rbm_cli.inputs.excitation import GroundMotion
 from rbm_cli.models import status as cr
+from rbm_cli.models.block.piece import B_FA2
 from rbm_cli.models.block.run import (
+    FRICTION2,
     LOG_COLLAPSE,
     LOG_IMPACT,
     LOG_REST,
     LOG_UPLIFT,
     N_LOG,
+    SLIP_IF,
     T_SLIP,
     run_block,
 )
@@ -70,9 +73,10 @@ class Block(NamedTuple):
     rbm: bool  # the RBM's outcome messages (else housner-linear's)
 
 
-def _params(p, alpha, e, limit, restitution, rest_rate, uplift, barrier, eps, fa, fb, at_zero):
+def _params(p, alpha, e, limit, restitution, rest_rate, uplift, barrier, eps, fa, fb, at_zero,
+            fa2=math.nan, fb2=math.nan):  # fmt: skip
     return np.array([p, alpha, e, limit, restitution, rest_rate, uplift, barrier, eps, fa,
-                     fb, at_zero], dtype=float)  # fmt: skip
+                     fb, at_zero, fa2, fb2], dtype=float)  # fmt: skip
 
 
 def rbm_block(model: Model) -> Block:
@@ -88,7 +92,10 @@ def rbm_block(model: Model) -> Block:
     alpha) with fa = (m / N)(1 + c e) [s^2/m] and fb = (m / N) c p^2 [1/rad] (block.piece's
     demand, linear in a_g and theta: exact on every piece). At rest theta'' = 0 and
     T / N = a_g / g (block.run._rest_friction), up to the uplift level alpha; at uplift
-    theta'' starts from 0 (p^2 s alpha = e a_g there), so the two meet.
+    theta'' starts from 0 (p^2 s alpha = e a_g there), so the two meet. A monolithic frame's
+    beam joint (Model.friction_normals' last) carries the beam share's shear
+    T_b = m_b (a_g + c_b theta''), c_b = H its top node's lever, on N_b = m_b g: the same form
+    with m_b and c_b, fa2 = (m_b / N_b)(1 + c_b e) and fb2 = (m_b / N_b) c_b p^2.
     """
     reason = model_why_not(model)
     if reason is not None:
@@ -104,15 +111,18 @@ def rbm_block(model: Model) -> Block:
     c_ratio = float(model.collapse_ratio)
     uplift, rest_rate, barrier = rest_levels(model)
     centre, mass = float(model.centre_map[0, 0]), float(col.masses[0])
+    fa2 = fb2 = math.nan
     if model.centre_map.shape[0] > 1:  # a frame's beam share on the top node too
         bodies = body_masses(col)
         mass = float(bodies.sum())
         centre = float(bodies @ model.centre_map[:, 0]) / mass
+        lever, share = float(model.centre_map[-1, 0]), bodies[-1] / model.friction_normals[-1]
+        fa2, fb2 = share * (1.0 + lever * e), share * lever * p2
     ratio = mass / float(col.normal_forces[0])
     params = _params(
         math.sqrt(p2), alpha, e, c_ratio * scale, model.restitution,
         rest_rate, float(uplift), barrier / model.mass[0, 0],
-        EVENT_EPS * tu, ratio * (1.0 + centre * e), ratio * centre * p2, 0.0,
+        EVENT_EPS * tu, ratio * (1.0 + centre * e), ratio * centre * p2, 0.0, fa2, fb2,
     )  # fmt: skip
     return Block(params, scale, float(col.heights[0]), True)
 
@@ -217,9 +227,10 @@ def run_closed_form(
     samples = sample_buffer(motion.t_end, output_dt, record, 1)
     run = run_block if solver.implementation == "compiled" else plain(run_block)
     rows = 0 if events is None else LOG_ROWS
+    joints = 1 if math.isnan(block.params[B_FA2]) else 2  # a monolithic frame's beam joint
     while True:
         log = np.zeros((rows, 2))
-        held = held_array(1, float(friction_duration) if block.rbm else 0.0,
+        held = held_array(joints, float(friction_duration) if block.rbm else 0.0,
                           float(friction_limit))  # fmt: skip
         armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
         try:
@@ -234,9 +245,9 @@ def run_closed_form(
         events.extend((float(t), _LOG_KINDS[int(k)]) for t, k in log[: int(st[N_LOG])])
     out = Outcome(t_end=float(st[0]), t_collapse=float(st[9]), max_top=block.height * st[5])
     out.max_ratio = np.array([st[5] / block.ratio_scale])
-    out.friction_peak = np.array([st[6] if block.rbm else math.nan])
+    out.friction_peak = np.array([st[6] if block.rbm else math.nan, st[FRICTION2]][:joints])
     if block.rbm:
-        slip = (st[T_SLIP], 0.0 if math.isnan(st[T_SLIP]) else 1.0)
+        slip = (st[T_SLIP], 0.0 if math.isnan(st[T_SLIP]) else st[SLIP_IF])
         out.friction, out.slip = held_result(held, out.friction_peak, slip)
     else:
         out.friction = out.friction_peak.copy()

@@ -43,23 +43,25 @@ from rbm_cli.models.rbm.exact.modal import HARMONIC, LINEAR, f_phase
 #: A piece: start time t0 [s], side s, C [rad], omega [rad/s], phi0 [rad], q0 [rad],
 #: q1 [rad/s], c1, c2 [rad], alpha [rad], p_g [rad/s]; the ground acceleration on it,
 #: a_g(t0 + tau) = A sin(omega tau + phi0) + g0 + g1 tau (A [m/s^2], g0 [m/s^2],
-#: g1 [m/s^3]); the friction factors fa [s^2/m], fb [1/rad] (0: none).
-T0, SIDE, AMP, OM, PHI, Q0, Q1, C1, C2, ALPHA, P, GA, G0, G1, FA, FB = range(16)
-PIECE_SIZE = 16
+#: g1 [m/s^3]); the friction factors fa [s^2/m], fb [1/rad] of the ground joint and fa2,
+#: fb2 of a monolithic frame's beam joint (0: none).
+T0, SIDE, AMP, OM, PHI, Q0, Q1, C1, C2, ALPHA, P, GA, G0, G1, FA, FB, FA2, FB2 = range(18)
+PIECE_SIZE = 18
 #: The block: p [rad/s], alpha [rad], e [rad/s^2 per m/s^2], collapse limit [rad],
 #: restitution [-], rest rate [rad/s], uplift level [m/s^2], energy barrier of the early
 #: stop [rad^2/s^2], event offset eps [rad], friction factors fa [s^2/m] and fb [1/rad]
 #: (NaN: no friction demand), where an impact is placed (0: s theta = -eps, the RBM's
-#: convention; 1: theta = 0, housner-linear's; impact_time).
+#: convention; 1: theta = 0, housner-linear's; impact_time), and the friction factors
+#: fa2, fb2 of a monolithic frame's beam joint (NaN: none; closed_form.rbm_block).
 (B_P, B_ALPHA, B_E, B_LIMIT, B_REST, B_REST_RATE, B_UPLIFT, B_BARRIER, B_EPS, B_FA,
- B_FB, B_AT_ZERO) = range(12)  # fmt: skip
-BLOCK_SIZE = 12
+ B_FB, B_AT_ZERO, B_FA2, B_FB2) = range(14)  # fmt: skip
+BLOCK_SIZE = 14
 #: What the scan of a piece keeps: the largest s theta [rad], the time of the interior
 #: maximum holding it [s] (-1: none), the evaluations made, the friction demand [-]; and,
 #: for a friction limit mu [-] (inf: none) it is given, the first time in the piece its
-#: |demand| exceeds mu [s] (-1: none).
-A_PEAK, A_TAU_PEAK, A_EVALS, A_FRICTION, A_MU, A_SLIP = range(6)
-ACC_SIZE = 6
+#: |demand| exceeds mu [s] (-1: none); then the beam joint's demand and first exceedance.
+A_PEAK, A_TAU_PEAK, A_EVALS, A_FRICTION, A_MU, A_SLIP, A_FRICTION2, A_SLIP2 = range(8)
+ACC_SIZE = 8
 #: Events of a piece.
 NONE, IMPACT, COLLAPSE = 0, 1, 2
 #: Longest scanning interval, in units of the shorter of 1/p and 1/omega [-] (the bound
@@ -97,14 +99,14 @@ def start_piece(blk, t, theta, rate, side, fc, gam, pc):
     pc[GA], pc[G0], pc[G1] = ga, g0, g1
     friction = not math.isnan(blk[B_FA])
     pc[FA], pc[FB] = (blk[B_FA], blk[B_FB]) if friction else (0.0, 0.0)
+    beam = not math.isnan(blk[B_FA2])
+    pc[FA2], pc[FB2] = (blk[B_FA2], blk[B_FB2]) if beam else (0.0, 0.0)
 
 
 @jit
-def point(pc, tau):
-    """At t0 + tau: s theta [rad], s theta' [rad/s], c1 e^(p tau), c2 e^(-p tau), the
-    friction demand's signed value fa a_g + fb (theta - s alpha) [-] (the shear ratio of
-    the RBM's equations, n = 1; 0 without friction factors), its rate [1/s] and s theta''
-    [rad/s^2]."""
+def _motion(pc, tau):
+    """At t0 + tau: c1 e^(p tau), c2 e^(-p tau), the sine of the forcing's phase,
+    theta - s alpha [rad], theta' [rad/s], a_g [m/s^2] and a_g' [m/s^3]."""
     p = pc[P]
     e1 = pc[C1] * math.exp(p * tau) if pc[C1] != 0.0 else 0.0
     e2 = pc[C2] * math.exp(-p * tau) if pc[C2] != 0.0 else 0.0
@@ -114,17 +116,39 @@ def point(pc, tau):
     rate = pc[AMP] * pc[OM] * cs + pc[Q1] + p * (e1 - e2)
     ag = pc[GA] * sn + pc[G0] + pc[G1] * tau
     ag_rate = pc[GA] * pc[OM] * cs + pc[G1]
+    return e1, e2, sn, dev, rate, ag, ag_rate
+
+
+@jit
+def point(pc, tau):
+    """At t0 + tau: s theta [rad], s theta' [rad/s], c1 e^(p tau), c2 e^(-p tau), the
+    friction demand's signed value fa a_g + fb (theta - s alpha) [-] (the shear ratio of
+    the RBM's equations, n = 1; 0 without friction factors), its rate [1/s] and s theta''
+    [rad/s^2]."""
+    e1, e2, sn, dev, rate, ag, ag_rate = _motion(pc, tau)
     demand = pc[FA] * ag + pc[FB] * dev
     demand_rate = pc[FA] * ag_rate + pc[FB] * rate
-    s = pc[SIDE]
+    s, p = pc[SIDE], pc[P]
     accel = p * p * (e1 + e2) - pc[AMP] * pc[OM] * pc[OM] * sn
     return pc[ALPHA] + s * dev, s * rate, e1, e2, demand, demand_rate, s * accel
 
 
 @jit
+def beam_demand(pc, tau):
+    """The friction demand of a monolithic frame's beam joint at t0 + tau, its signed value
+    fa2 a_g + fb2 (theta - s alpha) [-] (the beam share's shear ratio) and its rate [1/s]."""
+    _, _, _, dev, rate, ag, ag_rate = _motion(pc, tau)
+    return pc[FA2] * ag + pc[FB2] * dev, pc[FA2] * ag_rate + pc[FB2] * rate
+
+
+@jit
 def _value(pc, which, shift, tau):
     """s theta + shift (which 0), s theta' (which 1), the friction demand's rate
-    (which 2) or the friction demand + shift (which 3) at t0 + tau."""
+    (which 2) or the friction demand + shift (which 3) at t0 + tau; the beam joint's
+    demand's rate (which 4) or demand + shift (which 5)."""
+    if which >= 4:
+        d, dr = beam_demand(pc, tau)
+        return d + shift if which == 5 else dr
     f, g, _, _, d, dr, _ = point(pc, tau)
     if which == 0:
         return f + shift
@@ -213,35 +237,42 @@ def _interval(pc, blk, a, b, fa, ga, fb, gb, acc):
 
 
 @jit
-def _first_over(pc, a, b, da, db, tm, dm, mu, acc):
-    """The first time in [a, b] where |demand| exceeds mu, the demand being monotone on
-    [a, tm] and [tm, b] (tm < 0: on [a, b]) with its ends da, dm, db: Brent on
-    demand = +-mu on the first monotone part whose end is past it."""
+def _first_over(pc, a, b, da, db, tm, dm, mu, acc, row):
+    """The first time in [a, b] where |demand| of a row (0: the ground joint's, 1: the beam
+    joint's) exceeds mu, the demand being monotone on [a, tm] and [tm, b] (tm < 0: on
+    [a, b]) with its ends da, dm, db: Brent on demand = +-mu on the first monotone part
+    whose end is past it."""
     if abs(da) > mu:
         return a
     lo = a
+    which = 3 + 2 * row
     if tm >= 0.0:
         if abs(dm) > mu:
-            return brent(pc, 3, -mu if dm > 0.0 else mu, a, tm, acc)
+            return brent(pc, which, -mu if dm > 0.0 else mu, a, tm, acc)
         lo = tm
-    return brent(pc, 3, -mu if db > 0.0 else mu, lo, b, acc)
+    return brent(pc, which, -mu if db > 0.0 else mu, lo, b, acc)
 
 
 @jit
-def _friction(pc, a, b, da, db, dra, drb, acc):
-    """Raise acc's friction demand to the largest |demand| on [a, b]: its ends' (da, db)
-    and, where its rate (dra, drb) changes sign, the extremum's (Brent on the rate)."""
+def _friction(pc, a, b, da, db, dra, drb, acc, row):
+    """Raise acc's friction demand of a row (0: the ground joint's, 1: the beam joint's) to
+    the largest |demand| on [a, b]: its ends' (da, db) and, where its rate (dra, drb)
+    changes sign, the extremum's (Brent on the rate)."""
+    fr, sl = (A_FRICTION, A_SLIP) if row == 0 else (A_FRICTION2, A_SLIP2)
     best = max(abs(da), abs(db))
     tm, dm = -1.0, 0.0
     if dra * drb < 0.0:
-        tm = brent(pc, 2, 0.0, a, b, acc)
-        _, _, _, _, dm, _, _ = point(pc, tm)
+        tm = brent(pc, 2 + 2 * row, 0.0, a, b, acc)
+        if row == 0:
+            _, _, _, _, dm, _, _ = point(pc, tm)
+        else:
+            dm, _ = beam_demand(pc, tm)
         acc[A_EVALS] += 1
         best = max(best, abs(dm))
-    if best > acc[A_MU] and acc[A_SLIP] < 0.0:
-        acc[A_SLIP] = _first_over(pc, a, b, da, db, tm, dm, acc[A_MU], acc)
-    if best > acc[A_FRICTION]:
-        acc[A_FRICTION] = best
+    if best > acc[A_MU] and acc[sl] < 0.0:
+        acc[sl] = _first_over(pc, a, b, da, db, tm, dm, acc[A_MU], acc, row)
+    if best > acc[fr]:
+        acc[fr] = best
 
 
 @jit
@@ -254,8 +285,10 @@ def scan_piece(pc, blk, tau_max, acc):
     m3_sine = abs(pc[AMP]) * om * om * om
     p3 = pc[P] * pc[P] * pc[P]
     friction = pc[FA] != 0.0 or pc[FB] != 0.0
+    beam = pc[FA2] != 0.0 or pc[FB2] != 0.0  # a monolithic frame's beam joint
     a = 0.0
     fa, ga, _, e2a, da, dra, f2a = point(pc, 0.0)
+    ba, bra = beam_demand(pc, 0.0) if beam else (0.0, 0.0)
     acc[A_EVALS] += 1
     if fa > acc[A_PEAK]:
         acc[A_PEAK] = fa
@@ -264,6 +297,7 @@ def scan_piece(pc, blk, tau_max, acc):
     while a < tau_max:
         b = min(a + h, tau_max)
         fb, gb, e1b, e2b, db, drb, f2b = point(pc, b)
+        bb, brb = beam_demand(pc, b) if beam else (0.0, 0.0)
         acc[A_EVALS] += 1
         w = b - a
         m3 = m3_sine + p3 * (abs(e1b) + abs(e2a))  # bound of the third derivative on [a, b]
@@ -283,10 +317,16 @@ def scan_piece(pc, blk, tau_max, acc):
         if kind != NONE:
             if friction:
                 _, _, _, _, db, drb, _ = point(pc, tau)
-                _friction(pc, a, tau, da, db, dra, drb, acc)
+                _friction(pc, a, tau, da, db, dra, drb, acc, 0)
+            if beam:
+                bb, brb = beam_demand(pc, tau)
+                _friction(pc, a, tau, ba, bb, bra, brb, acc, 1)
             return kind, tau
         if friction:
-            _friction(pc, a, b, da, db, dra, drb, acc)
+            _friction(pc, a, b, da, db, dra, drb, acc, 0)
+        if beam:
+            _friction(pc, a, b, ba, bb, bra, brb, acc, 1)
         a, fa, ga, e2a, da, dra, f2a = b, fb, gb, e2b, db, drb, f2b
+        ba, bra = bb, brb
         h, halvings = min(2.0 * h, h_max), 0
     return NONE, tau_max

@@ -3,8 +3,10 @@ rest, uplift, pieces of closed-form motion (block.piece), impacts, collapse and 
 stop of free motion, in one call per run.
 
 Mutable scalars live in small arrays: st = [t, theta, rate, side, at rest, peak,
-friction, next output time, samples written, t_collapse, events logged, t_slip] (floats;
-t_slip: where the friction demand first exceeded the limit se[6], nan if not) and
+friction, next output time, samples written, t_collapse, events logged, t_slip, the beam
+joint's friction, slip joint] (floats; t_slip: where the friction demand first exceeded
+the limit se[6], nan if not, at the slip joint: 1 the ground's, 2 a monolithic frame's
+beam joint) and
 cnt = [uplifts, impacts, pieces, evaluations, events] (ints). A motion is mo = [pulse or
 record (0/1), amplitude, omega, phase, pulse_end, t_end] with its segments (start, end),
 their forcings (exact.modal) and, under a vertical record, the upward acceleration
@@ -19,7 +21,9 @@ crest or a line's ends), in motion the piece's largest |demand| (block.piece._fr
 and so is its first exceedance of the limit (the exceedance of |a_g| at rest, Brent on the
 piece's demand in motion): its peak. The demand held for a duration
 (models.rbm.pieces.held_push, the step and exact integrators' too) takes its samples from
-a_g at rest and from the piece's closed form in motion (block.piece.point).
+a_g at rest and from the piece's closed form in motion (block.piece.point). A monolithic
+frame's beam joint (its friction factors in the block: block.piece.beam_demand) has its
+own demand, the same way: a_g / g at rest, where every body moves with the ground.
 
 A vertical record makes the weights act as under g + a_v: on a piece the block obeys
 theta'' = p^2 gam (theta - s alpha) + e a_g with gam = (g + a_v) / g taken at the middle
@@ -41,9 +45,11 @@ from rbm_cli.inputs.ground import sine_exceedance
 from rbm_cli.models.block.piece import (
     A_EVALS,
     A_FRICTION,
+    A_FRICTION2,
     A_MU,
     A_PEAK,
     A_SLIP,
+    A_SLIP2,
     A_TAU_PEAK,
     ACC_SIZE,
     B_ALPHA,
@@ -58,6 +64,7 @@ from rbm_cli.models.block.piece import (
     IMPACT,
     NONE,
     PIECE_SIZE,
+    beam_demand,
     point,
     scan_piece,
     start_piece,
@@ -83,9 +90,8 @@ from rbm_cli.models.status import (
     guard_code,
 )
 
-T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG, T_SLIP = range(
-    12
-)
+(T, THETA, RATE, SIDE, AT_REST, PEAK, FRICTION, NEXT_OUT, N_OUT, T_COLLAPSE, N_LOG, T_SLIP,
+ FRICTION2, SLIP_IF) = range(14)  # fmt: skip
 UPLIFTS, IMPACTS, PIECES, EVALS, EVENTS = range(5)
 #: The kinds of the event log's rows (t [s], kind).
 LOG_UPLIFT, LOG_IMPACT, LOG_REST, LOG_COLLAPSE = 1, 2, 3, 4
@@ -151,15 +157,15 @@ def _emit(pc, st, samples, t_stop, dt, rest):
 @jit
 def _held_rest(fc, fv, t1, held, hw):
     """The held demand's samples due up to t1 [s] of the block at rest: a_g / (g + a_v)
-    (0 where no forcing acts). hw: the sample's shear ratios (x, y) and a peak they raise,
-    one value each."""
+    (0 where no forcing acts) at every joint. hw: the sample's shear ratios (x, y) and a
+    peak they raise, rows of one value per joint."""
     while held_time(held) <= t1:
         t_k = held_time(held)
         a = 0.0 if int(fc[0]) == ZERO else f_accel(fc, t_k)
         if fv.size > 0:
             a /= gravity_factor(fc, fv, t_k)
-        hw[0] = a / G
-        held_push(held, hw[0:1], hw[1:2], hw[2:3])
+        hw[0, :] = a / G
+        held_push(held, hw[0], hw[1], hw[2])
 
 
 @jit
@@ -174,7 +180,10 @@ def _rest_friction(st, fc, fv, t0, t1, mu):
         d = f_peak_on(fc, t0, t1) / G
     if d > st[FRICTION]:
         st[FRICTION] = d
+    if d > st[FRICTION2]:  # a monolithic frame's beam joint (unused otherwise)
+        st[FRICTION2] = d
     if math.isnan(st[T_SLIP]) and d > mu:
+        st[SLIP_IF] = 1.0
         if fv.size > 0:
             st[T_SLIP] = vertical_exceedance(fc, fv, t0, mu * G, t1)
         else:
@@ -253,7 +262,7 @@ def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log, h
     cnt[PIECES] += 1
     acc[A_PEAK], acc[A_TAU_PEAK], acc[A_EVALS], acc[A_FRICTION] = 0.0, -1.0, 0.0, st[FRICTION]
     acc[A_MU] = se[6] if math.isnan(st[T_SLIP]) else math.inf
-    acc[A_SLIP] = -1.0
+    acc[A_SLIP], acc[A_FRICTION2], acc[A_SLIP2] = -1.0, st[FRICTION2], -1.0
     kind, tau = scan_piece(pc, blk, seg_end - t, acc)
     cnt[EVALS] += int(acc[A_EVALS])
     stop_here = (
@@ -267,13 +276,18 @@ def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log, h
         _emit(pc, st, samples, t_new, se[5], False)
     while held_time(held) <= t_new:
         _, _, _, _, d_k, _, _ = point(pc, held_time(held) - t)
-        hw[0] = d_k
-        held_push(held, hw[0:1], hw[1:2], hw[2:3])
+        hw[0, 0] = d_k
+        if hw.shape[1] > 1:  # a monolithic frame's beam joint
+            hw[0, 1], _ = beam_demand(pc, held_time(held) - t)
+        held_push(held, hw[0], hw[1], hw[2])
     f, g, _, _, _, _, _ = point(pc, tau_end)
     st[THETA], st[RATE], st[T] = pc[1] * f, pc[1] * g, t_new
     st[PEAK], st[FRICTION] = max(st[PEAK], acc[A_PEAK]), acc[A_FRICTION]
-    if acc[A_SLIP] >= 0.0:
-        st[T_SLIP] = t + acc[A_SLIP]
+    st[FRICTION2] = acc[A_FRICTION2]
+    if acc[A_SLIP] >= 0.0 and not 0.0 <= acc[A_SLIP2] < acc[A_SLIP]:
+        st[T_SLIP], st[SLIP_IF] = t + acc[A_SLIP], 1.0
+    elif acc[A_SLIP2] >= 0.0:
+        st[T_SLIP], st[SLIP_IF] = t + acc[A_SLIP2], 2.0
     if stop_here:
         return STOPPED_EARLY
     if kind == IMPACT or kind == COLLAPSE:
@@ -310,16 +324,18 @@ def _segment(blk, st, cnt, mo, se, fc, fv, seg_end, can_stop, samples, pc, acc, 
 def run_block(blk, seg_t, seg_fc, seg_v, mo, se, theta0, rate0, samples, log, held):
     """One run from (theta0 [rad], rate0 [rad/s]) at t = 0: samples (rows t, theta, rate)
     written when se asks for them, events (rows t [s], kind LOG_*) logged while log has
-    rows, the held friction demand's samples taken into held (models.rbm.pieces.held_array;
-    one with no window takes none). Returns (code, st, cnt)."""
+    rows, the held friction demand's samples taken into held (models.rbm.pieces.held_array,
+    a row per joint: the ground's, and a monolithic frame's beam joint's; one with no window
+    takes none). Returns (code, st, cnt)."""
     side = 1.0 if theta0 > 0.0 else -1.0 if theta0 < 0.0 else (-1.0 if rate0 < 0.0 else 1.0)
     at_rest = 1.0 if theta0 == 0.0 and rate0 == 0.0 else 0.0
     st = np.array([0.0, theta0, rate0, side, at_rest, abs(theta0), 0.0, 0.0, 0.0, math.nan,
-                   0.0, math.nan])  # fmt: skip
+                   0.0, math.nan, 0.0, 0.0])  # fmt: skip
     no_v = np.zeros(0)
     cnt = np.zeros(5, dtype=np.int64)
     pc, acc = np.zeros(PIECE_SIZE), np.zeros(ACC_SIZE)
-    hw = np.zeros(3)  # a held demand's sample (x, y) and the peak it raises (not the block's)
+    # a held demand's sample (x, y) and the peak it raises (not the block's), a value a joint
+    hw = np.zeros((3, held.shape[0] - 1))
     if abs(theta0) >= blk[B_LIMIT]:
         st[T_COLLAPSE] = 0.0
         return COLLAPSED, st, cnt

@@ -208,8 +208,10 @@ def shear_ratios(ag, ag_y, gam, centre_map, acc, acc_y, masses, normal_forces, r
     their absolute horizontal accelerations: the ground's (ag, ag_y) [m/s^2] +
     centre_map @ (acc, acc_y) (acc the drums' theta'' [rad/s^2]; acc_y empty in the
     plane), masses [kg] (a body each); N_i the normal force [N] at rest (normal_forces
-    holds one per joint: body i lies on joint i, and a monolithic frame's beam share lies
-    on its base), gam = (g + a_v) / g [-] (1 without vertical motion)."""
+    holds one per joint whose demand is reported, Model.friction_normals: body i lies on
+    joint i, a frame's beam share on its beam joint, the last, even where a monolith folds
+    that joint's law into the base's), gam = (g + a_v) / g [-] (1 without vertical
+    motion)."""
     n = acc.size
     joints = normal_forces.size
     three = acc_y.size > 0

@@ -70,7 +70,7 @@ class RbmRunner:
         integrator = self._integrators.get(key)
         if integrator is None:
             integrator = self._integrators[key] = self.integrator_of(method)
-        n = self.model.joints
+        n, mf = self.model.joints, self.model.friction_joints
         t_lift = motion.lift_off  # a vertical record dropping faster than gravity
         t_shape = shape_change(self.model, motion)  # or changing the order of a law's pieces
         if t_shape is not None and t_lift is not None:  # the earlier one ends the run
@@ -96,8 +96,8 @@ class RbmRunner:
         except NUMERICAL_FAILURES as exc:
             out = Outcome(status="failed", message=f"numerical failure: {exc}")
             out.max_ratio = np.full(n, np.nan)
-            out.friction = np.full(n, np.nan)
-            out.friction_peak = np.full(n, np.nan)
+            out.friction = np.full(mf, np.nan)
+            out.friction_peak = np.full(mf, np.nan)
         if record:
             out.history = history_from_samples(self.model.node_map, motion, out.samples)
         out.method = out.method or method.name  # exact-first says which of its two ran

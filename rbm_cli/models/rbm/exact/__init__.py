@@ -3,8 +3,11 @@
 Inside one set of active law pieces the column's equations are linear with constant
 coefficients; the integrator decomposes them once per set of pieces (cached) and moves
 every mode in closed form (modal, piece): no time step and no truncation error, only
-rounding. The events are those of the Runge-Kutta integrator (rbm_cli.models.rbm.step,
-same surfaces, same EVENT_EPS, same actions):
+rounding. A column of n drums has n modes and m joints with a law: n, or n + 1 on a frame's
+column (structures.equations.Model.joints; the beam's joint on the top drum, argument
+-theta_n), whose pieces, event rows, impacts, friction demand and collapse ratios are
+those of the m joints, as in the step integrator. The events are those of the Runge-Kutta
+integrator (rbm_cli.models.rbm.step, same surfaces, same EVENT_EPS, same actions):
 
 - a law argument reaching the end of its piece (uplift, kink, impact with restitution;
   the pieces change and a new piece starts there);

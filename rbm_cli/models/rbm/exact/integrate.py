@@ -52,14 +52,16 @@ def prepare_exact(model: Model) -> PreparedExact:
     """The arrays and an empty cache of modes of a model the exact method takes
     (RbmError in one line otherwise)."""
     check_exact(model, "free")
-    return PreparedExact(column_arrays(model), new_cache(model.n))
+    return PreparedExact(column_arrays(model), new_cache(model.n, model.joints))
 
 
-def _outcome(code, st, cnt, maxima, fric, solver, n: int, held: np.ndarray) -> Outcome:
+def _outcome(code, st, cnt, maxima, fric, solver, m: int, held: np.ndarray) -> Outcome:
+    """The Outcome of what run_exact returned (m joints: maxima holds their collapse ratios,
+    then the top's displacement)."""
     out = Outcome()
     out.t_end = float(st[0])
-    out.max_ratio = maxima[:n].copy()
-    out.max_top = float(maxima[n])
+    out.max_ratio = maxima[:m].copy()
+    out.max_top = float(maxima[m])
     out.friction_peak = fric.copy()
     out.friction, out.slip = held_result(held, fric, st[6:8])  # run.T_SLIP, run.SLIP_IF
     out.n_uplifts, out.n_impacts, out.n_steps, out.n_rhs, out.n_events = (int(x) for x in cnt[:5])
@@ -116,11 +118,11 @@ def integrate_exact(
     seg_t, seg_fc = motion_arrays(model, motion)
     if prepared is None:
         prepared = prepare_exact(model)
-    n = model.n
-    solver = solver.for_run(motion.t_end, n)
+    n, m = model.n, model.joints
+    solver = solver.for_run(motion.t_end, m)
     mo, se = run_settings(motion, solver, early_stop, record, output_dt, friction_limit, until_open)
     samples = sample_buffer(motion.t_end, output_dt, record, n)
-    held = held_array(n, float(friction_duration), float(friction_limit))
+    held = held_array(model.friction_joints, float(friction_duration), float(friction_limit))
     armed = arm()  # Ctrl-C reaches the run through poll (rbm_cli.base.guard)
     try:
         run = run_exact if solver.implementation == "compiled" else plain(run_exact)
@@ -133,7 +135,7 @@ def integrate_exact(
         disarm(armed)
     if code == OPENED:
         return None
-    out = _outcome(code, st, cnt, maxima, fric, solver, n, held)
+    out = _outcome(code, st, cnt, maxima, fric, solver, m, held)
     if record:
         out.samples = sample_rows(samples, int(st[5]), n)
     return out

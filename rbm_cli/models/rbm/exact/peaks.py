@@ -30,10 +30,11 @@ Notes = namedtuple("Notes", "t h q v k side seg up count")
 
 
 @jit
-def new_notes(n, cap):
+def new_notes(n, m, cap):
+    """Room for cap notes of a column of n drums (modes) and m joints."""
     return Notes(np.zeros(cap), np.zeros(cap), np.zeros((cap, n)), np.zeros((cap, n)),
-                 np.zeros((cap, n), dtype=np.int64), np.zeros((cap, n), dtype=np.int64),
-                 np.zeros(cap, dtype=np.int64), np.zeros((cap, n + 1)),
+                 np.zeros((cap, m), dtype=np.int64), np.zeros((cap, m), dtype=np.int64),
+                 np.zeros(cap, dtype=np.int64), np.zeros((cap, m + 1)),
                  np.zeros(1, dtype=np.int64))  # fmt: skip
 
 
@@ -64,14 +65,14 @@ def _compact(notes, maxima):
 def may_exceed(pc, pts, maxima, mb, fb, fresh, up):
     """Raise the maxima to the values at points 0 and 1; up gets the upper bounds of the
     tracked quantities between them. Returns whether one may exceed its maximum there."""
-    n, of, nf = pc.n, 1 + 2 * pc.n, pc.nf
-    for i in range(n + 1):
-        maxima[i] = max(maxima[i], abs(pts[0, of + n + i]), abs(pts[1, of + n + i]))
+    n, m, of, nf = pc.n, pc.m, 1 + 2 * pc.n, pc.nf
+    for i in range(m + 1):
+        maxima[i] = max(maxima[i], abs(pts[0, of + m + i]), abs(pts[1, of + m + i]))
     fast = bounds_of(pc, pts, 0, 1, mb, fb) if not fresh else _any_fast(mb, n)
     h = pts[1, 0] - pts[0, 0]
     above = False
-    for i in range(n + 1):
-        kk = n + i
+    for i in range(m + 1):
+        kk = m + i
         up[i] = track_upper(kk, pts[0, of + kk], pts[1, of + kk], pts[0, of + nf + kk],
                             pts[1, of + nf + kk], fb, fast, h)  # fmt: skip
         above = above or not up[i] <= maxima[i]
@@ -114,12 +115,11 @@ def settle_peaks(mdl, cache, notes, seg_fc, maxima, wk):
     count = notes.count[0]
     if count == 0:
         return 0
-    n = notes.q.shape[1]
     excess = np.empty(count)
     for i in range(count):
         excess[i] = _excess(notes, i, maxima)
     evals = 0
-    none = np.zeros(n, dtype=np.bool_)
+    none = np.zeros(notes.k.shape[1], dtype=np.bool_)  # one per joint
     for i in np.argsort(-excess):
         if not _excess(notes, i, maxima) > 0.0:
             continue

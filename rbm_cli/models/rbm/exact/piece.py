@@ -8,16 +8,20 @@ possibly indefinite or singular), M-orthonormal: Phi^T M Phi = I, so q = Phi^T M
 They depend only on the slopes of the active pieces, so they are cached by the pieces'
 indices across the runs of one column (modes, in the cache new_cache makes), with what
 follows from them alone (the family rows gf = Gf Phi and |gf|); the intercepts (which side)
-only move the constant load f. A piece reads its modes in the cache, not a copy: it lives
+only move the constant load f. A column of n drums has m joints with a law: n, or n + 1
+with a frame's beam joint (structures.equations.Model.joints), so n modes and m sets of
+pieces. A piece reads its modes in the cache, not a copy: it lives
 until the next piece is made, and only making a piece can change the cache.
 
 Every event surface and every tracked peak quantity is linear in theta, so in modal
 coordinates a row is d(t) = G q(t) + h0 (event distances, >= 0 inside the piece) or
 z(t) = T q(t) (peaks). A point of a piece is a row of a pool array: [t, q (n), v (n),
-F (nf), F' (nf), F'' (nf)], F = Gf q the family values (nf = 2n + 1: law arguments over
-theta_u, collapse ratios, top displacement). An event row r is sgn[r] * F[fam[r]] + off[r],
-in the order: lower law bounds, upper law bounds, collapse on either side, then the silent
-zero crossings of the interfaces awaiting one.
+F (nf), F' (nf), F'' (nf)], F = Gf q the family values (nf = 2m + 1: the m law arguments
+over their scale, structures.equations.event_families, the m collapse ratios, the top
+displacement; the tracked ones, whose peaks are kept, are the families m and above). An
+event row r is sgn[r] * F[fam[r]] + off[r], in the order: lower law bounds, upper law
+bounds, collapse on either side (m each), then the silent zero crossings of the joints
+awaiting one.
 """
 
 from __future__ import annotations
@@ -32,11 +36,12 @@ from rbm_cli.models.rbm.pieces import bound_rows
 
 #: A linear piece: modes (lam, phi, tom = Phi^T M), modal loads f, g, the eligible modes
 #: and their frequencies w (exact.bounds), family rows gf = Gf Phi and |gf|, event rows
-#: (sgn, off, fam), the interfaces awaiting a silent crossing, the forcing fc.
+#: (sgn, off, fam), the joints awaiting a silent crossing, the forcing fc; n modes (the
+#: drums), m joints, nf = 2m + 1 families.
 #: The pool slot root finding works in.
 SCRATCH_SLOT = 2
 
-Piece = namedtuple("Piece", "lam phi tom f g elig w gf absgf sgn off fam silent fc n nf")
+Piece = namedtuple("Piece", "lam phi tom f g elig w gf absgf sgn off fam silent fc n m nf")
 
 
 # ------------------------------------------------------------------ modes (cached)
@@ -47,7 +52,7 @@ def _slot(keys, used, k):
     cap = used.size
     hsh = 17
     for x in k:
-        hsh = (hsh * 1000003 + x + 1) & 0x3FFFFFFFFFFF  # stays well inside int64
+        hsh = (hsh * 1000003 + x + 1) & 0xFFFFFFFFFF  # < 2^40: its product < 2^60
     i = hsh % cap
     while used[i]:
         same = True
@@ -61,16 +66,17 @@ def _slot(keys, used, k):
     return i
 
 
-def new_cache(n: int) -> tuple:
-    """An empty cache of modes for n interfaces (exact.piece.modes): a power-of-two
-    table of at most 8192 sets of pieces and 64 MB."""
-    nf = 2 * n + 1
-    per_set = 8 * (n * (2 * n + 3) + 2 * nf * n)  # bytes: keys, lam, phi, tom, g, gf, |gf|
+def new_cache(n: int, m: int | None = None) -> tuple:
+    """An empty cache of modes for n drums and m joints (n if None; exact.piece.modes): a
+    power-of-two table of at most 8192 sets of pieces and 64 MB."""
+    m = n if m is None else m
+    nf = 2 * m + 1
+    per_set = 8 * (m + n * (2 * n + 2) + 2 * nf * n)  # bytes: keys, lam, phi, tom, g, gf, |gf|
     cap = 64
     while cap * 2 <= min(8192, (64 << 20) // per_set):
         cap *= 2
     return (
-        np.zeros((cap, n), dtype=np.int64), np.zeros(cap, dtype=np.bool_), np.zeros((cap, n)),
+        np.zeros((cap, m), dtype=np.int64), np.zeros(cap, dtype=np.bool_), np.zeros((cap, n)),
         np.zeros((cap, n, n)), np.zeros((cap, n, n)), np.zeros((cap, n)),
         np.zeros(1, dtype=np.int64), np.zeros((cap, nf, n)), np.zeros((cap, nf, n)),
     )  # fmt: skip
@@ -78,9 +84,9 @@ def new_cache(n: int) -> tuple:
 
 @jit
 def modes(mdl, cache, k):
-    """Slot of the cache holding the modes of the pieces k (computed when absent: the
-    pencil (K, M) through the Cholesky factor M = L L^T, eigh of L^-1 K L^-T) and their
-    family rows."""
+    """Slot of the cache holding the modes of the pieces k (m joints; computed when absent:
+    the pencil (K, M), K = D^T diag(slopes) P - K_g, through the Cholesky factor M = L L^T,
+    eigh of L^-1 K L^-T) and their family rows."""
     keys, used, lam_s, phi_s, tom_s, g_s, count, gf_s, absgf_s = cache
     if count[0] >= (used.size * 3) // 4:  # full: start again
         used[:] = False
@@ -88,9 +94,9 @@ def modes(mdl, cache, k):
     i = _slot(keys, used, k)
     if used[i]:
         return i
-    n = k.size
-    slopes = np.empty(n)
-    for j in range(n):
+    m = k.size  # the joints
+    slopes = np.empty(m)
+    for j in range(m):
         slopes[j] = mdl.slopes[j, k[j]]
     stiff = mdl.diff_t @ (slopes[:, None] * mdl.argmap) - mdl.gravity
     stiff = 0.5 * (stiff + stiff.T)
@@ -114,38 +120,39 @@ def modes(mdl, cache, k):
 # ------------------------------------------------------------------ a piece
 @jit
 def _rows(mdl, side, k, pending, awaiting):
-    """(sgn, off, fam, silent) of the event rows of the current pieces."""
-    n = side.size
+    """(sgn, off, fam, silent) of the event rows of the current pieces (m joints)."""
+    m = side.size
     ns = 0
-    for i in range(n):
+    for i in range(m):
         ns += awaiting[i]
-    m = 4 * n + ns
-    sgn, off, fam = np.empty(m), np.empty(m), np.empty(m, dtype=np.int64)
+    rows = 4 * m + ns
+    sgn, off, fam = np.empty(rows), np.empty(rows), np.empty(rows, dtype=np.int64)
     silent = np.empty(ns, dtype=np.int64)
     bound_rows(side, k, pending, mdl.rigid, mdl.edges, mdl.nedges, mdl.tu, mdl.c_ratio,
-               np.empty(n), np.empty(n), off)  # fmt: skip
-    for i in range(n):
+               np.empty(m), np.empty(m), off)  # fmt: skip
+    for i in range(m):
         sgn[i], fam[i] = 1.0, i
-        sgn[n + i], fam[n + i] = -1.0, i
-        sgn[2 * n + i], fam[2 * n + i] = -1.0, n + i
-        sgn[3 * n + i], fam[3 * n + i] = 1.0, n + i
+        sgn[m + i], fam[m + i] = -1.0, i
+        sgn[2 * m + i], fam[2 * m + i] = -1.0, m + i
+        sgn[3 * m + i], fam[3 * m + i] = 1.0, m + i
     j = 0
-    for i in range(n):
+    for i in range(m):
         if awaiting[i]:
             silent[j] = i
-            sgn[4 * n + j], off[4 * n + j], fam[4 * n + j] = float(side[i]), 0.0, i
+            sgn[4 * m + j], off[4 * m + j], fam[4 * m + j] = float(side[i]), 0.0, i
             j += 1
     return sgn, off, fam, silent
 
 
 @jit
 def make_piece(mdl, cache, side, k, pending, awaiting, fc):
-    """The linear piece of the current law pieces under the forcing fc."""
-    n = side.size
+    """The linear piece of the current law pieces (side, k, ...: one per joint) under the
+    forcing fc."""
+    m = side.size  # the joints
     slot = modes(mdl, cache, k)
     lam, phi, tom, g = cache[2][slot], cache[3][slot], cache[4][slot], cache[5][slot]
-    a = np.empty(n)
-    for i in range(n):
+    a = np.empty(m)
+    for i in range(m):
         a[i] = side[i] * mdl.intercepts[i, k[i]]
     f = -(phi.T @ (mdl.diff_t @ a))
     elig = lam > 0.0
@@ -154,18 +161,19 @@ def make_piece(mdl, cache, side, k, pending, awaiting, fc):
     w = np.sqrt(np.where(elig, lam, 1.0))
     sgn, off, fam, silent = _rows(mdl, side, k, pending, awaiting)
     return Piece(lam, phi, tom, f, g, elig, w, cache[7][slot], cache[8][slot], sgn, off, fam,
-                 silent, fc, n, 2 * n + 1)  # fmt: skip
+                 silent, fc, lam.size, m, 2 * m + 1)  # fmt: skip
 
 
-def point_size(n: int) -> int:
-    """Length of a point row for n modes."""
-    return 1 + 2 * n + 3 * (2 * n + 1)
+def point_size(n: int, m: int | None = None) -> int:
+    """Length of a point row for n modes and m joints (n if None)."""
+    m = n if m is None else m
+    return 1 + 2 * n + 3 * (2 * m + 1)
 
 
 @jit(borrow=True)
 def _derived(pc, pts, i):
     """Family values and rates of point i from its (t, q, v), and the second derivatives
-    of the tracked families (the peaks' rows, n and above)."""
+    of the tracked families (the peaks' rows, m and above)."""
     n, nf = pc.n, pc.nf
     of = 1 + 2 * n
     for r in range(nf):
@@ -176,7 +184,7 @@ def _derived(pc, pts, i):
         pts[i, of + r] = fv
         pts[i, of + nf + r] = dv
     ag = f_accel(pc.fc, pts[i, 0])
-    for r in range(n, nf):
+    for r in range(pc.m, nf):
         ff = 0.0
         for j in range(n):  # the modal acceleration q''_j, as eval_family forms it
             ff += pc.gf[r, j] * (-pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag)

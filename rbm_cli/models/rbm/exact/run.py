@@ -147,7 +147,7 @@ def _passed_peak(mdl, pc, pts):
     ratio with less energy than the collapse barrier."""
     if math.isnan(mdl.barrier):
         return False
-    k = 1 + 2 * pc.n + pc.n  # collapse ratio of interface 1
+    k = 1 + 2 * pc.n + pc.m  # collapse ratio of interface 1
     dk = k + pc.nf
     if not pts[0, k] * pts[0, dk] > 0.0:
         return False
@@ -231,10 +231,11 @@ def _march(mdl, pc, wk, s, se, seg_end, can_stop, sure_stop, samples):
 @jit
 def _handle(mdl, pc, row, s, se):
     """Apply the event of a row at the state. Returns a code (OPENED, the state left as it
-    is, when the run stops at a joint's first event: se[7])."""
-    n = s.theta.size
-    if row >= 4 * n:
-        silent_impact(pc.silent[row - 4 * n], s.side, s.awaiting)
+    is, when the run stops at a joint's first event: se[7]). The rows are the m joints'
+    (exact.piece), a frame's beam joint the last."""
+    m = s.side.size
+    if row >= 4 * m:
+        silent_impact(pc.silent[row - 4 * m], s.side, s.awaiting)
         s.cnt[IMPACTS] += 1
         return GOING
     if se[7] != 0.0:
@@ -242,7 +243,7 @@ def _handle(mdl, pc, row, s, se):
     s.cnt[EVENTS] += 1
     if s.cnt[EVENTS] > se[1]:
         return FAILED_EVENTS
-    which, i = row // n, row % n
+    which, i = row // m, row % m
     if which >= 2:
         s.st[T_COLLAPSE] = s.st[T]
         s.cnt[COLLAPSE_IF] = i + 1
@@ -271,15 +272,19 @@ def _handle(mdl, pc, row, s, se):
 @jit
 def _rest_friction(s, fc, t0, t1, mu):
     """The friction demand of a monolith at rest on [t0, t1] [s]: |a_g| / g (T = m a_g,
-    N = m g); where it first exceeds mu, the time |a_g| reaches mu g."""
+    N = m g), at every joint it is reported for (a monolithic frame's beam joint too); where
+    it first exceeds mu, the time |a_g| reaches mu g."""
     d = f_peak_on(fc, t0, t1) / G
-    if d > s.fric[0]:
-        s.fric[0] = d
+    for i in range(s.fric.size):
+        if d > s.fric[i]:
+            s.fric[i] = d
     if s.st[SLIP_IF] == 0.0 and d > mu:
         s.st[T_SLIP] = f_exceedance(fc, t0, mu * G, t1)
         s.st[SLIP_IF] = 1.0
     while held_time(s.held) <= t1:
-        s.rx[0] = f_accel(fc, held_time(s.held)) / G
+        r = f_accel(fc, held_time(s.held)) / G
+        for i in range(s.rx.size):
+            s.rx[i] = r
         held_push(s.held, s.rx, s.ry, s.fric)
 
 
@@ -342,29 +347,33 @@ def _segment(mdl, cache, wk, s, mo, se, fc, seg_end, can_stop, sure_stop, sample
 
 @jit
 def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, stack, held):
-    """One run (exact.integrate.integrate_exact); held: the held friction demand
-    (pieces.held_array), changed in place. Returns (code, st, cnt, maxima, friction: its
-    peak)."""
+    """One run (exact.integrate.integrate_exact) of a column of n drums (theta0, rate0)
+    and m joints (mdl.argmap's rows: n, or n + 1 with a frame's beam joint); held: the held
+    friction demand (pieces.held_array), changed in place. Returns (code, st, cnt, maxima:
+    the m joints' collapse ratios and the top's displacement, friction: its peak at the
+    joints it is reported for, mdl.normal_forces')."""
     n = theta0.size
-    side = np.ones(n, dtype=np.int64)
-    k = np.zeros(n, dtype=np.int64)
-    pending = np.zeros(n, dtype=np.bool_)
-    awaiting = np.zeros(n, dtype=np.bool_)
+    m = mdl.argmap.shape[0]
+    mf = mdl.normal_forces.size
+    side = np.ones(m, dtype=np.int64)
+    k = np.zeros(m, dtype=np.int64)
+    pending = np.zeros(m, dtype=np.bool_)
+    awaiting = np.zeros(m, dtype=np.bool_)
     theta, rate = theta0.copy(), rate0.copy()
     locate(mdl.argmap @ theta, mdl.argmap @ rate, side, k, pending, mdl.rigid, mdl.edges,
            mdl.nedges)  # fmt: skip
     st = np.array([0.0, FIRST_STEP, 0.0, math.nan, 0.0, 0.0, math.nan, 0.0])
     if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
         st[AT_REST] = 1.0
-    s = State(theta, rate, side, k, pending, awaiting, np.zeros(n + 1), np.zeros(n), st,
-              np.zeros(8, dtype=np.int64), held, np.zeros(n), np.zeros(n), np.zeros(n),
+    s = State(theta, rate, side, k, pending, awaiting, np.zeros(m + 1), np.zeros(mf), st,
+              np.zeros(8, dtype=np.int64), held, np.zeros(mf), np.zeros(mf), np.zeros(n),
               np.zeros(n))  # fmt: skip
-    nf = 2 * n + 1
+    nf = 2 * m + 1
     wk = Work(np.zeros((pool, 1 + 2 * n + 3 * nf)), np.zeros((9, n)), np.zeros((8, nf)),
               np.zeros(pool, dtype=np.int64), np.zeros(pool - 3, dtype=np.int64),
               np.zeros((stack, 2), dtype=np.int64),
-              np.zeros((stack, n + 1), dtype=np.bool_), new_notes(n, NOTES),
-              np.zeros(n + 1))  # fmt: skip
+              np.zeros((stack, m + 1), dtype=np.bool_), new_notes(n, m, NOTES),
+              np.zeros(m + 1))  # fmt: skip
     code = GOING
     for i in range(seg_t.shape[0]):
         if s.st[T] >= seg_t[i, 1]:

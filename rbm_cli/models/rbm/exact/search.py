@@ -239,18 +239,18 @@ def _split_point(pc, pts, a, b, rows, c):
     """Make point c where [a, b] is split for the rows still open: the root of the first
     open row whose rate changes sign (its rate and those of the rows stationary there set
     to 0), else the midpoint. Returns the evaluations."""
-    n, of, nf = pc.n, 1 + 2 * pc.n, pc.nf
+    m, of, nf = pc.m, 1 + 2 * pc.n, pc.nf
     h = pts[b, 0] - pts[a, 0]
-    for i in range(n + 1):
-        k = n + i
+    for i in range(m + 1):
+        k = m + i
         if rows[i] and pts[a, of + nf + k] * pts[b, of + nf + k] < 0.0:
             tau, evals = _newton(pc, pts, a, h, pts[a, of + nf + k], pts[b, of + nf + k], k, 1,
                                  math.nan)  # fmt: skip
             if not STATIONARY_GAP * h < tau < (1.0 - STATIONARY_GAP) * h:
                 tau = 0.5 * h
             eval_point(pc, pts, a, tau, c)
-            for j in range(n + 1):
-                kj = n + j
+            for j in range(m + 1):
+                kj = m + j
                 gap = STATIONARY_GAP * (abs(pts[a, of + nf + kj]) + abs(pts[b, of + nf + kj]))
                 if abs(pts[c, of + nf + kj]) <= gap:
                     pts[c, of + nf + kj] = 0.0
@@ -262,12 +262,12 @@ def _split_point(pc, pts, a, b, rows, c):
 
 @jit
 def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
-    """Narrow rows (bool, n + 1) to those whose peak may still exceed its running maximum
-    on [a, b] (module docstring); returns whether any is left. fresh: mb and fb
-    hold the bounds of [a, b] already."""
-    n, of, nf = pc.n, 1 + 2 * pc.n, pc.nf
-    for i in range(n + 1):
-        maxima[i] = max(maxima[i], abs(pts[a, of + n + i]), abs(pts[b, of + n + i]))
+    """Narrow rows (bool, m + 1: the joints' collapse ratios, the top) to those whose peak
+    may still exceed its running maximum on [a, b] (module docstring); returns whether any
+    is left. fresh: mb and fb hold the bounds of [a, b] already."""
+    n, m, of, nf = pc.n, pc.m, 1 + 2 * pc.n, pc.nf
+    for i in range(m + 1):
+        maxima[i] = max(maxima[i], abs(pts[a, of + m + i]), abs(pts[b, of + m + i]))
     h = pts[b, 0] - pts[a, 0]
     if fresh:
         fast = False
@@ -276,8 +276,8 @@ def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
     else:
         fast = bounds_of(pc, pts, a, b, mb, fb)
     left = False
-    for i in range(n + 1):
-        k = n + i
+    for i in range(m + 1):
+        k = m + i
         if rows[i]:
             up = track_upper(k, pts[a, of + k], pts[b, of + k], pts[a, of + nf + k],
                              pts[b, of + nf + k], fb, fast, h)  # fmt: skip
@@ -286,9 +286,9 @@ def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
     if not left or h <= MIN_STEP * max(1.0, abs(pts[a, 0])):
         return False
     left = False
-    for i in range(n + 1):
+    for i in range(m + 1):
         if rows[i]:
-            k = n + i
+            k = m + i
             slack = PEAK_RTOL * maxima[i] / h
             rows[i] = not _monotone(pts, a, b, k, of, nf, fb[2, k], slack, h)
             left = left or rows[i]
@@ -297,11 +297,11 @@ def _open_rows(pc, pts, a, b, maxima, rows, mb, fb, fresh):
 
 @jit
 def refine_peaks(pc, pts, maxima, mb, fb, refs, free, st_ab, st_rows, fresh):
-    """Raise the running maxima (n + 1) to the peaks between points 0 and 1 (module
+    """Raise the running maxima (m + 1) to the peaks between points 0 and 1 (module
     docstring). refs, free: reference counts and free list of the pool's slots; st_ab,
     st_rows: the stack; fresh: mb and fb hold the bounds of [0, 1]. Returns the
     evaluations."""
-    n, of = pc.n, 1 + 2 * pc.n
+    m, of = pc.m, 1 + 2 * pc.n
     n_free = free.size
     for i in range(free.size):
         free[i] = pts.shape[0] - 1 - i
@@ -320,8 +320,8 @@ def refine_peaks(pc, pts, maxima, mb, fb, refs, free, st_ab, st_rows, fresh):
             n_free -= 1
             c = free[n_free]
             evals += _split_point(pc, pts, a, b, rows, c)
-            for i in range(n + 1):
-                maxima[i] = max(maxima[i], abs(pts[c, of + n + i]))
+            for i in range(m + 1):
+                maxima[i] = max(maxima[i], abs(pts[c, of + m + i]))
             st_ab[top, 0], st_ab[top, 1] = c, b
             st_rows[top, :] = rows
             st_ab[top + 1, 0], st_ab[top + 1, 1] = a, c

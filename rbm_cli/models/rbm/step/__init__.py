@@ -106,7 +106,7 @@ def integrate(
     samples = sample_buffer(motion.t_end, output_dt, record, n)
     deadline = time.monotonic() + float(solver.max_wall_time)
     settings = solver_settings(solver, prepared.atol_scale, deadline)
-    held = held_array(model.joints, float(friction_duration), float(friction_limit))
+    held = held_array(model.friction_joints, float(friction_duration), float(friction_limit))
     # a RunTask, as a plain tuple (step.inputs)
     task = (np.asarray(theta0, dtype=float), np.asarray(rate0, dtype=float),
             stop_level(early_stop, solver),

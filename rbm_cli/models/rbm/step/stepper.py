@@ -95,7 +95,9 @@ def rest_until(t, seg_end, last, uplift_level, amplitude, gr_full, knots, values
                y, side, k):  # fmt: skip
     """A rigid monolith at rest from t [s] in a forced segment (to seg_end [s]): its friction
     demand at rest (inputs.ground.rest_demand, exact; the held demand's samples; where it
-    first exceeds mu), its samples, and where it lifts (no later than last [s]).
+    first exceeds mu), the same at every joint it is reported for (a monolithic frame's
+    beam joint too: every body moves with the ground), its samples, and where it lifts (no
+    later than last [s]).
 
     Returns
     -------
@@ -105,10 +107,13 @@ def rest_until(t, seg_end, last, uplift_level, amplitude, gr_full, knots, values
     t_up = next_uplift(t, uplift_level, amplitude, gr_full, knots, values, vertical, last)
     t_rest = seg_end if t_up < 0.0 or t_up >= seg_end else t_up
     d_rest = rest_demand(t, t_rest, gr_full, knots, values, vertical)
-    if d_rest > friction[0]:
-        friction[0] = d_rest
+    for i in range(friction.size):
+        if d_rest > friction[i]:
+            friction[i] = d_rest
     while held_time(held) <= t_rest:
-        rx[0] = rest_shear(held_time(held), gr_full, knots, values, vertical)
+        r = rest_shear(held_time(held), gr_full, knots, values, vertical)
+        for i in range(rx.size):
+            rx[i] = r
         held_push(held, rx, ry, friction)
     if slip[1] == 0.0 and d_rest > mu:
         slip[0] = next_uplift(t, mu * G, amplitude, gr_full, knots, values, vertical, t_rest)
@@ -160,9 +165,10 @@ def plane_record(model, motion, task, n, vert):
     column_into(W, model)
     motion_into(W, motion)
     m = model.argmap.shape[0]
+    mf = model.normal_forces.size  # the joints whose friction demand is reported
     # max_ratio, friction, slip, swept (none), the energy account (run_kernel's Returns), the
     # top's peak
-    W.max_ratio, W.friction, W.slip = np.zeros(m), np.zeros(m), np.array([np.nan, 0.0])
+    W.max_ratio, W.friction, W.slip = np.zeros(m), np.zeros(mf), np.array([np.nan, 0.0])
     W.swept, W.ledger, W.top = np.zeros(0), np.zeros(5), np.zeros(1)
     nrow, nt, nv = 4 * m, m + 1, 2 * m if vert else 0
     W.side, W.k = np.ones(m, dtype=np.int64), np.zeros(m, dtype=np.int64)
@@ -189,7 +195,7 @@ def plane_record(model, motion, task, n, vert):
         np.empty(nrow),
     )
     W.acc, W.acc_old, W.acc_k = np.empty(n), np.empty(n), np.empty(n)
-    W.rx, W.ry, W.between, W.ends = np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(2)
+    W.rx, W.ry, W.between, W.ends = np.zeros(mf), np.zeros(mf), np.zeros(mf), np.zeros(2)
     W.samples, W.held, W.record = task.samples, task.held, task.record
     W.output_dt, W.mu, W.vert = task.output_dt, task.friction_limit, vert
     W.any_silent = model.silent.any()

@@ -146,9 +146,9 @@ ANCHORS = [
     (EXACT_RUN, "            code = _handle(mdl, pc, row, s, se)\n",
      "            c0 = cycles()\n            code = _handle(mdl, pc, row, s, se)\n"
      "            s.cnt[12] += cycles() - c0\n"),
-    (EXACT_RUN, "              np.zeros(8, dtype=np.int64), held, np.zeros(mf), np.zeros(mf),"
-     " np.zeros(n),\n              np.zeros(n))  # fmt: skip\n",
-     "              np.zeros(14, dtype=np.int64), held, np.zeros(mf), np.zeros(mf), np.zeros(n),\n"
+    (EXACT_RUN, "              np.zeros(8, dtype=np.int64), held, np.zeros(mf), np.zeros(mf),\n"
+     "              np.zeros(n))  # fmt: skip\n",
+     "              np.zeros(14, dtype=np.int64), held, np.zeros(mf), np.zeros(mf),\n"
      "              np.zeros(n))  # fmt: skip\n    c_all = cycles()\n"),
     (EXACT_RUN, "        ev = settle_peaks(mdl, cache, wk.notes, seg_fc, s.maxima, wk)\n",
      "        c0 = cycles()\n"

@@ -52,7 +52,9 @@ def prepare_exact(model: Model) -> PreparedExact:
     """The arrays and an empty cache of modes of a model the exact method takes
     (RbmError in one line otherwise)."""
     check_exact(model, "free")
-    return PreparedExact(column_arrays(model), new_cache(model.n, model.joints))
+    arrays = column_arrays(model)
+    bodies = arrays.centre_map.shape[0]
+    return PreparedExact(arrays, new_cache(model.n, model.joints, bodies))
 
 
 def _outcome(code, st, cnt, maxima, fric, solver, m: int, held: np.ndarray) -> Outcome:

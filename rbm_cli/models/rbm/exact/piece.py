@@ -37,11 +37,12 @@ from rbm_cli.models.rbm.pieces import bound_rows
 #: A linear piece: modes (lam, phi, tom = Phi^T M), modal loads f, g, the eligible modes
 #: and their frequencies w (exact.bounds), family rows gf = Gf Phi and |gf|, event rows
 #: (sgn, off, fam), the joints awaiting a silent crossing, the forcing fc; n modes (the
-#: drums), m joints, nf = 2m + 1 families.
+#: drums), m joints, nf = 2m + 1 families; cphi = centre_map Phi, the bodies' horizontal
+#: accelerations per modal acceleration (the friction demand's).
 #: The pool slot root finding works in.
 SCRATCH_SLOT = 2
 
-Piece = namedtuple("Piece", "lam phi tom f g elig w gf absgf sgn off fam silent fc n m nf")
+Piece = namedtuple("Piece", "lam phi tom f g elig w gf absgf sgn off fam silent fc n m nf cphi")
 
 
 # ------------------------------------------------------------------ modes (cached)
@@ -66,12 +67,15 @@ def _slot(keys, used, k):
     return i
 
 
-def new_cache(n: int, m: int | None = None) -> tuple:
-    """An empty cache of modes for n drums and m joints (n if None; exact.piece.modes): a
-    power-of-two table of at most 8192 sets of pieces and 64 MB."""
+def new_cache(n: int, m: int | None = None, bodies: int | None = None) -> tuple:
+    """An empty cache of modes for n drums, m joints and the bodies whose accelerations the
+    friction demand sums (n each if None; exact.piece.modes): a power-of-two table of at
+    most 8192 sets of pieces and 64 MB."""
     m = n if m is None else m
+    bodies = n if bodies is None else bodies
     nf = 2 * m + 1
-    per_set = 8 * (m + n * (2 * n + 2) + 2 * nf * n)  # bytes: keys, lam, phi, tom, g, gf, |gf|
+    # bytes: keys, lam, phi, tom, g, gf, |gf|, the bodies' map
+    per_set = 8 * (m + n * (2 * n + 2) + 2 * nf * n + bodies * n)
     cap = 64
     while cap * 2 <= min(8192, (64 << 20) // per_set):
         cap *= 2
@@ -79,6 +83,7 @@ def new_cache(n: int, m: int | None = None) -> tuple:
         np.zeros((cap, m), dtype=np.int64), np.zeros(cap, dtype=np.bool_), np.zeros((cap, n)),
         np.zeros((cap, n, n)), np.zeros((cap, n, n)), np.zeros((cap, n)),
         np.zeros(1, dtype=np.int64), np.zeros((cap, nf, n)), np.zeros((cap, nf, n)),
+        np.zeros((cap, bodies, n)),
     )  # fmt: skip
 
 
@@ -86,8 +91,9 @@ def new_cache(n: int, m: int | None = None) -> tuple:
 def modes(mdl, cache, k):
     """Slot of the cache holding the modes of the pieces k (m joints; computed when absent:
     the pencil (K, M), K = D^T diag(slopes) P - K_g, through the Cholesky factor M = L L^T,
-    eigh of L^-1 K L^-T) and their family rows."""
-    keys, used, lam_s, phi_s, tom_s, g_s, count, gf_s, absgf_s = cache
+    eigh of L^-1 K L^-T), their family rows and the bodies' accelerations per mode
+    (centre_map Phi: the friction demand's)."""
+    keys, used, lam_s, phi_s, tom_s, g_s, count, gf_s, absgf_s, cphi_s = cache
     if count[0] >= (used.size * 3) // 4:  # full: start again
         used[:] = False
         count[0] = 0
@@ -114,6 +120,7 @@ def modes(mdl, cache, k):
     gf = mdl.families @ phi
     gf_s[i, :, :] = gf
     absgf_s[i, :, :] = np.abs(gf)
+    cphi_s[i, :, :] = mdl.centre_map @ phi
     return i
 
 
@@ -161,7 +168,7 @@ def make_piece(mdl, cache, side, k, pending, awaiting, fc):
     w = np.sqrt(np.where(elig, lam, 1.0))
     sgn, off, fam, silent = _rows(mdl, side, k, pending, awaiting)
     return Piece(lam, phi, tom, f, g, elig, w, cache[7][slot], cache[8][slot], sgn, off, fam,
-                 silent, fc, lam.size, m, 2 * m + 1)  # fmt: skip
+                 silent, fc, lam.size, m, 2 * m + 1, cache[9][slot])  # fmt: skip
 
 
 def point_size(n: int, m: int | None = None) -> int:

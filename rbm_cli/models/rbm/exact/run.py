@@ -87,7 +87,7 @@ Work = namedtuple("Work", "pts mb fb refs free st_ab st_rows notes up")
 #: the tracked quantities, friction demand (its peak; the held demand, pieces.held_array,
 #: and the shear ratios of a sample).
 State = namedtuple(
-    "State", "theta rate side k pending awaiting maxima fric st cnt held rx ry modal_acc acc"
+    "State", "theta rate side k pending awaiting maxima fric st cnt held rx ry modal_acc"
 )
 
 
@@ -116,21 +116,21 @@ def _emit_rest(s, samples, t_stop, dt):
         s.st[NEXT_OUT] += dt
 
 
-@jit
+@jit(borrow=True)
 def _accel_and_friction(mdl, pc, pts, i, s):
     """The shear ratios (s.rx) of the state at point i (at its time pts[i, 0]); the peak
-    s.fric raised to them."""
+    s.fric raised to them. The bodies' accelerations are (centre_map Phi) q'', the modal
+    accelerations q'' mapped by the piece's cphi."""
     n = pc.n
     from_modes = s.modal_acc
     ag = f_accel(pc.fc, pts[i, 0])
     for j in range(n):
         from_modes[j] = -pc.lam[j] * pts[i, 1 + j] + pc.f[j] + pc.g[j] * ag
-    np.dot(pc.phi, from_modes, s.acc)
-    shear_ratios(ag, 0.0, 1.0, mdl.centre_map, s.acc, s.ry[:0], mdl.masses,
+    shear_ratios(ag, 0.0, 1.0, pc.cphi, from_modes, s.ry[:0], mdl.masses,
                  mdl.normal_forces, s.rx, s.ry, s.fric)  # fmt: skip
 
 
-@jit
+@jit(borrow=True)
 def _held_samples(mdl, pc, pts, s):
     """The held demand's samples due up to point 1, from the piece's closed form at point 0."""
     while held_time(s.held) <= pts[1, 0]:
@@ -366,7 +366,7 @@ def run_exact(mdl, cache, seg_t, seg_fc, mo, se, theta0, rate0, samples, pool, s
     if mdl.rigid_mono and not (np.any(theta != 0.0) or np.any(rate != 0.0)):
         st[AT_REST] = 1.0
     s = State(theta, rate, side, k, pending, awaiting, np.zeros(m + 1), np.zeros(mf), st,
-              np.zeros(8, dtype=np.int64), held, np.zeros(mf), np.zeros(mf), np.zeros(n),
+              np.zeros(8, dtype=np.int64), held, np.zeros(mf), np.zeros(mf),
               np.zeros(n))  # fmt: skip
     nf = 2 * m + 1
     wk = Work(np.zeros((pool, 1 + 2 * n + 3 * nf)), np.zeros((9, n)), np.zeros((8, nf)),

@@ -30,6 +30,7 @@ from rbm_cli.inputs.records import Record, write_at2
 from rbm_cli.models.registry import make_runner
 from rbm_cli.study.simulate import simulate
 
+from .converged import assert_agrees, converged
 from .paths import CONFIGS
 
 pytestmark = pytest.mark.timeout(900)
@@ -62,39 +63,15 @@ def _runs(drums, excitation, cells, interface=None):
     return out
 
 
-def _close(x, y, rel):
-    return (np.isnan(x) and np.isnan(y)) or abs(x - y) <= rel * abs(y)
-
-
-def _converged(k11, k12) -> bool:
-    return (
-        k11.status == k12.status
-        and (k11.n_uplifts, k11.n_impacts) == (k12.n_uplifts, k12.n_impacts)
-        and all(_close(getattr(k11, a), getattr(k12, a), 1e-9) for a in _COMPARED)
-    )
-
-
-_COMPARED = ("max_rotation_ratio", "max_top_displacement_m", "t_collapse_s")
-
-
 def _check(drums, excitation, cells, interface=None) -> int:
     """Compare exact with the step kernel on the converged cells; returns how many."""
     k11, k12, exact = _runs(drums, excitation, cells, interface)
     count = 0
     for cell, a, b, e in zip(cells, k11, k12, exact, strict=True):
-        if _converged(a, b):
-            _assert_same(b, e, cell)
+        if converged(a, b):
+            assert_agrees(b, e, cell)
             count += 1
     return count
-
-
-def _assert_same(step, exact, cell):
-    assert exact.status == step.status, cell
-    if "stopped early" not in (step.message + exact.message):
-        assert (exact.n_uplifts, exact.n_impacts) == (step.n_uplifts, step.n_impacts), cell
-    for name in _COMPARED:
-        x, y = getattr(exact, name), getattr(step, name)
-        assert _close(x, y, 1e-8), (cell, name, x, y)
 
 
 @pytest.mark.parametrize("kind", ["one-sine", "cycloidal"])

@@ -44,7 +44,7 @@ from rbm_cli.models.rbm.exact.modal import HARMONIC, LINEAR, f_phase
 #: q1 [rad/s], c1, c2 [rad], alpha [rad], p_g [rad/s]; the ground acceleration on it,
 #: a_g(t0 + tau) = A sin(omega tau + phi0) + g0 + g1 tau (A [m/s^2], g0 [m/s^2],
 #: g1 [m/s^3]); the friction factors fa [s^2/m], fb [1/rad] of the ground joint and fa2,
-#: fb2 of a monolithic frame's beam joint (0: none).
+#: fb2 of a monolithic frame's beam joint (0: none; a joint's pair is FA + 2 row, FB + 2 row).
 T0, SIDE, AMP, OM, PHI, Q0, Q1, C1, C2, ALPHA, P, GA, G0, G1, FA, FB, FA2, FB2 = range(18)
 PIECE_SIZE = 18
 #: The block: p [rad/s], alpha [rad], e [rad/s^2 per m/s^2], collapse limit [rad],
@@ -134,27 +134,25 @@ def point(pc, tau):
 
 
 @jit
-def beam_demand(pc, tau):
-    """The friction demand of a monolithic frame's beam joint at t0 + tau, its signed value
-    fa2 a_g + fb2 (theta - s alpha) [-] (the beam share's shear ratio) and its rate [1/s]."""
+def joint_demand(pc, tau, row):
+    """The friction demand of a joint (row 0: the ground's, :func:`point`'s; 1: a monolithic
+    frame's beam joint, the beam share's shear ratio) at t0 + tau: its signed value
+    fa a_g + fb (theta - s alpha) [-] with the row's factors, and its rate [1/s]."""
     _, _, _, dev, rate, ag, ag_rate = _motion(pc, tau)
-    return pc[FA2] * ag + pc[FB2] * dev, pc[FA2] * ag_rate + pc[FB2] * rate
+    fa, fb = pc[FA + 2 * row], pc[FB + 2 * row]
+    return fa * ag + fb * dev, fa * ag_rate + fb * rate
 
 
 @jit
 def _value(pc, which, shift, tau):
-    """s theta + shift (which 0), s theta' (which 1), the friction demand's rate
-    (which 2) or the friction demand + shift (which 3) at t0 + tau; the beam joint's
-    demand's rate (which 4) or demand + shift (which 5)."""
-    if which >= 4:
-        d, dr = beam_demand(pc, tau)
-        return d + shift if which == 5 else dr
-    f, g, _, _, d, dr, _ = point(pc, tau)
-    if which == 0:
-        return f + shift
-    if which == 3:
-        return d + shift
-    return g if which == 1 else dr
+    """s theta + shift (which 0), s theta' (which 1) at t0 + tau, or a joint's friction
+    demand's rate (which 2 + 2 row) or demand + shift (which 3 + 2 row; row 0 the ground
+    joint's, 1 a monolithic frame's beam joint's)."""
+    if which >= 2:
+        d, dr = joint_demand(pc, tau, (which - 2) // 2)
+        return d + shift if which % 2 == 1 else dr
+    f, g, _, _, _, _, _ = point(pc, tau)
+    return f + shift if which == 0 else g
 
 
 @jit
@@ -263,10 +261,7 @@ def _friction(pc, a, b, da, db, dra, drb, acc, row):
     tm, dm = -1.0, 0.0
     if dra * drb < 0.0:
         tm = brent(pc, 2 + 2 * row, 0.0, a, b, acc)
-        if row == 0:
-            _, _, _, _, dm, _, _ = point(pc, tm)
-        else:
-            dm, _ = beam_demand(pc, tm)
+        dm, _ = joint_demand(pc, tm, row)
         acc[A_EVALS] += 1
         best = max(best, abs(dm))
     if best > acc[A_MU] and acc[sl] < 0.0:
@@ -288,7 +283,7 @@ def scan_piece(pc, blk, tau_max, acc):
     beam = pc[FA2] != 0.0 or pc[FB2] != 0.0  # a monolithic frame's beam joint
     a = 0.0
     fa, ga, _, e2a, da, dra, f2a = point(pc, 0.0)
-    ba, bra = beam_demand(pc, 0.0) if beam else (0.0, 0.0)
+    ba, bra = joint_demand(pc, 0.0, 1) if beam else (0.0, 0.0)
     acc[A_EVALS] += 1
     if fa > acc[A_PEAK]:
         acc[A_PEAK] = fa
@@ -297,7 +292,7 @@ def scan_piece(pc, blk, tau_max, acc):
     while a < tau_max:
         b = min(a + h, tau_max)
         fb, gb, e1b, e2b, db, drb, f2b = point(pc, b)
-        bb, brb = beam_demand(pc, b) if beam else (0.0, 0.0)
+        bb, brb = joint_demand(pc, b, 1) if beam else (0.0, 0.0)
         acc[A_EVALS] += 1
         w = b - a
         m3 = m3_sine + p3 * (abs(e1b) + abs(e2a))  # bound of the third derivative on [a, b]
@@ -316,10 +311,10 @@ def scan_piece(pc, blk, tau_max, acc):
             acc[A_PEAK] = max(acc[A_PEAK], fb)
         if kind != NONE:
             if friction:
-                _, _, _, _, db, drb, _ = point(pc, tau)
+                db, drb = joint_demand(pc, tau, 0)
                 _friction(pc, a, tau, da, db, dra, drb, acc, 0)
             if beam:
-                bb, brb = beam_demand(pc, tau)
+                bb, brb = joint_demand(pc, tau, 1)
                 _friction(pc, a, tau, ba, bb, bra, brb, acc, 1)
             return kind, tau
         if friction:

@@ -22,7 +22,7 @@ and so is its first exceedance of the limit (the exceedance of |a_g| at rest, Br
 piece's demand in motion): its peak. The demand held for a duration
 (models.rbm.pieces.held_push, the step and exact integrators' too) takes its samples from
 a_g at rest and from the piece's closed form in motion (block.piece.point). A monolithic
-frame's beam joint (its friction factors in the block: block.piece.beam_demand) has its
+frame's beam joint (its friction factors in the block: block.piece.joint_demand) has its
 own demand, the same way: a_g / g at rest, where every body moves with the ground.
 
 A vertical record makes the weights act as under g + a_v: on a piece the block obeys
@@ -64,7 +64,7 @@ from rbm_cli.models.block.piece import (
     IMPACT,
     NONE,
     PIECE_SIZE,
-    beam_demand,
+    joint_demand,
     point,
     scan_piece,
     start_piece,
@@ -275,10 +275,8 @@ def _piece(blk, st, cnt, fc, fv, seg_end, can_stop, se, samples, pc, acc, log, h
     if se[4] != 0.0:
         _emit(pc, st, samples, t_new, se[5], False)
     while held_time(held) <= t_new:
-        _, _, _, _, d_k, _, _ = point(pc, held_time(held) - t)
-        hw[0, 0] = d_k
-        if hw.shape[1] > 1:  # a monolithic frame's beam joint
-            hw[0, 1], _ = beam_demand(pc, held_time(held) - t)
+        for row in range(hw.shape[1]):  # the ground joint, a monolithic frame's beam joint
+            hw[0, row], _ = joint_demand(pc, held_time(held) - t, row)
         held_push(held, hw[0], hw[1], hw[2])
     f, g, _, _, _, _, _ = point(pc, tau_end)
     st[THETA], st[RATE], st[T] = pc[1] * f, pc[1] * g, t_new

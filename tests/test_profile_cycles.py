@@ -44,3 +44,16 @@ def test_a_changed_run_loop_stops_the_script_in_one_line(tmp_path, monkeypatch):
         assert message.startswith("profile_cycles: ") and "\n" not in message
     else:
         raise AssertionError("a missing anchor was not refused")
+
+
+def test_drum_counts_that_are_not_counts_are_refused_in_one_line(monkeypatch):
+    script = _script()
+    for args in (["--drums"], ["--drums", "0"], ["--drums", "8", "x"], ["--columns", "8"]):
+        monkeypatch.setattr(script.sys, "argv", ["profile_cycles.py", *args])
+        try:
+            script.main()
+        except SystemExit as exc:
+            message = str(exc.code)
+            assert message.startswith("profile_cycles: usage") and "\n" not in message
+        else:
+            raise AssertionError(f"{args} was not refused")

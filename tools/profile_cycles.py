@@ -2,6 +2,7 @@
 per part of the run loop, per event (docs/performance.md, "Record suites: inside an event").
 
     python tools/profile_cycles.py           # the 40 runs, both integrators: ~5 min
+    python tools/profile_cycles.py --drums 8 16   # one record run a column, ~4 min
 
 The compiled code cannot be profiled by Python's profilers, and the uncompiled code spends
 its time elsewhere. So this script copies the package to a temporary folder, adds a read of
@@ -11,7 +12,9 @@ functions, models.rbm.step.stepper) and of the exact integrator (models.rbm.exac
 compiles that copy (its own numba cache: two compiles, about 3 min) and runs the 40 runs of
 `configs/ci/suite_multidrum_ci.yaml` with each method, one at a time in one process, after
 one run that compiles. It prints, for each part, the cycles it took per event of the runs
-and its share of the runs' cycles.
+and its share of the runs' cycles. With --drums N ..., it runs instead the band's column cut
+into N drums (each N in turn) under its first record at 0.2 g with the step kernel: how an
+event's parts grow with the drums.
 The package itself is not changed. The counters cost a few percent: the shares, not the
 totals, are the result. Say the load.
 
@@ -176,29 +179,33 @@ def instrumented(source: Path, target: Path) -> None:
         (target / f).write_text(text)
 
 
-def _child(method: str) -> None:
-    """Run the 40 runs with the method (in the instrumented copy: the counters print)."""
+def _child(method: str, drums: int) -> None:
+    """Run the 40 runs with the method, or (drums > 0) the band's first record at 0.2 g on
+    its column in that many drums (in the instrumented copy: the counters print)."""
     import dataclasses
 
     sys.path.insert(0, str(ROOT / "tools"))
     from profile_records import CONFIG, points
 
+    from rbm_cli.api import with_value
     from rbm_cli.config.load import load_config
     from rbm_cli.inputs.excitation import make_ground_motion
     from rbm_cli.models.registry import make_runner
 
     config = load_config(CONFIG)
+    cells = [(cfg, a) for _, cfg in points(config) for a in config.grid.amplitudes_g]
+    if drums > 0:
+        cells = [(with_value(cells[0][0], "column.drums", drums), 0.2)]
     first = True
-    for _, cfg in points(config):
+    for cfg, a in cells:
         cfg = dataclasses.replace(cfg, solver=dataclasses.replace(cfg.solver, method=method))
         runner = make_runner(cfg)
-        for a in config.grid.amplitudes_g:
-            motion = make_ground_motion(cfg.excitation, a)
-            if first:  # compiles; its counters are left out
-                runner.run(motion, cfg.solver)
-                print("COMPILED", flush=True)
-                first = False
+        motion = make_ground_motion(cfg.excitation, a)
+        if first:  # compiles; its counters are left out
             runner.run(motion, cfg.solver)
+            print("COMPILED", flush=True)
+            first = False
+        runner.run(motion, cfg.solver)
 
 
 def _table(lines: list[str], parts: list[str]) -> None:
@@ -216,20 +223,27 @@ def _table(lines: list[str], parts: list[str]) -> None:
 
 
 def main() -> None:
-    if len(sys.argv) == 3 and sys.argv[1] == "--child":
-        _child(sys.argv[2])
+    if len(sys.argv) == 4 and sys.argv[1] == "--child":
+        _child(sys.argv[2], int(sys.argv[3]))
         return
+    jobs = [("DOP853", STEP_PARTS, 0), ("exact", EXACT_PARTS, 0)]
+    if len(sys.argv) > 1:
+        counts = sys.argv[2:]
+        usable = all(a.isdigit() and int(a) > 0 for a in counts)
+        if sys.argv[1] != "--drums" or not counts or not usable:
+            sys.exit("profile_cycles: usage: profile_cycles.py [--drums N [N ...]]")
+        jobs = [("DOP853", STEP_PARTS, int(a)) for a in counts]
     with tempfile.TemporaryDirectory(prefix="rbm-cycles-") as tmp:
         instrumented(ROOT, Path(tmp))
         env = dict(os.environ, PYTHONPATH=tmp, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
-        for method, parts in (("DOP853", STEP_PARTS), ("exact", EXACT_PARTS)):
-            done = subprocess.run([sys.executable, __file__, "--child", method], env=env,
-                                  capture_output=True, text=True, check=False)  # fmt: skip
+        for method, parts, drums in jobs:
+            done = subprocess.run([sys.executable, __file__, "--child", method, str(drums)],
+                                  env=env, capture_output=True, text=True, check=False)  # fmt: skip
             if done.returncode != 0:
                 sys.exit(f"profile_cycles: the {method} runs failed: "
                          f"{(done.stderr.strip().splitlines() or ['?'])[-1]}")  # fmt: skip
             out = done.stdout.split("COMPILED", 1)[1].splitlines()
-            print(f"\n{method}:")
+            print(f"\n{method}" + (f", {drums} drums:" if drums else ":"))
             _table([line for line in out if line.startswith("CYCLES")], parts)
 
 

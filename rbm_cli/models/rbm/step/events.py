@@ -33,30 +33,32 @@ def row_poly(mc, F, y_old, event_rows, row, h0, n, rate, coef):
     h0[row] (or, rate, the rate event_rows[row] theta') as a polynomial in the step's
     fraction, with dense_eval's form. Fills coef, returns the constant term;
     poly_val evaluates it (a few flops instead of the whole state's interpolant)."""
-    row_coef(mc, F, event_rows, row, n, rate, coef)
-    return row_base(y_old, event_rows, row, 1.0, 0.0 if rate else h0[row], n, rate)
+    row_coef(mc, F, event_rows, row, 0, n, n, rate, coef)
+    return row_base(y_old, event_rows, row, 1.0, 0.0 if rate else h0[row], 0, n, n, rate)
 
 
 @jit(inline=True)
-def row_coef(mc, F, rows, row, n, rate, coef):
+def row_coef(mc, F, rows, row, lo, hi, n, rate, coef):
     """The interpolant's coefficients of rows[row] theta (or theta', rate) into coef
-    (row_poly without the constant term)."""
+    (row_poly without the constant term), over the row's columns lo..hi - 1 (the rest
+    zeros: a sum from 0.0 is the same without them, to the bit)."""
     off = n if rate else 0
     for q in range(TAB_NP[mc]):
         v = 0.0
-        for j in range(n):
+        for j in range(lo, hi):
             v += rows[row, j] * F[q, off + j]
         coef[q] = v
 
 
 @jit(inline=True)
-def row_base(y_old, rows, row, sign, start, n, rate):
+def row_base(y_old, rows, row, sign, start, lo, hi, n, rate):
     """The constant term of the row sign * rows[row] (row_poly): start (a distance's offset,
-    0 for a rate) plus the row at the step's start. sign is +-1: the negated row's terms
-    are the same products, negated, added in the same order."""
+    0 for a rate) plus the row at the step's start, over its columns lo..hi - 1 (row_coef).
+    sign is +-1: the negated row's terms are the same products, negated, added in the same
+    order."""
     off = n if rate else 0
     base = start
-    for j in range(n):
+    for j in range(lo, hi):
         base += (sign * rows[row, j]) * y_old[off + j]
     return base
 
@@ -195,8 +197,8 @@ def within_reach(d0, d1, r0, r1, a0, a1, dt, mask):
 
 
 @jit(borrow=True)
-def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1, rcol0, rcol1,
-                    mask, CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
+def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, spans, h0, n, D, R, dcol0, dcol1, rcol0,
+                   rcol1, mask, CP, BP, CR, BR, gr, mv_e, mv_w):  # fmt: skip
     """events.first_crossing on the step's dense output, over the rows in `mask`:
     (t, row) of the earliest crossing of any event surface in [t0, t1], or (-1, -1).
 
@@ -218,6 +220,7 @@ def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1
     for b in range(m if same else 2 * m):
         i = b % m
         rows = gx if b < m else gc
+        lo, hi = (spans[0, i], spans[1, i]) if b < m else (spans[2, i], spans[3, i])
         # the rows built on rows[i], with their signs: the first is where its interpolant is
         # projected; the collapse pair too when same (-1: none)
         p = i if b < m else 3 * m + i
@@ -228,16 +231,16 @@ def first_crossing(mc, t0, t1, y_old, F, gx, gc, same, h0, n, D, R, dcol0, dcol1
             used = used or (r >= 0 and mask[r])
         if not used:
             continue
-        row_coef(mc, F, rows, i, n, False, CP[p])
-        row_coef(mc, F, rows, i, n, True, CR[p])
+        row_coef(mc, F, rows, i, lo, hi, n, False, CP[p])
+        row_coef(mc, F, rows, i, lo, hi, n, True, CR[p])
         for r, sign in signed:
             if r < 0 or not mask[r]:
                 continue
             if r != p:
                 for c in range(nq):
                     CP[r, c], CR[r, c] = sign * CP[p, c], sign * CR[p, c]
-            BP[r] = row_base(y_old, rows, i, sign, h0[r], n, False)
-            BR[r] = row_base(y_old, rows, i, sign, 0.0, n, True)
+            BP[r] = row_base(y_old, rows, i, sign, h0[r], lo, hi, n, False)
+            BR[r] = row_base(y_old, rows, i, sign, 0.0, lo, hi, n, True)
         for q in range(nseg + 1):
             tq = t0 + h * q / nseg if q < nseg else t1
             x = (tq - t0) / h
@@ -311,39 +314,47 @@ def system(side, k, intercepts, slopes, parts, vert, md, mg, argmap, damp, As, c
             As[p, n + q] = 0.0
             if damped:
                 As[p, 2 * n + q] = 0.0
+    # joint by joint, as the sums above say; within a joint, only the drums its argument
+    # reads (argmap's nonzero columns, two in a column of drums): the work grows as the
+    # drums squared, not cubed, and each entry takes the same terms in the same order
     for i in range(side.size):
         a = side[i] * intercepts[i, k[i]]
         b = parts[0, i, k[i]] if vert else slopes[i, k[i]]
         be = parts[1, i, k[i]] if vert else 0.0
         ci = damp[i] if damped and k[i] == 0 else 0.0
         for p in range(n):
-            w = md[p, i]
-            if w == 0.0:
+            if md[p, i] != 0.0:
+                cs[p] -= md[p, i] * a
+        for q in range(n):
+            g = argmap[i, q]
+            if g == 0.0:
                 continue
-            cs[p] -= w * a
-            for q in range(n):
-                if argmap[i, q] != 0.0:
-                    As[p, q] -= w * b * argmap[i, q]
-                    if be != 0.0:
-                        As[p, n + q] -= w * be * argmap[i, q]
-                    if ci != 0.0:
-                        As[p, 2 * n + q] -= w * ci * argmap[i, q]
+            for p in range(n):
+                w = md[p, i]
+                if w == 0.0:
+                    continue
+                As[p, q] -= w * b * g
+                if be != 0.0:
+                    As[p, n + q] -= w * be * g
+                if ci != 0.0:
+                    As[p, 2 * n + q] -= w * ci * g
 
 
 @jit
-def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
+def _event_rows(gx, gc, same, spans, v, off, h0, with_h0, out):
     """The event rows event_rows v[off:off + n] (+ h0) of the kernel (m joints, n drums),
     from their two distinct blocks: event_rows = [gx; -gx; -gc; gc] (gx = argmap / theta_u,
-    gc the normalised collapse map; `same` when gc == gx, as for `relative`)."""
+    gc the normalised collapse map; `same` when gc == gx, as for `relative`), each row
+    over its nonzero columns (spans: row_spans)."""
     n = gx.shape[0]  # the joints (the rows' blocks); the drums: gx.shape[1]
     for i in range(n):
         a = 0.0
-        for j in range(gx.shape[1]):
+        for j in range(spans[0, i], spans[1, i]):
             a += gx[i, j] * v[off + j]
         c = a
         if not same:
             c = 0.0
-            for j in range(gx.shape[1]):
+            for j in range(spans[2, i], spans[3, i]):
                 c += gc[i, j] * v[off + j]
         if with_h0:
             out[i], out[n + i] = a + h0[i], h0[n + i] - a
@@ -353,13 +364,31 @@ def _event_rows(gx, gc, same, v, off, h0, with_h0, out):
 
 
 @jit(borrow=True)
-def surfaces(gx, gc, same, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
+def surfaces(gx, gc, same, spans, y, acc, h0, d, dd, d2, t, gr, mv_e, mv_w):
     """The event distances d, rates dd and second derivatives d2 at the state y (time t [s])
     with accelerations acc; with a vertical record (mv_e not empty) the moving kinks'
     parts added (step.vertical)."""
     n = gx.shape[1]  # the drums: the rates' offset in y
-    _event_rows(gx, gc, same, y, 0, h0, True, d)
-    _event_rows(gx, gc, same, y, n, h0, False, dd)
-    _event_rows(gx, gc, same, acc, 0, h0, False, d2)
+    _event_rows(gx, gc, same, spans, y, 0, h0, True, d)
+    _event_rows(gx, gc, same, spans, y, n, h0, False, dd)
+    _event_rows(gx, gc, same, spans, acc, 0, h0, False, d2)
     if mv_e.size > 0:
         add_moving(t, gr, mv_e, mv_w, d, dd, d2)
+
+
+@jit
+def row_spans(gx, gc, spans):
+    """Each event row's nonzero columns, first and last + 1, into spans (4, m): gx's rows,
+    then gc's (0, 0 for a row of zeros). A joint's argument reads the drums next to it
+    (two columns of a column of drums), so the rows cost the same for any number of drums;
+    the zeros left out change no sum (each starts from 0.0)."""
+    for b in range(2):
+        rows = gx if b == 0 else gc
+        for i in range(rows.shape[0]):
+            lo, hi = 0, 0
+            for j in range(rows.shape[1]):
+                if rows[i, j] != 0.0:
+                    if hi == 0:
+                        lo = j
+                    hi = j + 1
+            spans[2 * b, i], spans[2 * b + 1, i] = lo, hi

@@ -39,6 +39,7 @@ from rbm_cli.models.rbm.step.events import (
     first_crossing,
     poly_val,
     row_poly,
+    row_spans,
     surfaces,
     system,
     within_reach,
@@ -186,6 +187,8 @@ def plane_record(model, motion, task, n, vert):
     W.d_old, W.d_new, W.dd_old = np.empty(nrow), np.empty(nrow), np.empty(nrow)
     W.dd_new, W.d2_old, W.d2_new = np.empty(nrow), np.empty(nrow), np.empty(nrow)
     W.near = np.zeros(nrow, dtype=np.bool_)
+    W.spans = np.empty((4, m), dtype=np.int64)
+    row_spans(W.gx, W.gc, W.spans)
     W.Dq, W.Rq = np.empty((nrow, CHECK_INTERVALS + 1)), np.empty((nrow, CHECK_INTERVALS + 1))
     W.dc0, W.dc1, W.rc0, W.rc1 = np.empty(nrow), np.empty(nrow), np.empty(nrow), np.empty(nrow)
     W.CP, W.BP, W.CR, W.BR = (
@@ -311,7 +314,7 @@ def restart(W, t, seg_end, seg_gain, h_carry, gr, mc, rtol, atol):
     affine(W.track, W.y, 0, W.no_offset, W.z_old)
     affine(W.track, W.y, n, W.no_offset, W.dz_old)
     acc_of(t, W.y, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
-    surfaces(W.gx, W.gc, W.same, W.y, W.acc, W.h0, W.d_old, W.dd_old, W.d2_old, t, gr,
+    surfaces(W.gx, W.gc, W.same, W.spans, W.y, W.acc, W.h0, W.d_old, W.dd_old, W.d2_old, t, gr,
              W.mv_e, W.mv_w)  # fmt: skip
     return h_abs, calls, gr
 
@@ -331,7 +334,7 @@ def find_event(W, mc, t_old, t_new, h, gr):
     n = W.y.size // 2
     copy_into(W.acc_old, W.acc)
     W.ends[0], W.ends[1] = acc_of(t_new, W.y_new, n, W.sys_A, W.sys_c, W.sys_e, gr, W.acc)
-    surfaces(W.gx, W.gc, W.same, W.y_new, W.acc, W.h0, W.d_new, W.dd_new, W.d2_new,
+    surfaces(W.gx, W.gc, W.same, W.spans, W.y_new, W.acc, W.h0, W.d_new, W.dd_new, W.d2_new,
              t_new, gr, W.mv_e, W.mv_w)  # fmt: skip
     if not within_reach(W.d_old, W.d_new, W.dd_old, W.dd_new, W.d2_old, W.d2_new, t_new - t_old,
                         W.near):  # fmt: skip
@@ -339,7 +342,7 @@ def find_event(W, mc, t_old, t_new, h, gr):
     calls = dense_prepare(
         mc, t_old, h, W.y, W.y_new, W.K, W.F, W.tmp, n, W.sys_A, W.sys_c, W.sys_e, gr
     )
-    t_e, row = first_crossing(mc, t_old, t_new, W.y, W.F, W.gx, W.gc, W.same, W.h0, n,
+    t_e, row = first_crossing(mc, t_old, t_new, W.y, W.F, W.gx, W.gc, W.same, W.spans, W.h0, n,
                               W.Dq, W.Rq, W.dc0, W.dc1, W.rc0, W.rc1, W.near, W.CP, W.BP, W.CR,
                               W.BR, gr, W.mv_e, W.mv_w)  # fmt: skip
     return t_e, row, True, calls

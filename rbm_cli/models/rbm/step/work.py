@@ -14,12 +14,13 @@ from rbm_cli.structures.arrays import COLUMN_FIELDS
 #: (step.vertical); the step's figures over the n + 1 tracked rows (their peaks, a
 #: polynomial's coefficients, zero offsets and none, the rows and their rates at the step's
 #: two ends and before it); the event location's (step.events: the rows' distances and their
-#: first and second rates at a step's two ends, the rows near a crossing, first_crossing's
-#: own); the friction demand's (theta'' at a step's end, at its start and at a sample of the
-#: held demand, the shear ratios there and their peak between step ends) and the ground at
-#: the step's end (ends: gravity's factor and the horizontal acceleration); and the run's
-#: task (its samples and held demand, in place; whether it records, the sampling interval
-#: [s], the friction limit [-]) and kind (a vertical record, silent impacts).
+#: first and second rates at a step's two ends, the rows near a crossing, each row's nonzero
+#: columns, first_crossing's own); the friction demand's (theta'' at a step's end, at its
+#: start and at a sample of the held demand, the shear ratios there and their peak between
+#: step ends) and the ground at the step's end (ends: gravity's factor and the horizontal
+#: acceleration); and the run's task (its samples and held demand, in place; whether it
+#: records, the sampling interval [s], the friction limit [-]) and kind (a vertical record,
+#: silent impacts).
 PLANE_WORK_FIELDS = [
     ("side", "int64[::1]"), ("k", "int64[::1]"), ("pending", "bool[::1]"),
     ("awaiting", "bool[::1]"), ("lo", "float64[::1]"), ("hi", "float64[::1]"),
@@ -29,8 +30,9 @@ PLANE_WORK_FIELDS = [
     ("z_prev", "float64[::1]"), ("dz_old", "float64[::1]"), ("dz_new", "float64[::1]"),
     ("dz_prev", "float64[::1]"), ("d_old", "float64[::1]"), ("d_new", "float64[::1]"),
     ("dd_old", "float64[::1]"), ("dd_new", "float64[::1]"), ("d2_old", "float64[::1]"),
-    ("d2_new", "float64[::1]"), ("near", "bool[::1]"), ("Dq", "float64[:, ::1]"),
-    ("Rq", "float64[:, ::1]"), ("dc0", "float64[::1]"), ("dc1", "float64[::1]"),
+    ("d2_new", "float64[::1]"), ("near", "bool[::1]"), ("spans", "int64[:, ::1]"),
+    ("Dq", "float64[:, ::1]"), ("Rq", "float64[:, ::1]"), ("dc0", "float64[::1]"),
+    ("dc1", "float64[::1]"),
     ("rc0", "float64[::1]"), ("rc1", "float64[::1]"), ("CP", "float64[:, ::1]"),
     ("BP", "float64[::1]"), ("CR", "float64[:, ::1]"), ("BR", "float64[::1]"),
     ("acc", "float64[::1]"), ("acc_old", "float64[::1]"), ("acc_k", "float64[::1]"),

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import rbm
-from rbm_cli.models.rbm.step.events import _event_rows, row_base, row_coef, row_spans
+from rbm_cli.models.rbm.step.events import row_base, row_coef, row_spans, surfaces
 from rbm_cli.structures.arrays import column_arrays
 from rbm_cli.study.simulate import model_from_config
 
@@ -26,8 +26,13 @@ def _column(drums, formulation="relative", frame=None):
     cfg = {
         "name": "spans",
         "model": "rbm",
-        "column": {"height": 5.0, "base_width": 0.96, "top_width": 0.66, "density": 2700,
-                   "drums": drums},  # fmt: skip
+        "column": {
+            "height": 5.0,
+            "base_width": 0.96,
+            "top_width": 0.66,
+            "density": 2700,
+            "drums": drums,
+        },  # fmt: skip
         "interface": {"stiffness": {"normal": 5e9}, "formulation": formulation},
         "excitation": {"type": "harmonic"},
     }
@@ -73,26 +78,28 @@ def test_a_columns_rows_read_two_drums_whatever_its_height(drums):
     ],
 )
 def test_rows_over_their_spans_are_whole_rows_to_the_bit(drums, formulation, frame):
-    """The event rows (with and without offsets), a row's interpolant coefficients and its
-    constant term over the spans equal numpy's whole-row products and the same functions
-    over whole rows, bit for bit, on random states (columns and frames, the three
-    formulations)."""
+    """The event distances, rates and second derivatives (surfaces), a row's interpolant
+    coefficients and its constant term over the spans are the same functions' over whole
+    rows, bit for bit, and numpy's products, on random states (columns and frames, the
+    three formulations)."""
     col = _column(drums, formulation, frame)
     gx, gc = col.gx, col.gc
     m, n = gx.shape
     spans = _spans(gx, gc)
     whole = np.array([[0] * m, [n] * m, [0] * m, [n] * m], dtype=np.int64)
     rng = np.random.default_rng(11)
+    none, ground = np.empty(0), np.zeros(8)
     for _ in range(20):
-        v = rng.normal(size=2 * n) * 10.0 ** rng.uniform(-6, 0)
+        y = rng.normal(size=2 * n) * 10.0 ** rng.uniform(-6, 0)
+        acc = rng.normal(size=n)
         h0 = rng.normal(size=4 * m)
-        for off, with_h0 in ((0, True), (n, False)):
-            a, b = np.empty(4 * m), np.empty(4 * m)
-            _event_rows(gx, gc, col.same, spans, v, off, h0, with_h0, a)
-            _event_rows(gx, gc, col.same, whole, v, off, h0, with_h0, b)
+        got = [np.empty(4 * m) for _ in range(6)]
+        surfaces(gx, gc, col.same, spans, y, acc, h0, *got[:3], 0.0, ground, none, none)
+        surfaces(gx, gc, col.same, whole, y, acc, h0, *got[3:], 0.0, ground, none, none)
+        for a, b in zip(got[:3], got[3:], strict=True):
             assert np.array_equal(a, b)
-            x = gx @ v[off : off + n]
-            assert np.allclose(a[:m], x + h0[:m] if with_h0 else x, rtol=1e-14, atol=0.0)
+        for d, v, offset in ((got[0], y[:n], h0[:m]), (got[1], y[n:], 0.0), (got[2], acc, 0.0)):
+            assert np.allclose(d[:m], gx @ v + offset, rtol=1e-13, atol=1e-300)
         F = rng.normal(size=(7, 2 * n))
         for b, rows in enumerate((gx, gc)):
             for i in range(m):
@@ -104,6 +111,6 @@ def test_rows_over_their_spans_are_whole_rows_to_the_bit(drums, formulation, fra
                     assert np.array_equal(c1, c2)
                     for sign in (1.0, -1.0):
                         start = 0.0 if rate else h0[i]
-                        assert row_base(v, rows, i, sign, start, lo, hi, n, rate) == row_base(
-                            v, rows, i, sign, start, 0, n, n, rate
+                        assert row_base(y, rows, i, sign, start, lo, hi, n, rate) == row_base(
+                            y, rows, i, sign, start, 0, n, n, rate
                         )

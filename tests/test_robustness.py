@@ -547,6 +547,18 @@ def half():  # a constructor interrupted: its finalizer fails once the object is
         raise
 
 
+class Named:
+    def __set_name__(self, owner, name):
+        ready()
+        time.sleep(30)
+
+
+@group.command()
+def named():  # the Ctrl-C lands in a class's __set_name__, as a dataclass's fields are built
+    class Built:
+        field = Named()
+
+
 class Slow:
     def __del__(self):
         ready()
@@ -572,6 +584,7 @@ main([mode])
         ("generated", "Error: interrupted (Ctrl-C)"),
         ("cleanup", "Error: interrupted: 3 of 9 cells are kept; resume with: rbm x"),
         ("half", "Error: interrupted (Ctrl-C)"),
+        ("named", "Error: interrupted (Ctrl-C)"),
         ("swallowed", "Error: interrupted (Ctrl-C)"),
     ],
 )
@@ -580,8 +593,10 @@ def test_case07_ctrl_c_where_a_command_meets_it_by_chance(tmp_path, mode, line):
     imports, a KeyboardInterrupt traceback (and SIGINT's -2); in code built by exec,
     `python -m` ended by SIGINT (-2) after saying its line; a second Ctrl-C during the
     stop replaced the line that says what is kept by a bare 'interrupted'; the finalizer of
-    an object the Ctrl-C left half-built printed a traceback; a Ctrl-C that a finalizer
-    swallowed let the command go on. Each: exit 130 and the one line."""
+    an object the Ctrl-C left half-built printed a traceback; a Ctrl-C inside a class's
+    __set_name__ (a dataclass built during the imports) ended in a RuntimeError traceback,
+    exit 1; a Ctrl-C that a finalizer swallowed let the command go on. Each: exit 130 and
+    the one line."""
     (tmp_path / "rbm_harness").mkdir()
     (tmp_path / "rbm_harness" / "__main__.py").write_text(HARNESS)
     proc = subprocess.Popen(

@@ -16,11 +16,12 @@ stop ends and says its line (how many cells a sweep kept, how to resume it); non
 changes the exit status once it is known. A compiled loop takes the handler over while it
 runs (rbm_cli.base.guard) and calls it when it returns. After a Ctrl-C, the errors of
 finalizers of objects it left half-built are not reported, and one a finalizer swallowed
-is sent again. CPython remembers a KeyboardInterrupt that ended an exec or eval of a
-string (numba, dataclasses and namedtuple build code so) even when it was caught, and
-``python -m rbm_cli`` then ended by SIGINT instead of its exit status: main() clears that
-before it ends. Only a Ctrl-C during Python's own start, before main() runs, ends the
-process otherwise.
+is sent again; an error a Ctrl-C caused (Python turns one inside a class's __set_name__
+into a RuntimeError) is said as the Ctrl-C. CPython remembers a KeyboardInterrupt that
+ended an exec or eval of a string (numba, dataclasses and namedtuple build code so) even
+when it was caught, and ``python -m rbm_cli`` then ended by SIGINT instead of its exit
+status: main() clears that before it ends. Only a Ctrl-C during Python's own start,
+before main() runs, ends the process otherwise.
 """
 
 from __future__ import annotations
@@ -121,6 +122,10 @@ def main(argv: list[str] | None = None) -> None:
         status = _run(commands(), argv)
     except KeyboardInterrupt:  # in the imports, or in click's own parsing or exit
         status = _interrupted()
+    except Exception as exc:
+        if not _from_ctrl_c(exc):
+            raise
+        status = _interrupted()
     finally:
         _ending[0] = True
         gc.freeze()
@@ -144,6 +149,19 @@ def _run(group, argv: list[str] | None):
         return exc.exit_code
     # the commands return None; an int is click's Exit (--help, --version): its status
     return returned if isinstance(returned, int) else 0
+
+
+def _from_ctrl_c(exc: BaseException) -> bool:
+    """Whether an error stands for a Ctrl-C: a KeyboardInterrupt is in its chain of causes.
+    Python 3.11 turns one raised inside a class's __set_name__ (a dataclass's fields,
+    built while the command imports) into a RuntimeError caused by it."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _interrupted() -> int:

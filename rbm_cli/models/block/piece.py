@@ -119,18 +119,43 @@ def _motion(pc, tau):
     return e1, e2, sn, dev, rate, ag, ag_rate
 
 
+@jit(inline=True)
+def _demand(pc, row, dev, rate, ag, ag_rate):
+    """A joint's friction demand from the motion at an instant (_motion's dev, rate, a_g,
+    a_g'): fa a_g + fb (theta - s alpha) [-] with the row's factors (row 0 the ground
+    joint's, 1 a monolithic frame's beam joint's; 0 without factors) and its rate [1/s]."""
+    fa, fb = pc[FA + 2 * row], pc[FB + 2 * row]
+    return fa * ag + fb * dev, fa * ag_rate + fb * rate
+
+
+@jit(inline=True)
+def _point_of(pc, motion):
+    """point's figures from the motion at the instant (_motion's tuple)."""
+    e1, e2, sn, dev, rate, ag, ag_rate = motion
+    demand, demand_rate = _demand(pc, 0, dev, rate, ag, ag_rate)
+    s, p = pc[SIDE], pc[P]
+    accel = p * p * (e1 + e2) - pc[AMP] * pc[OM] * pc[OM] * sn
+    return pc[ALPHA] + s * dev, s * rate, e1, e2, demand, demand_rate, s * accel
+
+
 @jit
 def point(pc, tau):
     """At t0 + tau: s theta [rad], s theta' [rad/s], c1 e^(p tau), c2 e^(-p tau), the
     friction demand's signed value fa a_g + fb (theta - s alpha) [-] (the shear ratio of
     the RBM's equations, n = 1; 0 without friction factors), its rate [1/s] and s theta''
     [rad/s^2]."""
-    e1, e2, sn, dev, rate, ag, ag_rate = _motion(pc, tau)
-    demand = pc[FA] * ag + pc[FB] * dev
-    demand_rate = pc[FA] * ag_rate + pc[FB] * rate
-    s, p = pc[SIDE], pc[P]
-    accel = p * p * (e1 + e2) - pc[AMP] * pc[OM] * pc[OM] * sn
-    return pc[ALPHA] + s * dev, s * rate, e1, e2, demand, demand_rate, s * accel
+    return _point_of(pc, _motion(pc, tau))
+
+
+@jit
+def point_and_beam(pc, tau):
+    """:func:`point` at t0 + tau and a monolithic frame's beam joint's friction demand and
+    its rate (0 without a beam), from one evaluation of the motion (scan_piece's)."""
+    motion = _motion(pc, tau)
+    _, _, _, dev, rate, ag, ag_rate = motion
+    beam, beam_rate = _demand(pc, 1, dev, rate, ag, ag_rate)
+    f, g, e1, e2, demand, demand_rate, accel = _point_of(pc, motion)
+    return f, g, e1, e2, demand, demand_rate, accel, beam, beam_rate
 
 
 @jit
@@ -139,8 +164,7 @@ def joint_demand(pc, tau, row):
     frame's beam joint, the beam share's shear ratio) at t0 + tau: its signed value
     fa a_g + fb (theta - s alpha) [-] with the row's factors, and its rate [1/s]."""
     _, _, _, dev, rate, ag, ag_rate = _motion(pc, tau)
-    fa, fb = pc[FA + 2 * row], pc[FB + 2 * row]
-    return fa * ag + fb * dev, fa * ag_rate + fb * rate
+    return _demand(pc, row, dev, rate, ag, ag_rate)
 
 
 @jit
@@ -282,8 +306,7 @@ def scan_piece(pc, blk, tau_max, acc):
     friction = pc[FA] != 0.0 or pc[FB] != 0.0
     beam = pc[FA2] != 0.0 or pc[FB2] != 0.0  # a monolithic frame's beam joint
     a = 0.0
-    fa, ga, _, e2a, da, dra, f2a = point(pc, 0.0)
-    ba, bra = joint_demand(pc, 0.0, 1) if beam else (0.0, 0.0)
+    fa, ga, _, e2a, da, dra, f2a, ba, bra = point_and_beam(pc, 0.0)
     acc[A_EVALS] += 1
     if fa > acc[A_PEAK]:
         acc[A_PEAK] = fa
@@ -291,8 +314,7 @@ def scan_piece(pc, blk, tau_max, acc):
     h, halvings = h_max, 0
     while a < tau_max:
         b = min(a + h, tau_max)
-        fb, gb, e1b, e2b, db, drb, f2b = point(pc, b)
-        bb, brb = joint_demand(pc, b, 1) if beam else (0.0, 0.0)
+        fb, gb, e1b, e2b, db, drb, f2b, bb, brb = point_and_beam(pc, b)
         acc[A_EVALS] += 1
         w = b - a
         m3 = m3_sine + p3 * (abs(e1b) + abs(e2a))  # bound of the third derivative on [a, b]
@@ -310,11 +332,11 @@ def scan_piece(pc, blk, tau_max, acc):
             kind, tau = NONE, b
             acc[A_PEAK] = max(acc[A_PEAK], fb)
         if kind != NONE:
+            if friction or beam:
+                _, _, _, _, db, drb, _, bb, brb = point_and_beam(pc, tau)
             if friction:
-                db, drb = joint_demand(pc, tau, 0)
                 _friction(pc, a, tau, da, db, dra, drb, acc, 0)
             if beam:
-                bb, brb = joint_demand(pc, tau, 1)
                 _friction(pc, a, tau, ba, bb, bra, brb, acc, 1)
             return kind, tau
         if friction:
